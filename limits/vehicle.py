@@ -1,0 +1,104 @@
+"""Value objects for the drive limits of each vehicle and the separation."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from topology.errors import LimitsError, SeparationError
+from topology.graph import _finite_real
+
+__all__ = [
+    "ILLUSTRATIVE_LIMITS",
+    "ILLUSTRATIVE_MIN_SEPARATION",
+    "ILLUSTRATIVE_VEHICLE",
+    "Limits",
+    "VehicleLimits",
+]
+
+
+@dataclass(frozen=True, slots=True)
+class VehicleLimits:
+    """Kinematic limits of one vehicle along its own path (names as in Ruckig).
+
+    Parameters
+    ----------
+    max_velocity : float
+        Largest speed ``|v|``, m/s, finite and > 0.
+    max_acceleration : float
+        Largest ``|a|``, m/s², finite and > 0.
+    max_jerk : float
+        Largest ``|j|``, m/s³, finite and > 0.
+
+    Raises
+    ------
+    LimitsError
+        A limit that is not a finite positive number.
+    """
+
+    max_velocity: float
+    max_acceleration: float
+    max_jerk: float
+
+    def __post_init__(self) -> None:
+        for name, unit in (("max_velocity", "m/s"), ("max_acceleration", "m/s^2"), ("max_jerk", "m/s^3")):
+            value = _finite_real(getattr(self, name), f"{name} ({unit})", LimitsError)
+            if value <= 0.0:
+                raise LimitsError(f"{name} must be > 0 {unit}, got {value!r}")
+            object.__setattr__(self, name, value)
+
+    def scaled(self, factor: float) -> VehicleLimits:
+        """These limits with velocity, acceleration and jerk all multiplied by ``factor`` > 0."""
+        return VehicleLimits(
+            self.max_velocity * factor, self.max_acceleration * factor, self.max_jerk * factor
+        )
+
+
+@dataclass(frozen=True, slots=True)
+class Limits:
+    """Limits of both vehicles and the minimum separation between them.
+
+    Parameters
+    ----------
+    vehicles : tuple of 2 VehicleLimits
+        Vehicle 1's limits, then vehicle 2's; they may differ.
+    min_separation : float
+        Minimum track distance between the vehicles, metres, finite and >= 0.
+        Whether it fits the track (at most the shortest leg) is checked when
+        planning.
+    """
+
+    vehicles: tuple[VehicleLimits, VehicleLimits]
+    min_separation: float
+
+    def __post_init__(self) -> None:
+        vehicles = tuple(self.vehicles) if isinstance(self.vehicles, (tuple, list)) else None
+        if vehicles is None or len(vehicles) != 2:
+            raise LimitsError(f"vehicles must be a pair of VehicleLimits, got {self.vehicles!r}")
+        for k, vehicle in enumerate(vehicles, start=1):
+            if not isinstance(vehicle, VehicleLimits):
+                raise LimitsError(
+                    f"limits of vehicle {k} must be VehicleLimits, got {vehicle!r} ({type(vehicle).__name__})"
+                )
+        separation = _finite_real(self.min_separation, "min_separation (metres)", SeparationError)
+        if separation < 0.0:
+            raise SeparationError(f"min_separation must be >= 0 m, got {separation!r}")
+        object.__setattr__(self, "vehicles", vehicles)
+        object.__setattr__(self, "min_separation", separation)
+
+    @property
+    def first(self) -> VehicleLimits:
+        """Limits of vehicle 1."""
+        return self.vehicles[0]
+
+    @property
+    def second(self) -> VehicleLimits:
+        """Limits of vehicle 2."""
+        return self.vehicles[1]
+
+
+#: Illustrative limits of one AGV (1.0 m/s, 0.5 m/s², 1.0 m/s³). Not a real vehicle's data.
+ILLUSTRATIVE_VEHICLE = VehicleLimits(max_velocity=1.0, max_acceleration=0.5, max_jerk=1.0)
+#: Illustrative minimum separation, metres. Not a safety figure for any real vehicle.
+ILLUSTRATIVE_MIN_SEPARATION = 1.5
+#: Both vehicles with the illustrative limits and separation.
+ILLUSTRATIVE_LIMITS = Limits(vehicles=(ILLUSTRATIVE_VEHICLE, ILLUSTRATIVE_VEHICLE), min_separation=1.5)

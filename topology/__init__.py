@@ -1,0 +1,55 @@
+"""Exact collision-free motion planner for two vehicles on a Y-shaped track.
+
+Implements Baldi, *Collision-Free Motion Planning Algorithm in a Y-Graph*,
+with the conventions of ``ALGORITHM.md``: the configuration space deforms onto
+a circle, so two continuous instructions suffice (topological complexity 2).
+
+Examples
+--------
+>>> from topology import YGraph, Position, Configuration, plan
+>>> track = YGraph({"A": 1.0, "B": 1.0, "C": 1.0})
+>>> start = Configuration(Position("A", 1.0), Position("B", 1.0))
+>>> route = plan(track, start, start.swapped())
+>>> route.instruction
+<Instruction.COUNTERCLOCKWISE: 'counterclockwise'>
+>>> [str(w) for w in route.waypoints]
+['(A:1, B:1)', '(A:1, O)', '(A:1, C:1)', '(O, C:1)', '(B:1, C:1)', '(B:1, O)', '(B:1, A:1)']
+"""
+
+from topology.cycle import ANTIPODAL_TOLERANCE, Cell, boundary_angle, classify, is_antipodal, retract
+from topology.errors import (
+    InputError,
+    OptionError,
+    PositionError,
+    SeparationError,
+    TrackError,
+    TrajgenError,
+)
+from topology.graph import JUNCTION, JUNCTION_NAME, Configuration, Position, YGraph
+from topology.route import Instruction, Region, Route, plan, reduce_regions, region_sequence
+
+__all__ = [
+    "ANTIPODAL_TOLERANCE",
+    "JUNCTION",
+    "JUNCTION_NAME",
+    "Cell",
+    "Configuration",
+    "InputError",
+    "Instruction",
+    "OptionError",
+    "Position",
+    "PositionError",
+    "Region",
+    "Route",
+    "SeparationError",
+    "TrackError",
+    "TrajgenError",
+    "YGraph",
+    "boundary_angle",
+    "classify",
+    "is_antipodal",
+    "plan",
+    "reduce_regions",
+    "region_sequence",
+    "retract",
+]

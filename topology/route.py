@@ -1,0 +1,349 @@
+"""The two-instruction motion planner and its result, the :class:`Route`.
+
+ALGORITHM.md sections 5 and 6: retract the start onto the boundary circle, go
+round the circle (shortest way, or counterclockwise half a turn when the goal
+is the start with the vehicles swapped), then undo the goal's retraction.
+"""
+
+from __future__ import annotations
+
+import bisect
+import enum
+import itertools
+from dataclasses import dataclass, field
+
+from topology.cycle import (
+    _AT_JUNCTION,
+    ANTIPODAL_TOLERANCE,
+    _as_tuple,
+    _leg_travel,
+    _retract,
+    _separation,
+    _step,
+)
+from topology.errors import OptionError, SeparationError
+from topology.graph import Configuration, YGraph, _finite_real
+
+__all__ = ["Instruction", "Region", "Route", "plan", "reduce_regions", "region_sequence"]
+
+_Tuple = tuple[int, float, int, float]
+
+
+class Instruction(enum.StrEnum):
+    """The two continuous instructions of the planner (topological complexity 2)."""
+
+    SHORTEST = "shortest"  #: paper Instruction 2: the shorter way round the boundary
+    COUNTERCLOCKWISE = "counterclockwise"  #: paper Instruction 1: half a turn, for swaps
+
+    @classmethod
+    def lookup(cls, name: str) -> Instruction:
+        """The instruction named ``name`` (case-insensitive); raises OptionError otherwise."""
+        try:
+            return cls(str(name).lower())
+        except ValueError:
+            raise OptionError(
+                f"instruction {name!r} is unknown: expected one of {[i.value for i in cls]!r}"
+            ) from None
+
+
+@dataclass(frozen=True, slots=True)
+class Region:
+    """A contractible region of the configuration space (ALGORITHM.md section 6).
+
+    ``Q(i, j)``: vehicle 1 on leg ``i``, vehicle 2 on another leg ``j``.
+    ``T(k, r)``: both vehicles on leg ``k``, vehicle ``r`` (1 or 2) nearer the
+    junction. Either vehicle may also be at the junction, where regions meet.
+
+    Parameters
+    ----------
+    first_leg, second_leg : str
+        Legs of vehicle 1 and vehicle 2.
+    nearer : int or None
+        For a shared leg, the vehicle (1 or 2) nearer the junction; ``None``
+        for different legs.
+    """
+
+    first_leg: str
+    second_leg: str
+    nearer: int | None = None
+
+    def __post_init__(self) -> None:
+        shared = self.first_leg == self.second_leg
+        if shared and self.nearer not in (1, 2):
+            raise OptionError(
+                f"region on shared leg {self.first_leg!r} needs nearer 1 or 2, got {self.nearer!r}"
+            )
+        if not shared and self.nearer is not None:
+            raise OptionError(f"region on different legs needs nearer None, got {self.nearer!r}")
+
+    @property
+    def shared_leg(self) -> bool:
+        """Whether both vehicles are on one leg (a ``T`` region)."""
+        return self.first_leg == self.second_leg
+
+    def __str__(self) -> str:
+        if self.shared_leg:
+            return f"T({self.first_leg},{self.nearer})"
+        return f"Q({self.first_leg},{self.second_leg})"
+
+
+def _region_key(leg1: int, s1: float, leg2: int, s2: float) -> tuple[int, int, int] | None:
+    """Region of a configuration off the rays, as indices; ``None`` on a ray."""
+    if leg1 == _AT_JUNCTION or leg2 == _AT_JUNCTION:
+        return None
+    if leg1 != leg2:
+        return (leg1, leg2, 0)
+    return (leg1, leg2, 1 if s1 < s2 else 2)
+
+
+def reduce_regions(sequence) -> tuple:
+    """Reduce a region sequence to its homotopy class representative.
+
+    Merges repeats and cancels immediate back-and-forth ``R1, R2, R1`` (two
+    adjacent regions share exactly one ray, so that excursion is null-homotopic).
+
+    Parameters
+    ----------
+    sequence : iterable of hashable
+        Regions in visiting order; ``None`` entries (on a ray) are skipped.
+    """
+    stack: list = []
+    for region in sequence:
+        if region is None or (stack and stack[-1] == region):
+            continue
+        if len(stack) >= 2 and stack[-2] == region:
+            stack.pop()
+            continue
+        stack.append(region)
+    return tuple(stack)
+
+
+def region_sequence(graph: YGraph, configurations) -> tuple[Region, ...]:
+    """Reduced region sequence of densely sampled configurations.
+
+    Parameters
+    ----------
+    graph : YGraph
+    configurations : iterable of Configuration
+        Samples along a motion, in time order, dense enough that no region is
+        entered and left between two samples except through the same ray.
+    """
+    keys = []
+    for configuration in configurations:
+        c = _as_tuple(graph, configuration)
+        keys.append(_region_key(*c))
+    return tuple(_key_to_region(graph, key) for key in reduce_regions(keys))
+
+
+def _key_to_region(graph: YGraph, key: tuple[int, int, int]) -> Region:
+    names = graph.names
+    return Region(names[key[0]], names[key[1]], key[2] or None)
+
+
+def _segment_region_key(a: _Tuple, b: _Tuple) -> tuple[int, int, int] | None:
+    """Region of the interior of a route segment (each vehicle stays on one leg)."""
+    leg1 = a[0] if a[0] != _AT_JUNCTION else b[0]
+    leg2 = a[2] if a[2] != _AT_JUNCTION else b[2]
+    return _region_key(leg1, a[1] + b[1], leg2, a[3] + b[3])
+
+
+@dataclass(frozen=True, slots=True)
+class Route:
+    """A collision-free route of the two vehicles, as the planner produced it.
+
+    Attributes
+    ----------
+    graph : YGraph
+        The track.
+    instruction : Instruction
+        Which of the two instructions produced the route.
+    waypoints : tuple of Configuration
+        Start first, goal last; shape (n,), ``n >= 1``. Between consecutive
+        waypoints each vehicle moves linearly within one leg (it crosses the
+        junction only at a waypoint); no segment has zero length.
+    min_separation : float
+        The separation the route was planned for, metres.
+    arc_length : float
+        Signed length of the trip round the boundary circle, metres,
+        positive counterclockwise.
+    """
+
+    graph: YGraph
+    instruction: Instruction
+    waypoints: tuple[Configuration, ...]
+    min_separation: float
+    arc_length: float
+    _tuples: tuple[_Tuple, ...] = field(repr=False, compare=False)
+    _cumulative: tuple[float, ...] = field(repr=False, compare=False)
+
+    @property
+    def start(self) -> Configuration:
+        """The start configuration."""
+        return self.waypoints[0]
+
+    @property
+    def goal(self) -> Configuration:
+        """The goal configuration."""
+        return self.waypoints[-1]
+
+    @property
+    def length(self) -> float:
+        """Total travel ``sum |ds1| + |ds2|`` along the route, metres."""
+        return self._cumulative[-1]
+
+    @property
+    def travel(self) -> tuple[float, float]:
+        """Distance driven by vehicle 1 and by vehicle 2, metres."""
+        t = self._tuples
+        first = sum(_leg_travel(a[0], a[1], b[0], b[1]) for a, b in itertools.pairwise(t))
+        second = sum(_leg_travel(a[2], a[3], b[2], b[3]) for a, b in itertools.pairwise(t))
+        return (first, second)
+
+    @property
+    def segment_travel(self) -> tuple[tuple[float, float], ...]:
+        """Per segment, the distance driven by vehicle 1 and vehicle 2, metres; shape (n-1, 2)."""
+        t = self._tuples
+        return tuple(
+            (_leg_travel(a[0], a[1], b[0], b[1]), _leg_travel(a[2], a[3], b[2], b[3]))
+            for a, b in itertools.pairwise(t)
+        )
+
+    @property
+    def separation_floor(self) -> float:
+        """``min(dist(start), dist(goal), shortest leg)``: no point of the route is closer, metres."""
+        return min(_separation(self._tuples[0]), _separation(self._tuples[-1]), self.graph.shortest_leg)
+
+    @property
+    def regions(self) -> tuple[Region, ...]:
+        """The homotopy class: reduced sequence of regions visited (ALGORITHM.md section 6).
+
+        Empty when the whole route stays on one ray (a vehicle parked at the
+        junction while the other moves on one leg) or does not move.
+        """
+        t = self._tuples
+        keys = (_segment_region_key(a, b) for a, b in itertools.pairwise(t))
+        return tuple(_key_to_region(self.graph, key) for key in reduce_regions(keys))
+
+    def at(self, tau: float) -> Configuration:
+        """The configuration a fraction ``tau`` in [0, 1] of the travel along the route.
+
+        Parameters
+        ----------
+        tau : float
+            Fraction of the total travel ``|ds1| + |ds2|``; clipped to [0, 1].
+        """
+        tau = _finite_real(tau, "route parameter tau", OptionError)
+        cumulative = self._cumulative
+        tuples = self._tuples
+        if len(tuples) == 1 or tau <= 0.0:
+            return self.waypoints[0]
+        if tau >= 1.0:
+            return self.waypoints[-1]
+        target = tau * cumulative[-1]
+        k = min(bisect.bisect_right(cumulative, target) - 1, len(tuples) - 2)
+        a, b = tuples[k], tuples[k + 1]
+        span = cumulative[k + 1] - cumulative[k]
+        fraction = (target - cumulative[k]) / span
+        leg1 = a[0] if a[0] != _AT_JUNCTION else b[0]
+        leg2 = a[2] if a[2] != _AT_JUNCTION else b[2]
+        # s is 0 at the junction, so linear interpolation holds through it too.
+        s1 = _between(a[1], b[1], fraction)
+        s2 = _between(a[3], b[3], fraction)
+        cycle = self.graph._cycle
+        return cycle.configuration(
+            (leg1 if s1 > 0.0 else _AT_JUNCTION, s1, leg2 if s2 > 0.0 else _AT_JUNCTION, s2)
+        )
+
+
+def _between(s_a: float, s_b: float, fraction: float) -> float:
+    """Linear interpolation clamped to the segment (round-off must not overshoot a leg's end)."""
+    s = s_a + fraction * (s_b - s_a)
+    return min(max(s, min(s_a, s_b)), max(s_a, s_b))
+
+
+def plan(graph: YGraph, start: Configuration, goal: Configuration, *, min_separation: float = 0.0) -> Route:
+    """Plan a collision-free route from ``start`` to ``goal`` (ALGORITHM.md section 5).
+
+    Parameters
+    ----------
+    graph : YGraph
+        The track.
+    start, goal : Configuration
+        Vehicle 1 and vehicle 2 positions at the start and at the goal.
+    min_separation : float, optional
+        Minimum track distance between the vehicles, metres,
+        ``0 <= min_separation <= shortest leg``. ``0`` means only "not the
+        same point".
+
+    Returns
+    -------
+    Route
+        The route; the track distance along it never drops below
+        ``min(dist(start), dist(goal), shortest leg) >= min_separation``.
+
+    Raises
+    ------
+    PositionError
+        A position is not on the track.
+    SeparationError
+        ``min_separation`` out of range, or the vehicles closer than it at
+        the start or at the goal.
+    """
+    if not isinstance(graph, YGraph):
+        raise TypeError(f"graph must be a YGraph, got {graph!r} ({type(graph).__name__})")
+    separation = _check_min_separation(graph, min_separation)
+    a = _as_tuple(graph, start)
+    b = _as_tuple(graph, goal)
+    for name, config, c in (("start", start, a), ("goal", goal, b)):
+        if _separation(c) < separation:
+            raise SeparationError(
+                f"vehicles at the {name} {config} are {_separation(c)!r} m apart along the track: "
+                f"expected at least the min_separation {separation!r} m"
+            )
+    lengths = graph.lengths
+    cycle = graph._cycle
+    to_boundary = _retract(a, lengths)
+    from_boundary = _retract(b, lengths)
+    origin = cycle.locate(to_boundary[-1])
+    target = cycle.locate(from_boundary[-1])
+    perimeter = cycle.perimeter
+    half = 0.5 * perimeter
+    delta = cycle.counterclockwise_distance(origin, target)
+    if abs(delta - half) <= ANTIPODAL_TOLERANCE * perimeter:
+        instruction, counterclockwise = Instruction.COUNTERCLOCKWISE, True
+    else:
+        instruction, counterclockwise = Instruction.SHORTEST, delta < half
+    arc_length = delta if counterclockwise else -(perimeter - delta)
+    candidates = to_boundary + cycle.arc(origin, target, counterclockwise) + from_boundary[::-1]
+
+    # Drop zero-length segments only: a tiny step (even 1e-300 m) may carry a vehicle
+    # to the junction, and dropping it would make that vehicle change legs mid-segment.
+    kept = [a]
+    cumulative = [0.0]
+    for c in candidates[1:]:
+        step = _step(kept[-1], c)
+        if step > 0.0:
+            kept.append(c)
+            cumulative.append(cumulative[-1] + step)
+    vertex = cycle.vertex_configuration
+    inner = tuple(vertex.get(c) or cycle.configuration(c) for c in kept[1:-1])
+    waypoints = (start, *inner, goal) if len(kept) > 1 else (start,)
+    return Route(
+        graph=graph,
+        instruction=instruction,
+        waypoints=waypoints,
+        min_separation=separation,
+        arc_length=arc_length,
+        _tuples=tuple(kept),
+        _cumulative=tuple(cumulative),
+    )
+
+
+def _check_min_separation(graph: YGraph, min_separation: float) -> float:
+    separation = _finite_real(min_separation, "min_separation (metres)", SeparationError)
+    shortest = graph.shortest_leg
+    if separation < 0.0 or separation > shortest:
+        raise SeparationError(
+            f"min_separation must be between 0 m and the shortest leg {shortest!r} m, got {separation!r} m"
+        )
+    return separation
