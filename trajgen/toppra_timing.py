@@ -1,0 +1,377 @@
+"""The ``toppra`` method: round the route's corners where safe, then TOPPRA timing.
+
+In the plane of the two signed axes the route is a polyline. Where it turns
+without any vehicle reversing, the corner is replaced by a quadratic Bézier
+blend, as large as half of each adjacent piece, shrunk until the blend keeps
+the separation (with a margin that covers the gaps between its samples) and
+visits the same regions as the corner. Corners that cannot be rounded (a
+vehicle reverses, or no blend is safe) are stops; between stops TOPPRA
+(``toppra``, constant-acceleration parametrizer) gives the time-optimal
+velocity- and acceleration-limited timing. Jerk is not limited.
+
+TOPPRA enforces its constraints at grid points; with the acceleration
+constraint discretized by interpolation and a grid that contains every blend
+boundary, acceleration is linear in ``s`` between grid points. Speed on a blend
+may bulge between grid points by a tiny amount, so TOPPRA plans with limits
+scaled by :data:`HEADROOM`. A section whose TOPPRA timing would be slower than
+the closed-form rest-to-rest trapezoids of its pieces (possible only through
+the headroom) takes the trapezoids, so ``toppra`` is never slower than
+``exact`` without jerk limits.
+"""
+
+from __future__ import annotations
+
+import logging
+from dataclasses import dataclass
+
+import numpy as np
+
+from limits import Limits
+from topology import Route
+from topology.errors import SolverError
+from topology.route import reduce_regions
+from trajgen.schedule import (
+    AxisMap,
+    CubicKinematics,
+    Kinematics,
+    Method,
+    RouteAxes,
+    Schedule,
+    Section,
+    _piece_maps,
+    exact_schedule,
+    piece_profiles,
+    route_axes,
+    straight_pieces,
+)
+
+__all__ = ["toppra_schedule", "HEADROOM", "BlendedPath"]
+
+logger = logging.getLogger(__name__)
+
+#: Fraction of the velocity and acceleration limits TOPPRA plans with.
+HEADROOM = 1.0 - 1e-4
+#: Grid points TOPPRA uses per section (plus every blend boundary).
+GRID_POINTS = 120
+#: Blend sizes tried, as fractions of the largest possible one.
+_BLEND_FRACTIONS = (1.0, 0.5, 0.25, 0.125)
+_BLEND_SAMPLES = 256
+
+
+@dataclass(frozen=True, slots=True)
+class _Blend:
+    before: np.ndarray  # shape (2,): where the blend leaves the incoming line
+    corner: np.ndarray  # shape (2,): Bézier control point (the route's corner)
+    after: np.ndarray  # shape (2,): where it joins the outgoing line
+
+    def points(self, w: np.ndarray) -> np.ndarray:
+        """Bézier points for w in [0, 1], shape (n, 2)."""
+        w = w[:, None]
+        return (1 - w) ** 2 * self.before + 2 * w * (1 - w) * self.corner + w**2 * self.after
+
+
+class BlendedPath:
+    """A C1 path in the axis plane: straight lines joined by quadratic Bézier blends.
+
+    Parameterized by ``s`` (metres): on lines ``s`` is arc length; a blend of
+    half-size ``r`` spans ``2 r`` of ``s`` so that ``|dq/ds| = 1`` at its ends.
+    Implements the interface TOPPRA expects of a geometric path.
+    """
+
+    def __init__(self, vertices: np.ndarray, blends: list[_Blend | None]) -> None:
+        # pieces: (kind, s0, s1, data); kind 0 line (p0, unit), 1 blend (_Blend)
+        kinds, starts, ends, p0, d1, d2 = [], [0.0], [], [], [], []
+        s = 0.0
+        point = vertices[0].astype(float)
+        for k in range(1, len(vertices)):
+            blend = blends[k] if k < len(vertices) - 1 else None
+            target = blend.before if blend is not None else vertices[k]
+            length = float(np.linalg.norm(target - point))
+            if length > 0.0:
+                unit = (target - point) / length
+                kinds.append(0)
+                p0.append(point)
+                d1.append(unit)
+                d2.append(np.zeros(2))
+                s += length
+                ends.append(s)
+                starts.append(s)
+            if blend is not None:
+                size = 2.0 * float(np.linalg.norm(blend.corner - blend.before))
+                # q(w) = before + 2w(P - before) + w^2 (before - 2P + after), w = (s - s0) / size
+                kinds.append(1)
+                p0.append(blend.before)
+                d1.append(2.0 * (blend.corner - blend.before) / size)
+                d2.append(2.0 * (blend.before - 2.0 * blend.corner + blend.after) / size**2)
+                s += size
+                ends.append(s)
+                starts.append(s)
+                point = blend.after
+            else:
+                point = target
+        self._starts = np.array(starts[:-1])
+        self._ends = np.array(ends)
+        self._p0 = np.array(p0)
+        self._d1 = np.array(d1)
+        self._d2 = np.array(d2)
+        self.length = s
+        self.breakpoints = np.array(starts)
+
+    # TOPPRA's geometric path interface
+    @property
+    def dof(self) -> int:
+        return 2
+
+    @property
+    def path_interval(self) -> np.ndarray:
+        return np.array([0.0, self.length])
+
+    @property
+    def waypoints(self):
+        return self.breakpoints, self(self.breakpoints)
+
+    def __call__(self, ss, order: int = 0) -> np.ndarray:
+        scalar = np.isscalar(ss)
+        ss = np.clip(np.atleast_1d(np.asarray(ss, dtype=float)), 0.0, self.length)
+        k = np.clip(np.searchsorted(self._starts, ss, side="right") - 1, 0, len(self._starts) - 1)
+        h = (ss - self._starts[k])[:, None]
+        if order == 0:
+            out = self._p0[k] + h * self._d1[k] + 0.5 * h * h * self._d2[k]
+        elif order == 1:
+            out = self._d1[k] + h * self._d2[k]
+        elif order == 2:
+            out = np.broadcast_to(self._d2[k], (ss.size, 2)).copy()
+        else:
+            out = np.zeros((ss.size, 2))
+        return out[0] if scalar else out
+
+    def eval(self, ss):
+        return self(ss, 0)
+
+    def evald(self, ss):
+        return self(ss, 1)
+
+    def evaldd(self, ss):
+        return self(ss, 2)
+
+
+@dataclass(frozen=True, slots=True)
+class ToppraKinematics(Kinematics):
+    """A section timed by TOPPRA: ``s(t)`` piecewise quadratic between grid points.
+
+    Attributes
+    ----------
+    path : BlendedPath
+    grid : ndarray, shape (m,)
+        Path positions of TOPPRA's grid, metres.
+    speed : ndarray, shape (m,)
+        Path velocity ``ds/dt`` at the grid points, m/s.
+    times : ndarray, shape (m,)
+        Time at each grid point, seconds (constant ``d²s/dt²`` in between).
+    """
+
+    path: BlendedPath
+    grid: np.ndarray
+    speed: np.ndarray
+    times: np.ndarray
+
+    @property
+    def duration(self) -> float:
+        return float(self.times[-1])
+
+    def evaluate(self, t: np.ndarray) -> np.ndarray:
+        t = np.clip(np.asarray(t, dtype=float), 0.0, self.times[-1])
+        k = np.clip(np.searchsorted(self.times, t, side="right") - 1, 0, len(self.grid) - 2)
+        ds = np.diff(self.grid)
+        accel = (self.speed[1:] ** 2 - self.speed[:-1] ** 2) / (2.0 * ds)
+        h = t - self.times[k]
+        s = self.grid[k] + h * (self.speed[k] + 0.5 * h * accel[k])
+        sd = self.speed[k] + h * accel[k]
+        sdd = accel[k]
+        at_end = t >= self.times[-1]
+        s = np.where(at_end, self.grid[-1], np.minimum(s, self.grid[k + 1]))
+        sd = np.where(at_end, 0.0, sd)
+        sdd = np.where(at_end, 0.0, sdd)
+        q = self.path(s, 0)
+        dq = self.path(s, 1)
+        ddq = self.path(s, 2)
+        out = np.empty((2, 4, t.size))
+        out[:, 0] = q.T
+        out[:, 1] = (dq * sd[:, None]).T
+        out[:, 2] = (ddq * (sd * sd)[:, None] + dq * sdd[:, None]).T
+        out[:, 3] = (3.0 * ddq * (sd * sdd)[:, None]).T  # within intervals; unbounded at switch points
+        return out
+
+
+def _reverses(incoming: np.ndarray, outgoing: np.ndarray) -> bool:
+    return bool(np.any(incoming * outgoing < 0.0))
+
+
+def _locate_both(maps: tuple[AxisMap, AxisMap], points: np.ndarray):
+    leg1, s1 = maps[0].locate(points[:, 0])
+    leg2, s2 = maps[1].locate(points[:, 1])
+    return leg1, s1, leg2, s2
+
+
+def _separation(leg1, s1, leg2, s2) -> np.ndarray:
+    same = (leg1 == leg2) & (leg1 >= 0)
+    return np.where(same, np.abs(s1 - s2), s1 + s2)
+
+
+def _regions(leg1, s1, leg2, s2) -> tuple:
+    keys = [
+        None if a < 0 or b < 0 else ((a, b, 0) if a != b else (a, b, 1 if x < y else 2))
+        for a, b, x, y in zip(leg1.tolist(), leg2.tolist(), s1.tolist(), s2.tolist(), strict=True)
+    ]
+    return reduce_regions(keys)
+
+
+def _safe_blend(
+    axes: RouteAxes, pieces: list[tuple[int, int]], corner: int, required: float
+) -> _Blend | None:
+    """The largest safe blend at the corner between pieces ``corner - 1`` and ``corner``."""
+    (first, middle), (_, last) = pieces[corner - 1], pieces[corner]
+    points = axes.axes
+    p = points[middle]
+    incoming, outgoing = p - points[first], points[last] - p
+    if _reverses(incoming, outgoing):
+        return None
+    len_in, len_out = float(np.linalg.norm(incoming)), float(np.linalg.norm(outgoing))
+    maps = _piece_maps(axes, first, last)
+    w = np.linspace(0.0, 1.0, _BLEND_SAMPLES + 1)
+    for fraction in _BLEND_FRACTIONS:
+        r = 0.5 * fraction * min(len_in, len_out)
+        blend = _Blend(p - r * incoming / len_in, p, p + r * outgoing / len_out)
+        curve = blend.points(w)
+        spacing = float(np.max(np.linalg.norm(np.diff(curve, axis=0), axis=1)))
+        located = _locate_both(maps, curve)
+        # between samples the separation changes by at most |da1| + |da2| <= sqrt(2) * spacing
+        if np.min(_separation(*located)) < required + 1.5 * spacing:
+            continue
+        polyline = np.concatenate([blend.before + np.outer(w, p - blend.before), p + np.outer(w, blend.after - p)])
+        if _regions(*located) != _regions(*_locate_both(maps, polyline)):
+            continue
+        return blend
+    return None
+
+
+def _toppra_section(path: BlendedPath, limits: Limits) -> ToppraKinematics:
+    import toppra
+    import toppra.algorithm
+    import toppra.constraint
+
+    v = np.array([vehicle.max_velocity for vehicle in limits.vehicles]) * HEADROOM
+    a = np.array([vehicle.max_acceleration for vehicle in limits.vehicles]) * HEADROOM
+    velocity = toppra.constraint.JointVelocityConstraint(np.column_stack([-v, v]))
+    acceleration = toppra.constraint.JointAccelerationConstraint(
+        np.column_stack([-a, a]), discretization_scheme=toppra.constraint.DiscretizationType.Interpolation
+    )
+    grid = np.unique(np.concatenate([np.linspace(0.0, path.length, GRID_POINTS), path.breakpoints]))
+    instance = toppra.algorithm.TOPPRA(
+        [velocity, acceleration], path, gridpoints=grid, parametrizer="ParametrizeConstAccel"
+    )
+    instance.compute_parameterization(0.0, 0.0)
+    data = instance.problem_data
+    speed = None if data.sd_vec is None else np.asarray(data.sd_vec, dtype=float)
+    if speed is None or not np.all(np.isfinite(speed)):
+        raise SolverError(f"TOPPRA could not parameterize a section: return code {data.return_code}")
+    grid = np.asarray(data.gridpoints, dtype=float)
+    speed = np.maximum(speed, 0.0)
+    speed[0] = speed[-1] = 0.0
+    mean = 0.5 * (speed[1:] + speed[:-1])
+    if np.any(mean <= 0.0):
+        raise SolverError("TOPPRA returned a zero path velocity inside a section")
+    times = np.concatenate([[0.0], np.cumsum(np.diff(grid) / mean)])
+    return _fit_to_limits(ToppraKinematics(path, grid, speed, times), limits)
+
+
+def _groups(axes: RouteAxes, pieces: list[tuple[int, int]], blends: list[_Blend | None]):
+    """Runs of pieces joined by rounded corners, as (first piece, end piece) index ranges.
+
+    A run never contains a reversal of either vehicle (even across a piece in
+    which that vehicle stands still): within a section each vehicle's axis is
+    monotone, so it maps onto the track one-to-one.
+    """
+    start = 0
+    heading = np.sign(axes.axes[pieces[0][1]] - axes.axes[pieces[0][0]])
+    for corner in range(1, len(pieces)):
+        step = np.sign(axes.axes[pieces[corner][1]] - axes.axes[pieces[corner][0]])
+        if blends[corner] is None or np.any(heading * step < 0):
+            yield start, corner
+            start = corner
+            heading = step
+        else:
+            heading = np.where(heading == 0, step, heading)
+    yield start, len(pieces)
+
+
+def _fit_to_limits(kinematics: ToppraKinematics, limits: Limits) -> ToppraKinematics:
+    """Stretch a TOPPRA section uniformly in time until it meets the limits between grid points too.
+
+    Scaling time by ``c >= 1`` divides velocities by ``c`` and accelerations by ``c**2`` exactly.
+    """
+    fine = np.linspace(0.0, 1.0, 17)[:-1]
+    times = (kinematics.times[:-1, None] + np.diff(kinematics.times)[:, None] * fine).ravel()
+    values = kinematics.evaluate(np.append(times, kinematics.times[-1]))
+    ratio = 1.0
+    for vehicle, vehicle_limits in enumerate(limits.vehicles):
+        ratio = max(
+            ratio,
+            float(np.max(np.abs(values[vehicle, 1]))) / vehicle_limits.max_velocity,
+            float(np.sqrt(np.max(np.abs(values[vehicle, 2])) / vehicle_limits.max_acceleration)),
+        )
+    if ratio <= 1.0:
+        return kinematics
+    stretch = ratio * (1.0 + 1e-7)  # the dense samples bound the maxima to well within this
+    logger.debug("TOPPRA section stretched in time by %.3g to meet the limits between grid points", stretch)
+    return ToppraKinematics(kinematics.path, kinematics.grid, kinematics.speed / stretch, kinematics.times * stretch)
+
+
+def toppra_schedule(route: Route, limits: Limits) -> Schedule:
+    """Round corners where safe, then time each stop-to-stop section with TOPPRA.
+
+    Returns
+    -------
+    Schedule
+        Method ``toppra``, ``jerk_limited=False``. Never slower than
+        :func:`~trajgen.schedule.exact_schedule` with ``jerk=False``.
+    """
+    axes = route_axes(route)
+    pieces = straight_pieces(axes.axes)
+    if not pieces:  # nothing moves
+        schedule = exact_schedule(route, limits, jerk=False)
+        return Schedule(route, limits, Method.TOPPRA, schedule.sections, jerk_limited=False)
+    required = max(limits.min_separation, route.min_separation)
+    blends: list[_Blend | None] = [None] + [
+        _safe_blend(axes, pieces, corner, required) for corner in range(1, len(pieces))
+    ]
+    sections: list[Section] = []
+    clock = 0.0
+    rounded = toppra_sections = 0
+    for start, stop in _groups(axes, pieces, blends):
+        group = pieces[start:stop]
+        trapezoids = [
+            CubicKinematics(piece_profiles(axes.axes[a], axes.axes[b], limits, jerk=False)) for a, b in group
+        ]
+        timed = None
+        if len(group) > 1:
+            vertices = axes.axes[[group[0][0]] + [b for _, b in group]]
+            timed = _toppra_section(BlendedPath(vertices, [None, *blends[start + 1 : stop], None]), limits)
+            if timed.duration >= sum(k.duration for k in trapezoids):
+                logger.info("TOPPRA section is not faster than stopping at its corners; keeping the stops")
+                timed = None
+        if timed is not None:
+            sections.append(Section(clock, timed, _piece_maps(axes, group[0][0], group[-1][1])))
+            clock += timed.duration
+            rounded += len(group) - 1
+            toppra_sections += 1
+        else:
+            for (first, last), kinematics in zip(group, trapezoids, strict=True):
+                sections.append(Section(clock, kinematics, _piece_maps(axes, first, last)))
+                clock += kinematics.duration
+    notes = (
+        f"{rounded} of {len(pieces) - 1} corners rounded; {toppra_sections} section(s) timed by TOPPRA",
+        "jerk is not limited by this method",
+    )
+    logger.info("toppra schedule: %s", notes[0])
+    return Schedule(route, limits, Method.TOPPRA, tuple(sections), jerk_limited=False, notes=notes)

@@ -1,0 +1,257 @@
+"""Independent verifier: nothing leaves the library unless it passes.
+
+The verifier re-samples a schedule on a fine time grid (1 ms or finer, plus
+every section boundary) and checks, from the sampled track positions and
+kinematics alone:
+
+- the track distance between the vehicles never drops below the minimum
+  separation;
+- ``|v|``, ``|a|`` (and ``|j|`` where the method limits it) stay within each
+  vehicle's limits, to a relative tolerance;
+- the start and the goal are the route's, to 1e-9 m, at rest;
+- the positions move no faster than the sampled velocities allow (the track
+  positions and the kinematics tell one story);
+- the sequence of regions visited (the homotopy class) is the route's.
+
+Tolerance: 1e-6 relative for every method. The ``toppra`` method enforces its
+limits at grid points only and therefore plans with a small headroom
+(:data:`trajgen.toppra_timing.HEADROOM`), so the true limits hold between
+grid points too; the verifier checks them at the same 1e-6.
+"""
+
+from __future__ import annotations
+
+import logging
+from dataclasses import dataclass
+
+import numpy as np
+
+from topology.errors import VerificationError
+from topology.route import reduce_regions
+from trajgen.schedule import Schedule, ScheduleState
+
+__all__ = ["VerificationReport", "verify", "verified", "RELATIVE_TOLERANCE", "POSITION_TOLERANCE"]
+
+logger = logging.getLogger(__name__)
+
+#: Relative tolerance on velocity, acceleration and jerk limits.
+RELATIVE_TOLERANCE = 1e-6
+#: Absolute tolerance on start, goal and separation, metres.
+POSITION_TOLERANCE = 1e-9
+#: Coarsest sampling the verifier accepts, seconds.
+MAX_PERIOD = 1e-3
+
+
+@dataclass(frozen=True, slots=True)
+class VerificationReport:
+    """Outcome of :func:`verify`.
+
+    Attributes
+    ----------
+    passed : bool
+        Whether every check passed.
+    failures : tuple of str
+        One message per failed check, naming the quantity, value and limit.
+    samples : int
+        Number of time samples checked.
+    period : float
+        Sample period, seconds.
+    min_separation : float
+        Smallest track distance between the vehicles, metres.
+    separation_margin : float
+        ``min_separation - required``, metres (negative: violated).
+    velocity_ratio, acceleration_ratio, jerk_ratio : tuple of 2 float
+        Per vehicle, largest ``|value| / limit`` (1.0 is at the limit).
+    start_error, goal_error : float
+        Track distance of the schedule's first and last positions from the route's, metres.
+    regions_match : bool
+        Whether the sampled region sequence equals the route's.
+    """
+
+    passed: bool
+    failures: tuple[str, ...]
+    samples: int
+    period: float
+    min_separation: float
+    separation_margin: float
+    velocity_ratio: tuple[float, float]
+    acceleration_ratio: tuple[float, float]
+    jerk_ratio: tuple[float, float]
+    start_error: float
+    goal_error: float
+    regions_match: bool
+
+    def raise_if_failed(self) -> None:
+        """Raise VerificationError listing the failures, if any."""
+        if not self.passed:
+            raise VerificationError("schedule failed verification: " + "; ".join(self.failures))
+
+    def summary(self) -> dict:
+        """JSON-ready worst margins."""
+        return {
+            "verified": self.passed,
+            "failures": list(self.failures),
+            "samples": self.samples,
+            "sample_period_s": self.period,
+            "min_separation_m": self.min_separation,
+            "separation_margin_m": self.separation_margin,
+            "velocity_ratio": list(self.velocity_ratio),
+            "acceleration_ratio": list(self.acceleration_ratio),
+            "jerk_ratio": list(self.jerk_ratio),
+            "start_error_m": self.start_error,
+            "goal_error_m": self.goal_error,
+            "regions_match": self.regions_match,
+        }
+
+
+def _track_distance(leg_a, s_a, leg_b, s_b) -> np.ndarray:
+    """Vectorized track distance: same leg |s_a - s_b|, otherwise s_a + s_b."""
+    same = (leg_a == leg_b) & (leg_a >= 0)
+    return np.where(same, np.abs(s_a - s_b), s_a + s_b)
+
+
+def _sample_times(schedule: Schedule, period: float) -> np.ndarray:
+    duration = schedule.duration
+    count = max(int(np.ceil(duration / period)), 1)
+    grid = np.linspace(0.0, duration, count + 1)
+    boundaries = np.array([section.start_time for section in schedule.sections] + [duration])
+    return np.unique(np.concatenate([grid, boundaries]))
+
+
+def _region_keys(state: ScheduleState) -> list:
+    leg1, leg2 = state.leg
+    s1, s2 = state.s
+    keys: list = []
+    for a, b, x, y in zip(leg1.tolist(), leg2.tolist(), s1.tolist(), s2.tolist(), strict=True):
+        if a < 0 or b < 0:
+            keys.append(None)
+        elif a != b:
+            keys.append((a, b, 0))
+        else:
+            keys.append((a, b, 1 if x < y else 2))
+    return keys
+
+
+def verify(schedule: Schedule, *, period: float = MAX_PERIOD) -> VerificationReport:
+    """Check a schedule independently of how it was computed.
+
+    Parameters
+    ----------
+    schedule : Schedule
+    period : float, optional
+        Sample period in seconds, at most 1e-3 (finer is allowed).
+
+    Returns
+    -------
+    VerificationReport
+    """
+    period = min(float(period), MAX_PERIOD)
+    route = schedule.route
+    graph = route.graph
+    limits = schedule.limits
+    required = max(limits.min_separation, route.min_separation)
+    state = schedule.state(_sample_times(schedule, period))
+    failures: list[str] = []
+
+    separation = _track_distance(state.leg[0], state.s[0], state.leg[1], state.s[1])
+    worst = int(np.argmin(separation))
+    if separation[worst] < required - POSITION_TOLERANCE:
+        failures.append(
+            f"separation {separation[worst]:.9g} m at t={state.t[worst]:.4f} s is below the minimum {required:g} m"
+        )
+    if separation[worst] <= 0.0:
+        failures.append(f"vehicles collide at t={state.t[worst]:.4f} s")
+
+    ratios = {}
+    checks = [("velocity", state.velocity, "max_velocity", "m/s"),
+              ("acceleration", state.acceleration, "max_acceleration", "m/s^2")]
+    if schedule.jerk_limited:
+        checks.append(("jerk", state.jerk, "max_jerk", "m/s^3"))
+    for name, values, limit_name, unit in checks:
+        per_vehicle = []
+        for vehicle in range(2):
+            limit = getattr(limits.vehicles[vehicle], limit_name)
+            k = int(np.argmax(np.abs(values[vehicle])))
+            ratio = float(abs(values[vehicle, k]) / limit)
+            per_vehicle.append(ratio)
+            if ratio > 1.0 + RELATIVE_TOLERANCE:
+                failures.append(
+                    f"vehicle {vehicle + 1} {name} {values[vehicle, k]:.9g} {unit} at t={state.t[k]:.4f} s "
+                    f"exceeds its {limit_name} {limit:g} {unit}"
+                )
+        ratios[name] = (per_vehicle[0], per_vehicle[1])
+    if not schedule.jerk_limited:
+        ratios["jerk"] = (float("nan"), float("nan"))
+
+    ends = []
+    for label, index, expected in (("start", 0, route.start), ("goal", -1, route.goal)):
+        error = 0.0
+        for vehicle, position in enumerate(expected):
+            leg = -1 if position.leg is None else graph.index(position.leg)
+            error += float(
+                _track_distance(np.array([state.leg[vehicle, index]]), np.array([state.s[vehicle, index]]),
+                                np.array([leg]), np.array([position.s]))[0]
+            )
+            # at rest: v = 0; a jerk-limited method also starts and ends with a = 0
+            residue = abs(state.velocity[vehicle, index])
+            if schedule.jerk_limited:
+                residue += abs(state.acceleration[vehicle, index])
+            if residue > 1e-9:
+                failures.append(f"vehicle {vehicle + 1} is not at rest at the {label} (|v| + |a| = {residue:.3g})")
+        if error > POSITION_TOLERANCE:
+            failures.append(f"{label} is off the route's {label} by {error:.3g} m (expected <= 1e-9 m)")
+        ends.append(error)
+
+    # positions must move no faster than the velocities say (consistency of the two)
+    dt = np.diff(state.t)
+    for vehicle in range(2):
+        moved = _track_distance(state.leg[vehicle, :-1], state.s[vehicle, :-1], state.leg[vehicle, 1:],
+                                state.s[vehicle, 1:])
+        bound = limits.vehicles[vehicle].max_velocity * dt * (1.0 + RELATIVE_TOLERANCE) + POSITION_TOLERANCE
+        jumps = np.nonzero(moved > bound)[0]
+        if jumps.size:
+            k = int(jumps[0])
+            failures.append(
+                f"vehicle {vehicle + 1} jumps {moved[k]:.6g} m in {dt[k]:.3g} s at t={state.t[k]:.4f} s "
+                f"(faster than its max_velocity)"
+            )
+
+    expected_regions = tuple(
+        (graph.index(r.first_leg), graph.index(r.second_leg), r.nearer or 0) for r in route.regions
+    )
+    sampled_regions = reduce_regions(_region_keys(state))
+    regions_match = sampled_regions == expected_regions
+    if not regions_match:
+        names = graph.names
+
+        def show(keys):
+            return " ".join(f"T({names[a]},{n})" if a == b else f"Q({names[a]},{names[b]})" for a, b, n in keys)
+
+        failures.append(
+            f"homotopy class differs: schedule visits [{show(sampled_regions)}], route [{show(expected_regions)}]"
+        )
+
+    report = VerificationReport(
+        passed=not failures,
+        failures=tuple(failures),
+        samples=int(state.t.size),
+        period=period,
+        min_separation=float(separation[worst]),
+        separation_margin=float(separation[worst] - required),
+        velocity_ratio=ratios["velocity"],
+        acceleration_ratio=ratios["acceleration"],
+        jerk_ratio=ratios["jerk"],
+        start_error=ends[0],
+        goal_error=ends[1],
+        regions_match=regions_match,
+    )
+    if not report.passed:
+        logger.warning("schedule (%s) failed verification: %s", schedule.method, "; ".join(failures))
+    return report
+
+
+def verified(schedule: Schedule, *, period: float = MAX_PERIOD) -> VerificationReport:
+    """Verify and raise :class:`~topology.errors.VerificationError` unless the schedule passes."""
+    report = verify(schedule, period=period)
+    report.raise_if_failed()
+    return report
