@@ -1,4 +1,4 @@
-"""The command line: output, JSON summary and exit status."""
+"""The command line: output, JSON summary, files, and exit status 0 / 1 / 2."""
 
 from __future__ import annotations
 
@@ -6,66 +6,128 @@ import json
 
 import pytest
 
-from trajgen.cli import EXIT_BAD_INPUT, EXIT_OK, main
+import trajgen.cli
+from tests.conftest import REPO
+from trajgen.cli import EXIT_BAD_INPUT, EXIT_FAILURE, EXIT_OK, main
+
+SWAP = str(REPO / "examples" / "swap.toml")
 
 
-def test_demo_prints_the_worked_example_route(capsys):
-    assert main(["demo"]) == EXIT_OK
+def test_plan_prints_the_route(capsys):
+    assert main(["plan", SWAP]) == EXIT_OK
     out = capsys.readouterr().out
     assert "counterclockwise" in out
-    assert "(A:1, C:1)" in out
-    assert "(B:1, A:1)" in out
+    assert "(A:10, C:10)" in out
 
 
 def test_plan_json_summary(capsys):
-    argv = ["plan", "--legs", "A=10,B=8,C=15", "--start", "A:3", "B:2", "--goal", "C:4", "C:9"]
-    assert main([*argv, "--min-separation", "1.5", "--json"]) == EXIT_OK
+    assert main(["plan", SWAP, "--json"]) == EXIT_OK
     summary = json.loads(capsys.readouterr().out)
-    assert summary["instruction"] == "shortest"
-    assert summary["regions"] == ["Q(A,B)", "Q(A,C)", "T(C,1)"]
-    assert summary["waypoints"][1][1] == {"leg": "B", "s_m": pytest.approx(20 / 3)}
+    assert summary["instruction"] == "counterclockwise"
+    assert summary["regions"] == ["Q(A,B)", "Q(A,C)", "Q(B,C)", "Q(B,A)"]
+    assert summary["waypoints"][2] == [{"leg": "A", "s_m": 10.0}, {"leg": "C", "s_m": 10.0}]
+
+
+@pytest.mark.parametrize("method", ["exact", "toppra"])
+def test_schedule_writes_verified_csv_and_plots(tmp_path, capsys, method):
+    csv_dir, plot_dir = tmp_path / "csv", tmp_path / "plots"
+    argv = ["schedule", SWAP, "--method", method, "--csv", str(csv_dir), "--plot", str(plot_dir), "--json"]
+    assert main(argv) == EXIT_OK
+    summary = json.loads(capsys.readouterr().out)
+    assert summary["method"] == method
+    assert summary["verified"] is True
+    assert summary["duration_s"] > 0
+    assert summary["worst_margins"]["separation_margin_m"] >= 0
+    assert summary["jerk_limited"] is (method == "exact")
+    assert sorted(p.name for p in csv_dir.iterdir()) == ["agv1.csv", "agv2.csv"]
+    for name in ("speed.png", "separation.png"):
+        assert (plot_dir / name).read_bytes().startswith(b"\x89PNG\r\n\x1a\n")
+
+
+def test_schedule_human_summary_and_options(tmp_path, capsys):
+    argv = [
+        "schedule",
+        SWAP,
+        "--csv",
+        str(tmp_path),
+        "--units",
+        "mm",
+        "--decimal",
+        ",",
+        "--delimiter",
+        "tab",
+        "--sample-period",
+        "0.5",
+    ]
+    assert main(argv) == EXIT_OK
+    out = capsys.readouterr().out
+    assert "verified: True" in out
+    assert "duration: 67.500 s" in out
+    assert (tmp_path / "agv1.csv").read_text().splitlines()[0].split("\t")[1] == "axis_mm"
+
+
+def test_demo_runs_the_default_scenario_end_to_end(tmp_path, capsys):
+    output = tmp_path / "demo"
+    assert main(["demo", "--output", str(output)]) == EXIT_OK
+    out = capsys.readouterr().out
+    assert "verified: True" in out
+    assert sorted(p.name for p in output.iterdir()) == ["agv1.csv", "agv2.csv", "separation.png", "speed.png"]
 
 
 @pytest.mark.parametrize(
     ("argv", "match"),
     [
+        pytest.param(["plan", "absent.toml"], "cannot read the scenario file", id="missing-file"),
+        pytest.param(["schedule", SWAP, "--method", "fast"], "method 'fast' is unknown", id="bad-method"),
         pytest.param(
-            ["plan", "--legs", "A=10,B=8", "--start", "A:1", "B:1", "--goal", "A:2", "B:2"],
-            "exactly 3 legs",
-            id="two-legs",
+            ["schedule", SWAP, "--sample-period", "-1"], "sample period must be > 0 s", id="bad-period"
         ),
-        pytest.param(
-            ["plan", "--legs", "A=10,B=8,C=x", "--start", "A:1", "B:1", "--goal", "A:2", "B:2"],
-            "'C=x' is malformed",
-            id="bad-length",
-        ),
-        pytest.param(
-            ["plan", "--legs", "A=10,B=8,C=5", "--start", "A:1", "B:1", "--goal", "D:2", "B:2"],
-            "unknown leg 'D'",
-            id="unknown-leg",
-        ),
-        pytest.param(
-            [
-                "plan",
-                "--legs",
-                "A=10,B=8,C=5",
-                "--start",
-                "A:1",
-                "A:1.2",
-                "--goal",
-                "A:2",
-                "B:2",
-                "--min-separation",
-                "1",
-            ],
-            "0.19999999999999996 m apart",
-            id="too-close",
-        ),
+        pytest.param(["schedule", SWAP, "--delimiter", ",", "--decimal", ","], "both ','", id="same-marks"),
         pytest.param(["nonsense"], "invalid choice", id="unknown-command"),
+        pytest.param(["schedule"], "the following arguments are required: scenario", id="missing-argument"),
     ],
 )
-def test_bad_input_exits_2_with_a_message(argv, match, capsys):
-    assert main(argv) == EXIT_BAD_INPUT
+def test_bad_input_exits_2_and_writes_nothing(tmp_path, argv, match, capsys):
+    output = tmp_path / "out"
+    extra = ["--csv", str(output)] if argv[0] == "schedule" and len(argv) > 1 else []
+    assert main(argv + extra) == EXIT_BAD_INPUT
     captured = capsys.readouterr()
     assert captured.out == ""
     assert match in captured.err
+    assert not output.exists()
+
+
+def test_bad_scenario_file_exits_2_naming_the_file(tmp_path, capsys):
+    bad = tmp_path / "bad.toml"
+    bad.write_text((REPO / "examples" / "swap.toml").read_text().replace("max_jerk = 1.0", "max_jerk = 0", 1))
+    assert main(["schedule", str(bad), "--csv", str(tmp_path / "out")]) == EXIT_BAD_INPUT
+    err = capsys.readouterr().err
+    assert str(bad) in err
+    assert "max_jerk must be > 0" in err
+    assert not (tmp_path / "out").exists()
+
+
+def test_a_schedule_failing_verification_exits_1_and_writes_nothing(tmp_path, capsys, monkeypatch):
+    from limits import Limits
+    from trajgen import schedule as schedule_module
+
+    real = schedule_module.make_schedule
+
+    def too_close(route, limits, *, method):
+        good = real(route, limits, method=method)
+        return schedule_module.Schedule(
+            good.route,
+            Limits(limits.vehicles, min_separation=10.5),
+            good.method,
+            good.sections,
+            good.jerk_limited,
+        )
+
+    monkeypatch.setattr(schedule_module, "make_schedule", too_close)
+    output = tmp_path / "out"
+    assert main(["schedule", SWAP, "--csv", str(output), "--plot", str(output)]) == EXIT_FAILURE
+    captured = capsys.readouterr()
+    assert "failed verification" in captured.err
+    assert captured.out == ""
+    assert not output.exists()
+    assert trajgen.cli.EXIT_FAILURE == 1

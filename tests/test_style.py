@@ -10,5 +10,7 @@ from tests.conftest import REPO
 
 def test_ruff_check_passes():
     # run through this interpreter: the venv's bin directory need not be on PATH
-    result = subprocess.run([sys.executable, "-m", "ruff", "check", str(REPO)], capture_output=True, text=True)
+    result = subprocess.run(
+        [sys.executable, "-m", "ruff", "check", str(REPO)], capture_output=True, text=True
+    )
     assert result.returncode == 0, result.stdout + result.stderr

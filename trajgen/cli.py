@@ -12,8 +12,9 @@ import logging
 import sys
 from collections.abc import Sequence
 
-from topology import Configuration, Position, Route, YGraph, plan
+from topology import Route, plan
 from topology.errors import InputError
+from trajgen.scenario import Scenario, default_scenario, load_scenario
 
 __all__ = ["main"]
 
@@ -54,39 +55,120 @@ def format_route(route: Route) -> str:
     return "\n".join(lines)
 
 
-def _swap_example() -> tuple[YGraph, Configuration, Configuration]:
-    """ALGORITHM.md section 7: legs of 1 m, swap the vehicles parked at A and B."""
-    track = YGraph({"A": 1.0, "B": 1.0, "C": 1.0})
-    start = Configuration(Position("A", 1.0), Position("B", 1.0))
-    return track, start, start.swapped()
+def _load(path: str | None) -> Scenario:
+    return default_scenario() if path is None else load_scenario(path)
 
 
-def _command_demo(args: argparse.Namespace) -> int:
-    track, start, goal = _swap_example()
-    route = plan(track, start, goal)
-    print("Swap example (ALGORITHM.md section 7): legs A, B, C of 1 m, vehicles at A:1 and B:1.")
-    print(format_route(route))
-    return EXIT_OK
-
-
-def _parse_legs(text: str) -> dict[str, float]:
-    legs = {}
-    for item in text.split(","):
-        name, _, length = item.partition("=")
-        try:
-            legs[name.strip()] = float(length)
-        except ValueError:
-            raise InputError(f"--legs item {item!r} is malformed: expected NAME=metres, e.g. A=10") from None
-    return legs
+def _plan_scenario(scenario: Scenario) -> Route:
+    return plan(scenario.track, scenario.start, scenario.goal, min_separation=scenario.limits.min_separation)
 
 
 def _command_plan(args: argparse.Namespace) -> int:
-    track = YGraph(_parse_legs(args.legs))
-    start = Configuration(Position.parse(args.start[0]), Position.parse(args.start[1]))
-    goal = Configuration(Position.parse(args.goal[0]), Position.parse(args.goal[1]))
-    route = plan(track, start, goal, min_separation=args.min_separation)
+    route = _plan_scenario(_load(args.scenario))
     print(json.dumps(route_summary(route), indent=2) if args.json else format_route(route))
     return EXIT_OK
+
+
+def _csv_options(args: argparse.Namespace):
+    from trajgen.export import CsvOptions, Units
+
+    delimiter = "\t" if args.delimiter in ("tab", "\\t") else args.delimiter
+    return CsvOptions(
+        sample_period=args.sample_period,
+        delimiter=delimiter,
+        decimal=args.decimal,
+        units=Units.lookup(args.units),
+    )
+
+
+def run_schedule(
+    scenario: Scenario, *, method: str, csv_dir: str | None, plot_dir: str | None, csv_options=None
+) -> dict:
+    """Plan, schedule, verify, then export: the whole job. Returns the JSON summary.
+
+    Nothing is written unless the schedule passes the verifier.
+    """
+    from trajgen.export import write_profiles
+    from trajgen.schedule import Method, make_schedule
+    from trajgen.verify import verified
+
+    method = Method.lookup(method)
+    route = _plan_scenario(scenario)
+    schedule = make_schedule(route, scenario.limits, method=method)
+    report = verified(schedule)
+    written: list[str] = []
+    if csv_dir is not None:
+        _, paths = write_profiles(schedule, scenario.names, csv_dir, options=csv_options)
+        written += [str(p) for p in paths]
+    if plot_dir is not None:
+        from trajgen.plotting import write_plots
+
+        written += [str(p) for p in write_plots(schedule, plot_dir, names=scenario.names)]
+    return {
+        "scenario": scenario.source,
+        "method": method.value,
+        "duration_s": schedule.duration,
+        "jerk_limited": schedule.jerk_limited,
+        "verified": report.passed,
+        "worst_margins": report.summary(),
+        "notes": list(schedule.notes),
+        "route": route_summary(route),
+        "files": written,
+    }
+
+
+def _print_schedule_summary(summary: dict) -> None:
+    margins = summary["worst_margins"]
+    print(f"scenario: {summary['scenario']}")
+    print(
+        f"method: {summary['method']}  duration: {summary['duration_s']:.3f} s  "
+        f"verified: {summary['verified']}"
+    )
+    print(
+        f"worst margins: separation {margins['min_separation_m']:.4f} m "
+        f"(margin {margins['separation_margin_m']:.4f} m), |v|/limit {max(margins['velocity_ratio']):.6f}, "
+        f"|a|/limit {max(margins['acceleration_ratio']):.6f}"
+        + (
+            f", |j|/limit {max(margins['jerk_ratio']):.6f}"
+            if summary["jerk_limited"]
+            else ", jerk not limited"
+        )
+    )
+    for note in summary["notes"]:
+        print(f"note: {note}")
+    for path in summary["files"]:
+        print(f"wrote {path}")
+
+
+def _command_schedule(args: argparse.Namespace) -> int:
+    scenario = _load(args.scenario)
+    options = _csv_options(args)
+    summary = run_schedule(
+        scenario, method=args.method, csv_dir=args.csv, plot_dir=args.plot, csv_options=options
+    )
+    if args.json:
+        print(json.dumps(summary, indent=2))
+    else:
+        _print_schedule_summary(summary)
+    return EXIT_OK
+
+
+def _command_demo(args: argparse.Namespace) -> int:
+    scenario = default_scenario()
+    output = args.output
+    print(f"Demo: the built-in scenario {scenario.source} (two AGVs swap ends of legs A and B).")
+    print(format_route(_plan_scenario(scenario)))
+    summary = run_schedule(scenario, method=args.method, csv_dir=output, plot_dir=output)
+    _print_schedule_summary(summary)
+    print(f"CSV profiles and plots are in {output}/")
+    return EXIT_OK
+
+
+def _add_csv_options(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--sample-period", type=float, default=0.01, help="seconds between CSV rows (0.01)")
+    parser.add_argument("--delimiter", default=";", help="CSV field separator (';'); 'tab' for a tab")
+    parser.add_argument("--decimal", default=".", choices=[".", ","], help="decimal mark ('.')")
+    parser.add_argument("--units", default="m", choices=["m", "mm"], help="length unit of the CSV (m)")
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -96,19 +178,25 @@ def build_parser() -> argparse.ArgumentParser:
     )
     parser.add_argument("-v", "--verbose", action="store_true", help="log progress to stderr")
     commands = parser.add_subparsers(dest="command", required=True, parser_class=_ArgumentParser)
-    demo = commands.add_parser("demo", help="run the built-in swap example")
+
+    demo = commands.add_parser("demo", help="run the built-in swap scenario end to end")
+    demo.add_argument("--output", default="trajgen-demo", help="folder for CSV and plots (trajgen-demo)")
+    demo.add_argument("--method", default="exact", help="exact or toppra (exact)")
     demo.set_defaults(run=_command_demo)
-    plan_parser = commands.add_parser("plan", help="plan a route between two configurations")
-    plan_parser.add_argument("--legs", required=True, help="leg lengths, counterclockwise: A=10,B=10,C=10")
-    plan_parser.add_argument(
-        "--start", nargs=2, required=True, metavar=("FIRST", "SECOND"), help="e.g. A:10 B:10"
-    )
-    plan_parser.add_argument(
-        "--goal", nargs=2, required=True, metavar=("FIRST", "SECOND"), help="e.g. B:10 A:10"
-    )
-    plan_parser.add_argument("--min-separation", type=float, default=0.0, help="metres along the track")
+
+    plan_parser = commands.add_parser("plan", help="print the planner's route for a scenario file")
+    plan_parser.add_argument("scenario", help="scenario TOML file")
     plan_parser.add_argument("--json", action="store_true", help="print a machine-readable summary")
     plan_parser.set_defaults(run=_command_plan)
+
+    schedule = commands.add_parser("schedule", help="schedule, verify and export a scenario")
+    schedule.add_argument("scenario", help="scenario TOML file")
+    schedule.add_argument("--method", default="exact", help="exact or toppra (exact)")
+    schedule.add_argument("--csv", metavar="DIR", help="write DIR/<vehicle name>.csv per vehicle")
+    schedule.add_argument("--plot", metavar="DIR", help="write DIR/speed.png and DIR/separation.png")
+    schedule.add_argument("--json", action="store_true", help="print a machine-readable summary")
+    _add_csv_options(schedule)
+    schedule.set_defaults(run=_command_schedule)
     return parser
 
 

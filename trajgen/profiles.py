@@ -10,7 +10,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["PiecewiseCubic", "scurve_phases", "trapezoid_phases", "rest_to_rest_time"]
+__all__ = ["PiecewiseCubic", "rest_to_rest_time", "scurve_phases", "trapezoid_phases"]
 
 
 def scurve_phases(distance: float, v_max: float, a_max: float, j_max: float) -> list[tuple[float, float]]:
@@ -171,7 +171,7 @@ class PiecewiseCubic:
                 p0 + h * (v0 + h * (a0 / 2.0 + h * j / 6.0)),
                 v0 + h * (a0 + h * j / 2.0),
                 a0 + h * j,
-                j,
+                np.where(t >= self.times[-1], 0.0, j),  # no jerk once the motion has ended
             ]
         )
 

@@ -28,16 +28,16 @@ from topology.graph import _finite_real
 from trajgen.profiles import PiecewiseCubic, scurve_phases, trapezoid_phases
 
 __all__ = [
-    "Method",
     "AxisMap",
-    "Section",
+    "Method",
+    "RouteAxes",
     "Schedule",
     "ScheduleState",
-    "RouteAxes",
-    "route_axes",
+    "Section",
+    "check_period",
     "exact_schedule",
     "make_schedule",
-    "check_period",
+    "route_axes",
 ]
 
 logger = logging.getLogger(__name__)
@@ -57,7 +57,9 @@ class Method(enum.StrEnum):
         try:
             return cls(str(name).lower())
         except ValueError:
-            raise OptionError(f"method {name!r} is unknown: expected one of {[m.value for m in cls]!r}") from None
+            raise OptionError(
+                f"method {name!r} is unknown: expected one of {[m.value for m in cls]!r}"
+            ) from None
 
 
 def check_period(period: float) -> float:
@@ -452,7 +454,9 @@ def _parked_maps(route: Route) -> tuple[AxisMap, AxisMap]:
     """Axis maps for a route that does not move (start is goal on the boundary)."""
     c = route._tuples[0]
     return tuple(
-        AxisMap(np.zeros(1), np.zeros(1), np.array([c[2 * v]]), np.array([c[2 * v + 1]]), np.zeros(1, dtype=int))
+        AxisMap(
+            np.zeros(1), np.zeros(1), np.array([c[2 * v]]), np.array([c[2 * v + 1]]), np.zeros(1, dtype=int)
+        )
         for v in range(2)
     )  # type: ignore[return-value]
 

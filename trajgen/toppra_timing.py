@@ -45,7 +45,7 @@ from trajgen.schedule import (
     straight_pieces,
 )
 
-__all__ = ["toppra_schedule", "HEADROOM", "BlendedPath"]
+__all__ = ["HEADROOM", "BlendedPath", "toppra_schedule"]
 
 logger = logging.getLogger(__name__)
 
@@ -130,10 +130,18 @@ class BlendedPath:
     def waypoints(self):
         return self.breakpoints, self(self.breakpoints)
 
+    def piece(self, ss: np.ndarray) -> np.ndarray:
+        """Index of the piece (line or blend) holding each path position, shape (n,)."""
+        return np.clip(np.searchsorted(self._starts, ss, side="right") - 1, 0, len(self._starts) - 1)
+
     def __call__(self, ss, order: int = 0) -> np.ndarray:
         scalar = np.isscalar(ss)
         ss = np.clip(np.atleast_1d(np.asarray(ss, dtype=float)), 0.0, self.length)
-        k = np.clip(np.searchsorted(self._starts, ss, side="right") - 1, 0, len(self._starts) - 1)
+        out = self.on_piece(self.piece(ss), ss, order)
+        return out[0] if scalar else out
+
+    def on_piece(self, k: np.ndarray, ss: np.ndarray, order: int) -> np.ndarray:
+        """Derivative ``order`` at ``ss`` using the polynomial of piece ``k`` (one-sided at its ends)."""
         h = (ss - self._starts[k])[:, None]
         if order == 0:
             out = self._p0[k] + h * self._d1[k] + 0.5 * h * h * self._d2[k]
@@ -143,7 +151,7 @@ class BlendedPath:
             out = np.broadcast_to(self._d2[k], (ss.size, 2)).copy()
         else:
             out = np.zeros((ss.size, 2))
-        return out[0] if scalar else out
+        return out
 
     def eval(self, ss):
         return self(ss, 0)
@@ -192,9 +200,13 @@ class ToppraKinematics(Kinematics):
         s = np.where(at_end, self.grid[-1], np.minimum(s, self.grid[k + 1]))
         sd = np.where(at_end, 0.0, sd)
         sdd = np.where(at_end, 0.0, sdd)
-        q = self.path(s, 0)
-        dq = self.path(s, 1)
-        ddq = self.path(s, 2)
+        # every path breakpoint is a grid point, so grid interval k lies in one path piece:
+        # evaluate with that piece, so the end of an interval is its one-sided limit
+        piece = self.path.piece(np.minimum(self.grid[k], self.grid[-1]))
+        piece = np.where(at_end, self.path.piece(np.array([self.grid[-2]]))[0], piece)
+        q = self.path.on_piece(piece, s, 0)
+        dq = self.path.on_piece(piece, s, 1)
+        ddq = self.path.on_piece(piece, s, 2)
         out = np.empty((2, 4, t.size))
         out[:, 0] = q.T
         out[:, 1] = (dq * sd[:, None]).T
@@ -248,7 +260,9 @@ def _safe_blend(
         # between samples the separation changes by at most |da1| + |da2| <= sqrt(2) * spacing
         if np.min(_separation(*located)) < required + 1.5 * spacing:
             continue
-        polyline = np.concatenate([blend.before + np.outer(w, p - blend.before), p + np.outer(w, blend.after - p)])
+        polyline = np.concatenate(
+            [blend.before + np.outer(w, p - blend.before), p + np.outer(w, blend.after - p)]
+        )
         if _regions(*located) != _regions(*_locate_both(maps, polyline)):
             continue
         return blend
@@ -310,9 +324,11 @@ def _fit_to_limits(kinematics: ToppraKinematics, limits: Limits) -> ToppraKinema
 
     Scaling time by ``c >= 1`` divides velocities by ``c`` and accelerations by ``c**2`` exactly.
     """
-    fine = np.linspace(0.0, 1.0, 17)[:-1]
+    # acceleration is linear in s within a grid interval: its extremes are at the interval ends,
+    # which are sampled as one-sided limits (ends nudged inside); speed is sampled densely
+    fine = np.concatenate([[0.0], np.linspace(0.0, 1.0, 17)[1:-1], [1.0 - 1e-9]])
     times = (kinematics.times[:-1, None] + np.diff(kinematics.times)[:, None] * fine).ravel()
-    values = kinematics.evaluate(np.append(times, kinematics.times[-1]))
+    values = kinematics.evaluate(times)
     ratio = 1.0
     for vehicle, vehicle_limits in enumerate(limits.vehicles):
         ratio = max(
@@ -324,7 +340,9 @@ def _fit_to_limits(kinematics: ToppraKinematics, limits: Limits) -> ToppraKinema
         return kinematics
     stretch = ratio * (1.0 + 1e-7)  # the dense samples bound the maxima to well within this
     logger.debug("TOPPRA section stretched in time by %.3g to meet the limits between grid points", stretch)
-    return ToppraKinematics(kinematics.path, kinematics.grid, kinematics.speed / stretch, kinematics.times * stretch)
+    return ToppraKinematics(
+        kinematics.path, kinematics.grid, kinematics.speed / stretch, kinematics.times * stretch
+    )
 
 
 def toppra_schedule(route: Route, limits: Limits) -> Schedule:

@@ -30,7 +30,7 @@ from topology.errors import VerificationError
 from topology.route import reduce_regions
 from trajgen.schedule import Schedule, ScheduleState
 
-__all__ = ["VerificationReport", "verify", "verified", "RELATIVE_TOLERANCE", "POSITION_TOLERANCE"]
+__all__ = ["POSITION_TOLERANCE", "RELATIVE_TOLERANCE", "VerificationReport", "verified", "verify"]
 
 logger = logging.getLogger(__name__)
 
@@ -157,14 +157,17 @@ def verify(schedule: Schedule, *, period: float = MAX_PERIOD) -> VerificationRep
     worst = int(np.argmin(separation))
     if separation[worst] < required - POSITION_TOLERANCE:
         failures.append(
-            f"separation {separation[worst]:.9g} m at t={state.t[worst]:.4f} s is below the minimum {required:g} m"
+            f"separation {separation[worst]:.9g} m at t={state.t[worst]:.4f} s "
+            f"is below the minimum {required:g} m"
         )
     if separation[worst] <= 0.0:
         failures.append(f"vehicles collide at t={state.t[worst]:.4f} s")
 
     ratios = {}
-    checks = [("velocity", state.velocity, "max_velocity", "m/s"),
-              ("acceleration", state.acceleration, "max_acceleration", "m/s^2")]
+    checks = [
+        ("velocity", state.velocity, "max_velocity", "m/s"),
+        ("acceleration", state.acceleration, "max_acceleration", "m/s^2"),
+    ]
     if schedule.jerk_limited:
         checks.append(("jerk", state.jerk, "max_jerk", "m/s^3"))
     for name, values, limit_name, unit in checks:
@@ -189,15 +192,21 @@ def verify(schedule: Schedule, *, period: float = MAX_PERIOD) -> VerificationRep
         for vehicle, position in enumerate(expected):
             leg = -1 if position.leg is None else graph.index(position.leg)
             error += float(
-                _track_distance(np.array([state.leg[vehicle, index]]), np.array([state.s[vehicle, index]]),
-                                np.array([leg]), np.array([position.s]))[0]
+                _track_distance(
+                    np.array([state.leg[vehicle, index]]),
+                    np.array([state.s[vehicle, index]]),
+                    np.array([leg]),
+                    np.array([position.s]),
+                )[0]
             )
             # at rest: v = 0; a jerk-limited method also starts and ends with a = 0
             residue = abs(state.velocity[vehicle, index])
             if schedule.jerk_limited:
                 residue += abs(state.acceleration[vehicle, index])
             if residue > 1e-9:
-                failures.append(f"vehicle {vehicle + 1} is not at rest at the {label} (|v| + |a| = {residue:.3g})")
+                failures.append(
+                    f"vehicle {vehicle + 1} is not at rest at the {label} (|v| + |a| = {residue:.3g})"
+                )
         if error > POSITION_TOLERANCE:
             failures.append(f"{label} is off the route's {label} by {error:.3g} m (expected <= 1e-9 m)")
         ends.append(error)
@@ -205,8 +214,9 @@ def verify(schedule: Schedule, *, period: float = MAX_PERIOD) -> VerificationRep
     # positions must move no faster than the velocities say (consistency of the two)
     dt = np.diff(state.t)
     for vehicle in range(2):
-        moved = _track_distance(state.leg[vehicle, :-1], state.s[vehicle, :-1], state.leg[vehicle, 1:],
-                                state.s[vehicle, 1:])
+        moved = _track_distance(
+            state.leg[vehicle, :-1], state.s[vehicle, :-1], state.leg[vehicle, 1:], state.s[vehicle, 1:]
+        )
         bound = limits.vehicles[vehicle].max_velocity * dt * (1.0 + RELATIVE_TOLERANCE) + POSITION_TOLERANCE
         jumps = np.nonzero(moved > bound)[0]
         if jumps.size:
@@ -225,10 +235,13 @@ def verify(schedule: Schedule, *, period: float = MAX_PERIOD) -> VerificationRep
         names = graph.names
 
         def show(keys):
-            return " ".join(f"T({names[a]},{n})" if a == b else f"Q({names[a]},{names[b]})" for a, b, n in keys)
+            return " ".join(
+                f"T({names[a]},{n})" if a == b else f"Q({names[a]},{names[b]})" for a, b, n in keys
+            )
 
         failures.append(
-            f"homotopy class differs: schedule visits [{show(sampled_regions)}], route [{show(expected_regions)}]"
+            f"homotopy class differs: schedule visits [{show(sampled_regions)}], "
+            f"route [{show(expected_regions)}]"
         )
 
     report = VerificationReport(

@@ -1,0 +1,20 @@
+"""Shared builders for schedule tests."""
+
+from __future__ import annotations
+
+from limits import Limits, VehicleLimits
+from topology import Configuration, Position, YGraph, plan
+
+SLOW = VehicleLimits(max_velocity=0.7, max_acceleration=0.35, max_jerk=0.6)
+AGV = VehicleLimits(max_velocity=1.0, max_acceleration=0.5, max_jerk=1.0)
+LIMITS = Limits(vehicles=(AGV, AGV), min_separation=1.5)
+MIXED = Limits(vehicles=(AGV, SLOW), min_separation=1.5)
+
+
+def conf(first: str, second: str) -> Configuration:
+    return Configuration(Position.parse(first), Position.parse(second))
+
+
+def route_of(legs, start, goal, separation=1.5):
+    track = YGraph(dict(zip("ABC", legs, strict=True)))
+    return plan(track, conf(*start), conf(*goal), min_separation=separation)

@@ -1,0 +1,141 @@
+"""CSV profiles: format, round trip re-verified from the file, options, atomicity."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from limits import Limits
+from tests.helpers import LIMITS, MIXED, route_of
+from topology.errors import OptionError, VerificationError
+from trajgen.export import CsvOptions, Units, write_profiles
+from trajgen.schedule import Schedule, exact_schedule
+from trajgen.toppra_timing import toppra_schedule
+
+SWAP = ((10.0, 10.0, 10.0), ("A:10", "B:10"), ("B:10", "A:10"))
+NAMES = ("agv1", "agv2")
+
+
+def read_profile(path, options: CsvOptions):
+    raw = path.read_bytes()
+    assert raw.endswith(b"\r\n")
+    lines = raw.decode("ascii").split("\r\n")[:-1]
+    assert all("\n" not in line and "\r" not in line for line in lines)
+    header = lines[0].split(options.delimiter)
+    rows = [
+        [field.replace(options.decimal, ".") for field in line.split(options.delimiter)] for line in lines[1:]
+    ]
+    data = np.array(rows, dtype=float)
+    return header, data
+
+
+@pytest.mark.parametrize(
+    ("method", "limits"),
+    [pytest.param("exact", LIMITS, id="exact"), pytest.param("toppra", MIXED, id="toppra-mixed-limits")],
+)
+def test_csv_round_trip_re_verified_from_the_files(tmp_path, method, limits):
+    route = route_of(*SWAP)
+    schedule = exact_schedule(route, limits) if method == "exact" else toppra_schedule(route, limits)
+    options = CsvOptions()
+    report, paths = write_profiles(schedule, NAMES, tmp_path, options=options)
+    assert report.passed
+    assert [p.name for p in paths] == ["agv1.csv", "agv2.csv"]
+    tables = [read_profile(p, options) for p in paths]
+    for header, data in tables:
+        assert header == ["t_s", "axis_m", "v_mps", "a_mps2", "j_mps3", "leg", "s_m", "x_m", "y_m"]
+        t = data[:, 0]
+        assert t[0] == 0.0
+        assert t[-1] == pytest.approx(schedule.duration, abs=1e-6)
+        assert np.allclose(np.diff(t)[:-1], 0.01, atol=1e-6)
+        assert 0.0 < t[-1] - t[-2] <= 0.01 + 1e-6
+        assert set(np.unique(data[:, 5])) <= {0.0, 1.0, 2.0, 3.0}
+        assert np.all((data[:, 5] == 0) == (data[:, 6] == 0))
+    # re-verify from the files alone
+    (_, first), (_, second) = tables
+    legs = np.stack([first[:, 5], second[:, 5]]).astype(int)
+    s = np.stack([first[:, 6], second[:, 6]])
+    separation = np.where((legs[0] == legs[1]) & (legs[0] > 0), np.abs(s[0] - s[1]), s[0] + s[1])
+    assert separation.min() >= limits.min_separation - 1e-6
+    for data, vehicle in zip((first, second), limits.vehicles, strict=True):
+        assert np.abs(data[:, 2]).max() <= vehicle.max_velocity * (1 + 1e-6)
+        assert np.abs(data[:, 3]).max() <= vehicle.max_acceleration * (1 + 1e-6)
+        # v consistent with the finite difference of the axis (error bounded by a_max * h / 2)
+        h = np.diff(data[:, 0])
+        difference = np.diff(data[:, 1]) / h
+        midpoint_v = 0.5 * (data[1:, 2] + data[:-1, 2])
+        assert np.abs(difference - midpoint_v).max() <= vehicle.max_acceleration * h.max() / 2 + 1e-6
+        # x, y agree with the leg angles
+        angles = np.radians(np.array([0.0, 90.0, 210.0, 330.0]))[data[:, 5].astype(int)]
+        assert np.allclose(data[:, 7], data[:, 6] * np.cos(angles), atol=1e-8)
+        assert np.allclose(data[:, 8], data[:, 6] * np.sin(angles), atol=1e-8)
+    # start and goal: agv1 from A (leg 1) end to B (leg 2) end
+    assert (first[0, 5], first[0, 6], first[-1, 5], first[-1, 6]) == (1, 10.0, 2, 10.0)
+    assert (second[0, 5], second[0, 6], second[-1, 5], second[-1, 6]) == (2, 10.0, 1, 10.0)
+    assert not list(tmp_path.glob(".*.tmp"))
+
+
+def test_millimetres_comma_decimal_and_tab(tmp_path):
+    schedule = exact_schedule(route_of(*SWAP), LIMITS)
+    metres = CsvOptions(sample_period=0.1)
+    millimetres = CsvOptions(sample_period=0.1, delimiter="\t", decimal=",", units=Units.MILLIMETRES)
+    _, (m_path, _) = write_profiles(schedule, NAMES, tmp_path / "m", options=metres)
+    _, (mm_path, _) = write_profiles(schedule, NAMES, tmp_path / "mm", options=millimetres)
+    _, in_metres = read_profile(m_path, metres)
+    mm_header, in_mm = read_profile(mm_path, millimetres)
+    assert mm_header == ["t_s", "axis_mm", "v_mmps", "a_mmps2", "j_mmps3", "leg", "s_mm", "x_mm", "y_mm"]
+    assert "," in mm_path.read_text().splitlines()[5]
+    assert np.allclose(in_mm[:, 0], in_metres[:, 0])
+    assert np.allclose(in_mm[:, 5], in_metres[:, 5])
+    for column in (1, 2, 3, 4, 6, 7, 8):
+        assert np.allclose(in_mm[:, column], 1000.0 * in_metres[:, column], atol=1e-5)
+
+
+def test_failing_schedule_writes_nothing(tmp_path):
+    schedule = exact_schedule(route_of(*SWAP), LIMITS)
+    broken = Schedule(
+        schedule.route,
+        Limits(LIMITS.vehicles, min_separation=10.5),
+        schedule.method,
+        schedule.sections,
+        schedule.jerk_limited,
+    )
+    target = tmp_path / "out"
+    with pytest.raises(VerificationError, match=r"below the minimum 10\.5 m"):
+        write_profiles(broken, NAMES, target)
+    assert not target.exists()
+
+
+def test_existing_files_are_replaced_whole(tmp_path):
+    schedule = exact_schedule(route_of(*SWAP), LIMITS)
+    (tmp_path / "agv1.csv").write_text("old")
+    write_profiles(schedule, NAMES, tmp_path, options=CsvOptions(sample_period=0.5))
+    assert (tmp_path / "agv1.csv").read_text().startswith("t_s;")
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["agv1.csv", "agv2.csv"]
+
+
+@pytest.mark.parametrize(
+    ("options", "match"),
+    [
+        pytest.param(
+            {"delimiter": ",", "decimal": ","}, "decimal mark and delimiter are both ','", id="same-marks"
+        ),
+        pytest.param(
+            {"decimal": ";", "delimiter": ","}, r"decimal mark ';' is not supported", id="bad-decimal"
+        ),
+        pytest.param({"delimiter": ";;"}, "delimiter ';;' is not usable", id="long-delimiter"),
+        pytest.param({"delimiter": "5"}, "delimiter '5' is not usable", id="digit-delimiter"),
+        pytest.param({"sample_period": 0.0}, r"sample period must be > 0 s, got 0\.0", id="zero-period"),
+        pytest.param({"sample_period": float("nan")}, "sample period.*must be finite", id="nan-period"),
+        pytest.param(
+            {"units": "inch"}, r"units 'inch' are unknown: expected one of \['m', 'mm'\]", id="units"
+        ),
+    ],
+)
+def test_bad_csv_options(options, match):
+    with pytest.raises(ValueError, match=match):
+        CsvOptions(**options)
+
+
+def test_option_errors_are_option_errors():
+    with pytest.raises(OptionError):
+        CsvOptions(delimiter=",", decimal=",")

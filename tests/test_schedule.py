@@ -1,0 +1,161 @@
+"""Schedules: exact vs toppra, stops and reversals, and the verifier catching broken schedules."""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+import pytest
+
+from limits import Limits, VehicleLimits
+from tests.helpers import LIMITS, MIXED, route_of
+from topology import YGraph, plan
+from topology.errors import OptionError, VerificationError
+from trajgen.sampling import random_scenarios
+from trajgen.schedule import Method, Schedule, exact_schedule, make_schedule, route_axes, straight_pieces
+from trajgen.toppra_timing import toppra_schedule
+from trajgen.verify import verified, verify
+
+SWAP = ((10.0, 10.0, 10.0), ("A:10", "B:10"), ("B:10", "A:10"))
+TRACK = YGraph({"A": 12.0, "B": 8.0, "C": 15.0})
+RANDOM = random_scenarios(12, seed=7, track=TRACK, limits=MIXED)
+
+
+def _plan(scenario):
+    return plan(scenario.track, scenario.start, scenario.goal, min_separation=scenario.limits.min_separation)
+
+
+def test_swap_exact_reference_duration():
+    # three straight pieces of 20 m each (merged through the junction), 22.5 s each
+    schedule = exact_schedule(route_of(*SWAP), LIMITS)
+    assert len(schedule.sections) == 3
+    assert schedule.duration == pytest.approx(67.5)
+    assert verify(schedule).passed
+
+
+def test_vehicles_stop_where_the_direction_changes_and_reverse_with_negative_velocity():
+    route = route_of(*SWAP)
+    schedule = exact_schedule(route, LIMITS)
+    for section in schedule.sections:
+        state = schedule.state([section.start_time, section.start_time + section.duration])
+        assert np.allclose(state.velocity, 0.0, atol=1e-12)
+    # vehicle 2 drives B -> O -> C forward, then backs out of C to A
+    state = schedule.sample(0.5)
+    assert state.velocity[1].max() == pytest.approx(1.0)
+    assert state.velocity[1].min() == pytest.approx(-1.0)
+    assert state.axis[1, -1] == pytest.approx(0.0, abs=1e-9)  # back to where its odometer started
+    axes = route_axes(route).axes
+    assert straight_pieces(axes) == [(0, 2), (2, 4), (4, 6)]
+
+
+@pytest.mark.parametrize("scenario", RANDOM, ids=[s.source for s in RANDOM])
+def test_exact_and_toppra_pass_the_verifier_and_toppra_is_never_slower(scenario):
+    route = _plan(scenario)
+    exact = exact_schedule(route, scenario.limits)
+    timed = toppra_schedule(route, scenario.limits)
+    no_jerk = exact_schedule(route, scenario.limits, jerk=False)
+    assert verify(exact).passed, verify(exact).failures
+    report = verify(timed)
+    assert report.passed, report.failures
+    assert timed.duration <= no_jerk.duration + 1e-9
+    assert no_jerk.duration <= exact.duration + 1e-9  # a jerk limit never makes a move faster
+    assert not timed.jerk_limited
+    assert "jerk is not limited" in " ".join(timed.notes)
+
+
+def test_toppra_on_the_swap_rounds_corners_and_beats_exact():
+    route = route_of(*SWAP)
+    timed = toppra_schedule(route, LIMITS)
+    assert verify(timed).passed
+    assert timed.duration < exact_schedule(route, LIMITS, jerk=False).duration - 1.0
+    assert "1 of 2 corners rounded" in timed.notes[0]  # vehicle 2 reverses: the other corner is a stop
+
+
+def test_toppra_on_a_single_straight_move_is_the_trapezoid():
+    route = route_of((10.0, 8.0, 15.0), ("A:2", "O"), ("A:10", "O"))
+    timed = toppra_schedule(route, LIMITS)
+    assert timed.duration == pytest.approx(exact_schedule(route, LIMITS, jerk=False).duration, rel=1e-12)
+
+
+def test_method_lookup():
+    assert Method.lookup("TOPPRA") is Method.TOPPRA
+    with pytest.raises(OptionError, match=r"method 'fast' is unknown: expected one of \['exact', 'toppra'\]"):
+        make_schedule(route_of(*SWAP), LIMITS, method="fast")
+
+
+# -- the verifier catches broken schedules ------------------------------------------------------------
+
+
+def _relabelled(schedule: Schedule, **changes) -> Schedule:
+    return Schedule(
+        changes.get("route", schedule.route),
+        changes.get("limits", schedule.limits),
+        schedule.method,
+        schedule.sections,
+        schedule.jerk_limited,
+    )
+
+
+def test_verifier_catches_a_schedule_that_is_too_fast():
+    fast = VehicleLimits(max_velocity=1.2, max_acceleration=0.6, max_jerk=1.2)
+    schedule = exact_schedule(route_of(*SWAP), Limits(vehicles=(fast, fast), min_separation=1.5))
+    broken = _relabelled(schedule, limits=LIMITS)
+    report = verify(broken)
+    assert not report.passed
+    assert report.velocity_ratio[0] == pytest.approx(1.2)
+    assert any("velocity 1.2" in f and "exceeds its max_velocity 1" in f for f in report.failures)
+    with pytest.raises(VerificationError, match="exceeds its max_velocity"):
+        verified(broken)
+
+
+def test_verifier_catches_vehicles_too_close():
+    schedule = exact_schedule(route_of(*SWAP), LIMITS)
+    broken = _relabelled(schedule, limits=Limits(vehicles=LIMITS.vehicles, min_separation=10.5))
+    report = verify(broken)
+    assert report.separation_margin == pytest.approx(-0.5)
+    assert any("below the minimum 10.5 m" in f for f in report.failures)
+
+
+def test_verifier_catches_a_wrong_goal():
+    schedule = exact_schedule(route_of(*SWAP), LIMITS)
+    other = route_of((10.0, 10.0, 10.0), ("A:10", "B:10"), ("B:10", "C:10"))
+    report = verify(_relabelled(schedule, route=other))
+    assert report.goal_error == pytest.approx(20.0)
+    assert any("goal is off" in f for f in report.failures)
+
+
+def test_verifier_catches_the_other_homotopy_class():
+    # the swap clockwise: same start and goal, the other way round the circle
+    route = route_of(*SWAP)
+    back = route_of((10.0, 10.0, 10.0), SWAP[2], SWAP[1])
+    clockwise = dataclasses.replace(
+        route,
+        waypoints=back.waypoints[::-1],
+        _tuples=back._tuples[::-1],
+        _cumulative=tuple(back.length - c for c in back._cumulative[::-1]),
+    )
+    assert clockwise.start == route.start
+    assert clockwise.goal == route.goal
+    assert clockwise.regions != route.regions
+    schedule = exact_schedule(clockwise, LIMITS)
+    report = verify(_relabelled(schedule, route=route))
+    assert not report.regions_match
+    assert any("homotopy class differs" in f for f in report.failures)
+    assert verify(schedule).passed  # it is a fine schedule of its own route
+
+
+def test_verifier_catches_a_broken_position_map():
+    schedule = exact_schedule(route_of(*SWAP), LIMITS)
+    section = schedule.sections[1]
+    first, second = section.maps
+    shifted = dataclasses.replace(first, s_start=first.s_start + 0.5)
+    broken = dataclasses.replace(
+        schedule,
+        sections=(
+            schedule.sections[0],
+            dataclasses.replace(section, maps=(shifted, second)),
+            schedule.sections[2],
+        ),
+    )
+    report = verify(broken)
+    assert any("jumps" in f for f in report.failures)
