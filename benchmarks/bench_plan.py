@@ -12,18 +12,8 @@ import random
 import statistics
 import time
 
-from topology import Configuration, Position, YGraph, plan
-
-
-def random_position(rng: random.Random, graph: YGraph) -> Position:
-    """A position with the special points (junction, endpoints) well represented."""
-    roll = rng.random()
-    if roll < 0.1:
-        return graph.junction
-    leg = rng.choice(graph.names)
-    if roll < 0.3:
-        return graph.endpoint(leg)
-    return Position(leg, rng.uniform(0.0, graph.length(leg)))
+from topology import Configuration, YGraph, plan
+from trajgen.sampling import random_position
 
 
 def random_queries(count: int, seed: int):

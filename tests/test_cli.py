@@ -28,7 +28,7 @@ def test_plan_json_summary(capsys):
     assert summary["waypoints"][2] == [{"leg": "A", "s_m": 10.0}, {"leg": "C", "s_m": 10.0}]
 
 
-@pytest.mark.parametrize("method", ["exact", "toppra"])
+@pytest.mark.parametrize("method", ["exact", "toppra", "optimal"])
 def test_schedule_writes_verified_csv_and_plots(tmp_path, capsys, method):
     csv_dir, plot_dir = tmp_path / "csv", tmp_path / "plots"
     argv = ["schedule", SWAP, "--method", method, "--csv", str(csv_dir), "--plot", str(plot_dir), "--json"]
@@ -38,9 +38,10 @@ def test_schedule_writes_verified_csv_and_plots(tmp_path, capsys, method):
     assert summary["verified"] is True
     assert summary["duration_s"] > 0
     assert summary["worst_margins"]["separation_margin_m"] >= 0
-    assert summary["jerk_limited"] is (method == "exact")
+    assert summary["jerk_limited"] is (method != "toppra")
+    assert summary["fallback_reason"] is None
     assert sorted(p.name for p in csv_dir.iterdir()) == ["agv1.csv", "agv2.csv"]
-    for name in ("speed.png", "separation.png"):
+    for name in ("speed.png", "separation.png", "coordination.png"):
         assert (plot_dir / name).read_bytes().startswith(b"\x89PNG\r\n\x1a\n")
 
 
@@ -71,7 +72,13 @@ def test_demo_runs_the_default_scenario_end_to_end(tmp_path, capsys):
     assert main(["demo", "--output", str(output)]) == EXIT_OK
     out = capsys.readouterr().out
     assert "verified: True" in out
-    assert sorted(p.name for p in output.iterdir()) == ["agv1.csv", "agv2.csv", "separation.png", "speed.png"]
+    assert sorted(p.name for p in output.iterdir()) == [
+        "agv1.csv",
+        "agv2.csv",
+        "coordination.png",
+        "separation.png",
+        "speed.png",
+    ]
 
 
 @pytest.mark.parametrize(

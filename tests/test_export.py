@@ -127,7 +127,7 @@ def test_existing_files_are_replaced_whole(tmp_path):
         pytest.param({"sample_period": 0.0}, r"sample period must be > 0 s, got 0\.0", id="zero-period"),
         pytest.param({"sample_period": float("nan")}, "sample period.*must be finite", id="nan-period"),
         pytest.param(
-            {"units": "inch"}, r"units 'inch' are unknown: expected one of \['m', 'mm'\]", id="units"
+            {"units": "inch"}, r"units 'inch' is unknown: expected one of \['m', 'mm'\]", id="units"
         ),
     ],
 )

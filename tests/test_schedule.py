@@ -79,7 +79,9 @@ def test_toppra_on_a_single_straight_move_is_the_trapezoid():
 
 def test_method_lookup():
     assert Method.lookup("TOPPRA") is Method.TOPPRA
-    with pytest.raises(OptionError, match=r"method 'fast' is unknown: expected one of \['exact', 'toppra'\]"):
+    with pytest.raises(
+        OptionError, match=r"method 'fast' is unknown: expected one of \['exact', 'toppra', 'optimal'\]"
+    ):
         make_schedule(route_of(*SWAP), LIMITS, method="fast")
 
 

@@ -7,9 +7,7 @@ tuples ``(leg1, s1, leg2, s2)`` with leg index ``-1`` at the junction.
 
 from __future__ import annotations
 
-import enum
-
-from topology.errors import OptionError, PositionError, SeparationError
+from topology.errors import PositionError, SeparationError
 from topology.graph import (
     JUNCTION,
     Configuration,
@@ -18,6 +16,7 @@ from topology.graph import (
     _configuration_unchecked,
     _position_unchecked,
 )
+from topology.options import Option
 
 __all__ = [
     "ANTIPODAL_TOLERANCE",
@@ -34,7 +33,7 @@ ANTIPODAL_TOLERANCE = 1e-9
 _AT_JUNCTION = -1
 
 
-class Cell(enum.StrEnum):
+class Cell(Option):
     """Cell of the configuration space holding a configuration (paper section 5.2)."""
 
     TRIANGLE = "triangle"
@@ -43,16 +42,6 @@ class Cell(enum.StrEnum):
     BOUNDARY = "boundary"  #: interior of a boundary edge ("intermediate" in the paper)
     PEAK = "peak"
     VALLEY = "valley"
-
-    @classmethod
-    def lookup(cls, name: str) -> Cell:
-        """The cell named ``name`` (case-insensitive); raises OptionError otherwise."""
-        try:
-            return cls(str(name).lower())
-        except ValueError:
-            raise OptionError(
-                f"cell {name!r} is unknown: expected one of {[c.value for c in cls]!r}"
-            ) from None
 
     @property
     def on_boundary(self) -> bool:

@@ -150,6 +150,17 @@ class Configuration:
         yield self.first
         yield self.second
 
+    def __getitem__(self, vehicle: int) -> Position:
+        """Position of vehicle 0 (``first``) or 1 (``second``)."""
+        if vehicle in (0, -2):
+            return self.first
+        if vehicle in (1, -1):
+            return self.second
+        raise IndexError(f"a configuration has vehicles 0 and 1, got index {vehicle!r}")
+
+    def __len__(self) -> int:
+        return 2
+
     def __str__(self) -> str:
         return f"({self.first}, {self.second})"
 

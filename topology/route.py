@@ -8,7 +8,6 @@ is the start with the vehicles swapped), then undo the goal's retraction.
 from __future__ import annotations
 
 import bisect
-import enum
 import itertools
 from dataclasses import dataclass, field
 
@@ -23,27 +22,18 @@ from topology.cycle import (
 )
 from topology.errors import OptionError, SeparationError
 from topology.graph import Configuration, YGraph, _finite_real
+from topology.options import Option
 
 __all__ = ["Instruction", "Region", "Route", "plan", "reduce_regions", "region_sequence"]
 
 _Tuple = tuple[int, float, int, float]
 
 
-class Instruction(enum.StrEnum):
+class Instruction(Option):
     """The two continuous instructions of the planner (topological complexity 2)."""
 
     SHORTEST = "shortest"  #: paper Instruction 2: the shorter way round the boundary
     COUNTERCLOCKWISE = "counterclockwise"  #: paper Instruction 1: half a turn, for swaps
-
-    @classmethod
-    def lookup(cls, name: str) -> Instruction:
-        """The instruction named ``name`` (case-insensitive); raises OptionError otherwise."""
-        try:
-            return cls(str(name).lower())
-        except ValueError:
-            raise OptionError(
-                f"instruction {name!r} is unknown: expected one of {[i.value for i in cls]!r}"
-            ) from None
 
 
 @dataclass(frozen=True, slots=True)

@@ -11,6 +11,7 @@ import json
 import logging
 import sys
 from collections.abc import Sequence
+from pathlib import Path
 
 from topology import Route, plan
 from topology.errors import InputError
@@ -101,9 +102,16 @@ def run_schedule(
         _, paths = write_profiles(schedule, scenario.names, csv_dir, options=csv_options)
         written += [str(p) for p in paths]
     if plot_dir is not None:
-        from trajgen.plotting import write_plots
+        from trajgen.plotting import plot_coordination, write_plots
 
         written += [str(p) for p in write_plots(schedule, plot_dir, names=scenario.names)]
+        # the coordination diagram compares all three methods on this route
+        others = {
+            m.value: schedule if m is method else make_schedule(route, scenario.limits, method=m)
+            for m in Method
+        }
+        written.append(str(plot_coordination(others, Path(plot_dir) / "coordination.png")))
+    info = schedule.info
     return {
         "scenario": scenario.source,
         "method": method.value,
@@ -112,6 +120,16 @@ def run_schedule(
         "verified": report.passed,
         "worst_margins": report.summary(),
         "notes": list(schedule.notes),
+        "fallback_reason": schedule.fallback_reason,
+        "solver": None
+        if info is None
+        else {
+            "solve_time_s": info.solve_time,
+            "built": info.built,
+            "iterations": info.iterations,
+            "status": info.status,
+            "source": info.source,
+        },
         "route": route_summary(route),
         "files": written,
     }
@@ -136,6 +154,8 @@ def _print_schedule_summary(summary: dict) -> None:
     )
     for note in summary["notes"]:
         print(f"note: {note}")
+    if summary["fallback_reason"]:
+        print(f"warning: fell back to the exact schedule: {summary['fallback_reason']}")
     for path in summary["files"]:
         print(f"wrote {path}")
 
@@ -181,7 +201,7 @@ def build_parser() -> argparse.ArgumentParser:
 
     demo = commands.add_parser("demo", help="run the built-in swap scenario end to end")
     demo.add_argument("--output", default="trajgen-demo", help="folder for CSV and plots (trajgen-demo)")
-    demo.add_argument("--method", default="exact", help="exact or toppra (exact)")
+    demo.add_argument("--method", default="exact", help="exact, toppra or optimal (%(default)s)")
     demo.set_defaults(run=_command_demo)
 
     plan_parser = commands.add_parser("plan", help="print the planner's route for a scenario file")
@@ -191,9 +211,11 @@ def build_parser() -> argparse.ArgumentParser:
 
     schedule = commands.add_parser("schedule", help="schedule, verify and export a scenario")
     schedule.add_argument("scenario", help="scenario TOML file")
-    schedule.add_argument("--method", default="exact", help="exact or toppra (exact)")
+    schedule.add_argument("--method", default="exact", help="exact, toppra or optimal (%(default)s)")
     schedule.add_argument("--csv", metavar="DIR", help="write DIR/<vehicle name>.csv per vehicle")
-    schedule.add_argument("--plot", metavar="DIR", help="write DIR/speed.png and DIR/separation.png")
+    schedule.add_argument(
+        "--plot", metavar="DIR", help="write DIR/speed.png, DIR/separation.png, DIR/coordination.png"
+    )
     schedule.add_argument("--json", action="store_true", help="print a machine-readable summary")
     _add_csv_options(schedule)
     schedule.set_defaults(run=_command_schedule)

@@ -8,7 +8,6 @@ then renamed into place, so a failure leaves no partial file behind.
 
 from __future__ import annotations
 
-import enum
 import os
 import tempfile
 from collections.abc import Sequence
@@ -18,27 +17,18 @@ from pathlib import Path
 import numpy as np
 
 from topology.errors import InputError, OptionError
+from topology.options import Option
 from trajgen.schedule import Schedule, ScheduleState, check_period
 from trajgen.verify import VerificationReport, verified
 
 __all__ = ["HEADER_NAMES", "CsvOptions", "Units", "atomic_write_files", "profile_rows", "write_profiles"]
 
 
-class Units(enum.StrEnum):
+class Units(Option):
     """Length unit of a CSV export (time stays in seconds)."""
 
     METRES = "m"
     MILLIMETRES = "mm"
-
-    @classmethod
-    def lookup(cls, name: str) -> Units:
-        """The unit named ``name`` ('m' or 'mm'); raises OptionError otherwise."""
-        try:
-            return cls(str(name).lower())
-        except ValueError:
-            raise OptionError(
-                f"units {name!r} are unknown: expected one of {[u.value for u in cls]!r}"
-            ) from None
 
     @property
     def scale(self) -> float:

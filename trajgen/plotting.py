@@ -104,3 +104,84 @@ def write_plots(
         plot_speed(schedule, directory / "speed.png", names=names),
         plot_separation(schedule, directory / "separation.png"),
     )
+
+
+def travelled(schedule: Schedule, period: float = 0.01):
+    """Each vehicle's travelled distance over time and the track positions it passes.
+
+    Returns
+    -------
+    (t, distance, leg, s)
+        ``t`` shape (n,); ``distance``, ``leg``, ``s`` shape (2, n): odometer
+        (metres, never decreasing), leg index and distance from the junction.
+    """
+    state = schedule.sample(period)
+    same = state.leg[:, 1:] == state.leg[:, :-1]
+    step = np.where(same, np.abs(np.diff(state.s, axis=1)), state.s[:, 1:] + state.s[:, :-1])
+    distance = np.concatenate([np.zeros((2, 1)), np.cumsum(step, axis=1)], axis=1)
+    return state.t, distance, state.leg, state.s
+
+
+def _forbidden(schedule: Schedule, required: float, resolution: int = 240):
+    """Grid over both vehicles' travelled distances; True where their positions are too close."""
+    _, distance, leg, s = travelled(schedule)
+    axes = []
+    for vehicle in range(2):
+        total = distance[vehicle, -1]
+        grid = np.linspace(0.0, total, resolution) if total > 0 else np.zeros(1)
+        index = np.clip(np.searchsorted(distance[vehicle], grid), 0, distance.shape[1] - 1)
+        axes.append((grid, leg[vehicle, index], s[vehicle, index]))
+    (d1, leg1, s1), (d2, leg2, s2) = axes
+    same = (leg1[None, :] == leg2[:, None]) & (leg1[None, :] >= 0)
+    gap = np.where(same, np.abs(s1[None, :] - s2[:, None]), s1[None, :] + s2[:, None])
+    return d1, d2, gap < required
+
+
+def plot_coordination(schedules: dict[str, Schedule], path: str | Path) -> Path:
+    """The coordination diagram: both vehicles' travelled distances, forbidden region shaded.
+
+    Each panel holds the schedules that drive the same paths (the route's
+    paths for ``exact`` and ``toppra``; ``optimal`` parks shallower, so its
+    paths, and therefore its forbidden region, differ). A schedule's curve
+    must stay out of the shaded region of its panel.
+
+    Parameters
+    ----------
+    schedules : dict of name -> Schedule
+        Verified before plotting; at least one.
+    path : path
+        PNG file to write.
+    """
+    if not schedules:
+        raise ValueError("plot_coordination needs at least one schedule")
+    for schedule in schedules.values():
+        verified(schedule)
+    groups: dict[tuple, list[str]] = {}
+    for name, schedule in schedules.items():
+        _, distance, _, _ = travelled(schedule)
+        key = tuple(np.round(distance[:, -1], 6))  # same paths drive the same distances
+        groups.setdefault(key, []).append(name)
+    figure = _figure(figsize=(5.2 * len(groups), 5.0))
+    panels = figure.subplots(1, len(groups), squeeze=False)[0]
+    colours = {"exact": "tab:blue", "toppra": "tab:green", "optimal": "tab:red"}
+    for axis, names in zip(panels, groups.values(), strict=True):
+        reference = schedules[names[0]]
+        required = max(reference.limits.min_separation, reference.route.min_separation)
+        d1, d2, forbidden = _forbidden(reference, required)
+        if forbidden.any():
+            axis.contourf(d1, d2, forbidden.astype(float), levels=[0.5, 1.5], colors=["tab:gray"], alpha=0.35)
+        for name in names:
+            _, distance, _, _ = travelled(schedules[name])
+            axis.plot(
+                distance[0],
+                distance[1],
+                color=colours.get(name, "black"),
+                label=f"{name} ({schedules[name].duration:.1f} s)",
+            )
+        axis.set_xlabel("vehicle 1 travelled [m]")
+        axis.set_ylabel("vehicle 2 travelled [m]")
+        axis.set_title(f"paths of {', '.join(names)}\n(grey: closer than {required:g} m)", fontsize=10)
+        axis.legend(loc="lower right", fontsize=8)
+        axis.grid(True, alpha=0.3)
+    figure.tight_layout()
+    return _save(figure, Path(path))

@@ -15,7 +15,6 @@ from the axis value. Methods:
 
 from __future__ import annotations
 
-import enum
 import logging
 from dataclasses import dataclass, field
 
@@ -23,8 +22,9 @@ import numpy as np
 
 from limits import Limits
 from topology import Configuration, Route
-from topology.errors import InputError, OptionError
+from topology.errors import InputError
 from topology.graph import _finite_real
+from topology.options import Option
 from trajgen.profiles import PiecewiseCubic, scurve_phases, trapezoid_phases
 
 __all__ = [
@@ -45,21 +45,12 @@ logger = logging.getLogger(__name__)
 _AT_JUNCTION = -1
 
 
-class Method(enum.StrEnum):
+class Method(Option):
     """How a route is turned into a schedule."""
 
     EXACT = "exact"  #: the route exactly, one straight piece at a time, jerk-limited S-curves
     TOPPRA = "toppra"  #: rounded corners where safe, TOPPRA velocity/acceleration-limited timing
-
-    @classmethod
-    def lookup(cls, name: str) -> Method:
-        """The method named ``name`` (case-insensitive); raises OptionError otherwise."""
-        try:
-            return cls(str(name).lower())
-        except ValueError:
-            raise OptionError(
-                f"method {name!r} is unknown: expected one of {[m.value for m in cls]!r}"
-            ) from None
+    OPTIMAL = "optimal"  #: time-optimal jerk-limited schedule in the route's homotopy class (CasADi)
 
 
 def check_period(period: float) -> float:
@@ -189,9 +180,14 @@ class AxisMap:
         """Leg index and distance from the junction for axis values, shape (n,) each.
 
         A value outside every sub-range (round-off at the ends) takes the
-        nearest sub-range; ``s`` is clipped at 0 (the junction).
+        nearest sub-range; ``s`` is clipped at 0 (the junction). With a single
+        sub-range the vehicle stays on one leg, where the affine map holds for
+        every axis value (it may drive back and forth).
         """
         axis = np.asarray(axis, dtype=float)
+        if len(self.legs) == 1:
+            s = np.maximum(self.s_start[0] + self.outward[0] * (axis - self.axis_start[0]), 0.0)
+            return np.where(s > 0.0, self.legs[0], _AT_JUNCTION), s
         low = np.minimum(self.axis_start, self.axis_end)
         high = np.maximum(self.axis_start, self.axis_end)
         gap = np.maximum(low[:, None] - axis[None, :], 0.0) + np.maximum(axis[None, :] - high[:, None], 0.0)
@@ -293,6 +289,11 @@ class Schedule:
         Whether the method limits jerk (``toppra`` does not).
     notes : tuple of str
         What the method did that a user should know (e.g. corners rounded).
+    fallback_reason : str or None
+        Set when a method could not deliver and this is the ``exact``
+        schedule in its place; says why.
+    info : object or None
+        Method diagnostics (e.g. :class:`trajgen.optimal.OptimalInfo`).
     """
 
     route: Route
@@ -301,6 +302,8 @@ class Schedule:
     sections: tuple[Section, ...]
     jerk_limited: bool
     notes: tuple[str, ...] = ()
+    fallback_reason: str | None = None
+    info: object = field(default=None, compare=False)
     _starts: np.ndarray = field(init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
@@ -351,11 +354,13 @@ class Schedule:
         from topology import Position
 
         state = self.state(t)
-        names = self.route.graph.names
-        positions = [
-            Position(names[state.leg[v, 0]] if state.leg[v, 0] >= 0 else None, float(state.s[v, 0]))
-            for v in range(2)
-        ]
+        graph = self.route.graph
+        positions = []
+        for v in range(2):
+            leg, s = int(state.leg[v, 0]), float(state.s[v, 0])
+            if leg >= 0 and 0.0 < s - graph.lengths[leg] <= 1e-6:
+                s = graph.lengths[leg]  # round-off at a leg's end; larger overruns still raise
+            positions.append(Position(graph.names[leg] if leg >= 0 else None, s))
         return Configuration(*positions)
 
 
@@ -466,6 +471,10 @@ def make_schedule(route: Route, limits: Limits, *, method: Method | str = Method
     method = Method.lookup(method) if not isinstance(method, Method) else method
     if method is Method.EXACT:
         return exact_schedule(route, limits)
+    if method is Method.OPTIMAL:
+        from trajgen.optimal import optimal_schedule
+
+        return optimal_schedule(route, limits)
     from trajgen.toppra_timing import toppra_schedule
 
     return toppra_schedule(route, limits)

@@ -8,7 +8,8 @@ kinematics alone:
   separation;
 - ``|v|``, ``|a|`` (and ``|j|`` where the method limits it) stay within each
   vehicle's limits, to a relative tolerance;
-- the start and the goal are the route's, to 1e-9 m, at rest;
+- the start and the goal are the route's, to 1e-9 m, at rest (1e-6 m/s);
+- every position is on the track (at most 1e-6 m past a leg's end);
 - the positions move no faster than the sampled velocities allow (the track
   positions and the kinematics tell one story);
 - the sequence of regions visited (the homotopy class) is the route's.
@@ -38,6 +39,10 @@ logger = logging.getLogger(__name__)
 RELATIVE_TOLERANCE = 1e-6
 #: Absolute tolerance on start, goal and separation, metres.
 POSITION_TOLERANCE = 1e-9
+#: At rest at the start and goal: |v| in m/s (plus |a| in m/s² for jerk-limited methods) at most this.
+REST_TOLERANCE = 1e-6
+#: How far past the end of its leg a sampled position may be (solver round-off), metres.
+TRACK_END_TOLERANCE = 1e-6
 #: Coarsest sampling the verifier accepts, seconds.
 MAX_PERIOD = 1e-3
 
@@ -163,6 +168,17 @@ def verify(schedule: Schedule, *, period: float = MAX_PERIOD) -> VerificationRep
     if separation[worst] <= 0.0:
         failures.append(f"vehicles collide at t={state.t[worst]:.4f} s")
 
+    lengths = np.array(graph.lengths)
+    overrun = np.where(state.leg >= 0, state.s - lengths[np.maximum(state.leg, 0)], 0.0)
+    worst_overrun = float(overrun.max())
+    if worst_overrun > TRACK_END_TOLERANCE:
+        vehicle, k = np.unravel_index(int(np.argmax(overrun)), overrun.shape)
+        leg_name = graph.names[state.leg[vehicle, k]]
+        failures.append(
+            f"vehicle {vehicle + 1} is {worst_overrun:.3g} m past the end of leg {leg_name!r} "
+            f"at t={state.t[k]:.4f} s (tolerance {TRACK_END_TOLERANCE:g} m)"
+        )
+
     ratios = {}
     checks = [
         ("velocity", state.velocity, "max_velocity", "m/s"),
@@ -203,7 +219,7 @@ def verify(schedule: Schedule, *, period: float = MAX_PERIOD) -> VerificationRep
             residue = abs(state.velocity[vehicle, index])
             if schedule.jerk_limited:
                 residue += abs(state.acceleration[vehicle, index])
-            if residue > 1e-9:
+            if residue > REST_TOLERANCE:
                 failures.append(
                     f"vehicle {vehicle + 1} is not at rest at the {label} (|v| + |a| = {residue:.3g})"
                 )

@@ -1,0 +1,137 @@
+"""Makespans of exact, toppra and optimal schedules against the lower bound (issue 4 sets a-d).
+
+Run: ``python benchmarks/bench_optimal.py [--random N] [--skip-refinement]``.
+
+Sets (limits 1.0 m/s, 0.5 m/s², 1.0 m/s³, separation 1.5 m unless stated):
+(a) the three swaps on legs (10, 10, 10) m; (b) the three swaps on (12, 8, 15) m;
+(c) 50 seeded random start/goal pairs on (12, 8, 15) m; (d) set (c) with the
+second vehicle limited to 0.7 m/s, 0.35 m/s², 0.6 m/s³.
+
+Per scenario: makespans of exact, toppra, optimal and the lower bound (larger
+of the two vehicles' own jerk-limited rest-to-rest times over their shortest
+paths), optimal/exact, optimal/lower bound, the solve time (including the
+one-time NLP build for the first query of each region-sequence shape, marked
+``*``), whether it fell back, and the change of the optimal makespan when the
+number of nodes per phase is doubled.
+"""
+
+from __future__ import annotations
+
+import argparse
+import statistics
+import time
+
+from limits import Limits, VehicleLimits
+from topology import Configuration, YGraph, plan
+from trajgen.optimal import DEFAULT_NODES, lower_bound, optimal_schedule
+from trajgen.sampling import random_scenarios
+from trajgen.schedule import exact_schedule
+from trajgen.toppra_timing import toppra_schedule
+from trajgen.verify import verify
+
+AGV = VehicleLimits(1.0, 0.5, 1.0)
+SLOW = VehicleLimits(0.7, 0.35, 0.6)
+SAME = Limits(vehicles=(AGV, AGV), min_separation=1.5)
+MIXED = Limits(vehicles=(AGV, SLOW), min_separation=1.5)
+
+
+def swaps(track: YGraph):
+    out = []
+    for i, j in ((0, 1), (1, 2), (2, 0)):
+        start = Configuration(track.endpoint(track.names[i]), track.endpoint(track.names[j]))
+        out.append((f"swap {track.names[i]}{track.names[j]}", start, start.swapped()))
+    return out
+
+
+def scenario_sets(random_count: int):
+    equal = YGraph({"A": 10.0, "B": 10.0, "C": 10.0})
+    unequal = YGraph({"A": 12.0, "B": 8.0, "C": 15.0})
+    randoms = [
+        (f"random {k}", s.start, s.goal)
+        for k, s in enumerate(random_scenarios(random_count, seed=2026, track=unequal, limits=SAME))
+    ]
+    return [
+        ("a", equal, SAME, swaps(equal)),
+        ("b", unequal, SAME, swaps(unequal)),
+        ("c", unequal, SAME, randoms),
+        ("d", unequal, MIXED, randoms),
+    ]
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--random", type=int, default=50, help="random pairs in sets c and d (50)")
+    parser.add_argument("--skip-refinement", action="store_true", help="do not re-solve with doubled nodes")
+    args = parser.parse_args()
+    rows = []
+    header = (
+        f"{'set':>3} {'scenario':>11} {'exact':>7} {'toppra':>7} {'optimal':>8} {'lower':>7} "
+        f"{'opt/ex':>6} {'opt/lb':>6} {'solve ms':>9} {'fallback':>8} {'2N change':>9}"
+    )
+    print(header)
+    for label, track, limits, scenarios in scenario_sets(args.random):
+        for name, start, goal in scenarios:
+            route = plan(track, start, goal, min_separation=limits.min_separation)
+            exact = exact_schedule(route, limits)
+            timed = toppra_schedule(route, limits)
+            best = optimal_schedule(route, limits)
+            bound = lower_bound(route, limits)
+            info = best.info
+            change = float("nan")
+            if not args.skip_refinement and best.fallback_reason is None:
+                fine = optimal_schedule(route, limits, nodes=2 * DEFAULT_NODES)
+                if fine.fallback_reason is None:
+                    change = abs(fine.duration - best.duration) / best.duration
+            passed = all(verify(s).passed for s in (exact, timed, best))
+            rows.append(
+                (
+                    label,
+                    name,
+                    exact.duration,
+                    timed.duration,
+                    best.duration,
+                    bound,
+                    info.solve_time,
+                    info.built,
+                    best.fallback_reason,
+                    change,
+                    passed,
+                )
+            )
+            print(
+                f"{label:>3} {name:>11} {exact.duration:7.2f} {timed.duration:7.2f} {best.duration:8.3f} "
+                f"{bound:7.2f} {best.duration / exact.duration:6.3f} {best.duration / bound:6.3f} "
+                f"{1e3 * info.solve_time:8.0f}{'*' if info.built else ' '} "
+                f"{'yes' if best.fallback_reason else 'no':>8} {100 * change:8.3f}%",
+                flush=True,
+            )
+    swaps_rows = [r for r in rows if r[0] in "ab"]
+    solve = [r[6] for r in rows]
+    solve_cached = [r[6] for r in rows if not r[7]]
+    changes = [r[9] for r in rows if r[9] == r[9]]
+    print()
+    print(f"scenarios: {len(rows)}; all schedules verified: {all(r[10] for r in rows)}")
+    print(f"swaps: optimal/exact max {max(r[4] / r[2] for r in swaps_rows):.3f} (target <= 0.5)")
+    ordered = sum(r[5] <= r[4] * (1 + 1e-9) and r[4] <= r[2] * (1 + 1e-9) for r in rows)
+    print(f"lower bound <= optimal <= exact: {ordered} of {len(rows)}")
+    print(f"fallbacks: {sum(r[8] is not None for r in rows)} (target 0)")
+    print(
+        f"solve time: median {1e3 * statistics.median(solve):.0f} ms, worst {1e3 * max(solve):.0f} ms "
+        f"(targets 150 ms, 1000 ms); without the one-time builds: median "
+        f"{1e3 * statistics.median(solve_cached):.0f} ms, worst {1e3 * max(solve_cached):.0f} ms "
+        f"({len(solve) - len(solve_cached)} builds)"
+    )
+    if changes:
+        print(
+            f"doubling nodes ({DEFAULT_NODES} -> {2 * DEFAULT_NODES}): makespan change max "
+            f"{100 * max(changes):.3f} %, median {100 * statistics.median(changes):.3f} % "
+            f"over {len(changes)} scenarios (target < 0.5 %)"
+        )
+    for reason in {r[8] for r in rows if r[8]}:
+        print(f"fallback reason: {reason}")
+
+
+if __name__ == "__main__":
+    started = time.perf_counter()
+    main()
+    print(f"benchmark wall time {time.perf_counter() - started:.0f} s")

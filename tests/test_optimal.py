@@ -1,0 +1,145 @@
+"""The optimal method: closed-form cases, ordering against exact and the lower bound,
+homotopy class, verification, NLP reuse and the forced fallback."""
+
+from __future__ import annotations
+
+import logging
+
+import pytest
+
+from limits import Limits, VehicleLimits
+from tests.helpers import LIMITS, MIXED, conf, route_of
+from topology import YGraph, plan, region_sequence
+from topology.errors import InputError
+from trajgen.optimal import lower_bound, optimal_schedule
+from trajgen.profiles import rest_to_rest_time
+from trajgen.sampling import random_scenarios
+from trajgen.schedule import Method, exact_schedule, make_schedule
+from trajgen.verify import verify
+
+EQUAL = (10.0, 10.0, 10.0)
+UNEQUAL = (12.0, 8.0, 15.0)
+SWAPS = [
+    pytest.param(legs, (f"{a}:{legs['ABC'.index(a)]}", f"{b}:{legs['ABC'.index(b)]}"), id=f"{a}{b}-{label}")
+    for label, legs in (("equal", EQUAL), ("unequal", UNEQUAL))
+    for a, b in (("A", "B"), ("B", "C"), ("C", "A"))
+]
+TRACK = YGraph(dict(zip("ABC", UNEQUAL, strict=True)))
+RANDOM = random_scenarios(6, seed=404, track=TRACK, limits=MIXED)
+
+
+@pytest.mark.parametrize(("legs", "start"), SWAPS)
+def test_swaps_are_at_most_half_of_exact_and_stay_in_the_class(legs, start):
+    route = route_of(legs, start, start[::-1])
+    schedule = optimal_schedule(route, LIMITS)
+    assert schedule.fallback_reason is None, schedule.fallback_reason
+    assert schedule.method is Method.OPTIMAL
+    report = verify(schedule)
+    assert report.passed, report.failures
+    assert report.regions_match
+    exact = exact_schedule(route, LIMITS)
+    assert schedule.duration <= 0.5 * exact.duration
+    assert lower_bound(route, LIMITS) <= schedule.duration
+    # the sampled region sequence is the route's homotopy class
+    times = [k * schedule.duration / 2000 for k in range(2001)]
+    assert region_sequence(route.graph, [schedule.configuration_at(t) for t in times]) == route.regions
+
+
+def test_equal_legs_swaps_have_equal_makespans():
+    # the three swaps on an equilateral Y are rotations of one another
+    durations = [
+        optimal_schedule(route_of(EQUAL, s, s[::-1]), LIMITS).duration
+        for s in (("A:10", "B:10"), ("B:10", "C:10"), ("C:10", "A:10"))
+    ]
+    assert max(durations) - min(durations) < 1e-6 * durations[0]
+
+
+def test_vehicles_that_never_interact_take_the_slower_vehicles_own_time():
+    # vehicle 1 drives out of the junction into C while vehicle 2 backs up a little on A:
+    # they never come near each other, so the makespan is vehicle 1's own S-curve time
+    route = plan(TRACK, conf("O", "A:7.5"), conf("C:15", "A:5"), min_separation=1.5)
+    schedule = optimal_schedule(route, LIMITS)
+    own = max(rest_to_rest_time(15.0, 1.0, 0.5, 1.0), rest_to_rest_time(2.5, 1.0, 0.5, 1.0))
+    assert own == pytest.approx(17.5)
+    assert lower_bound(route, LIMITS) == pytest.approx(own)
+    assert own <= schedule.duration <= own * (1 + 5e-3)
+    assert verify(schedule).passed
+
+
+def test_slower_vehicle_sets_the_time_when_it_moves_alone():
+    slow = VehicleLimits(0.7, 0.35, 0.6)
+    limits = Limits(vehicles=(slow, VehicleLimits(1.0, 0.5, 1.0)), min_separation=1.5)
+    route = plan(TRACK, conf("A:2", "O"), conf("A:11", "O"), min_separation=1.5)
+    schedule = optimal_schedule(route, limits)
+    own = rest_to_rest_time(9.0, 0.7, 0.35, 0.6)
+    assert own <= schedule.duration <= own * (1 + 5e-3)
+
+
+@pytest.mark.parametrize("scenario", RANDOM, ids=[s.source for s in RANDOM])
+def test_lower_bound_optimal_exact_order_and_verification(scenario):
+    route = plan(scenario.track, scenario.start, scenario.goal, min_separation=scenario.limits.min_separation)
+    schedule = optimal_schedule(route, scenario.limits)
+    exact = exact_schedule(route, scenario.limits)
+    report = verify(schedule)
+    assert report.passed, report.failures
+    assert lower_bound(route, scenario.limits) <= schedule.duration * (1 + 1e-9)
+    assert schedule.duration <= exact.duration * (1 + 1e-9)
+    assert schedule.route.regions == route.regions
+
+
+def test_nlp_is_built_once_per_shape_and_reused():
+    first = optimal_schedule(route_of(EQUAL, ("A:10", "B:10"), ("B:10", "A:10")), LIMITS)
+    second = optimal_schedule(route_of(EQUAL, ("B:10", "C:10"), ("C:10", "B:10")), LIMITS)
+    assert second.info.built is False  # same region-sequence shape, new parameters
+    assert second.duration == pytest.approx(first.duration, rel=1e-6)
+
+
+def test_forced_solver_failure_falls_back_to_exact_and_logs(caplog):
+    route = route_of(UNEQUAL, ("A:12", "B:8"), ("B:8", "A:12"))
+    with caplog.at_level(logging.WARNING, logger="trajgen.optimal"):
+        schedule = optimal_schedule(route, LIMITS, max_iterations=1)
+    exact = exact_schedule(route, LIMITS)
+    assert schedule.fallback_reason is not None
+    assert "did not converge" in schedule.fallback_reason
+    assert schedule.method is Method.EXACT
+    assert schedule.duration == exact.duration
+    assert verify(schedule).passed
+    assert any("fell back to exact" in record.message for record in caplog.records)
+
+
+def test_make_schedule_dispatches_optimal():
+    route = route_of(UNEQUAL, ("A:3", "B:2"), ("C:4", "C:9"))
+    schedule = make_schedule(route, LIMITS, method="optimal")
+    assert schedule.method is Method.OPTIMAL
+    assert schedule.duration < exact_schedule(route, LIMITS).duration
+
+
+@pytest.mark.parametrize(
+    ("options", "match"),
+    [
+        pytest.param({"nodes": 0}, "nodes per segment must be an integer >= 1, got 0", id="nodes"),
+        pytest.param({"segments": 0}, "segments per phase must be an integer >= 1, got 0", id="segments"),
+        pytest.param({"max_iterations": 0}, "max_iterations must be an integer >= 1, got 0", id="iterations"),
+    ],
+)
+def test_bad_options(options, match):
+    with pytest.raises(InputError, match=match):
+        optimal_schedule(route_of(EQUAL, ("A:10", "B:10"), ("B:10", "A:10")), LIMITS, **options)
+
+
+def test_coordination_plot_is_written_for_all_three_methods(tmp_path):
+    from trajgen.plotting import plot_coordination, travelled
+
+    route = route_of(EQUAL, ("A:10", "B:10"), ("B:10", "A:10"))
+    schedules = {
+        "exact": exact_schedule(route, LIMITS),
+        "optimal": optimal_schedule(route, LIMITS),
+    }
+    path = plot_coordination(schedules, tmp_path / "coordination.png")
+    assert path.read_bytes().startswith(b"\x89PNG")
+    # travelled distances never decrease, and the optimal one parks shallower (drives less)
+    _, exact_distance, _, _ = travelled(schedules["exact"])
+    _, optimal_distance, _, _ = travelled(schedules["optimal"])
+    assert (exact_distance[:, 1:] >= exact_distance[:, :-1]).all()
+    assert exact_distance[1, -1] == pytest.approx(40.0, abs=1e-6)
+    assert optimal_distance[1, -1] < exact_distance[1, -1]
