@@ -24,7 +24,15 @@ from topology.errors import OptionError, SeparationError
 from topology.graph import Configuration, YGraph, _finite_real
 from topology.options import Option
 
-__all__ = ["Instruction", "Region", "Route", "plan", "reduce_regions", "region_sequence"]
+__all__ = [
+    "Instruction",
+    "Region",
+    "Route",
+    "plan",
+    "reduce_regions",
+    "reduce_regions_indexed",
+    "region_sequence",
+]
 
 _Tuple = tuple[int, float, int, float]
 
@@ -97,14 +105,24 @@ def reduce_regions(sequence) -> tuple:
     sequence : iterable of hashable
         Regions in visiting order; ``None`` entries (on a ray) are skipped.
     """
+    return tuple(region for region, _ in reduce_regions_indexed(sequence))
+
+
+def reduce_regions_indexed(sequence) -> tuple:
+    """Like :func:`reduce_regions`, with the index at which each kept region was entered.
+
+    Returns
+    -------
+    tuple of (region, int)
+    """
     stack: list = []
-    for region in sequence:
-        if region is None or (stack and stack[-1] == region):
+    for index, region in enumerate(sequence):
+        if region is None or (stack and stack[-1][0] == region):
             continue
-        if len(stack) >= 2 and stack[-2] == region:
+        if len(stack) >= 2 and stack[-2][0] == region:
             stack.pop()
             continue
-        stack.append(region)
+        stack.append((region, index))
     return tuple(stack)
 
 
@@ -184,10 +202,8 @@ class Route:
     @property
     def travel(self) -> tuple[float, float]:
         """Distance driven by vehicle 1 and by vehicle 2, metres."""
-        t = self._tuples
-        first = sum(_leg_travel(a[0], a[1], b[0], b[1]) for a, b in itertools.pairwise(t))
-        second = sum(_leg_travel(a[2], a[3], b[2], b[3]) for a, b in itertools.pairwise(t))
-        return (first, second)
+        segments = self.segment_travel
+        return (sum(first for first, _ in segments), sum(second for _, second in segments))
 
     @property
     def segment_travel(self) -> tuple[tuple[float, float], ...]:

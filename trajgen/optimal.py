@@ -41,7 +41,9 @@ import numpy as np
 
 from limits import Limits
 from topology import Route
+from topology.arrays import region_keys
 from topology.errors import InputError, SolverError
+from topology.route import reduce_regions_indexed
 from trajgen.profiles import PiecewiseCubic, rest_to_rest_time
 from trajgen.schedule import (
     AxisMap,
@@ -372,24 +374,11 @@ def _gap(phase: _Phase, s1, s2):
 def _phase_windows(schedule: Schedule, phases: list[_Phase]) -> list[tuple[float, float]]:
     """Time windows of the exact schedule that the reduced region sequence attributes to each phase."""
     state = schedule.sample(min(0.01, schedule.duration / 200 or 0.01))
-    keys = []
-    for a, b, x, y in zip(state.leg[0], state.leg[1], state.s[0], state.s[1], strict=True):
-        if a < 0 or b < 0:
-            keys.append(None)
-        else:
-            keys.append((int(a), int(b), 0 if a != b else (1 if x < y else 2)))
-    stack: list[tuple[tuple, float]] = []
-    for key, t in zip(keys, state.t, strict=True):
-        if key is None or (stack and stack[-1][0] == key):
-            continue
-        if len(stack) >= 2 and stack[-2][0] == key:
-            stack.pop()
-            continue
-        stack.append((key, float(t)))
-    if len(stack) != len(phases):  # the ray-only route, or a sampling corner case: share time evenly
+    entered = reduce_regions_indexed(region_keys(state.leg[0], state.s[0], state.leg[1], state.s[1]))
+    if len(entered) != len(phases):  # the ray-only route, or a sampling corner case: share time evenly
         edges = np.linspace(0.0, schedule.duration, len(phases) + 1)
     else:
-        edges = np.array([0.0] + [t for _, t in stack[1:]] + [schedule.duration])
+        edges = np.array([0.0] + [float(state.t[index]) for _, index in entered[1:]] + [schedule.duration])
         # a phase starts when its region is entered; keep the windows positive
         edges = np.maximum.accumulate(edges)
     return [(float(edges[p]), float(max(edges[p + 1], edges[p] + _MIN_PHASE))) for p in range(len(phases))]

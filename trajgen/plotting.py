@@ -10,6 +10,7 @@ from pathlib import Path
 
 import numpy as np
 
+from topology.arrays import track_distance
 from trajgen.export import atomic_write_files
 from trajgen.schedule import Schedule
 from trajgen.verify import verified
@@ -77,8 +78,7 @@ def plot_separation(schedule: Schedule, path: str | Path) -> Path:
     """Track distance between the vehicles over time with the minimum line, as a PNG."""
     verified(schedule)
     state = schedule.sample(_PLOT_PERIOD)
-    same = (state.leg[0] == state.leg[1]) & (state.leg[0] >= 0)
-    distance = np.where(same, np.abs(state.s[0] - state.s[1]), state.s[0] + state.s[1])
+    distance = track_distance(state.leg[0], state.s[0], state.leg[1], state.s[1])
     required = max(schedule.limits.min_separation, schedule.route.min_separation)
     figure = _figure(figsize=(9, 4))
     axis = figure.subplots()
@@ -116,8 +116,7 @@ def travelled(schedule: Schedule, period: float = 0.01):
         (metres, never decreasing), leg index and distance from the junction.
     """
     state = schedule.sample(period)
-    same = state.leg[:, 1:] == state.leg[:, :-1]
-    step = np.where(same, np.abs(np.diff(state.s, axis=1)), state.s[:, 1:] + state.s[:, :-1])
+    step = track_distance(state.leg[:, :-1], state.s[:, :-1], state.leg[:, 1:], state.s[:, 1:])
     distance = np.concatenate([np.zeros((2, 1)), np.cumsum(step, axis=1)], axis=1)
     return state.t, distance, state.leg, state.s
 
@@ -132,8 +131,7 @@ def _forbidden(schedule: Schedule, required: float, resolution: int = 240):
         index = np.clip(np.searchsorted(distance[vehicle], grid), 0, distance.shape[1] - 1)
         axes.append((grid, leg[vehicle, index], s[vehicle, index]))
     (d1, leg1, s1), (d2, leg2, s2) = axes
-    same = (leg1[None, :] == leg2[:, None]) & (leg1[None, :] >= 0)
-    gap = np.where(same, np.abs(s1[None, :] - s2[:, None]), s1[None, :] + s2[:, None])
+    gap = track_distance(leg1[None, :], s1[None, :], leg2[:, None], s2[:, None])
     return d1, d2, gap < required
 
 

@@ -28,6 +28,7 @@ import numpy as np
 
 from limits import Limits
 from topology import Route
+from topology.arrays import region_keys, track_distance
 from topology.errors import SolverError
 from topology.route import reduce_regions
 from trajgen.schedule import (
@@ -225,17 +226,8 @@ def _locate_both(maps: tuple[AxisMap, AxisMap], points: np.ndarray):
     return leg1, s1, leg2, s2
 
 
-def _separation(leg1, s1, leg2, s2) -> np.ndarray:
-    same = (leg1 == leg2) & (leg1 >= 0)
-    return np.where(same, np.abs(s1 - s2), s1 + s2)
-
-
 def _regions(leg1, s1, leg2, s2) -> tuple:
-    keys = [
-        None if a < 0 or b < 0 else ((a, b, 0) if a != b else (a, b, 1 if x < y else 2))
-        for a, b, x, y in zip(leg1.tolist(), leg2.tolist(), s1.tolist(), s2.tolist(), strict=True)
-    ]
-    return reduce_regions(keys)
+    return reduce_regions(region_keys(leg1, s1, leg2, s2))
 
 
 def _safe_blend(
@@ -258,7 +250,7 @@ def _safe_blend(
         spacing = float(np.max(np.linalg.norm(np.diff(curve, axis=0), axis=1)))
         located = _locate_both(maps, curve)
         # between samples the separation changes by at most |da1| + |da2| <= sqrt(2) * spacing
-        if np.min(_separation(*located)) < required + 1.5 * spacing:
+        if np.min(track_distance(*located)) < required + 1.5 * spacing:
             continue
         polyline = np.concatenate(
             [blend.before + np.outer(w, p - blend.before), p + np.outer(w, blend.after - p)]

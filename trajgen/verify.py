@@ -27,9 +27,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from topology.arrays import region_keys, track_distance
 from topology.errors import VerificationError
 from topology.route import reduce_regions
-from trajgen.schedule import Schedule, ScheduleState
+from trajgen.schedule import Schedule
 
 __all__ = ["POSITION_TOLERANCE", "RELATIVE_TOLERANCE", "VerificationReport", "verified", "verify"]
 
@@ -109,32 +110,12 @@ class VerificationReport:
         }
 
 
-def _track_distance(leg_a, s_a, leg_b, s_b) -> np.ndarray:
-    """Vectorized track distance: same leg |s_a - s_b|, otherwise s_a + s_b."""
-    same = (leg_a == leg_b) & (leg_a >= 0)
-    return np.where(same, np.abs(s_a - s_b), s_a + s_b)
-
-
 def _sample_times(schedule: Schedule, period: float) -> np.ndarray:
     duration = schedule.duration
     count = max(int(np.ceil(duration / period)), 1)
     grid = np.linspace(0.0, duration, count + 1)
     boundaries = np.array([section.start_time for section in schedule.sections] + [duration])
     return np.unique(np.concatenate([grid, boundaries]))
-
-
-def _region_keys(state: ScheduleState) -> list:
-    leg1, leg2 = state.leg
-    s1, s2 = state.s
-    keys: list = []
-    for a, b, x, y in zip(leg1.tolist(), leg2.tolist(), s1.tolist(), s2.tolist(), strict=True):
-        if a < 0 or b < 0:
-            keys.append(None)
-        elif a != b:
-            keys.append((a, b, 0))
-        else:
-            keys.append((a, b, 1 if x < y else 2))
-    return keys
 
 
 def verify(schedule: Schedule, *, period: float = MAX_PERIOD) -> VerificationReport:
@@ -158,7 +139,7 @@ def verify(schedule: Schedule, *, period: float = MAX_PERIOD) -> VerificationRep
     state = schedule.state(_sample_times(schedule, period))
     failures: list[str] = []
 
-    separation = _track_distance(state.leg[0], state.s[0], state.leg[1], state.s[1])
+    separation = track_distance(state.leg[0], state.s[0], state.leg[1], state.s[1])
     worst = int(np.argmin(separation))
     if separation[worst] < required - POSITION_TOLERANCE:
         failures.append(
@@ -208,7 +189,7 @@ def verify(schedule: Schedule, *, period: float = MAX_PERIOD) -> VerificationRep
         for vehicle, position in enumerate(expected):
             leg = -1 if position.leg is None else graph.index(position.leg)
             error += float(
-                _track_distance(
+                track_distance(
                     np.array([state.leg[vehicle, index]]),
                     np.array([state.s[vehicle, index]]),
                     np.array([leg]),
@@ -230,7 +211,7 @@ def verify(schedule: Schedule, *, period: float = MAX_PERIOD) -> VerificationRep
     # positions must move no faster than the velocities say (consistency of the two)
     dt = np.diff(state.t)
     for vehicle in range(2):
-        moved = _track_distance(
+        moved = track_distance(
             state.leg[vehicle, :-1], state.s[vehicle, :-1], state.leg[vehicle, 1:], state.s[vehicle, 1:]
         )
         bound = limits.vehicles[vehicle].max_velocity * dt * (1.0 + RELATIVE_TOLERANCE) + POSITION_TOLERANCE
@@ -245,7 +226,7 @@ def verify(schedule: Schedule, *, period: float = MAX_PERIOD) -> VerificationRep
     expected_regions = tuple(
         (graph.index(r.first_leg), graph.index(r.second_leg), r.nearer or 0) for r in route.regions
     )
-    sampled_regions = reduce_regions(_region_keys(state))
+    sampled_regions = reduce_regions(region_keys(state.leg[0], state.s[0], state.leg[1], state.s[1]))
     regions_match = sampled_regions == expected_regions
     if not regions_match:
         names = graph.names
