@@ -1,6 +1,6 @@
 """Makespans of exact, toppra and optimal schedules against the lower bound (issue 4 sets a-d).
 
-Run: ``python benchmarks/bench_optimal.py [--random N] [--skip-refinement]``.
+Run: ``python benchmarks/bench_optimal.py [--random N] [--nodes N] [--skip-refinement]``.
 
 Sets (limits 1.0 m/s, 0.5 m/s², 1.0 m/s³, separation 1.5 m unless stated):
 (a) the three swaps on legs (10, 10, 10) m; (b) the three swaps on (12, 8, 15) m;
@@ -61,6 +61,7 @@ def scenario_sets(random_count: int):
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--random", type=int, default=50, help="random pairs in sets c and d (50)")
+    parser.add_argument("--nodes", type=int, default=DEFAULT_NODES, help=f"nodes per phase ({DEFAULT_NODES})")
     parser.add_argument("--skip-refinement", action="store_true", help="do not re-solve with doubled nodes")
     args = parser.parse_args()
     rows = []
@@ -74,12 +75,12 @@ def main() -> None:
             route = plan(track, start, goal, min_separation=limits.min_separation)
             exact = exact_schedule(route, limits)
             timed = toppra_schedule(route, limits)
-            best = optimal_schedule(route, limits)
+            best = optimal_schedule(route, limits, nodes=args.nodes)
             bound = lower_bound(route, limits)
             info = best.info
             change = float("nan")
             if not args.skip_refinement and best.fallback_reason is None:
-                fine = optimal_schedule(route, limits, nodes=2 * DEFAULT_NODES)
+                fine = optimal_schedule(route, limits, nodes=2 * args.nodes)
                 if fine.fallback_reason is None:
                     change = abs(fine.duration - best.duration) / best.duration
             passed = all(verify(s).passed for s in (exact, timed, best))
@@ -96,6 +97,8 @@ def main() -> None:
                     best.fallback_reason,
                     change,
                     passed,
+                    info.status,
+                    info.source,
                 )
             )
             print(
@@ -123,10 +126,16 @@ def main() -> None:
     )
     if changes:
         print(
-            f"doubling nodes ({DEFAULT_NODES} -> {2 * DEFAULT_NODES}): makespan change max "
+            f"doubling nodes ({args.nodes} -> {2 * args.nodes}): makespan change max "
             f"{100 * max(changes):.3f} %, median {100 * statistics.median(changes):.3f} % "
             f"over {len(changes)} scenarios (target < 0.5 %)"
         )
+    solved_by: dict[str, int] = {}
+    for row in rows:
+        solver = next((a.split(" solved")[0] for a in row[11].split("; ") if " solved in " in a), "none")
+        key = solver if row[12] == "nlp" else f"{solver}, exact faster"
+        solved_by[key] = solved_by.get(key, 0) + 1
+    print("solved by: " + ", ".join(f"{name} {count}" for name, count in sorted(solved_by.items())))
     for reason in {r[8] for r in rows if r[8]}:
         print(f"fallback reason: {reason}")
 

@@ -63,6 +63,39 @@ def test_exact_and_toppra_pass_the_verifier_and_toppra_is_never_slower(scenario)
     assert "jerk is not limited" in " ".join(timed.notes)
 
 
+# Found by the 600-scenario stress run of benchmarks/bench_optimal.py (--random 300): a
+# velocity peak inside a long grid interval of a blend, 4e-6 m/s above the limit, fell between
+# the samples the time stretch used to look at; the stretch now uses the closed-form peak.
+STRESS = random_scenarios(300, seed=2026, track=TRACK, limits=MIXED)
+
+
+@pytest.mark.parametrize("index", [90, 241], ids=["stress-90", "stress-241"])
+def test_toppra_velocity_peaks_between_grid_points_are_within_limits(index):
+    scenario = STRESS[index]
+    timed = toppra_schedule(_plan(scenario), scenario.limits)
+    report = verify(timed)
+    assert report.passed, report.failures
+
+
+@pytest.mark.parametrize("index", [90, 241, 0, 1, 2], ids=lambda i: f"stress-{i}")
+def test_closed_form_velocity_peaks_agree_with_dense_sampling(index):
+    from trajgen.toppra_timing import ToppraKinematics, _interior_velocity_peaks
+
+    scenario = STRESS[index]
+    timed = toppra_schedule(_plan(scenario), scenario.limits)
+    sections = [s.kinematics for s in timed.sections if isinstance(s.kinematics, ToppraKinematics)]
+    assert sections
+    for kinematics in sections:
+        # 400 samples inside every grid interval: close to the true maximum, never above it
+        fine = np.linspace(0.0, 1.0, 402)[1:-1]
+        times = (kinematics.times[:-1, None] + np.diff(kinematics.times)[:, None] * fine).ravel()
+        sampled = np.max(np.abs(kinematics.evaluate(times)[:, 1]), axis=1)
+        ends = np.max(np.abs(kinematics.evaluate(kinematics.times[:-1])[:, 1]), axis=1)
+        peaks = _interior_velocity_peaks(kinematics)
+        assert np.all(np.maximum(peaks, ends) >= sampled - 1e-12)
+        assert np.all(peaks <= np.maximum(sampled, ends) + 1e-6)
+
+
 def test_toppra_on_the_swap_rounds_corners_and_beats_exact():
     route = route_of(*SWAP)
     timed = toppra_schedule(route, LIMITS)

@@ -201,7 +201,7 @@ def build_parser() -> argparse.ArgumentParser:
 
     demo = commands.add_parser("demo", help="run the built-in swap scenario end to end")
     demo.add_argument("--output", default="trajgen-demo", help="folder for CSV and plots (trajgen-demo)")
-    demo.add_argument("--method", default="exact", help="exact, toppra or optimal (%(default)s)")
+    demo.add_argument("--method", default="optimal", help="exact, toppra or optimal (%(default)s)")
     demo.set_defaults(run=_command_demo)
 
     plan_parser = commands.add_parser("plan", help="print the planner's route for a scenario file")
@@ -211,7 +211,7 @@ def build_parser() -> argparse.ArgumentParser:
 
     schedule = commands.add_parser("schedule", help="schedule, verify and export a scenario")
     schedule.add_argument("scenario", help="scenario TOML file")
-    schedule.add_argument("--method", default="exact", help="exact, toppra or optimal (%(default)s)")
+    schedule.add_argument("--method", default="optimal", help="exact, toppra or optimal (%(default)s)")
     schedule.add_argument("--csv", metavar="DIR", help="write DIR/<vehicle name>.csv per vehicle")
     schedule.add_argument(
         "--plot", metavar="DIR", help="write DIR/speed.png, DIR/separation.png, DIR/coordination.png"

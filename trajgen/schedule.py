@@ -466,8 +466,12 @@ def _parked_maps(route: Route) -> tuple[AxisMap, AxisMap]:
     )  # type: ignore[return-value]
 
 
-def make_schedule(route: Route, limits: Limits, *, method: Method | str = Method.EXACT) -> Schedule:
-    """Time-parameterize a route with the chosen method (unverified; see :func:`trajgen.verify.verify`)."""
+def make_schedule(route: Route, limits: Limits, *, method: Method | str = Method.OPTIMAL) -> Schedule:
+    """Time-parameterize a route with the chosen method (unverified; see :func:`trajgen.verify.verify`).
+
+    The default, ``optimal``, is the fastest jerk-limited schedule in the route's
+    homotopy class (or the ``exact`` schedule, flagged, if its solvers fail).
+    """
     method = Method.lookup(method) if not isinstance(method, Method) else method
     if method is Method.EXACT:
         return exact_schedule(route, limits)

@@ -1,0 +1,30 @@
+"""The README's Python example runs verbatim and says what it computes."""
+
+from __future__ import annotations
+
+import pytest
+
+from tests.conftest import REPO
+
+
+def _python_block() -> str:
+    text = (REPO / "README.md").read_text(encoding="utf-8")
+    begin = text.index("```python\n") + len("```python\n")
+    return text[begin : text.index("```", begin)]
+
+
+def test_readme_python_example_runs_and_its_comments_hold(tmp_path, monkeypatch):
+    from topology import Instruction
+    from trajgen.schedule import exact_schedule
+
+    monkeypatch.chdir(tmp_path)
+    namespace: dict = {}
+    exec(compile(_python_block(), "README.md", "exec"), namespace)  # our own README, verbatim
+    route, schedule, limits = namespace["route"], namespace["schedule"], namespace["limits"]
+    assert route.instruction is Instruction.COUNTERCLOCKWISE
+    assert [str(r) for r in route.regions] == ["Q(A,B)", "Q(A,C)", "Q(B,C)", "Q(B,A)"]
+    assert schedule.duration == pytest.approx(25.5, abs=0.05)
+    assert exact_schedule(route, limits).duration == pytest.approx(73.5)
+    assert schedule.fallback_reason is None
+    assert (tmp_path / "out" / "agv1.csv").is_file()
+    assert (tmp_path / "out" / "agv2.csv").is_file()
