@@ -97,7 +97,7 @@ def main() -> None:
                     best.fallback_reason,
                     change,
                     passed,
-                    info.status,
+                    info.solver or "none",
                     info.source,
                 )
             )
@@ -132,8 +132,7 @@ def main() -> None:
         )
     solved_by: dict[str, int] = {}
     for row in rows:
-        solver = next((a.split(" solved")[0] for a in row[11].split("; ") if " solved in " in a), "none")
-        key = solver if row[12] == "nlp" else f"{solver}, exact faster"
+        key = row[11] if row[12] == "nlp" else f"{row[11]}, exact faster"
         solved_by[key] = solved_by.get(key, 0) + 1
     print("solved by: " + ", ".join(f"{name} {count}" for name, count in sorted(solved_by.items())))
     for reason in {r[8] for r in rows if r[8]}:

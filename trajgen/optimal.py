@@ -113,6 +113,9 @@ class OptimalInfo:
         Iterations of the solver that succeeded (-1 if none did).
     status : str
         What each solver tried (fatrop first, then Ipopt) reported.
+    solver : str
+        The solver that succeeded: ``"fatrop"``, ``"ipopt-polish"`` (Ipopt
+        warm-started from fatrop's last iterate), ``"ipopt"``; ``""`` if none did.
     source : str
         ``"nlp"`` when the schedule is the solver's; ``"exact"`` when the exact
         schedule was faster than the discretized optimum and was returned.
@@ -122,6 +125,7 @@ class OptimalInfo:
     built: bool
     iterations: int
     status: str
+    solver: str = ""
     source: str = "nlp"
 
 
@@ -285,8 +289,9 @@ def _build(phases: list[_Phase], nodes: int, segments: int, max_iterations: int)
     """Build the parametric NLP of a region-sequence shape, stage by stage.
 
     Each phase is split into ``segments`` segments of free duration, each of
-    ``nodes`` equal intervals, so that jerk switching instants need not fall
-    on a fixed grid. Stage ``k`` has state ``x_k = (s1, v1, a1, s2, v2, a2, T)``
+    ``nodes`` intervals (fixed fractions of it, :func:`_grid_fractions`), so
+    that jerk switching instants need not fall on a fixed grid. Stage ``k``
+    has state ``x_k = (s1, v1, a1, s2, v2, a2, T)``
     (``T`` the current segment's duration) and control ``u_k = (w1, w2)``
     (jerk / max jerk), plus the next segment's duration on the last interval
     of a segment. Variables are ordered ``x_0, u_0, x_1, ...`` and
@@ -296,7 +301,8 @@ def _build(phases: list[_Phase], nodes: int, segments: int, max_iterations: int)
     Returns
     -------
     dict
-        ``solvers`` (fatrop, then Ipopt on the same NLP), bounds and sizes.
+        ``solvers`` (fatrop), ``builders`` of the Ipopt backups on the same NLP,
+        ``bounds`` (``lbx``, ``ubx``, ``lbg``, ``ubg``) and ``size``.
     """
     import casadi as ca
 
@@ -322,6 +328,12 @@ def _build(phases: list[_Phase], nodes: int, segments: int, max_iterations: int)
         g_lower.extend(low)
         g_upper.extend(high)
         equality.extend(low == high)
+
+    def at_rest(x, phase: _Phase, positions):
+        for vehicle in range(2):
+            if phase.legs[vehicle] != -1:
+                constrain(x[3 * vehicle] - positions[vehicle], 0.0, 0.0)
+                constrain(x[3 * vehicle + 1 : 3 * vehicle + 3], 0.0, 0.0)
 
     def add_state(name: str, phase: _Phase, pinned: tuple[int, ...] = ()):
         x = ca.SX.sym(name, _STATE)
@@ -371,10 +383,7 @@ def _build(phases: list[_Phase], nodes: int, segments: int, max_iterations: int)
             if k == 0 and p > 0:  # the vehicle that changed leg is at the junction
                 constrain(x[3 * phases[p - 1].switching], 0.0, 0.0)
             if first:  # rest at the start, which the planner has checked: no node constraints
-                for vehicle in range(2):
-                    if phase.legs[vehicle] != -1:
-                        constrain(x[3 * vehicle] - start[vehicle], 0.0, 0.0)
-                        constrain(x[3 * vehicle + 1 : 3 * vehicle + 3], 0.0, 0.0)
+                at_rest(x, phase, start)
             if node_path.numel():
                 constrain(node_path, *stage.path_bounds)
             if between.numel():
@@ -383,10 +392,7 @@ def _build(phases: list[_Phase], nodes: int, segments: int, max_iterations: int)
             if boundary:
                 objective += u[2]
             x = x_next
-    for vehicle in range(2):  # rest at the goal, which the planner has checked: no node constraints
-        if phases[-1].legs[vehicle] != -1:
-            constrain(x[3 * vehicle] - goal[vehicle], 0.0, 0.0)
-            constrain(x[3 * vehicle + 1 : 3 * vehicle + 3], 0.0, 0.0)
+    at_rest(x, phases[-1], goal)  # the goal, which the planner has checked: no node constraints
 
     nlp = {"x": ca.vertcat(*variables), "p": parameters, "f": objective, "g": ca.vertcat(*constraints)}
     fatrop = ca.nlpsol(
@@ -433,12 +439,15 @@ def _build(phases: list[_Phase], nodes: int, segments: int, max_iterations: int)
         return ca.nlpsol("trajgen_optimal_ipopt" + ("_polish" if warm else ""), "ipopt", nlp, options)
 
     return {
+        "solvers": {"fatrop": fatrop},
         # the Ipopt solvers are built on first need (most shapes never need them)
-        "solvers": {"fatrop": fatrop, "ipopt-polish": lambda: ipopt(True), "ipopt": lambda: ipopt(False)},
-        "lbx": np.array(lower, dtype=float),
-        "ubx": np.array(upper, dtype=float),
-        "lbg": np.array(g_lower, dtype=float),
-        "ubg": np.array(g_upper, dtype=float),
+        "builders": {"ipopt-polish": lambda: ipopt(True), "ipopt": lambda: ipopt(False)},
+        "bounds": {
+            "lbx": np.array(lower, dtype=float),
+            "ubx": np.array(upper, dtype=float),
+            "lbg": np.array(g_lower, dtype=float),
+            "ubg": np.array(g_upper, dtype=float),
+        },
         "size": int(nlp["x"].numel()),
     }
 
@@ -694,15 +703,8 @@ def optimal_schedule(
     except Exception as error:  # a malformed guess is a bug, but must not leak an unverified schedule
         return _fallback(exact, f"initial guess failed: {type(error).__name__}: {error}", began, built)
     attempts = []
-    solution = None
+    solution, solved_by = None, ""
     solvers = layout["solvers"]
-    bounds = {
-        "p": parameters,
-        "lbx": layout["lbx"],
-        "ubx": layout["ubx"],
-        "lbg": layout["lbg"],
-        "ubg": layout["ubg"],
-    }
     previous = None  # the last solver's result, to warm-start the polish
     for name in _SOLVER_ORDER:
         if name == "ipopt-polish":
@@ -711,11 +713,11 @@ def optimal_schedule(
             start = {"x0": previous["x"], "lam_x0": previous["lam_x"], "lam_g0": previous["lam_g"]}
         else:
             start = {"x0": guess}
-        if not hasattr(solvers[name], "stats"):
-            solvers[name] = solvers[name]()  # build a backup on first need
-        solver = solvers[name]
+        solver = solvers.get(name)
+        if solver is None:
+            solver = solvers[name] = layout["builders"][name]()
         try:
-            result = solver(**start, **bounds)
+            result = solver(**start, p=parameters, **layout["bounds"])
             stats = solver.stats()
         except RuntimeError as error:  # CasADi reports evaluation and solver errors as RuntimeError
             attempts.append(f"{name} raised: {error}")
@@ -724,14 +726,16 @@ def optimal_schedule(
         status = str(stats.get("return_status", stats.get("success")))
         iterations = int(stats.get("iter_count", -1))
         if stats.get("success", False):
-            solution = np.array(result["x"]).ravel()
+            solution, solved_by = np.array(result["x"]).ravel(), name
             attempts.append(f"{name} solved in {iterations} iterations")
             break
         previous = result if np.all(np.isfinite(np.array(result["x"]))) else None
         attempts.append(f"{name} did not converge ({status}, {iterations} iterations)")
         logger.info("optimal: %s did not converge (%s); trying the next solver", name, status)
     elapsed = time.perf_counter() - began
-    info = OptimalInfo(elapsed, built, iterations if solution is not None else -1, "; ".join(attempts))
+    info = OptimalInfo(
+        elapsed, built, iterations if solution is not None else -1, "; ".join(attempts), solver=solved_by
+    )
     if solution is None:
         return _fallback(exact, "; ".join(attempts), began, built, info)
     schedule = _to_schedule(
