@@ -21,41 +21,10 @@ import argparse
 import statistics
 import time
 
-from limits import Limits, VehicleLimits
-from topology import Configuration, YGraph, plan
-from trajgen.optimal import DEFAULT_NODES, lower_bound, optimal_schedule
-from trajgen.sampling import random_scenarios
-from trajgen.schedule import exact_schedule
-from trajgen.toppra_timing import toppra_schedule
-from trajgen.verify import verify
-
-AGV = VehicleLimits(1.0, 0.5, 1.0)
-SLOW = VehicleLimits(0.7, 0.35, 0.6)
-SAME = Limits(vehicles=(AGV, AGV), min_separation=1.5)
-MIXED = Limits(vehicles=(AGV, SLOW), min_separation=1.5)
-
-
-def swaps(track: YGraph):
-    out = []
-    for i, j in ((0, 1), (1, 2), (2, 0)):
-        start = Configuration(track.endpoint(track.names[i]), track.endpoint(track.names[j]))
-        out.append((f"swap {track.names[i]}{track.names[j]}", start, start.swapped()))
-    return out
-
-
-def scenario_sets(random_count: int):
-    equal = YGraph({"A": 10.0, "B": 10.0, "C": 10.0})
-    unequal = YGraph({"A": 12.0, "B": 8.0, "C": 15.0})
-    randoms = [
-        (f"random {k}", s.start, s.goal)
-        for k, s in enumerate(random_scenarios(random_count, seed=2026, track=unequal, limits=SAME))
-    ]
-    return [
-        ("a", equal, SAME, swaps(equal)),
-        ("b", unequal, SAME, swaps(unequal)),
-        ("c", unequal, SAME, randoms),
-        ("d", unequal, MIXED, randoms),
-    ]
+from topology import plan
+from trajgen import Exact, Optimal, Toppra, lower_bound, verify
+from trajgen.methods.optimal import DEFAULT_NODES, Source
+from trajgen.sampling import reference_sets
 
 
 def main() -> None:
@@ -70,17 +39,19 @@ def main() -> None:
         f"{'opt/ex':>6} {'opt/lb':>6} {'solve ms':>9} {'fallback':>8} {'2N change':>9}"
     )
     print(header)
-    for label, track, limits, scenarios in scenario_sets(args.random):
-        for name, start, goal in scenarios:
-            route = plan(track, start, goal, min_separation=limits.min_separation)
-            exact = exact_schedule(route, limits)
-            timed = toppra_schedule(route, limits)
-            best = optimal_schedule(route, limits, nodes=args.nodes)
+    optimal, refined = Optimal(nodes=args.nodes), Optimal(nodes=2 * args.nodes)
+    for reference in reference_sets(args.random):
+        label, limits = reference.label, reference.limits
+        for name, start, goal in reference.scenarios:
+            route = plan(reference.track, start, goal, min_separation=limits.min_separation)
+            exact = Exact().schedule(route, limits)
+            timed = Toppra().schedule(route, limits)
+            best = optimal.schedule(route, limits)
             bound = lower_bound(route, limits)
             info = best.info
             change = float("nan")
             if not args.skip_refinement and best.fallback_reason is None:
-                fine = optimal_schedule(route, limits, nodes=2 * args.nodes)
+                fine = refined.schedule(route, limits)
                 if fine.fallback_reason is None:
                     change = abs(fine.duration - best.duration) / best.duration
             passed = all(verify(s).passed for s in (exact, timed, best))
@@ -97,7 +68,7 @@ def main() -> None:
                     best.fallback_reason,
                     change,
                     passed,
-                    info.solver or "none",
+                    info.solver.value if info.solver else "none",
                     info.source,
                 )
             )
@@ -132,7 +103,7 @@ def main() -> None:
         )
     solved_by: dict[str, int] = {}
     for row in rows:
-        key = row[11] if row[12] == "nlp" else f"{row[11]}, exact faster"
+        key = row[11] if row[12] is Source.NLP else f"{row[11]}, exact faster"
         solved_by[key] = solved_by.get(key, 0) + 1
     print("solved by: " + ", ".join(f"{name} {count}" for name, count in sorted(solved_by.items())))
     for reason in {r[8] for r in rows if r[8]}:

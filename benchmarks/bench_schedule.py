@@ -14,11 +14,9 @@ import statistics
 import time
 
 from limits import ILLUSTRATIVE_LIMITS
-from topology import YGraph, plan
+from topology import YGraph
+from trajgen import METHODS, TimingMethod, default_scenario, make_schedule, verify
 from trajgen.sampling import random_scenarios
-from trajgen.scenario import default_scenario
-from trajgen.schedule import Method, make_schedule
-from trajgen.verify import verify
 
 
 def scenarios(count: int, seed: int):
@@ -30,9 +28,9 @@ def scenarios(count: int, seed: int):
     return out
 
 
-def timed(scenario, method: Method):
+def timed(scenario, method: TimingMethod):
     begin = time.perf_counter()
-    route = plan(scenario.track, scenario.start, scenario.goal, min_separation=scenario.limits.min_separation)
+    route = scenario.plan()
     schedule = make_schedule(route, scenario.limits, method=method)
     elapsed = time.perf_counter() - begin
     begin = time.perf_counter()
@@ -52,7 +50,8 @@ def main() -> None:
         f"{'method':>7} {'set':>14} {'median ms':>10} {'max ms':>8} {'verify ms':>10} "
         f"{'makespan s (median)':>20}"
     )
-    for method in Method:
+    for method_class in METHODS:
+        method = method_class()
         timed(swap, method)  # warm-up
         for label, batch in (("swap", [swap] * 5), (f"{len(randoms)} random", randoms)):
             results = [timed(s, method) for s in batch]
@@ -61,7 +60,7 @@ def main() -> None:
             check = [1e3 * r[3] for r in results]
             makespan = statistics.median(r[0].duration for r in results)
             print(
-                f"{method.value:>7} {label:>14} {statistics.median(produce):10.2f} {max(produce):8.2f} "
+                f"{method.name:>7} {label:>14} {statistics.median(produce):10.2f} {max(produce):8.2f} "
                 f"{statistics.median(check):10.2f} {makespan:20.2f}"
             )
     print("targets: exact <= 5 ms median, toppra <= 50 ms median per scenario")

@@ -13,46 +13,41 @@ import os
 import tempfile
 from pathlib import Path
 
-from topology import plan
-from trajgen.optimal import lower_bound, optimal_schedule
-from trajgen.plotting import plot_coordination, write_plots
-from trajgen.scenario import load_scenario
-from trajgen.schedule import exact_schedule
-from trajgen.toppra_timing import toppra_schedule
-from trajgen.verify import verify
+from trajgen import METHODS, certify, load_scenario, lower_bound, make_schedule
+from trajgen.export import commit_files
+from trajgen.plots import render_coordination, render_speed
 
 here = Path(__file__).resolve().parent
 scenario = load_scenario(here / "swap.toml")
 output = Path(os.environ.get("TRAJGEN_EXAMPLE_OUTPUT") or tempfile.mkdtemp(prefix="trajgen-example-"))
 
-route = plan(scenario.track, scenario.start, scenario.goal, min_separation=scenario.limits.min_separation)
+route = scenario.plan()
 print("homotopy class:", " -> ".join(str(region) for region in route.regions))
 
-schedules = {
-    "exact": exact_schedule(route, scenario.limits),
-    "toppra": toppra_schedule(route, scenario.limits),
-    "optimal": optimal_schedule(route, scenario.limits),
-}
+# Every registered method, each schedule certified by the verifier (it raises if one fails).
+verified = {m.name: certify(make_schedule(route, scenario.limits, method=m())) for m in METHODS}
 bound = lower_bound(route, scenario.limits)
-for name, schedule in schedules.items():
-    report = verify(schedule)
+for name, item in verified.items():
+    report = item.report
     print(
-        f"{name:>8}: {schedule.duration:6.2f} s  verified {report.passed}  "
+        f"{name:>8}: {item.schedule.duration:6.2f} s  verified {report.passed}  "
         f"closest approach {report.min_separation:5.2f} m  same class {report.regions_match}"
     )
 print(f"   bound: {bound:6.2f} s  (each vehicle alone on its shortest path)")
-optimal = schedules["optimal"]
-print(
-    f"optimal / exact = {optimal.duration / schedules['exact'].duration:.3f}; solver: {optimal.info.status}"
-)
+optimal = verified["optimal"].schedule
+ratio = optimal.duration / verified["exact"].schedule.duration
+print(f"optimal / exact = {ratio:.3f}; solver: {optimal.info.status}")
 
 # How deep does the waiting vehicle park? (exact parks it at the end of leg C)
 state = optimal.sample(0.01)
 print(f"deepest point of vehicle 2 in leg C: {state.s[1][state.leg[1] == 2].max():.2f} m of 10 m")
 
-plots = [
-    *write_plots(optimal, output, names=scenario.names),
-    plot_coordination(schedules, output / "coordination.png"),
-]
-for path in plots:
+# Renderers return bytes; the files are committed together.
+files = commit_files(
+    {
+        output / "speed.png": render_speed(verified["optimal"], names=scenario.names),
+        output / "coordination.png": render_coordination(verified),
+    }
+)
+for path in files:
     print(f"wrote {path}")

@@ -8,6 +8,7 @@ Examples
 1.5
 """
 
+from limits.errors import LimitsError
 from limits.vehicle import (
     ILLUSTRATIVE_LIMITS,
     ILLUSTRATIVE_MIN_SEPARATION,
@@ -21,5 +22,6 @@ __all__ = [
     "ILLUSTRATIVE_MIN_SEPARATION",
     "ILLUSTRATIVE_VEHICLE",
     "Limits",
+    "LimitsError",
     "VehicleLimits",
 ]

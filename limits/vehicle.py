@@ -4,8 +4,9 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from topology.errors import LimitsError, SeparationError
-from topology.graph import _finite_real
+from limits.errors import LimitsError
+from topology.errors import SeparationError
+from topology.validation import finite_real
 
 __all__ = [
     "ILLUSTRATIVE_LIMITS",
@@ -41,16 +42,10 @@ class VehicleLimits:
 
     def __post_init__(self) -> None:
         for name, unit in (("max_velocity", "m/s"), ("max_acceleration", "m/s^2"), ("max_jerk", "m/s^3")):
-            value = _finite_real(getattr(self, name), f"{name} ({unit})", LimitsError)
+            value = finite_real(getattr(self, name), f"{name} ({unit})", LimitsError)
             if value <= 0.0:
                 raise LimitsError(f"{name} must be > 0 {unit}, got {value!r}")
             object.__setattr__(self, name, value)
-
-    def scaled(self, factor: float) -> VehicleLimits:
-        """These limits with velocity, acceleration and jerk all multiplied by ``factor`` > 0."""
-        return VehicleLimits(
-            self.max_velocity * factor, self.max_acceleration * factor, self.max_jerk * factor
-        )
 
 
 @dataclass(frozen=True, slots=True)
@@ -79,7 +74,7 @@ class Limits:
                 raise LimitsError(
                     f"limits of vehicle {k} must be VehicleLimits, got {vehicle!r} ({type(vehicle).__name__})"
                 )
-        separation = _finite_real(self.min_separation, "min_separation (metres)", SeparationError)
+        separation = finite_real(self.min_separation, "min_separation (metres)", SeparationError)
         if separation < 0.0:
             raise SeparationError(f"min_separation must be >= 0 m, got {separation!r}")
         object.__setattr__(self, "vehicles", vehicles)

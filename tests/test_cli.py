@@ -119,13 +119,11 @@ def test_bad_scenario_file_exits_2_naming_the_file(tmp_path, capsys):
 
 def test_a_schedule_failing_verification_exits_1_and_writes_nothing(tmp_path, capsys, monkeypatch):
     from limits import Limits
-    from trajgen import schedule as schedule_module
-
-    real = schedule_module.make_schedule
+    from trajgen import Schedule, make_schedule, pipeline
 
     def too_close(route, limits, *, method):
-        good = real(route, limits, method=method)
-        return schedule_module.Schedule(
+        good = make_schedule(route, limits, method=method)
+        return Schedule(
             good.route,
             Limits(limits.vehicles, min_separation=10.5),
             good.method,
@@ -133,7 +131,7 @@ def test_a_schedule_failing_verification_exits_1_and_writes_nothing(tmp_path, ca
             good.jerk_limited,
         )
 
-    monkeypatch.setattr(schedule_module, "make_schedule", too_close)
+    monkeypatch.setattr(pipeline, "make_schedule", too_close)
     output = tmp_path / "out"
     assert main(["schedule", SWAP, "--csv", str(output), "--plot", str(output)]) == EXIT_FAILURE
     captured = capsys.readouterr()

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import os
+import re
 import subprocess
 import sys
 
@@ -13,6 +14,14 @@ from tests.conftest import REPO
 EXAMPLES = sorted((REPO / "examples").glob("[0-9][0-9]_*.py"))
 
 
+#: One figure each example must print: (pattern with one number, expected value, tolerance).
+FIGURES = {
+    "01_plan_a_swap": (r"vehicle 2 drives ([0-9.]+) m", 48.0, 1e-9),
+    "02_schedule_and_export": (r"exact makespan: ([0-9.]+) s", 67.5, 0.005),
+    "03_optimal_swap": (r"optimal / exact = ([0-9.]+)", 0.408, 0.0005),
+}
+
+
 @pytest.mark.parametrize("script", EXAMPLES, ids=[p.stem for p in EXAMPLES])
 def test_example_runs(script, tmp_path):
     env = {**os.environ, "MPLBACKEND": "Agg", "TRAJGEN_EXAMPLE_OUTPUT": str(tmp_path)}
@@ -20,8 +29,11 @@ def test_example_runs(script, tmp_path):
         [sys.executable, str(script)], cwd=tmp_path, env=env, capture_output=True, text=True, timeout=600
     )
     assert result.returncode == 0, result.stderr
-    assert result.stdout.strip(), "an example should tell its story on stdout"
+    pattern, expected, tolerance = FIGURES[script.stem]
+    found = re.search(pattern, result.stdout)
+    assert found, f"{script.name} should print {pattern!r}:\n{result.stdout}"
+    assert float(found.group(1)) == pytest.approx(expected, abs=tolerance)
 
 
-def test_there_are_examples():
-    assert EXAMPLES
+def test_every_example_has_its_figure():
+    assert sorted(FIGURES) == [p.stem for p in EXAMPLES]

@@ -7,10 +7,9 @@ import pytest
 
 from limits import Limits
 from tests.helpers import LIMITS, MIXED, route_of
-from topology.errors import OptionError, VerificationError
+from trajgen import Exact, Schedule, Toppra, certify
+from trajgen.errors import OptionError, UnverifiedScheduleError, VerificationError
 from trajgen.export import CsvOptions, Units, write_profiles
-from trajgen.schedule import Schedule, exact_schedule
-from trajgen.toppra_timing import toppra_schedule
 
 SWAP = ((10.0, 10.0, 10.0), ("A:10", "B:10"), ("B:10", "A:10"))
 NAMES = ("agv1", "agv2")
@@ -35,10 +34,9 @@ def read_profile(path, options: CsvOptions):
 )
 def test_csv_round_trip_re_verified_from_the_files(tmp_path, method, limits):
     route = route_of(*SWAP)
-    schedule = exact_schedule(route, limits) if method == "exact" else toppra_schedule(route, limits)
+    schedule = (Exact() if method == "exact" else Toppra()).schedule(route, limits)
     options = CsvOptions()
-    report, paths = write_profiles(schedule, NAMES, tmp_path, options=options)
-    assert report.passed
+    paths = write_profiles(certify(schedule), NAMES, tmp_path, options=options)
     assert [p.name for p in paths] == ["agv1.csv", "agv2.csv"]
     tables = [read_profile(p, options) for p in paths]
     for header, data in tables:
@@ -75,11 +73,11 @@ def test_csv_round_trip_re_verified_from_the_files(tmp_path, method, limits):
 
 
 def test_millimetres_comma_decimal_and_tab(tmp_path):
-    schedule = exact_schedule(route_of(*SWAP), LIMITS)
+    schedule = certify(Exact().schedule(route_of(*SWAP), LIMITS))
     metres = CsvOptions(sample_period=0.1)
     millimetres = CsvOptions(sample_period=0.1, delimiter="\t", decimal=",", units=Units.MILLIMETRES)
-    _, (m_path, _) = write_profiles(schedule, NAMES, tmp_path / "m", options=metres)
-    _, (mm_path, _) = write_profiles(schedule, NAMES, tmp_path / "mm", options=millimetres)
+    m_path, _ = write_profiles(schedule, NAMES, tmp_path / "m", options=metres)
+    mm_path, _ = write_profiles(schedule, NAMES, tmp_path / "mm", options=millimetres)
     _, in_metres = read_profile(m_path, metres)
     mm_header, in_mm = read_profile(mm_path, millimetres)
     assert mm_header == ["t_s", "axis_mm", "v_mmps", "a_mmps2", "j_mmps3", "leg", "s_mm", "x_mm", "y_mm"]
@@ -90,8 +88,8 @@ def test_millimetres_comma_decimal_and_tab(tmp_path):
         assert np.allclose(in_mm[:, column], 1000.0 * in_metres[:, column], atol=1e-5)
 
 
-def test_failing_schedule_writes_nothing(tmp_path):
-    schedule = exact_schedule(route_of(*SWAP), LIMITS)
+def test_failing_schedule_cannot_be_certified_nor_written(tmp_path):
+    schedule = Exact().schedule(route_of(*SWAP), LIMITS)
     broken = Schedule(
         schedule.route,
         Limits(LIMITS.vehicles, min_separation=10.5),
@@ -101,12 +99,16 @@ def test_failing_schedule_writes_nothing(tmp_path):
     )
     target = tmp_path / "out"
     with pytest.raises(VerificationError, match=r"below the minimum 10\.5 m"):
+        certify(broken)
+    with pytest.raises(
+        UnverifiedScheduleError, match=r"write_profiles takes a VerifiedSchedule.*got Schedule"
+    ):
         write_profiles(broken, NAMES, target)
     assert not target.exists()
 
 
 def test_existing_files_are_replaced_whole(tmp_path):
-    schedule = exact_schedule(route_of(*SWAP), LIMITS)
+    schedule = certify(Exact().schedule(route_of(*SWAP), LIMITS))
     (tmp_path / "agv1.csv").write_text("old")
     write_profiles(schedule, NAMES, tmp_path, options=CsvOptions(sample_period=0.5))
     assert (tmp_path / "agv1.csv").read_text().startswith("t_s;")

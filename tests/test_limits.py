@@ -6,8 +6,8 @@ import math
 
 import pytest
 
-from limits import ILLUSTRATIVE_LIMITS, ILLUSTRATIVE_VEHICLE, Limits, VehicleLimits
-from topology.errors import LimitsError, SeparationError
+from limits import ILLUSTRATIVE_LIMITS, ILLUSTRATIVE_VEHICLE, Limits, LimitsError, VehicleLimits
+from topology.errors import SeparationError
 
 
 def test_illustrative_defaults():

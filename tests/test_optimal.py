@@ -1,5 +1,7 @@
-"""The optimal method: closed-form cases, ordering against exact and the lower bound,
-homotopy class, verification, NLP reuse and the forced fallback."""
+"""The optimal method: closed-form cases, order against exact and the lower bound, and fallbacks.
+
+Also the homotopy class, verification, NLP reuse and the backup solvers.
+"""
 
 from __future__ import annotations
 
@@ -10,12 +12,13 @@ import pytest
 from limits import Limits, VehicleLimits
 from tests.helpers import LIMITS, MIXED, conf, route_of
 from topology import YGraph, plan, region_sequence
-from topology.errors import InputError
-from trajgen.optimal import lower_bound, optimal_schedule
+from trajgen import Exact, FallbackReason, Optimal, SolverCache, certify, lower_bound, make_schedule, verify
+from trajgen.analysis import travelled
+from trajgen.errors import InputError
+from trajgen.methods.optimal import Solver, Source
+from trajgen.plots import render_coordination
 from trajgen.profiles import rest_to_rest_time
-from trajgen.sampling import random_scenarios
-from trajgen.schedule import Method, exact_schedule, make_schedule
-from trajgen.verify import verify
+from trajgen.sampling import random_scenarios, reference_sets
 
 EQUAL = (10.0, 10.0, 10.0)
 UNEQUAL = (12.0, 8.0, 15.0)
@@ -28,14 +31,22 @@ TRACK = YGraph(dict(zip("ABC", UNEQUAL, strict=True)))
 RANDOM = random_scenarios(6, seed=404, track=TRACK, limits=MIXED)
 
 
+def optimal_schedule(route, limits, **options):
+    return Optimal(**options).schedule(route, limits)
+
+
+def exact_schedule(route, limits):
+    return Exact().schedule(route, limits)
+
+
 @pytest.mark.parametrize(("legs", "start"), SWAPS)
 def test_swaps_are_at_most_half_of_exact_and_stay_in_the_class(legs, start):
     route = route_of(legs, start, start[::-1])
     schedule = optimal_schedule(route, LIMITS)
     assert schedule.fallback_reason is None, schedule.fallback_reason
-    assert schedule.method is Method.OPTIMAL
+    assert schedule.method == Optimal()
     # start and goal at leg ends: no bound may be tied to a rest equality, or fatrop stalls
-    assert schedule.info.status.startswith("fatrop solved"), schedule.info.status
+    assert schedule.info.solver is Solver.FATROP, schedule.info.status
     report = verify(schedule)
     assert report.passed, report.failures
     assert report.regions_match
@@ -79,7 +90,7 @@ def test_slower_vehicle_sets_the_time_when_it_moves_alone():
 
 @pytest.mark.parametrize("scenario", RANDOM, ids=[s.source for s in RANDOM])
 def test_lower_bound_optimal_exact_order_and_verification(scenario):
-    route = plan(scenario.track, scenario.start, scenario.goal, min_separation=scenario.limits.min_separation)
+    route = scenario.plan()
     schedule = optimal_schedule(route, scenario.limits)
     exact = exact_schedule(route, scenario.limits)
     report = verify(schedule)
@@ -90,20 +101,24 @@ def test_lower_bound_optimal_exact_order_and_verification(scenario):
 
 
 def test_nlp_is_built_once_per_shape_and_reused():
-    first = optimal_schedule(route_of(EQUAL, ("A:10", "B:10"), ("B:10", "A:10")), LIMITS)
-    second = optimal_schedule(route_of(EQUAL, ("B:10", "C:10"), ("C:10", "B:10")), LIMITS)
+    method = Optimal(cache=SolverCache())
+    first = method.schedule(route_of(EQUAL, ("A:10", "B:10"), ("B:10", "A:10")), LIMITS)
+    second = method.schedule(route_of(EQUAL, ("B:10", "C:10"), ("C:10", "B:10")), LIMITS)
+    assert first.info.built is True
     assert second.info.built is False  # same region-sequence shape, new parameters
     assert second.duration == pytest.approx(first.duration, rel=1e-6)
+    assert len(method.cache) == 1
 
 
 def test_forced_solver_failure_falls_back_to_exact_and_logs(caplog):
     route = route_of(UNEQUAL, ("A:12", "B:8"), ("B:8", "A:12"))
-    with caplog.at_level(logging.WARNING, logger="trajgen.optimal"):
+    with caplog.at_level(logging.WARNING, logger="trajgen.methods.optimal"):
         schedule = optimal_schedule(route, LIMITS, max_iterations=1)
     exact = exact_schedule(route, LIMITS)
-    assert schedule.fallback_reason is not None
-    assert "did not converge" in schedule.fallback_reason
-    assert schedule.method is Method.EXACT
+    assert schedule.fallback_reason is FallbackReason.SOLVER_FAILED
+    assert "did not converge" in schedule.notes[0]
+    assert schedule.info.source is Source.EXACT
+    assert schedule.method == Exact()
     assert schedule.duration == exact.duration
     assert verify(schedule).passed
     assert any("fell back to exact" in record.message for record in caplog.records)
@@ -112,22 +127,19 @@ def test_forced_solver_failure_falls_back_to_exact_and_logs(caplog):
 @pytest.mark.parametrize(
     ("fatrop_iterations", "solved_by"),
     [
-        pytest.param(20, "ipopt-polish solved", id="polish-from-fatrop-iterate"),
-        pytest.param(5, "ipopt solved", id="cold-ipopt-after-failed-polish"),
+        pytest.param(20, Solver.IPOPT_POLISH, id="polish-from-fatrop-iterate"),
+        pytest.param(5, Solver.IPOPT, id="cold-ipopt-after-failed-polish"),
     ],
 )
-def test_backup_solvers_reach_fatrops_optimum(monkeypatch, fatrop_iterations, solved_by):
-    from trajgen import optimal
-
+def test_backup_solvers_reach_fatrops_optimum(fatrop_iterations, solved_by):
     route = route_of(UNEQUAL, ("A:12", "B:8"), ("B:8", "A:12"))
     reference = optimal_schedule(route, LIMITS)
-    assert reference.info.status.startswith("fatrop solved")
+    assert reference.info.solver is Solver.FATROP
     # a fresh NLP whose fatrop stops early: the chain must carry on to the same optimum
-    monkeypatch.setattr(optimal, "_SOLVERS", {})
-    monkeypatch.setattr(optimal, "_FATROP_MAX_ITER", fatrop_iterations)
-    schedule = optimal_schedule(route, LIMITS)
-    assert schedule.info.status.startswith("fatrop did not converge")
-    assert solved_by in schedule.info.status
+    schedule = optimal_schedule(route, LIMITS, fatrop_iterations=fatrop_iterations, cache=SolverCache())
+    assert schedule.info.attempts[0].solver is Solver.FATROP
+    assert "did not converge" in str(schedule.info.attempts[0])
+    assert schedule.info.solver is solved_by
     assert schedule.fallback_reason is None
     assert verify(schedule).passed
     assert schedule.duration == pytest.approx(reference.duration, rel=1e-6)
@@ -141,18 +153,17 @@ def test_fatrop_solves_the_five_phase_reordering_on_one_leg():
     route = plan(TRACK, scenario.start, scenario.goal, min_separation=1.5)
     assert len(route.regions) == 5
     schedule = optimal_schedule(route, LIMITS)
-    assert schedule.info.status.startswith("fatrop solved"), schedule.info.status
+    assert schedule.info.solver is Solver.FATROP, schedule.info.status
     assert verify(schedule).passed
     assert schedule.duration < 0.25 * exact_schedule(route, LIMITS).duration
 
 
 def test_every_benchmark_scenario_is_verified_and_between_its_bounds():
-    from benchmarks.bench_optimal import scenario_sets
-
     count = 0
-    for _, track, limits, scenarios in scenario_sets(50):
-        for name, start, goal in scenarios:
-            route = plan(track, start, goal, min_separation=limits.min_separation)
+    for reference in reference_sets(50):
+        limits = reference.limits
+        for name, start, goal in reference.scenarios:
+            route = plan(reference.track, start, goal, min_separation=limits.min_separation)
             schedule = optimal_schedule(route, limits)
             assert schedule.fallback_reason is None, (name, schedule.fallback_reason)
             report = verify(schedule)
@@ -168,33 +179,34 @@ def test_every_benchmark_scenario_is_verified_and_between_its_bounds():
 def test_make_schedule_dispatches_optimal():
     route = route_of(UNEQUAL, ("A:3", "B:2"), ("C:4", "C:9"))
     schedule = make_schedule(route, LIMITS, method="optimal")
-    assert schedule.method is Method.OPTIMAL
+    assert schedule.method == Optimal()
     assert schedule.duration < exact_schedule(route, LIMITS).duration
 
 
 @pytest.mark.parametrize(
     ("options", "match"),
     [
-        pytest.param({"nodes": 0}, "nodes per segment must be an integer >= 1, got 0", id="nodes"),
-        pytest.param({"segments": 0}, "segments per phase must be an integer >= 1, got 0", id="segments"),
+        pytest.param({"nodes": 0}, "option nodes must be an integer >= 1, got 0", id="nodes"),
+        pytest.param({"nodes": True}, "option nodes must be an integer >= 1, got True", id="nodes-bool"),
+        pytest.param({"segments": 0}, "option segments must be an integer >= 1, got 0", id="segments"),
         pytest.param({"max_iterations": 0}, "max_iterations must be an integer >= 1, got 0", id="iterations"),
+        pytest.param({"fatrop_iterations": 1.5}, "fatrop_iterations must be an integer", id="fatrop"),
+        pytest.param({"cache": {}}, "cache must be a SolverCache or None, got dict", id="cache"),
     ],
 )
 def test_bad_options(options, match):
     with pytest.raises(InputError, match=match):
-        optimal_schedule(route_of(EQUAL, ("A:10", "B:10"), ("B:10", "A:10")), LIMITS, **options)
+        Optimal(**options)
 
 
-def test_coordination_plot_is_written_for_all_three_methods(tmp_path):
-    from trajgen.plotting import plot_coordination, travelled
-
+def test_coordination_plot_is_rendered_for_verified_schedules():
     route = route_of(EQUAL, ("A:10", "B:10"), ("B:10", "A:10"))
     schedules = {
         "exact": exact_schedule(route, LIMITS),
         "optimal": optimal_schedule(route, LIMITS),
     }
-    path = plot_coordination(schedules, tmp_path / "coordination.png")
-    assert path.read_bytes().startswith(b"\x89PNG")
+    png = render_coordination({name: certify(s) for name, s in schedules.items()})
+    assert png.startswith(b"\x89PNG")
     # travelled distances never decrease, and the optimal one parks shallower (drives less)
     _, exact_distance, _, _ = travelled(schedules["exact"])
     _, optimal_distance, _, _ = travelled(schedules["optimal"])

@@ -10,8 +10,8 @@ from ruckig import InputParameter, Result, Ruckig, Trajectory
 
 from limits import Limits, VehicleLimits
 from tests.helpers import route_of
+from trajgen import Exact
 from trajgen.profiles import PiecewiseCubic, rest_to_rest_time, scurve_phases, trapezoid_phases
-from trajgen.schedule import exact_schedule
 
 
 def ruckig_move(distance: float, v: float, a: float, j: float) -> Trajectory:
@@ -96,7 +96,7 @@ def test_exact_schedule_of_a_single_move_is_the_slower_vehicles_scurve():
     slow = VehicleLimits(max_velocity=0.7, max_acceleration=0.35, max_jerk=0.6)
     limits = Limits(vehicles=(slow, VehicleLimits(1.0, 0.5, 1.0)), min_separation=1.5)
     route = route_of((10.0, 8.0, 15.0), ("A:2", "O"), ("A:10", "O"))
-    schedule = exact_schedule(route, limits)
+    schedule = Exact().schedule(route, limits)
     assert schedule.duration == pytest.approx(ruckig_move(8.0, 0.7, 0.35, 0.6).duration, rel=1e-9)
 
 
@@ -104,7 +104,7 @@ def test_exact_schedule_scales_limits_on_a_diagonal_piece():
     # quadrangle retraction moves both vehicles at once with speed ratio s1 : s2 = 3 : 2
     route = route_of((12.0, 8.0, 15.0), ("A:3", "B:2"), ("A:12", "B:8"), 0.0)
     limits = Limits(vehicles=(VehicleLimits(1.0, 0.5, 1.0), VehicleLimits(1.0, 0.5, 1.0)), min_separation=0.0)
-    schedule = exact_schedule(route, limits)
+    schedule = Exact().schedule(route, limits)
     # one piece: vehicle 1 moves 9 m, vehicle 2 moves 6 m; vehicle 1's limits bind
     assert len(schedule.sections) == 1
     assert schedule.duration == pytest.approx(ruckig_move(9.0, 1.0, 0.5, 1.0).duration, rel=1e-9)

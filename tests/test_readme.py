@@ -14,8 +14,7 @@ def _python_block() -> str:
 
 
 def test_readme_python_example_runs_and_its_comments_hold(tmp_path, monkeypatch):
-    from topology import Instruction
-    from trajgen.schedule import exact_schedule
+    from trajgen import Exact, Instruction
 
     monkeypatch.chdir(tmp_path)
     namespace: dict = {}
@@ -24,7 +23,24 @@ def test_readme_python_example_runs_and_its_comments_hold(tmp_path, monkeypatch)
     assert route.instruction is Instruction.COUNTERCLOCKWISE
     assert [str(r) for r in route.regions] == ["Q(A,B)", "Q(A,C)", "Q(B,C)", "Q(B,A)"]
     assert schedule.duration == pytest.approx(25.5, abs=0.05)
-    assert exact_schedule(route, limits).duration == pytest.approx(73.5)
+    assert Exact().schedule(route, limits).duration == pytest.approx(73.5)
     assert schedule.fallback_reason is None
+    assert namespace["verified"].report.passed
     assert (tmp_path / "out" / "agv1.csv").is_file()
     assert (tmp_path / "out" / "agv2.csv").is_file()
+    assert namespace["result"].summary()["duration_s"] == pytest.approx(27.53, abs=0.01)
+    assert sorted(p.name for p in (tmp_path / "run").iterdir()) == [
+        "agv1.csv",
+        "agv2.csv",
+        "coordination.png",
+        "separation.png",
+        "speed.png",
+    ]
+
+
+def test_readme_python_section_needs_at_most_two_import_lines():
+    import ast
+
+    tree = ast.parse(_python_block())
+    imports = [node for node in tree.body if isinstance(node, (ast.Import, ast.ImportFrom))]
+    assert 1 <= len(imports) <= 2

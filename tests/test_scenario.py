@@ -6,7 +6,7 @@ import pytest
 
 from tests.conftest import REPO
 from topology import Position
-from topology.errors import ScenarioError
+from trajgen.errors import ScenarioError
 from trajgen.scenario import default_scenario, load_scenario
 
 SWAP_FILE = REPO / "examples" / "swap.toml"

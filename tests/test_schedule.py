@@ -9,20 +9,24 @@ import pytest
 
 from limits import Limits, VehicleLimits
 from tests.helpers import LIMITS, MIXED, route_of
-from topology import YGraph, plan
-from topology.errors import OptionError, VerificationError
+from topology import YGraph
+from trajgen import METHODS, Exact, Schedule, Toppra, certify, make_schedule, verify
+from trajgen.axes import route_axes, straight_pieces
+from trajgen.errors import OptionError, VerificationError
+from trajgen.methods.toppra import ToppraKinematics
 from trajgen.sampling import random_scenarios
-from trajgen.schedule import Method, Schedule, exact_schedule, make_schedule, route_axes, straight_pieces
-from trajgen.toppra_timing import toppra_schedule
-from trajgen.verify import verified, verify
 
 SWAP = ((10.0, 10.0, 10.0), ("A:10", "B:10"), ("B:10", "A:10"))
 TRACK = YGraph({"A": 12.0, "B": 8.0, "C": 15.0})
 RANDOM = random_scenarios(12, seed=7, track=TRACK, limits=MIXED)
 
 
-def _plan(scenario):
-    return plan(scenario.track, scenario.start, scenario.goal, min_separation=scenario.limits.min_separation)
+def exact_schedule(route, limits, *, jerk=True):
+    return Exact(jerk=jerk).schedule(route, limits)
+
+
+def toppra_schedule(route, limits):
+    return Toppra().schedule(route, limits)
 
 
 def test_swap_exact_reference_duration():
@@ -50,7 +54,7 @@ def test_vehicles_stop_where_the_direction_changes_and_reverse_with_negative_vel
 
 @pytest.mark.parametrize("scenario", RANDOM, ids=[s.source for s in RANDOM])
 def test_exact_and_toppra_pass_the_verifier_and_toppra_is_never_slower(scenario):
-    route = _plan(scenario)
+    route = scenario.plan()
     exact = exact_schedule(route, scenario.limits)
     timed = toppra_schedule(route, scenario.limits)
     no_jerk = exact_schedule(route, scenario.limits, jerk=False)
@@ -72,17 +76,15 @@ STRESS = random_scenarios(300, seed=2026, track=TRACK, limits=MIXED)
 @pytest.mark.parametrize("index", [90, 241], ids=["stress-90", "stress-241"])
 def test_toppra_velocity_peaks_between_grid_points_are_within_limits(index):
     scenario = STRESS[index]
-    timed = toppra_schedule(_plan(scenario), scenario.limits)
+    timed = toppra_schedule(scenario.plan(), scenario.limits)
     report = verify(timed)
     assert report.passed, report.failures
 
 
 @pytest.mark.parametrize("index", [90, 241, 0, 1, 2], ids=lambda i: f"stress-{i}")
 def test_closed_form_velocity_peaks_agree_with_dense_sampling(index):
-    from trajgen.toppra_timing import ToppraKinematics, _interior_velocity_peaks
-
     scenario = STRESS[index]
-    timed = toppra_schedule(_plan(scenario), scenario.limits)
+    timed = toppra_schedule(scenario.plan(), scenario.limits)
     sections = [s.kinematics for s in timed.sections if isinstance(s.kinematics, ToppraKinematics)]
     assert sections
     for kinematics in sections:
@@ -91,7 +93,7 @@ def test_closed_form_velocity_peaks_agree_with_dense_sampling(index):
         times = (kinematics.times[:-1, None] + np.diff(kinematics.times)[:, None] * fine).ravel()
         sampled = np.max(np.abs(kinematics.evaluate(times)[:, 1]), axis=1)
         ends = np.max(np.abs(kinematics.evaluate(kinematics.times[:-1])[:, 1]), axis=1)
-        peaks = _interior_velocity_peaks(kinematics)
+        peaks = kinematics.interior_velocity_peaks()
         assert np.all(np.maximum(peaks, ends) >= sampled - 1e-12)
         assert np.all(peaks <= np.maximum(sampled, ends) + 1e-6)
 
@@ -111,7 +113,7 @@ def test_toppra_on_a_single_straight_move_is_the_trapezoid():
 
 
 def test_method_lookup():
-    assert Method.lookup("TOPPRA") is Method.TOPPRA
+    assert METHODS.lookup("TOPPRA") is Toppra
     with pytest.raises(
         OptionError, match=r"method 'fast' is unknown: expected one of \['exact', 'toppra', 'optimal'\]"
     ):
@@ -140,7 +142,7 @@ def test_verifier_catches_a_schedule_that_is_too_fast():
     assert report.velocity_ratio[0] == pytest.approx(1.2)
     assert any("velocity 1.2" in f and "exceeds its max_velocity 1" in f for f in report.failures)
     with pytest.raises(VerificationError, match="exceeds its max_velocity"):
-        verified(broken)
+        certify(broken)
 
 
 def test_verifier_catches_vehicles_too_close():
@@ -166,8 +168,8 @@ def test_verifier_catches_the_other_homotopy_class():
     clockwise = dataclasses.replace(
         route,
         waypoints=back.waypoints[::-1],
-        _tuples=back._tuples[::-1],
-        _cumulative=tuple(back.length - c for c in back._cumulative[::-1]),
+        indexed_waypoints=back.indexed_waypoints[::-1],
+        cumulative_travel=tuple(back.length - c for c in back.cumulative_travel[::-1]),
     )
     assert clockwise.start == route.start
     assert clockwise.goal == route.goal

@@ -16,7 +16,16 @@ Examples
 ['(A:1, B:1)', '(A:1, O)', '(A:1, C:1)', '(O, C:1)', '(B:1, C:1)', '(B:1, O)', '(B:1, A:1)']
 """
 
-from topology.cycle import ANTIPODAL_TOLERANCE, Cell, boundary_angle, classify, is_antipodal, retract
+from topology.boundary import BoundaryCycle
+from topology.cycle import (
+    ANTIPODAL_TOLERANCE,
+    Cell,
+    as_indexed,
+    boundary_angle,
+    classify,
+    is_antipodal,
+    retract,
+)
 from topology.errors import (
     InputError,
     OptionError,
@@ -25,26 +34,34 @@ from topology.errors import (
     TrackError,
     TrajgenError,
 )
-from topology.graph import JUNCTION, JUNCTION_NAME, Configuration, Position, YGraph
-from topology.route import Instruction, Region, Route, plan, reduce_regions, region_sequence
+from topology.graph import YGraph
+from topology.indexed import JUNCTION_INDEX, RegionKey, reduce_regions
+from topology.options import Option
+from topology.positions import JUNCTION, JUNCTION_NAME, Configuration, Position
+from topology.route import Instruction, Region, Route, plan, region_sequence
 
 __all__ = [
     "ANTIPODAL_TOLERANCE",
     "JUNCTION",
+    "JUNCTION_INDEX",
     "JUNCTION_NAME",
+    "BoundaryCycle",
     "Cell",
     "Configuration",
     "InputError",
     "Instruction",
+    "Option",
     "OptionError",
     "Position",
     "PositionError",
     "Region",
+    "RegionKey",
     "Route",
     "SeparationError",
     "TrackError",
     "TrajgenError",
     "YGraph",
+    "as_indexed",
     "boundary_angle",
     "classify",
     "is_antipodal",

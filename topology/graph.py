@@ -1,8 +1,7 @@
-"""The Y-shaped track, positions on it and configurations of two vehicles.
+"""The Y-shaped track: three legs of given lengths meeting at one junction.
 
-Conventions follow ``ALGORITHM.md`` sections 1 and 2: three legs listed in
-counterclockwise order around the junction ``O``, a position is ``(leg, s)``
-with ``s`` metres from ``O``, and the junction itself has ``leg is None``.
+Conventions follow ``ALGORITHM.md`` section 1: three legs listed in
+counterclockwise order around the junction ``O``.
 """
 
 from __future__ import annotations
@@ -10,166 +9,16 @@ from __future__ import annotations
 import math
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field
-from numbers import Real
 from types import MappingProxyType
 
+from topology.boundary import BoundaryCycle
 from topology.errors import PositionError, TrackError
+from topology.positions import JUNCTION, JUNCTION_NAME, Configuration, Position
+from topology.validation import finite_real
 
-__all__ = ["JUNCTION", "JUNCTION_NAME", "Configuration", "Position", "YGraph"]
-
-#: The name of the junction in text positions (``"O"``); no leg may use it.
-JUNCTION_NAME = "O"
+__all__ = ["YGraph"]
 
 _DEFAULT_ANGLES_DEG = (90.0, 210.0, 330.0)
-
-
-def _finite_real(value: object, quantity: str, error: type[Exception]) -> float:
-    """Return ``value`` as a float, or raise ``error`` naming ``quantity``."""
-    if type(value) is float and math.isfinite(value):
-        return value
-    if isinstance(value, bool) or not isinstance(value, Real):
-        raise error(f"{quantity} must be a real number, got {value!r} ({type(value).__name__})")
-    number = float(value)
-    if not math.isfinite(number):
-        raise error(f"{quantity} must be finite, got {number!r}")
-    return number
-
-
-@dataclass(frozen=True, slots=True)
-class Position:
-    """A point on the track.
-
-    Parameters
-    ----------
-    leg : str or None
-        Name of the leg; ``None`` only at the junction.
-    s : float
-        Distance from the junction along the leg, metres, ``s >= 0``.
-        ``s == 0`` is the junction, which belongs to every leg: the position
-        is normalized to ``leg=None`` there.
-
-    Notes
-    -----
-    Whether ``s`` fits the leg's length is checked by the track
-    (:meth:`YGraph.check`), which knows the lengths.
-    """
-
-    leg: str | None
-    s: float
-
-    def __post_init__(self) -> None:
-        s = _finite_real(self.s, "position s (metres from the junction)", PositionError)
-        if s < 0.0:
-            raise PositionError(f"position s must be >= 0 m (distance from the junction), got {s!r}")
-        if s == 0.0:
-            object.__setattr__(self, "leg", None)
-            object.__setattr__(self, "s", 0.0)
-            return
-        if self.leg is None:
-            raise PositionError(
-                f"position with leg None must be the junction (s == 0), got s={s!r} m; name the leg"
-            )
-        if not isinstance(self.leg, str) or not self.leg:
-            raise PositionError(f"position leg must be a non-empty string, got {self.leg!r}")
-        object.__setattr__(self, "s", s)
-
-    @classmethod
-    def parse(cls, text: str) -> Position:
-        """Read ``"LEG:metres"`` (e.g. ``"A:10.0"``) or ``"O"`` for the junction.
-
-        Raises
-        ------
-        PositionError
-            If the text is not of that form.
-        """
-        if not isinstance(text, str):
-            raise PositionError(f"position must be a string like 'A:10.0' or 'O', got {text!r}")
-        stripped = text.strip()
-        if stripped == JUNCTION_NAME:
-            return JUNCTION
-        leg, colon, metres = stripped.partition(":")
-        if not colon or not leg.strip() or not metres.strip():
-            raise PositionError(
-                f"position {text!r} is malformed: expected 'LEG:metres' (e.g. 'A:10.0') or 'O'"
-            )
-        try:
-            s = float(metres)
-        except ValueError:
-            raise PositionError(
-                f"position {text!r} has distance {metres.strip()!r}, expected a number of metres"
-            ) from None
-        return cls(leg.strip(), s)
-
-    @property
-    def at_junction(self) -> bool:
-        """Whether this is the junction ``O``."""
-        return self.leg is None
-
-    def __str__(self) -> str:
-        return JUNCTION_NAME if self.leg is None else f"{self.leg}:{self.s:g}"
-
-
-#: The junction ``O``.
-JUNCTION = Position(None, 0.0)
-
-
-def _position_unchecked(leg: str | None, s: float) -> Position:
-    """Build a Position from values already known to be valid (hot path)."""
-    position = object.__new__(Position)
-    object.__setattr__(position, "leg", leg)
-    object.__setattr__(position, "s", s)
-    return position
-
-
-@dataclass(frozen=True, slots=True)
-class Configuration:
-    """The positions of the two vehicles: vehicle 1 (``first``) then vehicle 2.
-
-    Parameters
-    ----------
-    first, second : Position
-        Positions of vehicle 1 and vehicle 2.
-    """
-
-    first: Position
-    second: Position
-
-    def __post_init__(self) -> None:
-        for name in ("first", "second"):
-            value = getattr(self, name)
-            if not isinstance(value, Position):
-                raise PositionError(
-                    f"configuration {name} must be a Position, got {value!r} ({type(value).__name__})"
-                )
-
-    def swapped(self) -> Configuration:
-        """The same two positions with the vehicles exchanged."""
-        return _configuration_unchecked(self.second, self.first)
-
-    def __iter__(self):
-        yield self.first
-        yield self.second
-
-    def __getitem__(self, vehicle: int) -> Position:
-        """Position of vehicle 0 (``first``) or 1 (``second``)."""
-        if vehicle in (0, -2):
-            return self.first
-        if vehicle in (1, -1):
-            return self.second
-        raise IndexError(f"a configuration has vehicles 0 and 1, got index {vehicle!r}")
-
-    def __len__(self) -> int:
-        return 2
-
-    def __str__(self) -> str:
-        return f"({self.first}, {self.second})"
-
-
-def _configuration_unchecked(first: Position, second: Position) -> Configuration:
-    configuration = object.__new__(Configuration)
-    object.__setattr__(configuration, "first", first)
-    object.__setattr__(configuration, "second", second)
-    return configuration
 
 
 def _leg_pairs(legs: object) -> list[tuple[object, object]]:
@@ -208,13 +57,15 @@ class YGraph:
         Leg lengths, metres.
     angles_deg : tuple of 3 float
         Leg directions, degrees.
+    cycle : BoundaryCycle
+        The oriented boundary cycle of the configuration space (ALGORITHM.md section 4).
     """
 
     names: tuple[str, str, str]
     lengths: tuple[float, float, float]
     angles_deg: tuple[float, float, float]
+    cycle: BoundaryCycle = field(repr=False, compare=False, hash=False)
     _index: Mapping[str, int] = field(repr=False, compare=False, hash=False)
-    _cycle: tuple = field(repr=False, compare=False, hash=False)
 
     def __init__(self, legs, *, angles_deg: Mapping[str, float] | None = None) -> None:
         pairs = _leg_pairs(legs)
@@ -232,7 +83,7 @@ class YGraph:
                 )
             if name in names:
                 raise TrackError(f"leg names must be distinct, got {name!r} twice")
-            value = _finite_real(length, f"length of leg {name!r} (metres)", TrackError)
+            value = finite_real(length, f"length of leg {name!r} (metres)", TrackError)
             if value <= 0.0:
                 raise TrackError(f"length of leg {name!r} must be > 0 m, got {value!r}")
             names.append(name)
@@ -242,10 +93,7 @@ class YGraph:
         object.__setattr__(self, "lengths", tuple(lengths))
         object.__setattr__(self, "angles_deg", angles)
         object.__setattr__(self, "_index", MappingProxyType({n: k for k, n in enumerate(names)}))
-        # Imported here: the cycle module needs YGraph's module to be complete.
-        from topology.cycle import _BoundaryCycle
-
-        object.__setattr__(self, "_cycle", _BoundaryCycle(self))
+        object.__setattr__(self, "cycle", BoundaryCycle(self.names, self.lengths))
 
     @staticmethod
     def _check_angles(names: list[str], angles_deg) -> tuple[float, float, float]:
@@ -257,9 +105,7 @@ class YGraph:
             raise TrackError(
                 f"angles_deg must give exactly the legs {names!r}, got {sorted(map(str, angles_deg))!r}"
             )
-        angles = tuple(
-            _finite_real(angles_deg[n], f"angle of leg {n!r} (degrees)", TrackError) for n in names
-        )
+        angles = tuple(finite_real(angles_deg[n], f"angle of leg {n!r} (degrees)", TrackError) for n in names)
         turn = [(a - angles[0]) % 360.0 for a in angles]
         if not 0.0 < turn[1] < turn[2] < 360.0:
             raise TrackError(
@@ -298,7 +144,7 @@ class YGraph:
 
     def endpoint(self, leg: str) -> Position:
         """The far endpoint ``E_leg`` of a leg."""
-        return self._cycle.endpoints[self.index(leg)]
+        return self.cycle.endpoints[self.index(leg)]
 
     @property
     def junction(self) -> Position:
@@ -353,14 +199,14 @@ class YGraph:
     @property
     def perimeter(self) -> float:
         """Length of the boundary cycle, ``4 (L_0 + L_1 + L_2)`` metres."""
-        return self._cycle.perimeter
+        return self.cycle.perimeter
 
     @property
     def boundary_vertices(self) -> tuple[Configuration, ...]:
         """The 12 cycle vertices, counterclockwise from ``P(first leg, second leg)``, shape (12,)."""
-        return self._cycle.vertices
+        return self.cycle.vertices
 
     @property
     def boundary_vertex_angles(self) -> tuple[float, ...]:
         """Arc length ``theta`` of each cycle vertex from ``P(A, B)``, metres, shape (12,)."""
-        return self._cycle.vertex_theta
+        return self.cycle.vertex_theta

@@ -11,30 +11,26 @@ import bisect
 import itertools
 from dataclasses import dataclass, field
 
-from topology.cycle import (
-    _AT_JUNCTION,
-    ANTIPODAL_TOLERANCE,
-    _as_tuple,
-    _leg_travel,
-    _retract,
-    _separation,
-    _step,
-)
+from topology.cycle import ANTIPODAL_TOLERANCE, as_indexed, retract_indexed
 from topology.errors import OptionError, SeparationError
-from topology.graph import Configuration, YGraph, _finite_real
+from topology.graph import YGraph
+from topology.indexed import (
+    JUNCTION_INDEX,
+    IndexedConfiguration,
+    RegionKey,
+    leg_travel,
+    reduce_regions,
+    reduce_regions_indexed,
+    region_key,
+    segment_region_key,
+    separation,
+    step,
+)
 from topology.options import Option
+from topology.positions import Configuration
+from topology.validation import finite_real
 
-__all__ = [
-    "Instruction",
-    "Region",
-    "Route",
-    "plan",
-    "reduce_regions",
-    "reduce_regions_indexed",
-    "region_sequence",
-]
-
-_Tuple = tuple[int, float, int, float]
+__all__ = ["Instruction", "Region", "Route", "plan", "region_sequence"]
 
 
 class Instruction(Option):
@@ -79,51 +75,20 @@ class Region:
         """Whether both vehicles are on one leg (a ``T`` region)."""
         return self.first_leg == self.second_leg
 
+    @classmethod
+    def from_key(cls, graph: YGraph, key: RegionKey) -> Region:
+        """The named region of a :class:`~topology.indexed.RegionKey` on ``graph``."""
+        names = graph.names
+        return cls(names[key.first_leg], names[key.second_leg], key.nearer or None)
+
+    def key(self, graph: YGraph) -> RegionKey:
+        """The region by leg indices of ``graph``."""
+        return RegionKey(graph.index(self.first_leg), graph.index(self.second_leg), self.nearer or 0)
+
     def __str__(self) -> str:
         if self.shared_leg:
             return f"T({self.first_leg},{self.nearer})"
         return f"Q({self.first_leg},{self.second_leg})"
-
-
-def _region_key(leg1: int, s1: float, leg2: int, s2: float) -> tuple[int, int, int] | None:
-    """Region of a configuration off the rays, as indices; ``None`` on a ray."""
-    if leg1 == _AT_JUNCTION or leg2 == _AT_JUNCTION:
-        return None
-    if leg1 != leg2:
-        return (leg1, leg2, 0)
-    return (leg1, leg2, 1 if s1 < s2 else 2)
-
-
-def reduce_regions(sequence) -> tuple:
-    """Reduce a region sequence to its homotopy class representative.
-
-    Merges repeats and cancels immediate back-and-forth ``R1, R2, R1`` (two
-    adjacent regions share exactly one ray, so that excursion is null-homotopic).
-
-    Parameters
-    ----------
-    sequence : iterable of hashable
-        Regions in visiting order; ``None`` entries (on a ray) are skipped.
-    """
-    return tuple(region for region, _ in reduce_regions_indexed(sequence))
-
-
-def reduce_regions_indexed(sequence) -> tuple:
-    """Like :func:`reduce_regions`, with the index at which each kept region was entered.
-
-    Returns
-    -------
-    tuple of (region, int)
-    """
-    stack: list = []
-    for index, region in enumerate(sequence):
-        if region is None or (stack and stack[-1][0] == region):
-            continue
-        if len(stack) >= 2 and stack[-2][0] == region:
-            stack.pop()
-            continue
-        stack.append((region, index))
-    return tuple(stack)
 
 
 def region_sequence(graph: YGraph, configurations) -> tuple[Region, ...]:
@@ -136,23 +101,8 @@ def region_sequence(graph: YGraph, configurations) -> tuple[Region, ...]:
         Samples along a motion, in time order, dense enough that no region is
         entered and left between two samples except through the same ray.
     """
-    keys = []
-    for configuration in configurations:
-        c = _as_tuple(graph, configuration)
-        keys.append(_region_key(*c))
-    return tuple(_key_to_region(graph, key) for key in reduce_regions(keys))
-
-
-def _key_to_region(graph: YGraph, key: tuple[int, int, int]) -> Region:
-    names = graph.names
-    return Region(names[key[0]], names[key[1]], key[2] or None)
-
-
-def _segment_region_key(a: _Tuple, b: _Tuple) -> tuple[int, int, int] | None:
-    """Region of the interior of a route segment (each vehicle stays on one leg)."""
-    leg1 = a[0] if a[0] != _AT_JUNCTION else b[0]
-    leg2 = a[2] if a[2] != _AT_JUNCTION else b[2]
-    return _region_key(leg1, a[1] + b[1], leg2, a[3] + b[3])
+    keys = (region_key(*as_indexed(graph, configuration)) for configuration in configurations)
+    return tuple(Region.from_key(graph, key) for key in reduce_regions(keys))
 
 
 @dataclass(frozen=True, slots=True)
@@ -181,8 +131,8 @@ class Route:
     waypoints: tuple[Configuration, ...]
     min_separation: float
     arc_length: float
-    _tuples: tuple[_Tuple, ...] = field(repr=False, compare=False)
-    _cumulative: tuple[float, ...] = field(repr=False, compare=False)
+    indexed_waypoints: tuple[IndexedConfiguration, ...] = field(repr=False, compare=False)
+    cumulative_travel: tuple[float, ...] = field(repr=False, compare=False)
 
     @property
     def start(self) -> Configuration:
@@ -197,7 +147,7 @@ class Route:
     @property
     def length(self) -> float:
         """Total travel ``sum |ds1| + |ds2|`` along the route, metres."""
-        return self._cumulative[-1]
+        return self.cumulative_travel[-1]
 
     @property
     def travel(self) -> tuple[float, float]:
@@ -208,16 +158,31 @@ class Route:
     @property
     def segment_travel(self) -> tuple[tuple[float, float], ...]:
         """Per segment, the distance driven by vehicle 1 and vehicle 2, metres; shape (n-1, 2)."""
-        t = self._tuples
         return tuple(
-            (_leg_travel(a[0], a[1], b[0], b[1]), _leg_travel(a[2], a[3], b[2], b[3]))
-            for a, b in itertools.pairwise(t)
+            (leg_travel(a[0], a[1], b[0], b[1]), leg_travel(a[2], a[3], b[2], b[3]))
+            for a, b in itertools.pairwise(self.indexed_waypoints)
         )
 
     @property
-    def separation_floor(self) -> float:
-        """``min(dist(start), dist(goal), shortest leg)``: no point of the route is closer, metres."""
-        return min(_separation(self._tuples[0]), _separation(self._tuples[-1]), self.graph.shortest_leg)
+    def segment_region_keys(self) -> tuple[RegionKey | None, ...]:
+        """Region of the interior of each segment; shape (n-1,); ``None`` for a segment on a ray."""
+        return tuple(segment_region_key(a, b) for a, b in itertools.pairwise(self.indexed_waypoints))
+
+    @property
+    def region_entries(self) -> tuple[tuple[RegionKey, int], ...]:
+        """The homotopy class by leg indices, with the segment in which each region is entered.
+
+        Returns
+        -------
+        tuple of (RegionKey, int)
+            Reduced region sequence; segment ``k`` runs from waypoint ``k`` to ``k + 1``.
+        """
+        return reduce_regions_indexed(self.segment_region_keys)
+
+    @property
+    def region_keys(self) -> tuple[RegionKey, ...]:
+        """The homotopy class by leg indices (see :attr:`regions`)."""
+        return tuple(key for key, _ in self.region_entries)
 
     @property
     def regions(self) -> tuple[Region, ...]:
@@ -226,9 +191,7 @@ class Route:
         Empty when the whole route stays on one ray (a vehicle parked at the
         junction while the other moves on one leg) or does not move.
         """
-        t = self._tuples
-        keys = (_segment_region_key(a, b) for a, b in itertools.pairwise(t))
-        return tuple(_key_to_region(self.graph, key) for key in reduce_regions(keys))
+        return tuple(Region.from_key(self.graph, key) for key in self.region_keys)
 
     def at(self, tau: float) -> Configuration:
         """The configuration a fraction ``tau`` in [0, 1] of the travel along the route.
@@ -238,9 +201,9 @@ class Route:
         tau : float
             Fraction of the total travel ``|ds1| + |ds2|``; clipped to [0, 1].
         """
-        tau = _finite_real(tau, "route parameter tau", OptionError)
-        cumulative = self._cumulative
-        tuples = self._tuples
+        tau = finite_real(tau, "route parameter tau", OptionError)
+        cumulative = self.cumulative_travel
+        tuples = self.indexed_waypoints
         if len(tuples) == 1 or tau <= 0.0:
             return self.waypoints[0]
         if tau >= 1.0:
@@ -250,14 +213,14 @@ class Route:
         a, b = tuples[k], tuples[k + 1]
         span = cumulative[k + 1] - cumulative[k]
         fraction = (target - cumulative[k]) / span
-        leg1 = a[0] if a[0] != _AT_JUNCTION else b[0]
-        leg2 = a[2] if a[2] != _AT_JUNCTION else b[2]
+        leg1 = a[0] if a[0] != JUNCTION_INDEX else b[0]
+        leg2 = a[2] if a[2] != JUNCTION_INDEX else b[2]
         # s is 0 at the junction, so linear interpolation holds through it too.
         s1 = _between(a[1], b[1], fraction)
         s2 = _between(a[3], b[3], fraction)
-        cycle = self.graph._cycle
+        cycle = self.graph.cycle
         return cycle.configuration(
-            (leg1 if s1 > 0.0 else _AT_JUNCTION, s1, leg2 if s2 > 0.0 else _AT_JUNCTION, s2)
+            (leg1 if s1 > 0.0 else JUNCTION_INDEX, s1, leg2 if s2 > 0.0 else JUNCTION_INDEX, s2)
         )
 
 
@@ -297,19 +260,19 @@ def plan(graph: YGraph, start: Configuration, goal: Configuration, *, min_separa
     """
     if not isinstance(graph, YGraph):
         raise TypeError(f"graph must be a YGraph, got {graph!r} ({type(graph).__name__})")
-    separation = _check_min_separation(graph, min_separation)
-    a = _as_tuple(graph, start)
-    b = _as_tuple(graph, goal)
+    required = _check_min_separation(graph, min_separation)
+    a = as_indexed(graph, start)
+    b = as_indexed(graph, goal)
     for name, config, c in (("start", start, a), ("goal", goal, b)):
-        if _separation(c) < separation:
+        if separation(c) < required:
             raise SeparationError(
-                f"vehicles at the {name} {config} are {_separation(c)!r} m apart along the track: "
-                f"expected at least the min_separation {separation!r} m"
+                f"vehicles at the {name} {config} are {separation(c)!r} m apart along the track: "
+                f"expected at least the min_separation {required!r} m"
             )
     lengths = graph.lengths
-    cycle = graph._cycle
-    to_boundary = _retract(a, lengths)
-    from_boundary = _retract(b, lengths)
+    cycle = graph.cycle
+    to_boundary = retract_indexed(a, lengths)
+    from_boundary = retract_indexed(b, lengths)
     origin = cycle.locate(to_boundary[-1])
     target = cycle.locate(from_boundary[-1])
     perimeter = cycle.perimeter
@@ -327,10 +290,10 @@ def plan(graph: YGraph, start: Configuration, goal: Configuration, *, min_separa
     kept = [a]
     cumulative = [0.0]
     for c in candidates[1:]:
-        step = _step(kept[-1], c)
-        if step > 0.0:
+        travel = step(kept[-1], c)
+        if travel > 0.0:
             kept.append(c)
-            cumulative.append(cumulative[-1] + step)
+            cumulative.append(cumulative[-1] + travel)
     vertex = cycle.vertex_configuration
     inner = tuple(vertex.get(c) or cycle.configuration(c) for c in kept[1:-1])
     waypoints = (start, *inner, goal) if len(kept) > 1 else (start,)
@@ -338,15 +301,15 @@ def plan(graph: YGraph, start: Configuration, goal: Configuration, *, min_separa
         graph=graph,
         instruction=instruction,
         waypoints=waypoints,
-        min_separation=separation,
+        min_separation=required,
         arc_length=arc_length,
-        _tuples=tuple(kept),
-        _cumulative=tuple(cumulative),
+        indexed_waypoints=tuple(kept),
+        cumulative_travel=tuple(cumulative),
     )
 
 
 def _check_min_separation(graph: YGraph, min_separation: float) -> float:
-    separation = _finite_real(min_separation, "min_separation (metres)", SeparationError)
+    separation = finite_real(min_separation, "min_separation (metres)", SeparationError)
     shortest = graph.shortest_leg
     if separation < 0.0 or separation > shortest:
         raise SeparationError(

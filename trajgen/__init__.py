@@ -1,13 +1,65 @@
-"""trajgen: collision-free, time-optimal schedules for two AGVs on a Y-track.
+"""trajgen: collision-free, time-optimal schedules for two AGVs on a Y-shaped track junction.
 
-The planner lives in :mod:`topology`, the vehicle limits in :mod:`limits`;
-this package turns routes into schedules and hands them to controllers.
-Heavy dependencies (CasADi, TOPPRA, Ruckig, matplotlib) are imported only by
-the modules that use them.
+The package face: scenarios, the planner's types, the timing methods, the
+verifier and the pipeline. The planner lives in :mod:`topology`, the vehicle
+limits in :mod:`limits`. Heavy dependencies (CasADi, TOPPRA, matplotlib) are
+imported only when used.
+
+Examples
+--------
+>>> from trajgen import default_scenario, make_schedule, certify, Exact
+>>> scenario = default_scenario()
+>>> verified = certify(make_schedule(scenario.plan(), scenario.limits, method=Exact()))
+>>> verified.report.passed, round(verified.schedule.duration, 1)
+(True, 67.5)
 """
 
-from topology import Configuration, Position, Route, YGraph, plan
-from topology.errors import TrajgenError
+from limits import Limits, VehicleLimits
+from topology import Configuration, Instruction, Position, Route, YGraph, plan
+from trajgen.analysis import lower_bound
+from trajgen.errors import InputError, TrajgenError, VerificationError
+from trajgen.export import CsvOptions, Units, write_profiles
+from trajgen.methods import METHODS, Exact, Optimal, SolverCache, Toppra, make_schedule
+from trajgen.pipeline import Outputs, RunResult, run
+from trajgen.scenario import Scenario, default_scenario, load_scenario, parse_scenario
+from trajgen.schedule import FallbackReason, Schedule, TimingMethod
+from trajgen.verify import VerificationReport, VerifiedSchedule, certify, verify
 
-__all__ = ["Configuration", "Position", "Route", "TrajgenError", "YGraph", "plan"]
+__all__ = [
+    "METHODS",
+    "Configuration",
+    "CsvOptions",
+    "Exact",
+    "FallbackReason",
+    "InputError",
+    "Instruction",
+    "Limits",
+    "Optimal",
+    "Outputs",
+    "Position",
+    "Route",
+    "RunResult",
+    "Scenario",
+    "Schedule",
+    "SolverCache",
+    "TimingMethod",
+    "Toppra",
+    "TrajgenError",
+    "Units",
+    "VehicleLimits",
+    "VerificationError",
+    "VerificationReport",
+    "VerifiedSchedule",
+    "YGraph",
+    "certify",
+    "default_scenario",
+    "load_scenario",
+    "lower_bound",
+    "make_schedule",
+    "parse_scenario",
+    "plan",
+    "run",
+    "verify",
+    "write_profiles",
+]
 __version__ = "0.1.0"

@@ -1,7 +1,7 @@
-"""The ``trajgen`` command line.
+"""The ``trajgen`` command line: parses arguments, runs the pipeline, prints the result.
 
 Exit status: 0 on success, 2 on bad input (message on stderr, nothing
-written), 1 on an internal failure.
+written), 1 on an internal failure (nothing written).
 """
 
 from __future__ import annotations
@@ -11,13 +11,15 @@ import json
 import logging
 import sys
 from collections.abc import Sequence
-from pathlib import Path
 
-from topology import Route, plan
-from topology.errors import InputError
+from trajgen.errors import InputError
+from trajgen.export import CsvOptions, Units
+from trajgen.methods import METHODS
+from trajgen.pipeline import Outputs, run
 from trajgen.scenario import Scenario, default_scenario, load_scenario
+from trajgen.summary import format_route, format_run, route_summary
 
-__all__ = ["main"]
+__all__ = ["EXIT_BAD_INPUT", "EXIT_FAILURE", "EXIT_OK", "build_parser", "main"]
 
 EXIT_OK = 0
 EXIT_FAILURE = 1
@@ -33,46 +35,17 @@ class _ArgumentParser(argparse.ArgumentParser):
         raise InputError(f"{self.prog}: {message}")
 
 
-def route_summary(route: Route) -> dict:
-    """A JSON-ready summary of a route."""
-    return {
-        "instruction": route.instruction.value,
-        "waypoints": [[{"leg": p.leg, "s_m": p.s} for p in (w.first, w.second)] for w in route.waypoints],
-        "regions": [str(r) for r in route.regions],
-        "travel_m": list(route.travel),
-        "min_separation_m": route.min_separation,
-    }
-
-
-def format_route(route: Route) -> str:
-    """Human-readable multi-line description of a route."""
-    lines = [
-        f"instruction: {route.instruction.value}",
-        f"homotopy class (regions): {' '.join(str(r) for r in route.regions) or '(one ray)'}",
-        f"travel: vehicle 1 {route.travel[0]:g} m, vehicle 2 {route.travel[1]:g} m",
-        "waypoints (vehicle 1, vehicle 2):",
-    ]
-    lines += [f"  {k:2d}  {w}" for k, w in enumerate(route.waypoints)]
-    return "\n".join(lines)
-
-
 def _load(path: str | None) -> Scenario:
     return default_scenario() if path is None else load_scenario(path)
 
 
-def _plan_scenario(scenario: Scenario) -> Route:
-    return plan(scenario.track, scenario.start, scenario.goal, min_separation=scenario.limits.min_separation)
-
-
 def _command_plan(args: argparse.Namespace) -> int:
-    route = _plan_scenario(_load(args.scenario))
+    route = _load(args.scenario).plan()
     print(json.dumps(route_summary(route), indent=2) if args.json else format_route(route))
     return EXIT_OK
 
 
-def _csv_options(args: argparse.Namespace):
-    from trajgen.export import CsvOptions, Units
-
+def _csv_options(args: argparse.Namespace) -> CsvOptions:
     delimiter = "\t" if args.delimiter in ("tab", "\\t") else args.delimiter
     return CsvOptions(
         sample_period=args.sample_period,
@@ -82,113 +55,40 @@ def _csv_options(args: argparse.Namespace):
     )
 
 
-def run_schedule(
-    scenario: Scenario, *, method: str, csv_dir: str | None, plot_dir: str | None, csv_options=None
-) -> dict:
-    """Plan, schedule, verify, then export: the whole job. Returns the JSON summary.
-
-    Nothing is written unless the schedule passes the verifier.
-    """
-    from trajgen.export import write_profiles
-    from trajgen.schedule import Method, make_schedule
-    from trajgen.verify import verified
-
-    method = Method.lookup(method)
-    route = _plan_scenario(scenario)
-    schedule = make_schedule(route, scenario.limits, method=method)
-    report = verified(schedule)
-    written: list[str] = []
-    if csv_dir is not None:
-        _, paths = write_profiles(schedule, scenario.names, csv_dir, options=csv_options)
-        written += [str(p) for p in paths]
-    if plot_dir is not None:
-        from trajgen.plotting import plot_coordination, write_plots
-
-        written += [str(p) for p in write_plots(schedule, plot_dir, names=scenario.names)]
-        # the coordination diagram compares all three methods on this route
-        others = {
-            m.value: schedule if m is method else make_schedule(route, scenario.limits, method=m)
-            for m in Method
-        }
-        written.append(str(plot_coordination(others, Path(plot_dir) / "coordination.png")))
-    info = schedule.info
-    return {
-        "scenario": scenario.source,
-        "method": method.value,
-        "duration_s": schedule.duration,
-        "jerk_limited": schedule.jerk_limited,
-        "verified": report.passed,
-        "worst_margins": report.summary(),
-        "notes": list(schedule.notes),
-        "fallback_reason": schedule.fallback_reason,
-        "solver": None
-        if info is None
-        else {
-            "solve_time_s": info.solve_time,
-            "built": info.built,
-            "iterations": info.iterations,
-            "status": info.status,
-            "source": info.source,
-        },
-        "route": route_summary(route),
-        "files": written,
-    }
-
-
-def _print_schedule_summary(summary: dict) -> None:
-    margins = summary["worst_margins"]
-    print(f"scenario: {summary['scenario']}")
-    print(
-        f"method: {summary['method']}  duration: {summary['duration_s']:.3f} s  "
-        f"verified: {summary['verified']}"
-    )
-    print(
-        f"worst margins: separation {margins['min_separation_m']:.4f} m "
-        f"(margin {margins['separation_margin_m']:.4f} m), |v|/limit {max(margins['velocity_ratio']):.6f}, "
-        f"|a|/limit {max(margins['acceleration_ratio']):.6f}"
-        + (
-            f", |j|/limit {max(margins['jerk_ratio']):.6f}"
-            if summary["jerk_limited"]
-            else ", jerk not limited"
-        )
-    )
-    for note in summary["notes"]:
-        print(f"note: {note}")
-    if summary["fallback_reason"]:
-        print(f"warning: fell back to the exact schedule: {summary['fallback_reason']}")
-    for path in summary["files"]:
-        print(f"wrote {path}")
-
-
 def _command_schedule(args: argparse.Namespace) -> int:
     scenario = _load(args.scenario)
-    options = _csv_options(args)
-    summary = run_schedule(
-        scenario, method=args.method, csv_dir=args.csv, plot_dir=args.plot, csv_options=options
-    )
-    if args.json:
-        print(json.dumps(summary, indent=2))
-    else:
-        _print_schedule_summary(summary)
+    outputs = Outputs(csv_dir=args.csv, plot_dir=args.plot, csv=_csv_options(args))
+    summary = run(scenario, method=args.method, outputs=outputs).summary()
+    print(json.dumps(summary, indent=2) if args.json else format_run(summary))
     return EXIT_OK
 
 
 def _command_demo(args: argparse.Namespace) -> int:
     scenario = default_scenario()
-    output = args.output
+    result = run(scenario, method=args.method, outputs=Outputs(csv_dir=args.output, plot_dir=args.output))
     print(f"Demo: the built-in scenario {scenario.source} (two AGVs swap ends of legs A and B).")
-    print(format_route(_plan_scenario(scenario)))
-    summary = run_schedule(scenario, method=args.method, csv_dir=output, plot_dir=output)
-    _print_schedule_summary(summary)
-    print(f"CSV profiles and plots are in {output}/")
+    print(format_route(result.route))
+    print(format_run(result.summary()))
+    print(f"CSV profiles and plots are in {args.output}/")
     return EXIT_OK
+
+
+def _add_method(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument(
+        "--method",
+        default=METHODS.default,
+        metavar="|".join(METHODS.names),
+        help=f"timing method; {METHODS.help()}",
+    )
 
 
 def _add_csv_options(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--sample-period", type=float, default=0.01, help="seconds between CSV rows (0.01)")
     parser.add_argument("--delimiter", default=";", help="CSV field separator (';'); 'tab' for a tab")
     parser.add_argument("--decimal", default=".", choices=[".", ","], help="decimal mark ('.')")
-    parser.add_argument("--units", default="m", choices=["m", "mm"], help="length unit of the CSV (m)")
+    parser.add_argument(
+        "--units", default="m", choices=[u.value for u in Units], help="length unit of the CSV (m)"
+    )
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -201,7 +101,7 @@ def build_parser() -> argparse.ArgumentParser:
 
     demo = commands.add_parser("demo", help="run the built-in swap scenario end to end")
     demo.add_argument("--output", default="trajgen-demo", help="folder for CSV and plots (trajgen-demo)")
-    demo.add_argument("--method", default="optimal", help="exact, toppra or optimal (%(default)s)")
+    _add_method(demo)
     demo.set_defaults(run=_command_demo)
 
     plan_parser = commands.add_parser("plan", help="print the planner's route for a scenario file")
@@ -211,7 +111,7 @@ def build_parser() -> argparse.ArgumentParser:
 
     schedule = commands.add_parser("schedule", help="schedule, verify and export a scenario")
     schedule.add_argument("scenario", help="scenario TOML file")
-    schedule.add_argument("--method", default="optimal", help="exact, toppra or optimal (%(default)s)")
+    _add_method(schedule)
     schedule.add_argument("--csv", metavar="DIR", help="write DIR/<vehicle name>.csv per vehicle")
     schedule.add_argument(
         "--plot", metavar="DIR", help="write DIR/speed.png, DIR/separation.png, DIR/coordination.png"

@@ -10,6 +10,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from trajgen.values import ArrayValue, readonly
+
 __all__ = ["PiecewiseCubic", "rest_to_rest_time", "scurve_phases", "trapezoid_phases"]
 
 
@@ -86,8 +88,8 @@ def rest_to_rest_time(distance: float, v_max: float, a_max: float, j_max: float 
     return sum(d for d, _ in scurve_phases(distance, v_max, a_max, j_max))
 
 
-@dataclass(frozen=True, slots=True)
-class PiecewiseCubic:
+@dataclass(frozen=True, slots=True, eq=False)
+class PiecewiseCubic(ArrayValue):
     """A trajectory ``p(t)`` whose jerk is constant between breakpoints.
 
     Attributes
@@ -104,6 +106,11 @@ class PiecewiseCubic:
     times: np.ndarray
     initial: np.ndarray
     jerk: np.ndarray
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "times", readonly(self.times, float))
+        object.__setattr__(self, "initial", readonly(self.initial, float))
+        object.__setattr__(self, "jerk", readonly(self.jerk, float))
 
     @classmethod
     def from_phases(
@@ -174,6 +181,38 @@ class PiecewiseCubic:
                 np.where(t >= self.times[-1], 0.0, j),  # no jerk once the motion has ended
             ]
         )
+
+    def time_at(self, position: float) -> float:
+        """The first time at which a monotone profile reaches ``position`` (metres), seconds.
+
+        The profile must not reverse (its velocity keeps one sign); the
+        position is clipped to the profile's range. Solved per interval by
+        bisection on the cubic, to round-off.
+        """
+        nodes = np.append(self.initial[:, 0], self.end_state()[0])
+        rising = nodes[-1] >= nodes[0]
+        low, high = (nodes[0], nodes[-1]) if rising else (nodes[-1], nodes[0])
+        target = min(max(float(position), low), high)
+        ordered = nodes if rising else -nodes
+        k = int(
+            np.clip(
+                np.searchsorted(ordered, target if rising else -target, side="left") - 1,
+                0,
+                len(self.jerk) - 1,
+            )
+        )
+        p0, v0, a0 = self.initial[k]
+        j = self.jerk[k]
+        sign = 1.0 if rising else -1.0
+        left, right = 0.0, float(self.times[k + 1] - self.times[k])
+        for _ in range(100):
+            middle = 0.5 * (left + right)
+            value = p0 + middle * (v0 + middle * (a0 / 2.0 + middle * j / 6.0))
+            if sign * (value - target) < 0.0:
+                left = middle
+            else:
+                right = middle
+        return float(self.times[k] + 0.5 * (left + right))
 
     def end_state(self) -> tuple[float, float, float]:
         """Position, velocity, acceleration at the end."""

@@ -3,12 +3,13 @@
 from __future__ import annotations
 
 import random
+from dataclasses import dataclass
 
-from limits import Limits
+from limits import Limits, VehicleLimits
 from topology import Configuration, Position, YGraph
 from trajgen.scenario import Scenario
 
-__all__ = ["random_configuration", "random_position", "random_scenarios"]
+__all__ = ["ReferenceSet", "random_configuration", "random_position", "random_scenarios", "reference_sets"]
 
 
 def random_position(rng: random.Random, track: YGraph) -> Position:
@@ -49,3 +50,55 @@ def random_scenarios(count: int, *, seed: int, track: YGraph, limits: Limits) ->
         goal = random_configuration(rng, track, limits.min_separation)
         scenarios.append(Scenario(track, limits, ("agv1", "agv2"), start, goal, f"<random {seed}:{k}>"))
     return scenarios
+
+
+@dataclass(frozen=True, slots=True)
+class ReferenceSet:
+    """A named set of scenarios on one track with one set of limits (the benchmark's sets).
+
+    Attributes
+    ----------
+    label : str
+    track : YGraph
+    limits : Limits
+    scenarios : tuple of (str, Configuration, Configuration)
+        Name, start and goal of each scenario.
+    """
+
+    label: str
+    track: YGraph
+    limits: Limits
+    scenarios: tuple[tuple[str, Configuration, Configuration], ...]
+
+
+def _swaps(track: YGraph) -> tuple[tuple[str, Configuration, Configuration], ...]:
+    out = []
+    for i, j in ((0, 1), (1, 2), (2, 0)):
+        start = Configuration(track.endpoint(track.names[i]), track.endpoint(track.names[j]))
+        out.append((f"swap {track.names[i]}{track.names[j]}", start, start.swapped()))
+    return tuple(out)
+
+
+def reference_sets(random_count: int = 50) -> tuple[ReferenceSet, ...]:
+    """The reference scenario sets of ``benchmarks/bench_optimal.py`` (limits 1.0/0.5/1.0, separation 1.5 m).
+
+    (a) the three swaps on legs (10, 10, 10) m; (b) the three swaps on
+    (12, 8, 15) m; (c) ``random_count`` seeded random start/goal pairs on
+    (12, 8, 15) m; (d) set (c) with vehicle 2 limited to 0.7 m/s, 0.35 m/s²,
+    0.6 m/s³.
+    """
+    agv = VehicleLimits(1.0, 0.5, 1.0)
+    same = Limits(vehicles=(agv, agv), min_separation=1.5)
+    mixed = Limits(vehicles=(agv, VehicleLimits(0.7, 0.35, 0.6)), min_separation=1.5)
+    equal = YGraph({"A": 10.0, "B": 10.0, "C": 10.0})
+    unequal = YGraph({"A": 12.0, "B": 8.0, "C": 15.0})
+    randoms = tuple(
+        (f"random {k}", s.start, s.goal)
+        for k, s in enumerate(random_scenarios(random_count, seed=2026, track=unequal, limits=same))
+    )
+    return (
+        ReferenceSet("a", equal, same, _swaps(equal)),
+        ReferenceSet("b", unequal, same, _swaps(unequal)),
+        ReferenceSet("c", unequal, same, randoms),
+        ReferenceSet("d", unequal, mixed, randoms),
+    )

@@ -30,8 +30,8 @@ from importlib import resources
 from pathlib import Path
 
 from limits import Limits, VehicleLimits
-from topology import Configuration, Position, YGraph
-from topology.errors import InputError, ScenarioError
+from topology import Configuration, Position, Route, YGraph, plan
+from trajgen.errors import InputError, ScenarioError
 
 __all__ = ["DEFAULT_SCENARIO_NAME", "Scenario", "default_scenario", "load_scenario", "parse_scenario"]
 
@@ -73,6 +73,10 @@ class Scenario:
     start: Configuration
     goal: Configuration
     source: str
+
+    def plan(self) -> Route:
+        """The planner's route from start to goal, keeping the scenario's minimum separation."""
+        return plan(self.track, self.start, self.goal, min_separation=self.limits.min_separation)
 
 
 def _check_keys(table: dict, allowed: dict[str, bool], where: str, source: str) -> None:

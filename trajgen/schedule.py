@@ -1,158 +1,104 @@
-"""Schedules: the two vehicles' motion over time along a planned route.
+"""Schedules: the two vehicles' motion over time along a planned route (the data model).
 
 A :class:`Schedule` is a sequence of :class:`Section` s in time. Within a
 section each vehicle's *signed axis* (its odometer along its own path,
 positive in the direction of its first move, decreasing when it reverses)
-maps monotonically onto the track, so the track position at any time follows
-from the axis value. Methods:
-
-- ``exact``: the planner's route followed exactly; along each straight piece
-  of the route (in the plane of the two axes) a time-optimal jerk-limited
-  rest-to-rest S-curve under both vehicles' limits scaled to the piece.
-- ``toppra``: corners rounded where safe, then TOPPRA (velocity and
-  acceleration limits; jerk not limited). See :mod:`trajgen.toppra_timing`.
+maps monotonically onto the track (:class:`AxisMap`), so the track position
+at any time follows from the axis value. The methods that compute schedules
+implement :class:`TimingMethod`; they live in :mod:`trajgen.methods`.
 """
 
 from __future__ import annotations
 
-import logging
+import abc
+import enum
 from dataclasses import dataclass, field
+from typing import ClassVar
 
 import numpy as np
 
 from limits import Limits
-from topology import Configuration, Route
-from topology.errors import InputError
-from topology.graph import _finite_real
-from topology.options import Option
-from trajgen.profiles import PiecewiseCubic, scurve_phases, trapezoid_phases
+from topology import JUNCTION_INDEX, Configuration, Position, Route
+from topology.validation import finite_real
+from trajgen.errors import InputError
+from trajgen.profiles import PiecewiseCubic
+from trajgen.values import ArrayValue, readonly
 
 __all__ = [
     "AxisMap",
-    "Method",
-    "RouteAxes",
+    "CubicKinematics",
+    "FallbackReason",
+    "Kinematics",
+    "MethodInfo",
     "Schedule",
     "ScheduleState",
     "Section",
+    "TimingMethod",
     "check_period",
-    "exact_schedule",
-    "make_schedule",
-    "route_axes",
 ]
-
-logger = logging.getLogger(__name__)
-
-_AT_JUNCTION = -1
-
-
-class Method(Option):
-    """How a route is turned into a schedule."""
-
-    EXACT = "exact"  #: the route exactly, one straight piece at a time, jerk-limited S-curves
-    TOPPRA = "toppra"  #: rounded corners where safe, TOPPRA velocity/acceleration-limited timing
-    OPTIMAL = "optimal"  #: time-optimal jerk-limited schedule in the route's homotopy class (CasADi)
 
 
 def check_period(period: float) -> float:
-    """Return a sample period in seconds if it is finite and > 0, else raise InputError."""
-    value = _finite_real(period, "sample period (seconds)", InputError)
+    """Return a sample period in seconds if it is finite and > 0, else raise InputError.
+
+    Examples
+    --------
+    >>> check_period(0.01)
+    0.01
+    """
+    value = finite_real(period, "sample period (seconds)", InputError)
     if value <= 0.0:
         raise InputError(f"sample period must be > 0 s, got {value!r}")
     return value
 
 
-# -- the route in the plane of the two signed axes ---------------------------------------------------
+class FallbackReason(enum.Enum):
+    """Why a method returned the ``exact`` schedule in place of its own."""
+
+    SOLVER_FAILED = "solver-failed"  #: no solver converged
+    VERIFICATION_FAILED = "verification-failed"  #: the solution failed the verifier
+    SETUP_FAILED = "setup-failed"  #: the problem could not be set up (initial guess, parameters)
 
 
-@dataclass(frozen=True, slots=True)
-class RouteAxes:
-    """The route's waypoints expressed on the vehicles' signed axes.
+class MethodInfo(abc.ABC):
+    """Diagnostics a timing method attaches to its schedules."""
 
-    Attributes
-    ----------
-    axes : ndarray, shape (n, 2)
-        Signed axis of vehicle 1 and vehicle 2 at each waypoint, metres.
-    legs : ndarray of int, shape (n - 1, 2)
-        Leg index of each vehicle in each segment (-1: parked at the junction).
-    s_start : ndarray, shape (n - 1, 2)
-        Distance from the junction at the start of each segment, metres.
-    outward : ndarray of int, shape (n - 1, 2)
-        ``ds/daxis`` of each vehicle in each segment: +1, -1 (0 if it does not move).
+    __slots__ = ()
+
+    @abc.abstractmethod
+    def summary(self) -> dict:
+        """JSON-ready diagnostics."""
+
+
+class TimingMethod(abc.ABC):
+    """Interface of the timing methods: turn ``(route, limits)`` into a :class:`Schedule`.
+
+    Implementations are frozen dataclasses that carry their own options; the
+    registry :data:`trajgen.methods.METHODS` lists them.
     """
 
-    axes: np.ndarray
-    legs: np.ndarray
-    s_start: np.ndarray
-    outward: np.ndarray
+    __slots__ = ()
+
+    #: Name of the method (``--method NAME`` on the command line).
+    name: ClassVar[str]
+    #: One line for the help texts.
+    summary: ClassVar[str]
+
+    @property
+    @abc.abstractmethod
+    def jerk_limited(self) -> bool:
+        """Whether the method's schedules limit jerk."""
+
+    @abc.abstractmethod
+    def schedule(self, route: Route, limits: Limits) -> Schedule:
+        """Time-parameterize ``route`` under ``limits`` (unverified: see :func:`trajgen.verify.certify`)."""
+
+    def __str__(self) -> str:
+        return self.name
 
 
-def route_axes(route: Route) -> RouteAxes:
-    """Signed axes of both vehicles along a route (positive: direction of first move)."""
-    tuples = route._tuples
-    n = len(tuples)
-    axes = np.zeros((n, 2))
-    legs = np.full((max(n - 1, 0), 2), _AT_JUNCTION, dtype=int)
-    s_start = np.zeros((max(n - 1, 0), 2))
-    outward = np.zeros((max(n - 1, 0), 2), dtype=int)
-    for vehicle in range(2):
-        heading = 0  # +1 moving outward, -1 inward (toward the junction), in the current leg
-        heading_leg = _AT_JUNCTION
-        sign = 1  # axis direction relative to the vehicle's current direction of travel
-        started = False
-        for k in range(n - 1):
-            leg_a, s_a = tuples[k][2 * vehicle], tuples[k][2 * vehicle + 1]
-            leg_b, s_b = tuples[k + 1][2 * vehicle], tuples[k + 1][2 * vehicle + 1]
-            leg = leg_a if leg_a != _AT_JUNCTION else leg_b
-            legs[k, vehicle] = leg
-            s_start[k, vehicle] = s_a
-            step = s_b - s_a
-            if step == 0.0:
-                axes[k + 1, vehicle] = axes[k, vehicle]
-                continue
-            direction = 1 if step > 0 else -1
-            if started:
-                through_junction = heading == -1 and direction == 1 and leg != heading_leg
-                if direction != heading and not through_junction:
-                    sign = -sign  # the vehicle reverses
-            started = True
-            heading, heading_leg = direction, leg
-            # axis moves by sign * |step|; ds/daxis = direction * sign
-            axes[k + 1, vehicle] = axes[k, vehicle] + sign * abs(step)
-            outward[k, vehicle] = direction * sign
-    return RouteAxes(axes=axes, legs=legs, s_start=s_start, outward=outward)
-
-
-def straight_pieces(axes: np.ndarray) -> list[tuple[int, int]]:
-    """Maximal runs of route segments along one direction of the axis plane.
-
-    Returns
-    -------
-    list of (first waypoint, last waypoint)
-        Waypoint index ranges; the vehicles come to rest at every range end.
-    """
-    pieces: list[tuple[int, int]] = []
-    n = len(axes)
-    k = 0
-    while k < n - 1:
-        direction = axes[k + 1] - axes[k]
-        end = k + 1
-        while end < n - 1:
-            following = axes[end + 1] - axes[end]
-            cross = direction[0] * following[1] - direction[1] * following[0]
-            scale = np.linalg.norm(direction) * np.linalg.norm(following)
-            if abs(cross) > 1e-12 * scale or float(np.dot(direction, following)) <= 0.0:
-                break
-            end += 1
-        pieces.append((k, end))
-        k = end
-    return pieces
-
-
-# -- sections and schedules ---------------------------------------------------------------------------
-
-
-@dataclass(frozen=True, slots=True)
-class AxisMap:
+@dataclass(frozen=True, slots=True, eq=False)
+class AxisMap(ArrayValue):
     """Where one vehicle is on the track as a function of its signed axis, within one section.
 
     Sub-ranges of the axis, each on one leg, in the order the vehicle drives
@@ -163,7 +109,7 @@ class AxisMap:
     axis_start, axis_end : ndarray, shape (r,)
         Axis at the start and end of each sub-range, metres.
     legs : ndarray of int, shape (r,)
-        Leg index (-1: at the junction).
+        Leg index (``JUNCTION_INDEX`` at the junction).
     s_start : ndarray, shape (r,)
         Distance from the junction at ``axis_start``, metres.
     outward : ndarray of int, shape (r,)
@@ -176,6 +122,21 @@ class AxisMap:
     s_start: np.ndarray
     outward: np.ndarray
 
+    def __post_init__(self) -> None:
+        for name, dtype in (
+            ("axis_start", float),
+            ("axis_end", float),
+            ("legs", int),
+            ("s_start", float),
+            ("outward", int),
+        ):
+            object.__setattr__(self, name, readonly(np.atleast_1d(getattr(self, name)), dtype))
+
+    @classmethod
+    def parked(cls, axis: float, leg: int, s: float) -> AxisMap:
+        """A vehicle that does not move in the section, at axis value ``axis``."""
+        return cls(np.array([axis]), np.array([axis]), np.array([leg]), np.array([s]), np.array([0]))
+
     def locate(self, axis: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Leg index and distance from the junction for axis values, shape (n,) each.
 
@@ -187,38 +148,55 @@ class AxisMap:
         axis = np.asarray(axis, dtype=float)
         if len(self.legs) == 1:
             s = np.maximum(self.s_start[0] + self.outward[0] * (axis - self.axis_start[0]), 0.0)
-            return np.where(s > 0.0, self.legs[0], _AT_JUNCTION), s
+            return np.where(s > 0.0, self.legs[0], JUNCTION_INDEX), s
         low = np.minimum(self.axis_start, self.axis_end)
         high = np.maximum(self.axis_start, self.axis_end)
         gap = np.maximum(low[:, None] - axis[None, :], 0.0) + np.maximum(axis[None, :] - high[:, None], 0.0)
         r = np.argmin(gap, axis=0)
         s = self.s_start[r] + self.outward[r] * (np.clip(axis, low[r], high[r]) - self.axis_start[r])
         s = np.maximum(s, 0.0)
-        legs = np.where(s > 0.0, self.legs[r], _AT_JUNCTION)
+        legs = np.where(s > 0.0, self.legs[r], JUNCTION_INDEX)
         return legs, s
 
+    def flipped(self) -> AxisMap:
+        """The same map for the axis of opposite sign."""
+        return AxisMap(-self.axis_start, -self.axis_end, self.legs, self.s_start, -self.outward)
 
-class Kinematics:
+
+class Kinematics(abc.ABC):
     """Interface of a section's motion: both vehicles' signed-axis kinematics over local time."""
 
-    duration: float
+    __slots__ = ()
 
+    @property
+    @abc.abstractmethod
+    def duration(self) -> float:
+        """Length of the section, seconds."""
+
+    @abc.abstractmethod
     def evaluate(self, t: np.ndarray) -> np.ndarray:
         """Axis, velocity, acceleration, jerk of both vehicles; shape (2, 4, n). ``t`` in [0, duration]."""
-        raise NotImplementedError
 
 
 @dataclass(frozen=True, slots=True)
 class CubicKinematics(Kinematics):
-    """Both vehicles as piecewise cubics (constant jerk between breakpoints)."""
+    """Both vehicles as piecewise cubics (constant jerk between breakpoints).
+
+    Attributes
+    ----------
+    vehicles : tuple of 2 PiecewiseCubic
+        Signed axis of vehicle 1 and vehicle 2 over the section's local time.
+    """
 
     vehicles: tuple[PiecewiseCubic, PiecewiseCubic]
 
     @property
     def duration(self) -> float:
+        """Length of the section, seconds: the later of the two vehicles' ends."""
         return max(self.vehicles[0].duration, self.vehicles[1].duration)
 
     def evaluate(self, t: np.ndarray) -> np.ndarray:
+        """Axis, velocity, acceleration, jerk of both vehicles; shape (2, 4, n)."""
         return np.stack([profile.evaluate(t) for profile in self.vehicles])
 
 
@@ -246,9 +224,9 @@ class Section:
         return self.kinematics.duration
 
 
-@dataclass(frozen=True, slots=True)
-class ScheduleState:
-    """States of both vehicles at sample times.
+@dataclass(frozen=True, slots=True, eq=False)
+class ScheduleState(ArrayValue):
+    """States of both vehicles at sample times (read-only arrays).
 
     Attributes
     ----------
@@ -257,7 +235,7 @@ class ScheduleState:
     axis, velocity, acceleration, jerk : ndarray, shape (2, n)
         Per vehicle: signed axis (m), its velocity (m/s), acceleration (m/s²), jerk (m/s³).
     leg : ndarray of int, shape (2, n)
-        Leg index (0, 1, 2 in the track's order) or -1 at the junction.
+        Leg index (0, 1, 2 in the track's order) or ``JUNCTION_INDEX`` at the junction.
     s : ndarray, shape (2, n)
         Distance from the junction, metres.
     """
@@ -270,8 +248,12 @@ class ScheduleState:
     leg: np.ndarray
     s: np.ndarray
 
+    def __post_init__(self) -> None:
+        for name in ("t", "axis", "velocity", "acceleration", "jerk", "leg", "s"):
+            getattr(self, name).flags.writeable = False
 
-@dataclass(frozen=True, slots=True)
+
+@dataclass(frozen=True, slots=True, weakref_slot=True)
 class Schedule:
     """A timed motion of both vehicles along a route.
 
@@ -281,33 +263,35 @@ class Schedule:
         The planner's route (its homotopy class is the schedule's).
     limits : Limits
         The vehicle limits and separation it was computed for.
-    method : Method
-        How it was computed.
+    method : TimingMethod
+        The method, with its options, that computed the motion.
     sections : tuple of Section
         Consecutive in time, the first at t = 0.
     jerk_limited : bool
-        Whether the method limits jerk (``toppra`` does not).
+        Whether the motion limits jerk (``toppra`` does not).
     notes : tuple of str
         What the method did that a user should know (e.g. corners rounded).
-    fallback_reason : str or None
-        Set when a method could not deliver and this is the ``exact``
-        schedule in its place; says why.
-    info : object or None
-        Method diagnostics (e.g. :class:`trajgen.optimal.OptimalInfo`).
+    fallback_reason : FallbackReason or None
+        Set when the requested method could not deliver and this is the
+        ``exact`` schedule in its place; ``notes`` say more.
+    info : MethodInfo or None
+        Method diagnostics (e.g. :class:`trajgen.methods.optimal.OptimalInfo`).
     """
 
     route: Route
     limits: Limits
-    method: Method
+    method: TimingMethod
     sections: tuple[Section, ...]
     jerk_limited: bool
     notes: tuple[str, ...] = ()
-    fallback_reason: str | None = None
-    info: object = field(default=None, compare=False)
+    fallback_reason: FallbackReason | None = None
+    info: MethodInfo | None = field(default=None, compare=False)
     _starts: np.ndarray = field(init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
-        object.__setattr__(self, "_starts", np.array([section.start_time for section in self.sections]))
+        object.__setattr__(self, "sections", tuple(self.sections))
+        object.__setattr__(self, "notes", tuple(self.notes))
+        object.__setattr__(self, "_starts", readonly([section.start_time for section in self.sections]))
 
     @property
     def duration(self) -> float:
@@ -350,135 +334,13 @@ class Schedule:
         return self.state(times)
 
     def configuration_at(self, t: float) -> Configuration:
-        """The two vehicles' positions at time ``t`` as a Configuration."""
-        from topology import Position
-
+        """The two vehicles' positions at time ``t`` (seconds) as a Configuration."""
         state = self.state(t)
         graph = self.route.graph
         positions = []
         for v in range(2):
             leg, s = int(state.leg[v, 0]), float(state.s[v, 0])
-            if leg >= 0 and 0.0 < s - graph.lengths[leg] <= 1e-6:
+            if leg != JUNCTION_INDEX and 0.0 < s - graph.lengths[leg] <= 1e-6:
                 s = graph.lengths[leg]  # round-off at a leg's end; larger overruns still raise
-            positions.append(Position(graph.names[leg] if leg >= 0 else None, s))
+            positions.append(Position(graph.names[leg] if leg != JUNCTION_INDEX else None, s))
         return Configuration(*positions)
-
-
-def _piece_maps(axes: RouteAxes, first: int, last: int) -> tuple[AxisMap, AxisMap]:
-    """Axis maps of both vehicles over waypoints first..last of a route."""
-    maps = []
-    for vehicle in range(2):
-        moving = [k for k in range(first, last) if axes.outward[k, vehicle] != 0]
-        if not moving:  # parked for the whole section
-            k = first
-            leg = axes.legs[k, vehicle] if axes.s_start[k, vehicle] > 0 else _AT_JUNCTION
-            value = axes.axes[first, vehicle]
-            maps.append(
-                AxisMap(
-                    np.array([value]),
-                    np.array([value]),
-                    np.array([leg]),
-                    np.array([axes.s_start[k, vehicle]]),
-                    np.array([0]),
-                )
-            )
-            continue
-        maps.append(
-            AxisMap(
-                axis_start=axes.axes[moving, vehicle],
-                axis_end=axes.axes[[k + 1 for k in moving], vehicle],
-                legs=axes.legs[moving, vehicle],
-                s_start=axes.s_start[moving, vehicle],
-                outward=axes.outward[moving, vehicle],
-            )
-        )
-    return maps[0], maps[1]
-
-
-def _scaled_limits(delta: np.ndarray, limits: Limits, *, jerk: bool) -> tuple[float, float, float | None]:
-    """Limits on the progress fraction along a straight piece moving the axes by ``delta``."""
-    v = a = j = np.inf
-    for vehicle, move in enumerate(np.abs(delta)):
-        if move > 0.0:
-            vehicle_limits = limits.vehicles[vehicle]
-            v = min(v, vehicle_limits.max_velocity / move)
-            a = min(a, vehicle_limits.max_acceleration / move)
-            j = min(j, vehicle_limits.max_jerk / move)
-    return float(v), float(a), (float(j) if jerk else None)
-
-
-def piece_profiles(
-    start: np.ndarray, end: np.ndarray, limits: Limits, *, jerk: bool = True
-) -> tuple[PiecewiseCubic, PiecewiseCubic]:
-    """Both axes along one straight piece, rest to rest, time-optimal under the scaled limits.
-
-    Parameters
-    ----------
-    start, end : ndarray, shape (2,)
-        Axes of both vehicles at the piece's ends, metres.
-    jerk : bool
-        S-curve (jerk-limited) if True, else trapezoid (velocity and acceleration only).
-    """
-    delta = end - start
-    v, a, j = _scaled_limits(delta, limits, jerk=jerk)
-    if jerk:
-        phases = [(d, np.nan, value) for d, value in scurve_phases(1.0, v, a, j)]
-    else:
-        phases = [(d, value, 0.0) for d, value in trapezoid_phases(1.0, v, a)]
-    profiles = []
-    for vehicle in range(2):
-        scaled = [(d, acc * delta[vehicle], jk * delta[vehicle]) for d, acc, jk in phases]
-        profiles.append(PiecewiseCubic.from_phases(float(start[vehicle]), scaled, end=float(end[vehicle])))
-    return profiles[0], profiles[1]
-
-
-def exact_schedule(route: Route, limits: Limits, *, jerk: bool = True) -> Schedule:
-    """The route followed exactly, one straight piece at a time, rest to rest.
-
-    Parameters
-    ----------
-    route : Route
-    limits : Limits
-    jerk : bool, optional
-        Jerk-limited S-curves (default). ``False`` gives velocity/acceleration
-        limited trapezoids, the reference that ``toppra`` must never be slower than.
-    """
-    axes = route_axes(route)
-    sections = []
-    clock = 0.0
-    for first, last in straight_pieces(axes.axes) or [(0, 0)]:
-        profiles = piece_profiles(axes.axes[first], axes.axes[last], limits, jerk=jerk)
-        maps = _piece_maps(axes, first, last) if last > first else _parked_maps(route)
-        section = Section(clock, CubicKinematics(profiles), maps)
-        sections.append(section)
-        clock += section.duration
-    return Schedule(route, limits, Method.EXACT, tuple(sections), jerk_limited=jerk)
-
-
-def _parked_maps(route: Route) -> tuple[AxisMap, AxisMap]:
-    """Axis maps for a route that does not move (start is goal on the boundary)."""
-    c = route._tuples[0]
-    return tuple(
-        AxisMap(
-            np.zeros(1), np.zeros(1), np.array([c[2 * v]]), np.array([c[2 * v + 1]]), np.zeros(1, dtype=int)
-        )
-        for v in range(2)
-    )  # type: ignore[return-value]
-
-
-def make_schedule(route: Route, limits: Limits, *, method: Method | str = Method.OPTIMAL) -> Schedule:
-    """Time-parameterize a route with the chosen method (unverified; see :func:`trajgen.verify.verify`).
-
-    The default, ``optimal``, is the fastest jerk-limited schedule in the route's
-    homotopy class (or the ``exact`` schedule, flagged, if its solvers fail).
-    """
-    method = Method.lookup(method) if not isinstance(method, Method) else method
-    if method is Method.EXACT:
-        return exact_schedule(route, limits)
-    if method is Method.OPTIMAL:
-        from trajgen.optimal import optimal_schedule
-
-        return optimal_schedule(route, limits)
-    from trajgen.toppra_timing import toppra_schedule
-
-    return toppra_schedule(route, limits)

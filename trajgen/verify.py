@@ -1,5 +1,10 @@
 """Independent verifier: nothing leaves the library unless it passes.
 
+Each schedule object is verified once: the report is kept (for the last
+:data:`_REMEMBERED` schedules) and returned again for the same schedule and
+period. :func:`certify` turns a passing schedule into a :class:`VerifiedSchedule`,
+the only kind of schedule that exporters and plots accept.
+
 The verifier re-samples a schedule on a fine time grid (1 ms or finer, plus
 every section boundary) and checks, from the sampled track positions and
 kinematics alone:
@@ -16,23 +21,37 @@ kinematics alone:
 
 Tolerance: 1e-6 relative for every method. The ``toppra`` method enforces its
 limits at grid points only and therefore plans with a small headroom
-(:data:`trajgen.toppra_timing.HEADROOM`), so the true limits hold between
+(:data:`trajgen.methods.toppra.HEADROOM`), so the true limits hold between
 grid points too; the verifier checks them at the same 1e-6.
 """
 
 from __future__ import annotations
 
+import collections
 import logging
+import threading
+import time
+import weakref
 from dataclasses import dataclass
 
 import numpy as np
 
-from topology.arrays import region_keys, track_distance
-from topology.errors import VerificationError
-from topology.route import reduce_regions
+from topology import Region, reduce_regions
+from topology.indexed import JUNCTION_INDEX, region_keys, track_distance
+from topology.validation import finite_real
+from trajgen.errors import InputError, UnverifiedScheduleError, VerificationError
 from trajgen.schedule import Schedule
 
-__all__ = ["POSITION_TOLERANCE", "RELATIVE_TOLERANCE", "VerificationReport", "verified", "verify"]
+__all__ = [
+    "MAX_PERIOD",
+    "POSITION_TOLERANCE",
+    "RELATIVE_TOLERANCE",
+    "VerificationReport",
+    "VerifiedSchedule",
+    "certify",
+    "require_verified",
+    "verify",
+]
 
 logger = logging.getLogger(__name__)
 
@@ -110,12 +129,50 @@ class VerificationReport:
         }
 
 
+@dataclass(frozen=True, slots=True)
+class VerifiedSchedule:
+    """A schedule that passed the verifier, with its report: what exporters and plots accept.
+
+    Made by :func:`certify`; constructing one from a failing report raises.
+
+    Attributes
+    ----------
+    schedule : Schedule
+    report : VerificationReport
+        The passed report.
+    """
+
+    schedule: Schedule
+    report: VerificationReport
+
+    def __post_init__(self) -> None:
+        if not isinstance(self.schedule, Schedule) or not isinstance(self.report, VerificationReport):
+            raise UnverifiedScheduleError("a VerifiedSchedule holds a Schedule and its VerificationReport")
+        if not self.report.passed:
+            raise VerificationError("schedule failed verification: " + "; ".join(self.report.failures))
+
+
 def _sample_times(schedule: Schedule, period: float) -> np.ndarray:
     duration = schedule.duration
     count = max(int(np.ceil(duration / period)), 1)
     grid = np.linspace(0.0, duration, count + 1)
     boundaries = np.array([section.start_time for section in schedule.sections] + [duration])
     return np.unique(np.concatenate([grid, boundaries]))
+
+
+#: Reports kept for schedules already verified (by identity and period).
+_REMEMBERED = 64
+_reports: collections.OrderedDict[tuple[int, float], tuple[weakref.ref, VerificationReport]] = (
+    collections.OrderedDict()
+)
+_reports_lock = threading.Lock()
+
+
+def _check_period(period: object) -> float:
+    value = finite_real(period, "verifier sample period (seconds)", InputError)
+    if not 0.0 < value <= MAX_PERIOD:
+        raise InputError(f"verifier sample period must be > 0 s and at most {MAX_PERIOD:g} s, got {value!r}")
+    return value
 
 
 def verify(schedule: Schedule, *, period: float = MAX_PERIOD) -> VerificationReport:
@@ -125,13 +182,44 @@ def verify(schedule: Schedule, *, period: float = MAX_PERIOD) -> VerificationRep
     ----------
     schedule : Schedule
     period : float, optional
-        Sample period in seconds, at most 1e-3 (finer is allowed).
+        Sample period in seconds, ``0 < period <= 1e-3``.
 
     Returns
     -------
     VerificationReport
+        The same report object for the same schedule and period, computed once.
+
+    Raises
+    ------
+    InputError
+        ``period`` not finite, not > 0 or above 1 ms; ``schedule`` not a Schedule.
     """
-    period = min(float(period), MAX_PERIOD)
+    period = _check_period(period)
+    if not isinstance(schedule, Schedule):
+        raise InputError(f"verify expects a Schedule, got {type(schedule).__name__}")
+    key = (id(schedule), period)
+    with _reports_lock:
+        remembered = _reports.get(key)
+        if remembered is not None and remembered[0]() is schedule:
+            _reports.move_to_end(key)
+            return remembered[1]
+    began = time.perf_counter()
+    report = _verify(schedule, period)
+    logger.debug(
+        "verified a %s schedule (%d samples) in %.1f ms: %s",
+        schedule.method,
+        report.samples,
+        1e3 * (time.perf_counter() - began),
+        "passed" if report.passed else "FAILED",
+    )
+    with _reports_lock:
+        _reports[key] = (weakref.ref(schedule), report)
+        while len(_reports) > _REMEMBERED:
+            _reports.popitem(last=False)
+    return report
+
+
+def _verify(schedule: Schedule, period: float) -> VerificationReport:
     route = schedule.route
     graph = route.graph
     limits = schedule.limits
@@ -150,7 +238,8 @@ def verify(schedule: Schedule, *, period: float = MAX_PERIOD) -> VerificationRep
         failures.append(f"vehicles collide at t={state.t[worst]:.4f} s")
 
     lengths = np.array(graph.lengths)
-    overrun = np.where(state.leg >= 0, state.s - lengths[np.maximum(state.leg, 0)], 0.0)
+    on_leg = state.leg != JUNCTION_INDEX
+    overrun = np.where(on_leg, state.s - lengths[np.where(on_leg, state.leg, 0)], 0.0)
     worst_overrun = float(overrun.max())
     if worst_overrun > TRACK_END_TOLERANCE:
         vehicle, k = np.unravel_index(int(np.argmax(overrun)), overrun.shape)
@@ -187,7 +276,7 @@ def verify(schedule: Schedule, *, period: float = MAX_PERIOD) -> VerificationRep
     for label, index, expected in (("start", 0, route.start), ("goal", -1, route.goal)):
         error = 0.0
         for vehicle, position in enumerate(expected):
-            leg = -1 if position.leg is None else graph.index(position.leg)
+            leg = JUNCTION_INDEX if position.leg is None else graph.index(position.leg)
             error += float(
                 track_distance(
                     np.array([state.leg[vehicle, index]]),
@@ -223,18 +312,13 @@ def verify(schedule: Schedule, *, period: float = MAX_PERIOD) -> VerificationRep
                 f"(faster than its max_velocity)"
             )
 
-    expected_regions = tuple(
-        (graph.index(r.first_leg), graph.index(r.second_leg), r.nearer or 0) for r in route.regions
-    )
+    expected_regions = route.region_keys
     sampled_regions = reduce_regions(region_keys(state.leg[0], state.s[0], state.leg[1], state.s[1]))
     regions_match = sampled_regions == expected_regions
     if not regions_match:
-        names = graph.names
 
         def show(keys):
-            return " ".join(
-                f"T({names[a]},{n})" if a == b else f"Q({names[a]},{names[b]})" for a, b, n in keys
-            )
+            return " ".join(str(Region.from_key(graph, key)) for key in keys)
 
         failures.append(
             f"homotopy class differs: schedule visits [{show(sampled_regions)}], "
@@ -260,8 +344,29 @@ def verify(schedule: Schedule, *, period: float = MAX_PERIOD) -> VerificationRep
     return report
 
 
-def verified(schedule: Schedule, *, period: float = MAX_PERIOD) -> VerificationReport:
-    """Verify and raise :class:`~topology.errors.VerificationError` unless the schedule passes."""
+def certify(schedule: Schedule, *, period: float = MAX_PERIOD) -> VerifiedSchedule:
+    """Verify ``schedule`` and return it certified, or raise.
+
+    Raises
+    ------
+    VerificationError
+        The schedule failed; the message lists every failure.
+    """
     report = verify(schedule, period=period)
     report.raise_if_failed()
-    return report
+    return VerifiedSchedule(schedule, report)
+
+
+def require_verified(value: object, what: str) -> VerifiedSchedule:
+    """Return ``value`` if it is a :class:`VerifiedSchedule`, else raise naming ``what`` needs one.
+
+    Raises
+    ------
+    UnverifiedScheduleError
+        ``value`` is not a VerifiedSchedule (e.g. a bare Schedule).
+    """
+    if not isinstance(value, VerifiedSchedule):
+        raise UnverifiedScheduleError(
+            f"{what} takes a VerifiedSchedule (from trajgen.certify), got {type(value).__name__}"
+        )
+    return value

@@ -1,27 +1,25 @@
-"""CSV speed profiles for AGV PLCs, one file per vehicle, written atomically.
+"""CSV speed profiles for AGV PLCs, one file per vehicle (the ``generic`` format).
 
-Every schedule is verified (:func:`trajgen.verify.verified`) before a byte is
-written; a schedule that fails raises and nothing is written. All files of one
-export are first written to temporary files in the target directory and only
-then renamed into place, so a failure leaves no partial file behind.
+Renderers return bytes and take only a :class:`~trajgen.verify.VerifiedSchedule`;
+:func:`write_profiles` commits both files together
+(:func:`~trajgen.export.atomic.commit_files`).
 """
 
 from __future__ import annotations
 
-import os
-import tempfile
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
-from topology.errors import InputError, OptionError
-from topology.options import Option
+from topology import JUNCTION_INDEX, Option
+from trajgen.errors import InputError, OptionError
+from trajgen.export.atomic import commit_files
 from trajgen.schedule import Schedule, ScheduleState, check_period
-from trajgen.verify import VerificationReport, verified
+from trajgen.verify import VerifiedSchedule, require_verified
 
-__all__ = ["HEADER_NAMES", "CsvOptions", "Units", "atomic_write_files", "profile_rows", "write_profiles"]
+__all__ = ["HEADER_NAMES", "CsvOptions", "Units", "profile_paths", "render_profile", "write_profiles"]
 
 
 class Units(Option):
@@ -94,11 +92,11 @@ def _xy(schedule: Schedule, state: ScheduleState, vehicle: int) -> tuple[np.ndar
     angles = np.radians(np.array(schedule.route.graph.angles_deg))
     leg = state.leg[vehicle]
     s = state.s[vehicle]
-    angle = angles[np.maximum(leg, 0)]
+    angle = angles[np.where(leg == JUNCTION_INDEX, 0, leg)]
     return s * np.cos(angle), s * np.sin(angle)
 
 
-def profile_rows(schedule: Schedule, vehicle: int, options: CsvOptions) -> list[str]:
+def _rows(schedule: Schedule, vehicle: int, options: CsvOptions) -> list[str]:
     """The lines of one vehicle's CSV profile (header first), without line ends."""
     state = schedule.sample(options.sample_period)
     scale = options.units.scale
@@ -130,46 +128,54 @@ def profile_rows(schedule: Schedule, vehicle: int, options: CsvOptions) -> list[
     return lines
 
 
-def atomic_write_files(contents: dict[Path, bytes]) -> None:
-    """Write several files so that either all appear complete or none is changed.
-
-    Each file is written to a temporary file in its own directory, flushed,
-    then all are renamed into place.
-    """
-    staged: list[tuple[str, Path]] = []
-    try:
-        for path, data in contents.items():
-            path.parent.mkdir(parents=True, exist_ok=True)
-            handle, temporary = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
-            staged.append((temporary, path))
-            os.chmod(temporary, 0o666 & ~_umask())  # mkstemp makes 0600; files are for other tools too
-            with os.fdopen(handle, "wb") as stream:
-                stream.write(data)
-                stream.flush()
-                os.fsync(stream.fileno())
-        for temporary, path in staged:
-            os.replace(temporary, path)
-        staged.clear()
-    finally:
-        for temporary, _ in staged:
-            if os.path.exists(temporary):
-                os.unlink(temporary)
-
-
-def _umask() -> int:
-    mask = os.umask(0)
-    os.umask(mask)
-    return mask
-
-
-def write_profiles(
-    schedule: Schedule, names: Sequence[str], directory: str | Path, *, options: CsvOptions | None = None
-) -> tuple[VerificationReport, tuple[Path, Path]]:
-    """Verify a schedule, then write ``directory/<name>.csv`` for both vehicles.
+def render_profile(verified: VerifiedSchedule, vehicle: int, options: CsvOptions | None = None) -> bytes:
+    """One vehicle's CSV profile: header, one row per sample period, CRLF after every line.
 
     Parameters
     ----------
-    schedule : Schedule
+    verified : VerifiedSchedule
+    vehicle : int
+        0 for vehicle 1, 1 for vehicle 2.
+    options : CsvOptions, optional
+
+    Returns
+    -------
+    bytes
+        ASCII text.
+    """
+    schedule = require_verified(verified, "render_profile").schedule
+    if vehicle not in (0, 1):
+        raise InputError(f"vehicle must be 0 or 1, got {vehicle!r}")
+    return ("\r\n".join(_rows(schedule, vehicle, options or CsvOptions())) + "\r\n").encode("ascii")
+
+
+def profile_paths(names: Sequence[str], directory: str | Path) -> tuple[Path, Path]:
+    """``directory/<name>.csv`` for both vehicles.
+
+    Raises
+    ------
+    InputError
+        Not two distinct names.
+    """
+    if isinstance(names, str) or len(names) != 2 or names[0] == names[1]:
+        raise InputError(f"vehicle names must be two distinct names, got {names!r}")
+    directory = Path(directory)
+    return (directory / f"{names[0]}.csv", directory / f"{names[1]}.csv")
+
+
+def write_profiles(
+    verified: VerifiedSchedule,
+    names: Sequence[str],
+    directory: str | Path,
+    *,
+    options: CsvOptions | None = None,
+) -> tuple[Path, Path]:
+    """Write ``directory/<name>.csv`` for both vehicles, both or neither.
+
+    Parameters
+    ----------
+    verified : VerifiedSchedule
+        From :func:`trajgen.verify.certify`.
     names : sequence of 2 str
         Vehicle names, used as file names.
     directory : path
@@ -178,27 +184,17 @@ def write_profiles(
 
     Returns
     -------
-    (VerificationReport, (Path, Path))
-        The passed verification and the two files written.
+    (Path, Path)
+        The two files written.
 
     Raises
     ------
-    VerificationError
-        The schedule failed verification; nothing was written.
+    UnverifiedScheduleError
+        ``verified`` is not a VerifiedSchedule.
     InputError
-        Bad names or options.
+        Bad names, options or output folder; nothing was written.
     """
-    options = options or CsvOptions()
-    if len(names) != 2 or names[0] == names[1]:
-        raise InputError(f"vehicle names must be two distinct names, got {list(names)!r}")
-    report = verified(schedule)
-    directory = Path(directory)
-    if directory.exists() and not directory.is_dir():
-        raise InputError(f"CSV output {str(directory)!r} exists and is not a directory")
-    paths = (directory / f"{names[0]}.csv", directory / f"{names[1]}.csv")
-    contents = {
-        path: ("\r\n".join(profile_rows(schedule, vehicle, options)) + "\r\n").encode("ascii")
-        for vehicle, path in enumerate(paths)
-    }
-    atomic_write_files(contents)
-    return report, paths
+    require_verified(verified, "write_profiles")
+    paths = profile_paths(names, directory)
+    commit_files({path: render_profile(verified, vehicle, options) for vehicle, path in enumerate(paths)})
+    return paths

@@ -22,48 +22,40 @@ the headroom) takes the trapezoids, so ``toppra`` is never slower than
 from __future__ import annotations
 
 import logging
-from dataclasses import dataclass
+from dataclasses import dataclass, field
+from typing import ClassVar
 
 import numpy as np
 
 from limits import Limits
-from topology import Route
-from topology.arrays import region_keys, track_distance
-from topology.errors import SolverError
-from topology.route import reduce_regions
-from trajgen.schedule import (
-    AxisMap,
-    CubicKinematics,
-    Kinematics,
-    Method,
-    RouteAxes,
-    Schedule,
-    Section,
-    _piece_maps,
-    exact_schedule,
-    piece_profiles,
-    route_axes,
-    straight_pieces,
-)
+from topology import Route, reduce_regions
+from topology.indexed import region_keys, track_distance
+from trajgen.axes import RouteAxes, piece_maps, piece_profiles, route_axes, straight_pieces
+from trajgen.errors import InputError, SolverError
+from trajgen.methods.exact import Exact
+from trajgen.schedule import AxisMap, CubicKinematics, Kinematics, Schedule, Section, TimingMethod
+from trajgen.values import ArrayValue, readonly
 
-__all__ = ["HEADROOM", "BlendedPath", "toppra_schedule"]
+__all__ = ["HEADROOM", "BlendedPath", "Toppra", "ToppraKinematics"]
 
 logger = logging.getLogger(__name__)
 
 #: Fraction of the velocity and acceleration limits TOPPRA plans with.
 HEADROOM = 1.0 - 1e-4
-#: Grid points TOPPRA uses per section (plus every blend boundary).
-GRID_POINTS = 120
 #: Blend sizes tried, as fractions of the largest possible one.
 _BLEND_FRACTIONS = (1.0, 0.5, 0.25, 0.125)
 _BLEND_SAMPLES = 256
 
 
-@dataclass(frozen=True, slots=True)
-class _Blend:
+@dataclass(frozen=True, slots=True, eq=False)
+class _Blend(ArrayValue):
     before: np.ndarray  # shape (2,): where the blend leaves the incoming line
     corner: np.ndarray  # shape (2,): Bézier control point (the route's corner)
     after: np.ndarray  # shape (2,): where it joins the outgoing line
+
+    def __post_init__(self) -> None:
+        for name in ("before", "corner", "after"):
+            object.__setattr__(self, name, readonly(getattr(self, name), float))
 
     def points(self, w: np.ndarray) -> np.ndarray:
         """Bézier points for w in [0, 1], shape (n, 2)."""
@@ -71,64 +63,82 @@ class _Blend:
         return (1 - w) ** 2 * self.before + 2 * w * (1 - w) * self.corner + w**2 * self.after
 
 
-class BlendedPath:
+@dataclass(frozen=True, slots=True, eq=False)
+class BlendedPath(ArrayValue):
     """A C1 path in the axis plane: straight lines joined by quadratic Bézier blends.
 
     Parameterized by ``s`` (metres): on lines ``s`` is arc length; a blend of
     half-size ``r`` spans ``2 r`` of ``s`` so that ``|dq/ds| = 1`` at its ends.
     Implements the interface TOPPRA expects of a geometric path.
+
+    Parameters
+    ----------
+    vertices : ndarray, shape (m, 2)
+        Corners of the polyline on the signed axes, metres.
+    blends : tuple of (blend or None), shape (m,)
+        The blend at each vertex (``None``: a sharp corner; first and last are ``None``).
     """
 
-    def __init__(self, vertices: np.ndarray, blends: list[_Blend | None]) -> None:
-        # pieces: (kind, s0, s1, data); kind 0 line (p0, unit), 1 blend (_Blend)
-        kinds, starts, ends, p0, d1, d2 = [], [0.0], [], [], [], []
+    vertices: np.ndarray
+    blends: tuple
+    length: float = field(init=False, compare=False)
+    breakpoints: np.ndarray = field(init=False, compare=False, repr=False)
+    _starts: np.ndarray = field(init=False, compare=False, repr=False)
+    _p0: np.ndarray = field(init=False, compare=False, repr=False)
+    _d1: np.ndarray = field(init=False, compare=False, repr=False)
+    _d2: np.ndarray = field(init=False, compare=False, repr=False)
+
+    def __post_init__(self) -> None:
+        vertices = readonly(self.vertices, float)
+        blends = tuple(self.blends)
+        object.__setattr__(self, "vertices", vertices)
+        object.__setattr__(self, "blends", blends)
+        # pieces: lines (p0, unit direction, 0) and blends (before, dq/ds at start, d2q/ds2)
+        starts, p0, d1, d2 = [0.0], [], [], []
         s = 0.0
-        point = vertices[0].astype(float)
+        point = vertices[0]
         for k in range(1, len(vertices)):
             blend = blends[k] if k < len(vertices) - 1 else None
             target = blend.before if blend is not None else vertices[k]
             length = float(np.linalg.norm(target - point))
             if length > 0.0:
-                unit = (target - point) / length
-                kinds.append(0)
                 p0.append(point)
-                d1.append(unit)
+                d1.append((target - point) / length)
                 d2.append(np.zeros(2))
                 s += length
-                ends.append(s)
                 starts.append(s)
             if blend is not None:
                 size = 2.0 * float(np.linalg.norm(blend.corner - blend.before))
                 # q(w) = before + 2w(P - before) + w^2 (before - 2P + after), w = (s - s0) / size
-                kinds.append(1)
                 p0.append(blend.before)
                 d1.append(2.0 * (blend.corner - blend.before) / size)
                 d2.append(2.0 * (blend.before - 2.0 * blend.corner + blend.after) / size**2)
                 s += size
-                ends.append(s)
                 starts.append(s)
                 point = blend.after
             else:
                 point = target
-        self._starts = np.array(starts[:-1])
-        self._ends = np.array(ends)
-        self._p0 = np.array(p0)
-        self._d1 = np.array(d1)
-        self._d2 = np.array(d2)
-        self.length = s
-        self.breakpoints = np.array(starts)
+        object.__setattr__(self, "_starts", readonly(starts[:-1]))
+        object.__setattr__(self, "_p0", readonly(p0))
+        object.__setattr__(self, "_d1", readonly(d1))
+        object.__setattr__(self, "_d2", readonly(d2))
+        object.__setattr__(self, "length", s)
+        object.__setattr__(self, "breakpoints", readonly(starts))
 
     # TOPPRA's geometric path interface
     @property
     def dof(self) -> int:
+        """Degrees of freedom: the two signed axes."""
         return 2
 
     @property
     def path_interval(self) -> np.ndarray:
+        """``[0, length]``, metres."""
         return np.array([0.0, self.length])
 
     @property
     def waypoints(self):
+        """Breakpoints and the points there."""
         return self.breakpoints, self(self.breakpoints)
 
     def piece(self, ss: np.ndarray) -> np.ndarray:
@@ -136,6 +146,7 @@ class BlendedPath:
         return np.clip(np.searchsorted(self._starts, ss, side="right") - 1, 0, len(self._starts) - 1)
 
     def __call__(self, ss, order: int = 0) -> np.ndarray:
+        """Derivative ``order`` of the path at ``ss`` (metres), shape (n, 2) or (2,) for a scalar."""
         scalar = np.isscalar(ss)
         ss = np.clip(np.atleast_1d(np.asarray(ss, dtype=float)), 0.0, self.length)
         out = self.on_piece(self.piece(ss), ss, order)
@@ -155,17 +166,20 @@ class BlendedPath:
         return out
 
     def eval(self, ss):
+        """Points at ``ss``, shape (n, 2)."""
         return self(ss, 0)
 
     def evald(self, ss):
+        """First derivatives at ``ss``, shape (n, 2)."""
         return self(ss, 1)
 
     def evaldd(self, ss):
+        """Second derivatives at ``ss``, shape (n, 2)."""
         return self(ss, 2)
 
 
-@dataclass(frozen=True, slots=True)
-class ToppraKinematics(Kinematics):
+@dataclass(frozen=True, slots=True, eq=False)
+class ToppraKinematics(ArrayValue, Kinematics):
     """A section timed by TOPPRA: ``s(t)`` piecewise quadratic between grid points.
 
     Attributes
@@ -184,11 +198,17 @@ class ToppraKinematics(Kinematics):
     speed: np.ndarray
     times: np.ndarray
 
+    def __post_init__(self) -> None:
+        for name in ("grid", "speed", "times"):
+            object.__setattr__(self, name, readonly(getattr(self, name), float))
+
     @property
     def duration(self) -> float:
+        """Length of the section, seconds."""
         return float(self.times[-1])
 
     def evaluate(self, t: np.ndarray) -> np.ndarray:
+        """Axis, velocity, acceleration, jerk of both vehicles; shape (2, 4, n)."""
         t = np.clip(np.asarray(t, dtype=float), 0.0, self.times[-1])
         k = np.clip(np.searchsorted(self.times, t, side="right") - 1, 0, len(self.grid) - 2)
         ds = np.diff(self.grid)
@@ -214,6 +234,29 @@ class ToppraKinematics(Kinematics):
         out[:, 2] = (ddq * (sd * sd)[:, None] + dq * sdd[:, None]).T
         out[:, 3] = (3.0 * ddq * (sd * sdd)[:, None]).T  # within intervals; unbounded at switch points
         return out
+
+    def interior_velocity_peaks(self) -> np.ndarray:
+        """Largest |velocity| of each vehicle strictly inside the grid intervals, shape (2,), m/s.
+
+        In grid interval ``k``, at ``x = s - s_k``, a vehicle's velocity is
+        ``(A + B x) sqrt(C + D x)`` (``dq/ds`` is linear on a line or blend, ``(ds/dt)^2``
+        is linear in ``s`` at constant ``d²s/dt²``); it is stationary at
+        ``x* = -(2 B C + D A) / (3 B D)``. Sampling instead misses such a peak by up to
+        ``|v''| dt^2 / 8``, more than the verifier's tolerance on long intervals.
+        """
+        grid, speed, path = self.grid, self.speed, self.path
+        width = np.diff(grid)
+        piece = path.piece(grid[:-1])
+        slope = path.on_piece(piece, grid[:-1], 1)  # A, shape (m - 1, 2)
+        bend = path.on_piece(piece, grid[:-1], 2)  # B
+        squared = (speed[:-1] ** 2)[:, None]  # C
+        growth = ((speed[1:] ** 2 - speed[:-1] ** 2) / width)[:, None]  # D
+        with np.errstate(divide="ignore", invalid="ignore"):
+            x = -(2.0 * bend * squared + growth * slope) / (3.0 * bend * growth)
+        inside = np.isfinite(x) & (x > 0.0) & (x < width[:, None])
+        x = np.where(inside, x, 0.0)
+        velocity = (slope + bend * x) * np.sqrt(np.maximum(squared + growth * x, 0.0))
+        return np.max(np.where(inside, np.abs(velocity), 0.0), axis=0, initial=0.0)
 
 
 def _reverses(incoming: np.ndarray, outgoing: np.ndarray) -> bool:
@@ -241,7 +284,7 @@ def _safe_blend(
     if _reverses(incoming, outgoing):
         return None
     len_in, len_out = float(np.linalg.norm(incoming)), float(np.linalg.norm(outgoing))
-    maps = _piece_maps(axes, first, last)
+    maps = piece_maps(axes, first, last)
     w = np.linspace(0.0, 1.0, _BLEND_SAMPLES + 1)
     for fraction in _BLEND_FRACTIONS:
         r = 0.5 * fraction * min(len_in, len_out)
@@ -261,7 +304,7 @@ def _safe_blend(
     return None
 
 
-def _toppra_section(path: BlendedPath, limits: Limits) -> ToppraKinematics:
+def _toppra_section(path: BlendedPath, limits: Limits, grid_points: int) -> ToppraKinematics:
     import toppra
     import toppra.algorithm
     import toppra.constraint
@@ -272,7 +315,7 @@ def _toppra_section(path: BlendedPath, limits: Limits) -> ToppraKinematics:
     acceleration = toppra.constraint.JointAccelerationConstraint(
         np.column_stack([-a, a]), discretization_scheme=toppra.constraint.DiscretizationType.Interpolation
     )
-    grid = np.unique(np.concatenate([np.linspace(0.0, path.length, GRID_POINTS), path.breakpoints]))
+    grid = np.unique(np.concatenate([np.linspace(0.0, path.length, grid_points), path.breakpoints]))
     instance = toppra.algorithm.TOPPRA(
         [velocity, acceleration], path, gridpoints=grid, parametrizer="ParametrizeConstAccel"
     )
@@ -311,30 +354,6 @@ def _groups(axes: RouteAxes, pieces: list[tuple[int, int]], blends: list[_Blend 
     yield start, len(pieces)
 
 
-def _interior_velocity_peaks(kinematics: ToppraKinematics) -> np.ndarray:
-    """Largest |velocity| of each vehicle strictly inside the grid intervals, shape (2,), m/s.
-
-    In grid interval ``k``, at ``x = s - s_k``, a vehicle's velocity is
-    ``(A + B x) sqrt(C + D x)`` (``dq/ds`` is linear on a line or blend, ``(ds/dt)^2``
-    is linear in ``s`` at constant ``d²s/dt²``); it is stationary at
-    ``x* = -(2 B C + D A) / (3 B D)``. Sampling instead misses such a peak by up to
-    ``|v''| dt^2 / 8``, more than the verifier's tolerance on long intervals.
-    """
-    grid, speed, path = kinematics.grid, kinematics.speed, kinematics.path
-    width = np.diff(grid)
-    piece = path.piece(grid[:-1])
-    slope = path.on_piece(piece, grid[:-1], 1)  # A, shape (m - 1, 2)
-    bend = path.on_piece(piece, grid[:-1], 2)  # B
-    squared = (speed[:-1] ** 2)[:, None]  # C
-    growth = ((speed[1:] ** 2 - speed[:-1] ** 2) / width)[:, None]  # D
-    with np.errstate(divide="ignore", invalid="ignore"):
-        x = -(2.0 * bend * squared + growth * slope) / (3.0 * bend * growth)
-    inside = np.isfinite(x) & (x > 0.0) & (x < width[:, None])
-    x = np.where(inside, x, 0.0)
-    velocity = (slope + bend * x) * np.sqrt(np.maximum(squared + growth * x, 0.0))
-    return np.max(np.where(inside, np.abs(velocity), 0.0), axis=0, initial=0.0)
-
-
 def _fit_to_limits(kinematics: ToppraKinematics, limits: Limits) -> ToppraKinematics:
     """Stretch a TOPPRA section uniformly in time until it meets the limits between grid points too.
 
@@ -345,7 +364,7 @@ def _fit_to_limits(kinematics: ToppraKinematics, limits: Limits) -> ToppraKinema
     fine = np.array([0.0, 1.0 - 1e-9])
     times = (kinematics.times[:-1, None] + np.diff(kinematics.times)[:, None] * fine).ravel()
     values = kinematics.evaluate(times)
-    peaks = _interior_velocity_peaks(kinematics)
+    peaks = kinematics.interior_velocity_peaks()
     ratio = 1.0
     for vehicle, vehicle_limits in enumerate(limits.vehicles):
         fastest = max(float(np.max(np.abs(values[vehicle, 1]))), float(peaks[vehicle]))
@@ -363,20 +382,14 @@ def _fit_to_limits(kinematics: ToppraKinematics, limits: Limits) -> ToppraKinema
     )
 
 
-def toppra_schedule(route: Route, limits: Limits) -> Schedule:
-    """Round corners where safe, then time each stop-to-stop section with TOPPRA.
-
-    Returns
-    -------
-    Schedule
-        Method ``toppra``, ``jerk_limited=False``. Never slower than
-        :func:`~trajgen.schedule.exact_schedule` with ``jerk=False``.
-    """
+def _toppra_schedule(method: Toppra, route: Route, limits: Limits) -> Schedule:
+    """Round corners where safe, then time each stop-to-stop section with TOPPRA."""
+    grid_points = method.grid_points
     axes = route_axes(route)
     pieces = straight_pieces(axes.axes)
     if not pieces:  # nothing moves
-        schedule = exact_schedule(route, limits, jerk=False)
-        return Schedule(route, limits, Method.TOPPRA, schedule.sections, jerk_limited=False)
+        schedule = Exact(jerk=False).schedule(route, limits)
+        return Schedule(route, limits, method, schedule.sections, jerk_limited=False)
     required = max(limits.min_separation, route.min_separation)
     blends: list[_Blend | None] = [None] + [
         _safe_blend(axes, pieces, corner, required) for corner in range(1, len(pieces))
@@ -392,22 +405,60 @@ def toppra_schedule(route: Route, limits: Limits) -> Schedule:
         timed = None
         if len(group) > 1:
             vertices = axes.axes[[group[0][0]] + [b for _, b in group]]
-            timed = _toppra_section(BlendedPath(vertices, [None, *blends[start + 1 : stop], None]), limits)
+            path = BlendedPath(vertices, (None, *blends[start + 1 : stop], None))
+            timed = _toppra_section(path, limits, grid_points)
             if timed.duration >= sum(k.duration for k in trapezoids):
                 logger.info("TOPPRA section is not faster than stopping at its corners; keeping the stops")
                 timed = None
         if timed is not None:
-            sections.append(Section(clock, timed, _piece_maps(axes, group[0][0], group[-1][1])))
+            sections.append(Section(clock, timed, piece_maps(axes, group[0][0], group[-1][1])))
             clock += timed.duration
             rounded += len(group) - 1
             toppra_sections += 1
         else:
             for (first, last), kinematics in zip(group, trapezoids, strict=True):
-                sections.append(Section(clock, kinematics, _piece_maps(axes, first, last)))
+                sections.append(Section(clock, kinematics, piece_maps(axes, first, last)))
                 clock += kinematics.duration
     notes = (
         f"{rounded} of {len(pieces) - 1} corners rounded; {toppra_sections} section(s) timed by TOPPRA",
         "jerk is not limited by this method",
     )
     logger.info("toppra schedule: %s", notes[0])
-    return Schedule(route, limits, Method.TOPPRA, tuple(sections), jerk_limited=False, notes=notes)
+    return Schedule(route, limits, method, tuple(sections), jerk_limited=False, notes=notes)
+
+
+@dataclass(frozen=True, slots=True)
+class Toppra(TimingMethod):
+    """Corners rounded where safe, then TOPPRA's time-optimal velocity/acceleration-limited timing.
+
+    Jerk is not limited. Never slower than ``Exact(jerk=False)``.
+
+    Parameters
+    ----------
+    grid_points : int, optional
+        Grid points TOPPRA uses per section, besides every blend boundary (default 120, at least 2).
+    """
+
+    name: ClassVar[str] = "toppra"
+    summary: ClassVar[str] = (
+        "rounded corners where safe, TOPPRA velocity/acceleration timing (jerk not limited)"
+    )
+
+    grid_points: int = 120
+
+    def __post_init__(self) -> None:
+        if (
+            isinstance(self.grid_points, bool)
+            or not isinstance(self.grid_points, int)
+            or self.grid_points < 2
+        ):
+            raise InputError(f"toppra option grid_points must be an integer >= 2, got {self.grid_points!r}")
+
+    @property
+    def jerk_limited(self) -> bool:
+        """Always False: TOPPRA limits velocity and acceleration only."""
+        return False
+
+    def schedule(self, route: Route, limits: Limits) -> Schedule:
+        """The TOPPRA schedule of ``route`` under ``limits``."""
+        return _toppra_schedule(self, route, limits)

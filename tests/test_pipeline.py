@@ -1,0 +1,151 @@
+"""The pipeline: every output rendered from verified schedules, then all files committed or none."""
+
+from __future__ import annotations
+
+import logging
+import os
+
+import pytest
+
+from limits import Limits
+from tests.conftest import REPO
+from trajgen import Outputs, Schedule, Toppra, default_scenario, run
+from trajgen.cli import EXIT_BAD_INPUT, main
+from trajgen.errors import InputError, OutputError
+from trajgen.export import atomic, commit_files
+
+SWAP = str(REPO / "examples" / "swap.toml")
+
+
+def _hidden(folder):
+    return sorted(p.name for p in folder.iterdir() if p.name.startswith("."))
+
+
+def test_commit_writes_every_file_and_leaves_no_temporary(tmp_path):
+    files = commit_files({tmp_path / "a" / "x.csv": b"x", tmp_path / "b" / "y.png": b"y"})
+    assert [p.read_bytes() for p in files] == [b"x", b"y"]
+    assert _hidden(tmp_path / "a") == _hidden(tmp_path / "b") == []
+
+
+def test_a_failed_rename_puts_every_earlier_file_back(tmp_path, monkeypatch):
+    (tmp_path / "agv1.csv").write_bytes(b"old 1")
+    (tmp_path / "agv2.csv").write_bytes(b"old 2")
+    real = os.replace
+    calls = []
+
+    def fail_on_second(source, target):
+        calls.append(target)
+        if len(calls) == 2:
+            raise PermissionError(13, "Permission denied", str(target))
+        return real(source, target)
+
+    monkeypatch.setattr(atomic.os, "replace", fail_on_second)
+    with pytest.raises(OutputError, match=r"cannot write '.*agv2\.csv': Permission denied"):
+        commit_files({tmp_path / "agv1.csv": b"new 1", tmp_path / "agv2.csv": b"new 2"})
+    assert (tmp_path / "agv1.csv").read_bytes() == b"old 1"
+    assert (tmp_path / "agv2.csv").read_bytes() == b"old 2"
+    assert _hidden(tmp_path) == []
+
+
+def test_a_failed_write_removes_the_folders_it_made(tmp_path, monkeypatch):
+    real = atomic.tempfile.mkstemp
+    calls = []
+
+    def fail_on_second(*args, **kwargs):
+        calls.append(1)
+        if len(calls) == 2:
+            raise OSError(28, "No space left on device")
+        return real(*args, **kwargs)
+
+    monkeypatch.setattr(atomic.tempfile, "mkstemp", fail_on_second)
+    with pytest.raises(OutputError, match="No space left on device"):
+        commit_files({tmp_path / "new" / "deep" / "a.csv": b"a", tmp_path / "new" / "b.csv": b"b"})
+    assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.parametrize(
+    ("layout", "match"),
+    [
+        pytest.param(
+            {"x.csv": "folder"}, r"output file '.*x\.csv' exists as a folder", id="target-is-folder"
+        ),
+        pytest.param(
+            {"out": "file"}, r"output folder '.*out' exists and is not a folder", id="parent-is-file"
+        ),
+    ],
+)
+def test_unusable_targets_are_refused_before_anything_is_written(tmp_path, layout, match):
+    for name, kind in layout.items():
+        (tmp_path / name).mkdir() if kind == "folder" else (tmp_path / name).write_text("a file")
+    before = sorted(p.name for p in tmp_path.iterdir())
+    with pytest.raises(OutputError, match=match):
+        commit_files({tmp_path / "ok.csv": b"1", tmp_path / "x.csv": b"2", tmp_path / "out" / "y.png": b"3"})
+    assert sorted(p.name for p in tmp_path.iterdir()) == before
+
+
+def test_cli_plot_onto_a_file_exits_2_and_writes_no_csv(tmp_path, capsys):
+    plot = tmp_path / "plot"
+    plot.write_text("a file")
+    csv = tmp_path / "csv"
+    assert main(["schedule", SWAP, "--csv", str(csv), "--plot", str(plot)]) == EXIT_BAD_INPUT
+    err = capsys.readouterr().err
+    assert f"output folder {str(plot)!r} exists and is not a folder" in err
+    assert not csv.exists()
+    assert plot.read_text() == "a file"
+
+
+def test_cli_csv_target_that_is_a_folder_exits_2_and_keeps_the_other_file(tmp_path, capsys):
+    (tmp_path / "agv1.csv").write_text("previous profile")
+    (tmp_path / "agv2.csv").mkdir()
+    assert main(["schedule", SWAP, "--method", "exact", "--csv", str(tmp_path)]) == EXIT_BAD_INPUT
+    assert "agv2.csv' exists as a folder: expected a file or nothing" in capsys.readouterr().err
+    assert (tmp_path / "agv1.csv").read_text() == "previous profile"
+
+
+def test_cli_empty_folder_name_exits_2(tmp_path, capsys, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    assert main(["schedule", SWAP, "--csv", ""]) == EXIT_BAD_INPUT
+    assert "CSV output folder must name a folder, got ''" in capsys.readouterr().err
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_a_run_verifies_each_schedule_once_and_commits_every_file(tmp_path, caplog):
+    with caplog.at_level(logging.DEBUG, logger="trajgen.verify"):
+        result = run(
+            default_scenario(), outputs=Outputs(csv_dir=tmp_path / "csv", plot_dir=tmp_path / "plots")
+        )
+    verifications = [r.message for r in caplog.records if r.message.startswith("verified a")]
+    assert sorted(m.split()[2] for m in verifications) == ["exact", "optimal", "toppra"]
+    assert [p.name for p in result.files] == [
+        "agv1.csv",
+        "agv2.csv",
+        "speed.png",
+        "separation.png",
+        "coordination.png",
+    ]
+    assert all(p.is_file() for p in result.files)
+    summary = result.summary()
+    assert summary["method"] == "optimal"
+    assert summary["solver"]["solver"] == "fatrop"
+    assert summary["fallback_reason"] is None
+
+
+def test_a_compared_method_that_fails_verification_is_left_out_of_the_plot(tmp_path, monkeypatch):
+    real = Toppra.schedule
+
+    def too_close(self, route, limits):
+        good = real(self, route, limits)
+        broken = Limits(limits.vehicles, min_separation=10.5)
+        return Schedule(good.route, broken, good.method, good.sections, good.jerk_limited)
+
+    monkeypatch.setattr(Toppra, "schedule", too_close)
+    result = run(default_scenario(), method="exact", outputs=Outputs(plot_dir=tmp_path))
+    assert any(
+        n.startswith("coordination plot: toppra left out: schedule failed verification") for n in result.notes
+    )
+    assert (tmp_path / "coordination.png").read_bytes().startswith(b"\x89PNG")
+
+
+def test_run_refuses_what_is_not_a_scenario():
+    with pytest.raises(InputError, match="run expects a Scenario, got str"):
+        run("examples/swap.toml")  # type: ignore[arg-type]

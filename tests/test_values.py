@@ -1,0 +1,66 @@
+"""Results are honest values: read-only arrays, value equality that never raises, hashes that agree."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from tests.helpers import LIMITS, route_of
+from trajgen import Exact, Optimal, Toppra
+from trajgen.axes import route_axes
+
+SWAP = ((10.0, 10.0, 10.0), ("A:10", "B:10"), ("B:10", "A:10"))
+
+
+@pytest.mark.parametrize("method", [Exact(), Toppra(), Optimal()], ids=["exact", "toppra", "optimal"])
+def test_equal_computations_give_equal_schedules_with_equal_hashes(method):
+    first = method.schedule(route_of(*SWAP), LIMITS)
+    second = method.schedule(route_of(*SWAP), LIMITS)
+    assert first is not second
+    assert first == second
+    assert hash(first) == hash(second)
+    assert len({first, second}) == 1
+
+
+def test_different_schedules_compare_unequal():
+    route = route_of(*SWAP)
+    assert Exact().schedule(route, LIMITS) != Exact(jerk=False).schedule(route, LIMITS)
+    assert Exact().schedule(route, LIMITS) != Toppra().schedule(route, LIMITS)
+    assert Exact().schedule(route, LIMITS) != "a schedule"
+
+
+@pytest.mark.parametrize("method", [Exact(), Toppra(), Optimal()], ids=["exact", "toppra", "optimal"])
+def test_arrays_inside_a_schedule_are_read_only(method):
+    schedule = method.schedule(route_of(*SWAP), LIMITS)
+    with pytest.raises(ValueError, match="read-only"):
+        schedule.sections[0].maps[0].legs[0] = 2
+    kinematics = schedule.sections[0].kinematics
+    arrays = (
+        [profile.initial for profile in kinematics.vehicles]
+        if hasattr(kinematics, "vehicles")
+        else [kinematics.speed, kinematics.times, kinematics.path.vertices]
+    )
+    for array in arrays:
+        with pytest.raises(ValueError, match="read-only"):
+            array[0] = 1.0
+    state = schedule.state([0.0, 1.0])
+    with pytest.raises(ValueError, match="read-only"):
+        state.s[0, 0] = 5.0
+
+
+def test_a_schedule_does_not_share_memory_with_its_inputs():
+    axes = route_axes(route_of(*SWAP))
+    with pytest.raises(ValueError, match="read-only"):
+        axes.axes[0, 0] = 1.0
+    source = np.array([0.0, 1.0])
+    from trajgen.schedule import AxisMap
+
+    mapped = AxisMap(source, source, np.array([0, 0]), source, np.array([1, 1]))
+    source[0] = 9.0
+    assert mapped.axis_start[0] == 0.0
+
+
+def test_frozen_fields_cannot_be_rebound():
+    schedule = Exact().schedule(route_of(*SWAP), LIMITS)
+    with pytest.raises(AttributeError):
+        schedule.sections = ()  # type: ignore[misc]

@@ -1,0 +1,64 @@
+"""The one public exception module of trajgen: every error the distribution raises on purpose.
+
+Input errors subclass ``ValueError`` (a wrong type: ``TypeError``), failed
+computations ``RuntimeError``; all subclass :class:`TrajgenError`. The
+planner's and the limits' errors are re-exported here.
+
+Examples
+--------
+>>> from trajgen.errors import InputError, TrajgenError
+>>> issubclass(InputError, ValueError) and issubclass(InputError, TrajgenError)
+True
+"""
+
+from __future__ import annotations
+
+from limits.errors import LimitsError
+from topology.errors import (
+    InputError,
+    OptionError,
+    PositionError,
+    SeparationError,
+    TrackError,
+    TrajgenError,
+)
+
+__all__ = [
+    "InputError",
+    "LimitsError",
+    "OptionError",
+    "OutputError",
+    "PositionError",
+    "ScenarioError",
+    "ScheduleError",
+    "SeparationError",
+    "SolverError",
+    "TrackError",
+    "TrajgenError",
+    "UnverifiedScheduleError",
+    "VerificationError",
+]
+
+
+class ScenarioError(InputError):
+    """A scenario file is unreadable, malformed or inconsistent."""
+
+
+class OutputError(InputError):
+    """An output path cannot take the files asked for (a file where a folder must be, ...)."""
+
+
+class UnverifiedScheduleError(TrajgenError, TypeError):
+    """An exporter or plot was given a schedule that has not passed the verifier."""
+
+
+class ScheduleError(TrajgenError, RuntimeError):
+    """A schedule could not be computed."""
+
+
+class VerificationError(ScheduleError):
+    """A schedule failed the independent verifier and must not leave the library."""
+
+
+class SolverError(ScheduleError):
+    """A numerical solver failed to deliver a usable result."""

@@ -1,0 +1,30 @@
+"""The ``optimal`` method: time-optimal jerk-limited schedules inside the route's homotopy class.
+
+Formulation (ALGORITHM.md section 6). The route's reduced region sequence
+``R_1 ... R_P`` fixes the homotopy class. Phase ``p`` keeps the vehicles in
+region ``R_p``: each vehicle on a fixed leg, tracked by its distance ``s``
+from the junction, with state ``(s, v, a)`` and jerk as control, piecewise
+constant on a grid of fixed fractions of free segment durations; the sum of
+the durations is minimized. Between phases one vehicle changes leg at the
+junction (``s = 0``), where its ``v`` and ``a`` change sign. Inside a region
+the separation is linear in ``(s1, s2)``.
+
+Modules: :mod:`~.phases` (phases from the route, the stage layout),
+:mod:`~.transcription` (the NLP), :mod:`~.solve` (solvers and their cache),
+:mod:`~.guess` (initial guess from ``exact``), :mod:`~.decode` (solution to
+schedule), :mod:`~.method` (the :class:`Optimal` method object).
+"""
+
+from trajgen.methods.optimal.method import DEFAULT_NODES, Optimal, OptimalInfo, Source
+from trajgen.methods.optimal.solve import Outcome, Solver, SolverAttempt, SolverCache
+
+__all__ = [
+    "DEFAULT_NODES",
+    "Optimal",
+    "OptimalInfo",
+    "Outcome",
+    "Solver",
+    "SolverAttempt",
+    "SolverCache",
+    "Source",
+]

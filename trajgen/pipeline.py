@@ -1,0 +1,174 @@
+"""One pipeline from a scenario to committed files.
+
+scenario -> route (the planner) -> schedule (a timing method) -> verified
+(once) -> every output rendered to bytes -> one atomic commit of all files.
+Nothing touches the disk until every output is rendered from verified
+schedules; a run that fails leaves the output folders as they were.
+"""
+
+from __future__ import annotations
+
+import logging
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from topology import Route
+from trajgen.errors import InputError, VerificationError
+from trajgen.export import CsvOptions, check_output_paths, commit_files, profile_paths, render_profile
+from trajgen.methods import METHODS, make_schedule
+from trajgen.plots import render_coordination, render_separation, render_speed
+from trajgen.scenario import Scenario
+from trajgen.schedule import TimingMethod
+from trajgen.summary import route_summary
+from trajgen.verify import VerifiedSchedule, certify
+
+__all__ = ["PLOT_NAMES", "Outputs", "RunResult", "run"]
+
+logger = logging.getLogger(__name__)
+
+#: The files written into the plot folder.
+PLOT_NAMES = ("speed.png", "separation.png", "coordination.png")
+
+
+def _folder(value: object, option: str) -> Path | None:
+    if value is None:
+        return None
+    if not isinstance(value, (str, Path)) or str(value) == "":
+        raise InputError(f"{option} must name a folder, got {value!r}")
+    return Path(value)
+
+
+@dataclass(frozen=True, slots=True)
+class Outputs:
+    """Which files a run writes.
+
+    Parameters
+    ----------
+    csv_dir : path or None
+        Folder for ``<vehicle name>.csv`` of both vehicles; ``None``: no CSV.
+    plot_dir : path or None
+        Folder for ``speed.png``, ``separation.png`` and ``coordination.png``; ``None``: no plots.
+    csv : CsvOptions
+        Format of the CSV profiles.
+    """
+
+    csv_dir: Path | None = None
+    plot_dir: Path | None = None
+    csv: CsvOptions = field(default_factory=CsvOptions)
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "csv_dir", _folder(self.csv_dir, "CSV output folder"))
+        object.__setattr__(self, "plot_dir", _folder(self.plot_dir, "plot output folder"))
+        if not isinstance(self.csv, CsvOptions):
+            raise InputError(f"csv options must be CsvOptions, got {type(self.csv).__name__}")
+
+    def paths(self, names: tuple[str, str]) -> tuple[Path, ...]:
+        """Every file this request writes for vehicles named ``names``."""
+        paths: list[Path] = []
+        if self.csv_dir is not None:
+            paths += profile_paths(names, self.csv_dir)
+        if self.plot_dir is not None:
+            paths += [self.plot_dir / name for name in PLOT_NAMES]
+        return tuple(paths)
+
+
+@dataclass(frozen=True, slots=True)
+class RunResult:
+    """What a run computed and wrote.
+
+    Attributes
+    ----------
+    scenario : Scenario
+    route : Route
+    verified : VerifiedSchedule
+        The schedule, certified by the verifier.
+    files : tuple of Path
+        Every file written (all committed together).
+    notes : tuple of str
+        What the run did beyond the schedule's own notes (e.g. a method left out of a plot).
+    """
+
+    scenario: Scenario
+    route: Route
+    verified: VerifiedSchedule
+    files: tuple[Path, ...]
+    notes: tuple[str, ...] = ()
+
+    def summary(self) -> dict:
+        """The JSON-ready summary printed by ``trajgen schedule --json``."""
+        schedule, report = self.verified.schedule, self.verified.report
+        return {
+            "scenario": self.scenario.source,
+            "method": schedule.method.name,
+            "duration_s": schedule.duration,
+            "jerk_limited": schedule.jerk_limited,
+            "verified": report.passed,
+            "worst_margins": report.summary(),
+            "notes": [*schedule.notes, *self.notes],
+            "fallback_reason": None if schedule.fallback_reason is None else schedule.fallback_reason.value,
+            "solver": None if schedule.info is None else schedule.info.summary(),
+            "route": route_summary(self.route),
+            "files": [str(path) for path in self.files],
+        }
+
+
+def _comparison(route: Route, scenario: Scenario, chosen: VerifiedSchedule) -> tuple[dict, list[str]]:
+    """Every registered method's verified schedule of ``route`` for the coordination plot."""
+    verified = {}
+    notes = []
+    for method in METHODS:
+        if method.name == chosen.schedule.method.name:
+            verified[method.name] = chosen
+            continue
+        try:
+            verified[method.name] = certify(make_schedule(route, scenario.limits, method=method()))
+        except VerificationError as error:
+            notes.append(f"coordination plot: {method.name} left out: {error}")
+            logger.warning("coordination plot: %s left out: %s", method.name, error)
+    return verified, notes
+
+
+def run(
+    scenario: Scenario, *, method: TimingMethod | str | None = None, outputs: Outputs | None = None
+) -> RunResult:
+    """Plan, schedule, verify, render and commit: the whole job.
+
+    Parameters
+    ----------
+    scenario : Scenario
+    method : TimingMethod or str, optional
+        A method object with its options, a registered name, or ``None`` for the default.
+    outputs : Outputs, optional
+        Files to write; none by default.
+
+    Returns
+    -------
+    RunResult
+
+    Raises
+    ------
+    InputError
+        Bad method or output paths (checked before anything is computed); nothing written.
+    VerificationError
+        The schedule failed the verifier; nothing written.
+    """
+    outputs = outputs if outputs is not None else Outputs()
+    if not isinstance(scenario, Scenario):
+        raise InputError(f"run expects a Scenario, got {type(scenario).__name__}")
+    chosen = METHODS.create(method)
+    check_output_paths(outputs.paths(scenario.names))
+    route = scenario.plan()
+    verified = certify(make_schedule(route, scenario.limits, method=chosen))
+    files: dict[Path, bytes] = {}
+    notes: list[str] = []
+    if outputs.csv_dir is not None:
+        for vehicle, path in enumerate(profile_paths(scenario.names, outputs.csv_dir)):
+            files[path] = render_profile(verified, vehicle, outputs.csv)
+    if outputs.plot_dir is not None:
+        compared, notes = _comparison(route, scenario, verified)
+        speed, separation, coordination = (outputs.plot_dir / name for name in PLOT_NAMES)
+        files[speed] = render_speed(verified, names=scenario.names)
+        files[separation] = render_separation(verified)
+        files[coordination] = render_coordination(compared)
+    written = commit_files(files) if files else ()
+    return RunResult(scenario, route, verified, written, tuple(notes))

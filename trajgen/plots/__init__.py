@@ -1,0 +1,10 @@
+"""Plots of verified schedules, rendered to PNG bytes (nothing here writes files).
+
+Only :mod:`trajgen.plots.figure` imports matplotlib, and only when a plot is rendered.
+"""
+
+from trajgen.plots.coordination import METHOD_COLOURS, render_coordination
+from trajgen.plots.separation import render_separation
+from trajgen.plots.speed import render_speed
+
+__all__ = ["METHOD_COLOURS", "render_coordination", "render_separation", "render_speed"]

@@ -1,0 +1,31 @@
+"""``separation.png``: the track distance between the vehicles over time, with the minimum."""
+
+from __future__ import annotations
+
+from topology.indexed import track_distance
+from trajgen.plots.figure import new_figure, png_bytes
+from trajgen.plots.speed import PLOT_PERIOD
+from trajgen.verify import VerifiedSchedule, require_verified
+
+__all__ = ["render_separation"]
+
+
+def render_separation(verified: VerifiedSchedule) -> bytes:
+    """Track distance between the vehicles over time with the minimum line, as PNG bytes."""
+    schedule = require_verified(verified, "render_separation").schedule
+    state = schedule.sample(PLOT_PERIOD)
+    distance = track_distance(state.leg[0], state.s[0], state.leg[1], state.s[1])
+    required = max(schedule.limits.min_separation, schedule.route.min_separation)
+    figure = new_figure(figsize=(9, 4))
+    axis = figure.subplots()
+    axis.plot(state.t, distance, label="track distance")
+    axis.axhline(required, color="tab:red", linestyle="--", label=f"minimum {required:g} m")
+    axis.fill_between(state.t, 0, required, color="tab:red", alpha=0.1)
+    axis.set_xlabel("t [s]")
+    axis.set_ylabel("separation [m]")
+    axis.set_ylim(bottom=0)
+    axis.set_title(f"{schedule.method.name} schedule: separation along the track")
+    axis.legend(loc="upper right")
+    axis.grid(True, alpha=0.3)
+    figure.tight_layout()
+    return png_bytes(figure)

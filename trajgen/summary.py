@@ -1,0 +1,51 @@
+"""Machine-readable (JSON-ready) and human-readable summaries of routes and runs."""
+
+from __future__ import annotations
+
+from topology import Route
+
+__all__ = ["format_route", "format_run", "route_summary"]
+
+
+def route_summary(route: Route) -> dict:
+    """A JSON-ready summary of a route."""
+    return {
+        "instruction": route.instruction.value,
+        "waypoints": [[{"leg": p.leg, "s_m": p.s} for p in (w.first, w.second)] for w in route.waypoints],
+        "regions": [str(r) for r in route.regions],
+        "travel_m": list(route.travel),
+        "min_separation_m": route.min_separation,
+    }
+
+
+def format_route(route: Route) -> str:
+    """Human-readable multi-line description of a route."""
+    lines = [
+        f"instruction: {route.instruction.value}",
+        f"homotopy class (regions): {' '.join(str(r) for r in route.regions) or '(one ray)'}",
+        f"travel: vehicle 1 {route.travel[0]:g} m, vehicle 2 {route.travel[1]:g} m",
+        "waypoints (vehicle 1, vehicle 2):",
+    ]
+    lines += [f"  {k:2d}  {w}" for k, w in enumerate(route.waypoints)]
+    return "\n".join(lines)
+
+
+def format_run(summary: dict) -> str:
+    """Human-readable lines of a run's JSON summary (:meth:`trajgen.pipeline.RunResult.summary`)."""
+    margins = summary["worst_margins"]
+    jerk = (
+        f", |j|/limit {max(margins['jerk_ratio']):.6f}" if summary["jerk_limited"] else ", jerk not limited"
+    )
+    lines = [
+        f"scenario: {summary['scenario']}",
+        f"method: {summary['method']}  duration: {summary['duration_s']:.3f} s  "
+        f"verified: {summary['verified']}",
+        f"worst margins: separation {margins['min_separation_m']:.4f} m "
+        f"(margin {margins['separation_margin_m']:.4f} m), |v|/limit {max(margins['velocity_ratio']):.6f}, "
+        f"|a|/limit {max(margins['acceleration_ratio']):.6f}{jerk}",
+    ]
+    lines += [f"note: {note}" for note in summary["notes"]]
+    if summary["fallback_reason"]:
+        lines.append(f"warning: fell back to the exact schedule ({summary['fallback_reason']})")
+    lines += [f"wrote {path}" for path in summary["files"]]
+    return "\n".join(lines)

@@ -1,0 +1,68 @@
+"""Helpers that make result objects honest values: read-only arrays, value equality and hashing."""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+
+__all__ = ["ArrayValue", "readonly"]
+
+
+def readonly(values, dtype=None) -> np.ndarray:
+    """A read-only copy of ``values`` as an array.
+
+    Examples
+    --------
+    >>> a = readonly([1.0, 2.0])
+    >>> a.flags.writeable
+    False
+    """
+    array = np.array(values, dtype=dtype, copy=True)
+    array.flags.writeable = False
+    return array
+
+
+def _same(a: object, b: object) -> bool:
+    if isinstance(a, np.ndarray) or isinstance(b, np.ndarray):
+        return (
+            isinstance(a, np.ndarray)
+            and isinstance(b, np.ndarray)
+            and a.dtype == b.dtype
+            and np.array_equal(a, b)
+        )
+    return bool(a == b)
+
+
+def _hash_key(value: object) -> object:
+    if isinstance(value, np.ndarray):
+        return (value.shape, value.dtype.str, value.tobytes())
+    return value
+
+
+class ArrayValue:
+    """Mixin for frozen dataclasses holding arrays: ``==`` compares values, ``hash`` agrees with it.
+
+    Use with ``@dataclass(frozen=True, slots=True, eq=False)``; fields with
+    ``compare=False`` are left out of both.
+    """
+
+    __slots__ = ()
+
+    def __eq__(self, other: object) -> bool:
+        if type(other) is not type(self):
+            return NotImplemented
+        return all(
+            _same(getattr(self, f.name), getattr(other, f.name))
+            for f in dataclasses.fields(self)  # type: ignore[arg-type]
+            if f.compare
+        )
+
+    def __hash__(self) -> int:
+        return hash(
+            tuple(
+                _hash_key(getattr(self, f.name))
+                for f in dataclasses.fields(self)  # type: ignore[arg-type]
+                if f.compare
+            )
+        )
