@@ -102,6 +102,59 @@ def _number(value: object, where: str, source: str) -> float:
     return float(value)
 
 
+def _parse_track(data: dict, source: str) -> YGraph:
+    track_table = _table(data["track"], "[track]", source)
+    _check_keys(track_table, _TRACK_KEYS, "[track]", source)
+    legs = _table(track_table["legs"], "[track] legs", source)
+    lengths = {name: _number(length, f"[track] legs.{name}", source) for name, length in legs.items()}
+    angles = None
+    if "angles_deg" in track_table:
+        angle_table = _table(track_table["angles_deg"], "[track] angles_deg", source)
+        angles = {name: _number(a, f"[track] angles_deg.{name}", source) for name, a in angle_table.items()}
+    try:
+        return YGraph(lengths, angles_deg=angles)
+    except InputError as error:
+        raise ScenarioError(f"{source}: [track]: {error}") from None
+
+
+def _parse_vehicle(vehicle: object, k: int, track: YGraph, taken: list[str], source: str):
+    """Name, limits, start and goal of ``[[vehicle]]`` number ``k``."""
+    where = f"[[vehicle]] {k}"
+    vehicle = _table(vehicle, where, source)
+    _check_keys(vehicle, _VEHICLE_KEYS, where, source)
+    name = vehicle["name"]
+    if not isinstance(name, str) or not _VEHICLE_NAME.match(name):
+        raise ScenarioError(
+            f"{source}: {where} name {name!r} is not usable as a file name: "
+            "expected 1-64 letters, digits, '_', '.' or '-', starting with a letter or digit"
+        )
+    if name in taken:
+        raise ScenarioError(
+            f"{source}: {where} name {name!r} is used by both vehicles: expected distinct names"
+        )
+    numbers = {
+        key: _number(vehicle[key], f"{where} {key}", source)
+        for key in ("max_velocity", "max_acceleration", "max_jerk")
+    }
+    try:
+        limits = VehicleLimits(**numbers)
+    except InputError as error:
+        raise ScenarioError(f"{source}: {where}: {error}") from None
+    ends = []
+    for key in ("start", "goal"):
+        text = vehicle[key]
+        if not isinstance(text, str):
+            raise ScenarioError(
+                f"{source}: {where} {key} must be a string like 'A:10.0' or 'O', "
+                f"got {type(text).__name__} {text!r}"
+            )
+        try:
+            ends.append(track.check(Position.parse(text)))
+        except InputError as error:
+            raise ScenarioError(f"{source}: {where} {key}: {error}") from None
+    return name, limits, ends[0], ends[1]
+
+
 def parse_scenario(data: dict, *, source: str = "<scenario>") -> Scenario:
     """Build a Scenario from parsed TOML data, naming ``source`` and the key in every error.
 
@@ -112,69 +165,25 @@ def parse_scenario(data: dict, *, source: str = "<scenario>") -> Scenario:
         track, limits or separation, or vehicles closer than the separation.
     """
     _check_keys(_table(data, "the scenario", source), _TOP_KEYS, "the scenario", source)
-    track_table = _table(data["track"], "[track]", source)
-    _check_keys(track_table, _TRACK_KEYS, "[track]", source)
-    legs = _table(track_table["legs"], "[track] legs", source)
-    lengths = {name: _number(length, f"[track] legs.{name}", source) for name, length in legs.items()}
-    angles = None
-    if "angles_deg" in track_table:
-        angle_table = _table(track_table["angles_deg"], "[track] angles_deg", source)
-        angles = {name: _number(a, f"[track] angles_deg.{name}", source) for name, a in angle_table.items()}
-    try:
-        track = YGraph(lengths, angles_deg=angles)
-    except InputError as error:
-        raise ScenarioError(f"{source}: [track]: {error}") from None
-
+    track = _parse_track(data, source)
     safety = _table(data["safety"], "[safety]", source)
     _check_keys(safety, _SAFETY_KEYS, "[safety]", source)
     separation = _number(safety["min_separation"], "[safety] min_separation", source)
-
     vehicles = data["vehicle"]
     if not isinstance(vehicles, list) or len(vehicles) != 2:
         count = len(vehicles) if isinstance(vehicles, list) else type(vehicles).__name__
         raise ScenarioError(f"{source}: expected exactly two [[vehicle]] tables, got {count}")
-    names, vehicle_limits, starts, goals = [], [], [], []
+    names: list[str] = []
+    parsed = []
     for k, vehicle in enumerate(vehicles, start=1):
-        where = f"[[vehicle]] {k}"
-        vehicle = _table(vehicle, where, source)
-        _check_keys(vehicle, _VEHICLE_KEYS, where, source)
-        name = vehicle["name"]
-        if not isinstance(name, str) or not _VEHICLE_NAME.match(name):
-            raise ScenarioError(
-                f"{source}: {where} name {name!r} is not usable as a file name: "
-                "expected 1-64 letters, digits, "
-                "'_', '.' or '-', starting with a letter or digit"
-            )
-        if name in names:
-            raise ScenarioError(
-                f"{source}: {where} name {name!r} is used by both vehicles: expected distinct names"
-            )
-        names.append(name)
-        numbers = {
-            key: _number(vehicle[key], f"{where} {key}", source)
-            for key in ("max_velocity", "max_acceleration", "max_jerk")
-        }
-        try:
-            vehicle_limits.append(VehicleLimits(**numbers))
-        except InputError as error:
-            raise ScenarioError(f"{source}: {where}: {error}") from None
-        for key, bucket in (("start", starts), ("goal", goals)):
-            text = vehicle[key]
-            if not isinstance(text, str):
-                raise ScenarioError(
-                    f"{source}: {where} {key} must be a string like 'A:10.0' or 'O', "
-                    f"got {type(text).__name__} {text!r}"
-                )
-            try:
-                bucket.append(track.check(Position.parse(text)))
-            except InputError as error:
-                raise ScenarioError(f"{source}: {where} {key}: {error}") from None
+        parsed.append(_parse_vehicle(vehicle, k, track, names, source))
+        names.append(parsed[-1][0])
     try:
-        limits = Limits(vehicles=(vehicle_limits[0], vehicle_limits[1]), min_separation=separation)
+        limits = Limits(vehicles=(parsed[0][1], parsed[1][1]), min_separation=separation)
     except InputError as error:
         raise ScenarioError(f"{source}: [safety]: {error}") from None
-    start = Configuration(starts[0], starts[1])
-    goal = Configuration(goals[0], goals[1])
+    start = Configuration(parsed[0][2], parsed[1][2])
+    goal = Configuration(parsed[0][3], parsed[1][3])
     shortest = track.shortest_leg
     if separation > shortest:
         raise ScenarioError(

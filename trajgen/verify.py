@@ -40,7 +40,7 @@ from topology import Region, reduce_regions
 from topology.indexed import JUNCTION_INDEX, region_keys, track_distance
 from topology.validation import finite_real
 from trajgen.errors import InputError, UnverifiedScheduleError, VerificationError
-from trajgen.schedule import Schedule
+from trajgen.schedule import Schedule, ScheduleState
 
 __all__ = [
     "MAX_PERIOD",
@@ -219,14 +219,8 @@ def verify(schedule: Schedule, *, period: float = MAX_PERIOD) -> VerificationRep
     return report
 
 
-def _verify(schedule: Schedule, period: float) -> VerificationReport:
-    route = schedule.route
-    graph = route.graph
-    limits = schedule.limits
-    required = max(limits.min_separation, route.min_separation)
-    state = schedule.state(_sample_times(schedule, period))
-    failures: list[str] = []
-
+def _check_separation(state: ScheduleState, required: float, failures: list[str]) -> float:
+    """Smallest track distance between the vehicles, metres; records a violation of ``required``."""
     separation = track_distance(state.leg[0], state.s[0], state.leg[1], state.s[1])
     worst = int(np.argmin(separation))
     if separation[worst] < required - POSITION_TOLERANCE:
@@ -236,30 +230,39 @@ def _verify(schedule: Schedule, period: float) -> VerificationReport:
         )
     if separation[worst] <= 0.0:
         failures.append(f"vehicles collide at t={state.t[worst]:.4f} s")
+    return float(separation[worst])
 
+
+def _check_on_track(state: ScheduleState, graph, failures: list[str]) -> None:
+    """Every sampled position within its leg (to :data:`TRACK_END_TOLERANCE`)."""
     lengths = np.array(graph.lengths)
     on_leg = state.leg != JUNCTION_INDEX
     overrun = np.where(on_leg, state.s - lengths[np.where(on_leg, state.leg, 0)], 0.0)
     worst_overrun = float(overrun.max())
     if worst_overrun > TRACK_END_TOLERANCE:
         vehicle, k = np.unravel_index(int(np.argmax(overrun)), overrun.shape)
-        leg_name = graph.names[state.leg[vehicle, k]]
         failures.append(
-            f"vehicle {vehicle + 1} is {worst_overrun:.3g} m past the end of leg {leg_name!r} "
-            f"at t={state.t[k]:.4f} s (tolerance {TRACK_END_TOLERANCE:g} m)"
+            f"vehicle {vehicle + 1} is {worst_overrun:.3g} m past the end of leg "
+            f"{graph.names[state.leg[vehicle, k]]!r} at t={state.t[k]:.4f} s "
+            f"(tolerance {TRACK_END_TOLERANCE:g} m)"
         )
 
-    ratios = {}
+
+def _check_limits(
+    state: ScheduleState, schedule: Schedule, failures: list[str]
+) -> dict[str, tuple[float, float]]:
+    """Largest ``|value| / limit`` per vehicle of velocity, acceleration and (if limited) jerk."""
     checks = [
         ("velocity", state.velocity, "max_velocity", "m/s"),
         ("acceleration", state.acceleration, "max_acceleration", "m/s^2"),
     ]
     if schedule.jerk_limited:
         checks.append(("jerk", state.jerk, "max_jerk", "m/s^3"))
+    ratios = {"jerk": (float("nan"), float("nan"))}
     for name, values, limit_name, unit in checks:
         per_vehicle = []
         for vehicle in range(2):
-            limit = getattr(limits.vehicles[vehicle], limit_name)
+            limit = getattr(schedule.limits.vehicles[vehicle], limit_name)
             k = int(np.argmax(np.abs(values[vehicle])))
             ratio = float(abs(values[vehicle, k]) / limit)
             per_vehicle.append(ratio)
@@ -269,21 +272,19 @@ def _verify(schedule: Schedule, period: float) -> VerificationReport:
                     f"exceeds its {limit_name} {limit:g} {unit}"
                 )
         ratios[name] = (per_vehicle[0], per_vehicle[1])
-    if not schedule.jerk_limited:
-        ratios["jerk"] = (float("nan"), float("nan"))
+    return ratios
 
-    ends = []
+
+def _check_ends(state: ScheduleState, schedule: Schedule, failures: list[str]) -> tuple[float, float]:
+    """Distance of the first and last sample from the route's start and goal, metres; both at rest."""
+    route, graph = schedule.route, schedule.route.graph
+    errors = []
     for label, index, expected in (("start", 0, route.start), ("goal", -1, route.goal)):
         error = 0.0
         for vehicle, position in enumerate(expected):
             leg = JUNCTION_INDEX if position.leg is None else graph.index(position.leg)
             error += float(
-                track_distance(
-                    np.array([state.leg[vehicle, index]]),
-                    np.array([state.s[vehicle, index]]),
-                    np.array([leg]),
-                    np.array([position.s]),
-                )[0]
+                track_distance(state.leg[vehicle, index], state.s[vehicle, index], leg, position.s)
             )
             # at rest: v = 0; a jerk-limited method also starts and ends with a = 0
             residue = abs(state.velocity[vehicle, index])
@@ -295,16 +296,19 @@ def _verify(schedule: Schedule, period: float) -> VerificationReport:
                 )
         if error > POSITION_TOLERANCE:
             failures.append(f"{label} is off the route's {label} by {error:.3g} m (expected <= 1e-9 m)")
-        ends.append(error)
+        errors.append(error)
+    return errors[0], errors[1]
 
-    # positions must move no faster than the velocities say (consistency of the two)
+
+def _check_consistency(state: ScheduleState, schedule: Schedule, failures: list[str]) -> None:
+    """Positions move no faster than the vehicles' velocity limits allow (track and kinematics agree)."""
     dt = np.diff(state.t)
     for vehicle in range(2):
         moved = track_distance(
             state.leg[vehicle, :-1], state.s[vehicle, :-1], state.leg[vehicle, 1:], state.s[vehicle, 1:]
         )
-        bound = limits.vehicles[vehicle].max_velocity * dt * (1.0 + RELATIVE_TOLERANCE) + POSITION_TOLERANCE
-        jumps = np.nonzero(moved > bound)[0]
+        limit = schedule.limits.vehicles[vehicle].max_velocity
+        jumps = np.nonzero(moved > limit * dt * (1.0 + RELATIVE_TOLERANCE) + POSITION_TOLERANCE)[0]
         if jumps.size:
             k = int(jumps[0])
             failures.append(
@@ -312,36 +316,48 @@ def _verify(schedule: Schedule, period: float) -> VerificationReport:
                 f"(faster than its max_velocity)"
             )
 
-    expected_regions = route.region_keys
-    sampled_regions = reduce_regions(region_keys(state.leg[0], state.s[0], state.leg[1], state.s[1]))
-    regions_match = sampled_regions == expected_regions
-    if not regions_match:
 
-        def show(keys):
-            return " ".join(str(Region.from_key(graph, key)) for key in keys)
+def _check_class(state: ScheduleState, route, failures: list[str]) -> bool:
+    """Whether the sampled region sequence (homotopy class) is the route's."""
+    expected = route.region_keys
+    sampled = reduce_regions(region_keys(state.leg[0], state.s[0], state.leg[1], state.s[1]))
+    if sampled == expected:
+        return True
 
-        failures.append(
-            f"homotopy class differs: schedule visits [{show(sampled_regions)}], "
-            f"route [{show(expected_regions)}]"
-        )
+    def show(keys):
+        return " ".join(str(Region.from_key(route.graph, key)) for key in keys)
 
-    report = VerificationReport(
+    failures.append(f"homotopy class differs: schedule visits [{show(sampled)}], route [{show(expected)}]")
+    return False
+
+
+def _verify(schedule: Schedule, period: float) -> VerificationReport:
+    route = schedule.route
+    required = max(schedule.limits.min_separation, route.min_separation)
+    state = schedule.state(_sample_times(schedule, period))
+    failures: list[str] = []
+    closest = _check_separation(state, required, failures)
+    _check_on_track(state, route.graph, failures)
+    ratios = _check_limits(state, schedule, failures)
+    start_error, goal_error = _check_ends(state, schedule, failures)
+    _check_consistency(state, schedule, failures)
+    regions_match = _check_class(state, route, failures)
+    if failures:
+        logger.warning("schedule (%s) failed verification: %s", schedule.method, "; ".join(failures))
+    return VerificationReport(
         passed=not failures,
         failures=tuple(failures),
         samples=int(state.t.size),
         period=period,
-        min_separation=float(separation[worst]),
-        separation_margin=float(separation[worst] - required),
+        min_separation=closest,
+        separation_margin=closest - required,
         velocity_ratio=ratios["velocity"],
         acceleration_ratio=ratios["acceleration"],
         jerk_ratio=ratios["jerk"],
-        start_error=ends[0],
-        goal_error=ends[1],
+        start_error=start_error,
+        goal_error=goal_error,
         regions_match=regions_match,
     )
-    if not report.passed:
-        logger.warning("schedule (%s) failed verification: %s", schedule.method, "; ".join(failures))
-    return report
 
 
 def certify(schedule: Schedule, *, period: float = MAX_PERIOD) -> VerifiedSchedule:
