@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from limits import Limits, VehicleLimits
 from topology import Configuration, Position, YGraph, plan
+from trajgen import Schedule
 
 SLOW = VehicleLimits(max_velocity=0.7, max_acceleration=0.35, max_jerk=0.6)
 AGV = VehicleLimits(max_velocity=1.0, max_acceleration=0.5, max_jerk=1.0)
@@ -18,3 +19,9 @@ def conf(first: str, second: str) -> Configuration:
 def route_of(legs, start, goal, separation=1.5):
     track = YGraph(dict(zip("ABC", legs, strict=True)))
     return plan(track, conf(*start), conf(*goal), min_separation=separation)
+
+
+def too_close(schedule: Schedule, separation: float = 10.5) -> Schedule:
+    """The same motion relabelled with a minimum separation it does not keep (a broken schedule)."""
+    limits = Limits(schedule.limits.vehicles, min_separation=separation)
+    return Schedule(schedule.route, limits, schedule.method, schedule.sections, schedule.jerk_limited)

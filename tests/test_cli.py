@@ -118,20 +118,13 @@ def test_bad_scenario_file_exits_2_naming_the_file(tmp_path, capsys):
 
 
 def test_a_schedule_failing_verification_exits_1_and_writes_nothing(tmp_path, capsys, monkeypatch):
-    from limits import Limits
-    from trajgen import Schedule, make_schedule, pipeline
+    from tests.helpers import too_close
+    from trajgen import make_schedule, pipeline
 
-    def too_close(route, limits, *, method):
-        good = make_schedule(route, limits, method=method)
-        return Schedule(
-            good.route,
-            Limits(limits.vehicles, min_separation=10.5),
-            good.method,
-            good.sections,
-            good.jerk_limited,
-        )
+    def broken(route, limits, *, method):
+        return too_close(make_schedule(route, limits, method=method))
 
-    monkeypatch.setattr(pipeline, "make_schedule", too_close)
+    monkeypatch.setattr(pipeline, "make_schedule", broken)
     output = tmp_path / "out"
     assert main(["schedule", SWAP, "--csv", str(output), "--plot", str(output)]) == EXIT_FAILURE
     captured = capsys.readouterr()

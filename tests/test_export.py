@@ -5,9 +5,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from limits import Limits
-from tests.helpers import LIMITS, MIXED, route_of
-from trajgen import Exact, Schedule, Toppra, certify
+from tests.helpers import LIMITS, MIXED, route_of, too_close
+from trajgen import Exact, Toppra, certify
 from trajgen.errors import OptionError, UnverifiedScheduleError, VerificationError
 from trajgen.export import CsvOptions, Units, write_profiles
 
@@ -89,14 +88,7 @@ def test_millimetres_comma_decimal_and_tab(tmp_path):
 
 
 def test_failing_schedule_cannot_be_certified_nor_written(tmp_path):
-    schedule = Exact().schedule(route_of(*SWAP), LIMITS)
-    broken = Schedule(
-        schedule.route,
-        Limits(LIMITS.vehicles, min_separation=10.5),
-        schedule.method,
-        schedule.sections,
-        schedule.jerk_limited,
-    )
+    broken = too_close(Exact().schedule(route_of(*SWAP), LIMITS))
     target = tmp_path / "out"
     with pytest.raises(VerificationError, match=r"below the minimum 10\.5 m"):
         certify(broken)

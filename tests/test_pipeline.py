@@ -7,9 +7,9 @@ import os
 
 import pytest
 
-from limits import Limits
 from tests.conftest import REPO
-from trajgen import Outputs, Schedule, Toppra, default_scenario, run
+from tests.helpers import too_close
+from trajgen import Outputs, Toppra, default_scenario, run
 from trajgen.cli import EXIT_BAD_INPUT, main
 from trajgen.errors import InputError, OutputError
 from trajgen.export import atomic, commit_files
@@ -133,12 +133,10 @@ def test_a_run_verifies_each_schedule_once_and_commits_every_file(tmp_path, capl
 def test_a_compared_method_that_fails_verification_is_left_out_of_the_plot(tmp_path, monkeypatch):
     real = Toppra.schedule
 
-    def too_close(self, route, limits):
-        good = real(self, route, limits)
-        broken = Limits(limits.vehicles, min_separation=10.5)
-        return Schedule(good.route, broken, good.method, good.sections, good.jerk_limited)
+    def broken(self, route, limits):
+        return too_close(real(self, route, limits))
 
-    monkeypatch.setattr(Toppra, "schedule", too_close)
+    monkeypatch.setattr(Toppra, "schedule", broken)
     result = run(default_scenario(), method="exact", outputs=Outputs(plot_dir=tmp_path))
     assert any(
         n.startswith("coordination plot: toppra left out: schedule failed verification") for n in result.notes

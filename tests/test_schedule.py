@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from limits import Limits, VehicleLimits
-from tests.helpers import LIMITS, MIXED, route_of
+from tests.helpers import LIMITS, MIXED, route_of, too_close
 from topology import YGraph
 from trajgen import METHODS, Exact, Schedule, Toppra, certify, make_schedule, verify
 from trajgen.axes import route_axes, straight_pieces
@@ -147,7 +147,7 @@ def test_verifier_catches_a_schedule_that_is_too_fast():
 
 def test_verifier_catches_vehicles_too_close():
     schedule = exact_schedule(route_of(*SWAP), LIMITS)
-    broken = _relabelled(schedule, limits=Limits(vehicles=LIMITS.vehicles, min_separation=10.5))
+    broken = too_close(schedule)
     report = verify(broken)
     assert report.separation_margin == pytest.approx(-0.5)
     assert any("below the minimum 10.5 m" in f for f in report.failures)

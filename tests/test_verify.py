@@ -8,9 +8,8 @@ import math
 
 import pytest
 
-from limits import Limits
-from tests.helpers import LIMITS, route_of
-from trajgen import Exact, Schedule, VerifiedSchedule, certify, verify
+from tests.helpers import LIMITS, route_of, too_close
+from trajgen import Exact, VerifiedSchedule, certify, verify
 from trajgen.errors import InputError, UnverifiedScheduleError, VerificationError
 
 SWAP = ((10.0, 10.0, 10.0), ("A:10", "B:10"), ("B:10", "A:10"))
@@ -53,14 +52,7 @@ def test_each_schedule_is_verified_once(caplog):
 
 
 def test_a_failing_report_cannot_make_a_certificate():
-    schedule = Exact().schedule(route_of(*SWAP), LIMITS)
-    broken = Schedule(
-        schedule.route,
-        Limits(LIMITS.vehicles, min_separation=10.5),
-        schedule.method,
-        schedule.sections,
-        schedule.jerk_limited,
-    )
+    broken = too_close(Exact().schedule(route_of(*SWAP), LIMITS))
     report = verify(broken)
     assert not report.passed
     with pytest.raises(VerificationError, match=r"below the minimum 10\.5 m"):
