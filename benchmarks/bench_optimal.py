@@ -22,7 +22,7 @@ import statistics
 import time
 
 from topology import plan
-from trajgen import Exact, Optimal, Toppra, lower_bound, verify
+from trajgen import Exact, Optimal, SolverCache, Toppra, lower_bound, verify
 from trajgen.methods.optimal import DEFAULT_NODES, Source
 from trajgen.sampling import reference_sets
 
@@ -39,7 +39,9 @@ def main() -> None:
         f"{'opt/ex':>6} {'opt/lb':>6} {'solve ms':>9} {'fallback':>8} {'2N change':>9}"
     )
     print(header)
-    optimal, refined = Optimal(nodes=args.nodes), Optimal(nodes=2 * args.nodes)
+    # one cache per grid, large enough for every shape of the sets: each shape is built once
+    optimal = Optimal(nodes=args.nodes, cache=SolverCache(maxsize=128))
+    refined = Optimal(nodes=2 * args.nodes, cache=SolverCache(maxsize=128))
     for reference in reference_sets(args.random):
         label, limits = reference.label, reference.limits
         for name, start, goal in reference.scenarios:

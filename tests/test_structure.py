@@ -168,3 +168,24 @@ def test_the_library_never_prints():
             if isinstance(node, ast.Call) and isinstance(node.func, ast.Name) and node.func.id == "print"
         ]
         assert not calls, module
+
+
+TEST_FILES = sorted((REPO / "tests").glob("*.py"))
+
+
+@pytest.mark.parametrize("path", TEST_FILES, ids=[p.stem for p in TEST_FILES])
+def test_tests_use_no_private_names_and_no_benchmark_module(path):
+    tree = ast.parse(path.read_text(encoding="utf-8"))
+    defined = _defined_private_names(tree)
+    problems = []
+    for node in ast.walk(tree):
+        if isinstance(node, ast.ImportFrom) and (node.module or "").split(".")[0] in PACKAGES:
+            problems += [f"imports {alias.name}" for alias in node.names if _private(alias.name)]
+        if isinstance(node, (ast.Import, ast.ImportFrom)):
+            names = (
+                [alias.name for alias in node.names] if isinstance(node, ast.Import) else [node.module or ""]
+            )
+            problems += [f"imports {name}" for name in names if name.split(".")[0] == "benchmarks"]
+        elif isinstance(node, ast.Attribute) and _private(node.attr) and node.attr not in defined:
+            problems.append(f"line {node.lineno}: uses .{node.attr}")
+    assert problems == []

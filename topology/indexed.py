@@ -150,20 +150,27 @@ def track_distance(leg_a, s_a, leg_b, s_b) -> np.ndarray:
 
 
 def region_keys(leg1, s1, leg2, s2) -> list[RegionKey | None]:
-    """Region of each sampled configuration; ``None`` on a ray.
+    """Region of each sampled configuration; ``None`` on a ray (vectorized :func:`region_key`).
 
     Parameters
     ----------
     leg1, s1, leg2, s2 : array_like, shape (n,)
         Leg indices and distances (metres) of vehicle 1 and vehicle 2.
+
+    Examples
+    --------
+    >>> region_keys([0, 0, -1], [1.0, 1.0, 0.0], [1, 0, 2], [2.0, 2.0, 3.0])
+    [RegionKey(first_leg=0, second_leg=1, nearer=0), RegionKey(first_leg=0, second_leg=0, nearer=1), None]
     """
-    return [
-        region_key(a, x, b, y)
-        for a, x, b, y in zip(
-            np.asarray(leg1).tolist(),
-            np.asarray(s1).tolist(),
-            np.asarray(leg2).tolist(),
-            np.asarray(s2).tolist(),
-            strict=True,
-        )
+    leg1, s1, leg2, s2 = (np.atleast_1d(np.asarray(x)) for x in (leg1, s1, leg2, s2))
+    ray = (leg1 == JUNCTION_INDEX) | (leg2 == JUNCTION_INDEX)
+    nearer = np.where(leg1 != leg2, 0, np.where(s1 < s2, 1, 2))
+    legs = int(max(leg1.max(initial=0), leg2.max(initial=0))) + 1
+    codes = np.where(ray, -1, (leg1 * legs + leg2) * 3 + nearer)
+    # one RegionKey object per distinct region, not per sample
+    unique, inverse = np.unique(codes, return_inverse=True)
+    keys = [
+        None if code < 0 else RegionKey(int(code) // 3 // legs, int(code) // 3 % legs, int(code) % 3)
+        for code in unique.tolist()
     ]
+    return [keys[k] for k in inverse.ravel().tolist()]
