@@ -26,7 +26,7 @@ from trajgen import (
 )
 from trajgen.errors import InputError, OptionError
 from trajgen.methods import MethodRegistry
-from trajgen.methods.optimal.phases import NlpShape
+from trajgen.methods.optimal.phases import NO_SWITCH, NlpShape, PhaseKind
 
 SWAP = ((10.0, 10.0, 10.0), ("A:10", "B:10"), ("B:10", "A:10"))
 
@@ -120,7 +120,11 @@ def test_a_registry_refuses_duplicates_and_an_unknown_default():
 
 def _shape(nodes: int) -> NlpShape:
     return NlpShape(
-        kinds=((False, False, 0, -1),), nodes=nodes, segments=1, max_iterations=10, fatrop_iterations=10
+        kinds=(PhaseKind((False, False), 0, NO_SWITCH),),
+        nodes=nodes,
+        segments=1,
+        max_iterations=10,
+        fatrop_iterations=10,
     )
 
 

@@ -12,6 +12,7 @@ from __future__ import annotations
 
 from collections.abc import Iterator
 from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 
@@ -22,6 +23,7 @@ __all__ = [
     "STATE_SIZE",
     "NlpShape",
     "Phase",
+    "PhaseKind",
     "Stage",
     "grid_fractions",
     "route_phases",
@@ -84,14 +86,32 @@ def route_phases(route: Route) -> tuple[Phase, ...]:
     return tuple(phases)
 
 
+class PhaseKind(NamedTuple):
+    """What of a phase fixes the NLP's structure (leg lengths and positions are parameters).
+
+    Attributes
+    ----------
+    parked : tuple of 2 bool
+        Whether vehicle 1, vehicle 2 stays at the junction all phase.
+    nearer : int
+        0 on different legs; on a shared leg the vehicle (1 or 2) nearer the junction.
+    switching : int
+        Vehicle (0 or 1) that changes leg at the end of the phase; ``NO_SWITCH`` for the last.
+    """
+
+    parked: tuple[bool, bool]
+    nearer: int
+    switching: int
+
+
 @dataclass(frozen=True, slots=True)
 class NlpShape:
     """What fixes the structure of the NLP: built once per shape, reused with new parameters.
 
     Attributes
     ----------
-    kinds : tuple of (bool, bool, int, int)
-        Per phase: vehicle 1 parked, vehicle 2 parked, ``nearer``, ``switching``.
+    kinds : tuple of PhaseKind
+        Per phase, what fixes its structure.
     nodes : int
         Control intervals per segment.
     segments : int
@@ -102,7 +122,7 @@ class NlpShape:
         Iteration limit of fatrop.
     """
 
-    kinds: tuple[tuple[bool, bool, int, int], ...]
+    kinds: tuple[PhaseKind, ...]
     nodes: int
     segments: int
     max_iterations: int
@@ -119,7 +139,7 @@ class NlpShape:
         fatrop_iterations: int,
     ) -> NlpShape:
         """The shape of the problem for ``phases`` with these options."""
-        kinds = tuple((p.parked(0), p.parked(1), p.nearer, p.switching) for p in phases)
+        kinds = tuple(PhaseKind((p.parked(0), p.parked(1)), p.nearer, p.switching) for p in phases)
         return cls(kinds, nodes, segments, max_iterations, fatrop_iterations)
 
     @property

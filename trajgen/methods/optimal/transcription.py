@@ -233,7 +233,7 @@ class _Builder:
         low, high = [-np.inf] * STATE_SIZE, [np.inf] * STATE_SIZE
         kind = self.shape.kinds[phase]
         for vehicle in range(2):
-            if kind[vehicle]:  # parked at the junction for the whole phase
+            if kind.parked[vehicle]:  # at the junction for the whole phase
                 low[3 * vehicle : 3 * vehicle + 3] = [0.0, 0.0, 0.0]
                 high[3 * vehicle : 3 * vehicle + 3] = [0.0, 0.0, 0.0]
             elif vehicle not in pinned:
@@ -246,14 +246,14 @@ class _Builder:
 
     def at_rest(self, x, phase: int, positions) -> None:
         for vehicle in range(2):
-            if not self.shape.kinds[phase][vehicle]:
+            if not self.shape.kinds[phase].parked[vehicle]:
                 self.constrain(x[3 * vehicle] - positions[vehicle], 0.0, 0.0)
                 self.constrain(x[3 * vehicle + 1 : 3 * vehicle + 3], 0.0, 0.0)
 
     def stage(self, stage: Stage, x, parameters: dict):
         """Add one control interval from node ``x``; returns the next node."""
         ca, kinds = self.ca, self.shape.kinds
-        parked_first, parked_second, nearer, switching = kinds[stage.phase]
+        kind = kinds[stage.phase]
         u = ca.SX.sym(f"u{stage.phase}_{stage.interval}", stage.control_size)
         self.variables.append(u)
         self.lower.extend([-1.0, -1.0] + ([MIN_SEGMENT] if stage.new_segment else []))
@@ -262,9 +262,9 @@ class _Builder:
         # jerk, s, v and the gap there are monotone (all of the form c + d t^3), so the node values
         # bound them. Stating them anyway would tie inequalities to the rest equalities.
         function = _stage_function(
-            (parked_first, parked_second),
-            nearer,
-            switching if stage.phase_end else NO_SWITCH,
+            kind.parked,
+            kind.nearer,
+            kind.switching if stage.phase_end else NO_SWITCH,
             path=not stage.first,
             between=not (stage.first or stage.last),
         )
@@ -278,11 +278,11 @@ class _Builder:
         )
         following, node_path, between, cost = function.function(x, u[:2], stage.fraction, limits)
         next_phase = stage.phase + 1 if stage.phase_end else stage.phase
-        pinned = (switching,) if stage.phase_end else (0, 1) if stage.last else ()
+        pinned = (kind.switching,) if stage.phase_end else (0, 1) if stage.last else ()
         x_next = self.state(f"x{stage.phase}_{stage.interval + 1}", next_phase, pinned)
         self.constrain(x_next - ca.vertcat(following, u[2] if stage.new_segment else x[6]), 0.0, 0.0)
         if stage.interval == 0 and stage.phase > 0:  # the vehicle that changed leg is at the junction
-            self.constrain(x[3 * kinds[stage.phase - 1][3]], 0.0, 0.0)
+            self.constrain(x[3 * kinds[stage.phase - 1].switching], 0.0, 0.0)
         if stage.first:  # rest at the start, which the planner has checked: no node constraints
             self.at_rest(x, stage.phase, parameters["start"])
         if node_path.numel():
