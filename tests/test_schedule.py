@@ -196,3 +196,13 @@ def test_verifier_catches_a_broken_position_map():
     )
     report = verify(broken)
     assert any("jumps" in f for f in report.failures)
+
+
+@pytest.mark.parametrize("method", ["exact", "toppra", "optimal"])
+@pytest.mark.parametrize("period", [0.005, 0.01, 0.5], ids=lambda p: f"{p}s")
+def test_the_last_sample_is_the_goal_at_rest_with_no_jerk(method, period):
+    schedule = make_schedule(route_of(*SWAP), LIMITS, method=method)
+    state = schedule.sample(period)
+    assert state.t[-1] == schedule.duration
+    assert np.all(state.jerk[:, -1] == 0.0)
+    assert np.all(np.abs(state.velocity[:, -1]) < 1e-9)

@@ -316,6 +316,8 @@ class Schedule:
             if not mask.any():
                 continue
             local = np.clip(t[mask] - section.start_time, 0.0, section.duration)
+            if k == len(self.sections) - 1:  # the goal is the end of the last section, not a round-off before
+                local[t[mask] >= self.duration] = section.duration
             values = section.kinematics.evaluate(local)
             kin[:, :, mask] = values
             for vehicle in range(2):
