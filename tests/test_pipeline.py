@@ -147,3 +147,69 @@ def test_a_compared_method_that_fails_verification_is_left_out_of_the_plot(tmp_p
 def test_run_refuses_what_is_not_a_scenario():
     with pytest.raises(InputError, match="run expects a Scenario, got str"):
         run("examples/swap.toml")  # type: ignore[arg-type]
+
+
+def test_a_fallback_run_reports_the_method_asked_for_and_plots_its_own_schedule(tmp_path, caplog):
+    from trajgen import Optimal, SolverCache
+
+    failing = Optimal(max_iterations=1, cache=SolverCache())
+    with caplog.at_level(logging.WARNING, logger="trajgen.methods.optimal"):
+        result = run(default_scenario(), method=failing, outputs=Outputs(plot_dir=tmp_path))
+    summary = result.summary()
+    assert (summary["method"], summary["computed_by"], summary["fallback_reason"]) == (
+        "optimal",
+        "exact",
+        "solver-failed",
+    )
+    # one optimal solve in the whole run: the coordination plot shows the run's own (fallback) schedule
+    assert len([r for r in caplog.records if "fell back to exact" in r.message]) == 1
+    assert (tmp_path / "coordination.png").is_file()
+
+
+@pytest.mark.parametrize(
+    "second",
+    [pytest.param("AGV1.csv", id="case"), pytest.param("link/agv1.csv", id="through-a-link")],
+)
+def test_one_file_asked_for_twice_under_two_spellings_is_refused(tmp_path, second):
+    (tmp_path / "link").symlink_to(tmp_path, target_is_directory=True)
+    with pytest.raises(OutputError, match="is asked for twice in one run"):
+        commit_files({tmp_path / "agv1.csv": b"first", tmp_path / second: b"second"})
+    assert not (tmp_path / "agv1.csv").exists()
+
+
+def test_rollback_keeps_a_dangling_link_that_was_there(tmp_path, monkeypatch):
+    (tmp_path / "a.csv").symlink_to(tmp_path / "nowhere")
+    real = os.replace
+    calls = []
+
+    def fail_on_second(source, target):
+        calls.append(target)
+        if len(calls) == 2:
+            raise PermissionError(13, "Permission denied", str(target))
+        return real(source, target)
+
+    monkeypatch.setattr(atomic.os, "replace", fail_on_second)
+    with pytest.raises(OutputError):
+        commit_files({tmp_path / "a.csv": b"a", tmp_path / "b.csv": b"b"})
+    assert (tmp_path / "a.csv").is_symlink()
+    assert os.readlink(tmp_path / "a.csv") == str(tmp_path / "nowhere")
+    assert _hidden(tmp_path) == []
+
+
+def test_written_files_get_the_permissions_a_plain_open_would_give(tmp_path):
+    (path,) = commit_files({tmp_path / "x.csv": b"x"})
+    reference = tmp_path / "reference"
+    reference.write_bytes(b"x")
+    assert path.stat().st_mode & 0o777 == reference.stat().st_mode & 0o777
+
+
+def test_cli_help_lists_one_line_per_method(capsys):
+    from trajgen import METHODS
+
+    with pytest.raises(SystemExit):
+        main(["schedule", "--help"])
+    out = capsys.readouterr().out
+    for cls in METHODS:
+        assert any(line.strip().startswith(f"{cls.name}: {cls.summary}") for line in out.splitlines()), (
+            cls.name
+        )

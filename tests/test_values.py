@@ -64,3 +64,53 @@ def test_frozen_fields_cannot_be_rebound():
     schedule = Exact().schedule(route_of(*SWAP), LIMITS)
     with pytest.raises(AttributeError):
         schedule.sections = ()  # type: ignore[misc]
+
+
+def test_equality_and_hash_agree_on_signed_zero_and_nan():
+    from trajgen.schedule import AxisMap
+
+    parked = AxisMap.parked(0.0, 1, 2.0)
+    assert parked == parked.flipped()
+    assert hash(parked) == hash(parked.flipped())
+    with_nan = AxisMap(np.array([np.nan]), np.array([1.0]), np.array([0]), np.array([1.0]), np.array([1]))
+    twin = AxisMap(np.array([-np.nan]), np.array([1.0]), np.array([0]), np.array([1.0]), np.array([1]))
+    assert with_nan == twin
+    assert hash(with_nan) == hash(twin)
+
+
+def test_sampled_states_cannot_be_written_through_their_base():
+    state = Exact().schedule(route_of(*SWAP), LIMITS).state([0.0, 5.0, 10.0])
+    for array in (state.axis, state.velocity, state.acceleration, state.jerk, state.leg, state.s, state.t):
+        base = array if array.base is None else array.base
+        with pytest.raises(ValueError, match="read-only"):
+            array.flat[0] = 1
+        with pytest.raises(ValueError, match="read-only"):
+            base.flat[0] = 1
+    with pytest.raises(ValueError, match="cannot set WRITEABLE flag"):
+        state.velocity.flags.writeable = True  # a view of a read-only buffer stays read-only
+
+
+def test_a_state_built_from_the_callers_arrays_copies_them():
+    from trajgen.schedule import ScheduleState
+
+    mine = np.zeros((2, 3))
+    state = ScheduleState(np.zeros(3), mine, mine, mine, mine, np.zeros((2, 3), dtype=int), mine)
+    mine[0, 0] = 7.0
+    assert state.axis[0, 0] == 0.0
+    assert mine.flags.writeable
+
+
+def test_routes_with_different_indexed_data_are_different_values():
+    import dataclasses
+
+    from topology import PositionError
+
+    route = route_of(*SWAP)
+    other = route_of((10.0, 10.0, 10.0), ("A:10", "B:10"), ("A:10", "C:5"))
+    forged = dataclasses.replace(
+        route,
+        indexed_waypoints=other.indexed_waypoints[:1] * len(route.waypoints),
+    )
+    assert forged != route
+    with pytest.raises(PositionError, match=r"one indexed waypoint and one cumulative travel per waypoint"):
+        dataclasses.replace(route, indexed_waypoints=other.indexed_waypoints)

@@ -6,11 +6,14 @@ import dataclasses
 import logging
 import math
 
+import numpy as np
 import pytest
 
 from tests.helpers import LIMITS, route_of, too_close
 from trajgen import Exact, VerifiedSchedule, certify, verify
 from trajgen.errors import InputError, UnverifiedScheduleError, VerificationError
+from trajgen.profiles import PiecewiseCubic
+from trajgen.schedule import CubicKinematics
 
 SWAP = ((10.0, 10.0, 10.0), ("A:10", "B:10"), ("B:10", "A:10"))
 
@@ -18,11 +21,12 @@ SWAP = ((10.0, 10.0, 10.0), ("A:10", "B:10"), ("B:10", "A:10"))
 @pytest.mark.parametrize(
     ("period", "match"),
     [
-        pytest.param(-1.0, r"must be > 0 s and at most 0\.001 s, got -1\.0", id="negative"),
-        pytest.param(0.0, r"must be > 0 s and at most 0\.001 s, got 0\.0", id="zero"),
+        pytest.param(-1.0, r"must be between 1e-06 s and 0\.001 s, got -1\.0", id="negative"),
+        pytest.param(0.0, r"must be between 1e-06 s and 0\.001 s, got 0\.0", id="zero"),
         pytest.param(math.inf, r"verifier sample period \(seconds\) must be finite, got inf", id="inf"),
         pytest.param(math.nan, "must be finite, got nan", id="nan"),
-        pytest.param(0.002, r"at most 0\.001 s, got 0\.002", id="coarse"),
+        pytest.param(0.002, r"between 1e-06 s and 0\.001 s, got 0\.002", id="coarse"),
+        pytest.param(5e-324, r"between 1e-06 s and 0\.001 s, got 5e-324", id="subnormal"),
         pytest.param("1e-3", "must be a real number, got '1e-3'", id="string"),
     ],
 )
@@ -61,3 +65,79 @@ def test_a_failing_report_cannot_make_a_certificate():
         VerifiedSchedule(broken, "passed")  # type: ignore[arg-type]
     with pytest.raises(InputError, match="verify expects a Schedule, got str"):
         verify("schedule")  # type: ignore[arg-type]
+
+
+def test_too_many_samples_are_refused_up_front():
+    schedule = Exact().schedule(route_of(*SWAP), LIMITS)  # 67.5 s
+    with pytest.raises(InputError, match=r"takes 6\.75e\+07 samples: expected at most 20,000,000"):
+        verify(schedule, period=1e-6)
+
+
+def _with_profile_values(schedule, vehicle: int, column: int, value: float):
+    """``schedule`` with one initial-state coefficient of the first section replaced (a mutant)."""
+    section = schedule.sections[0]
+    profiles = list(section.kinematics.vehicles)
+    initial = np.array(profiles[vehicle].initial)
+    initial[len(initial) // 2, column] = value
+    profiles[vehicle] = PiecewiseCubic(profiles[vehicle].times, initial, profiles[vehicle].jerk)
+    changed = dataclasses.replace(section, kinematics=CubicKinematics(tuple(profiles)))
+    return dataclasses.replace(schedule, sections=(changed, *schedule.sections[1:]))
+
+
+@pytest.mark.parametrize("value", [math.nan, math.inf, -math.inf], ids=["nan", "inf", "-inf"])
+@pytest.mark.parametrize(("column", "name"), [(0, "axis"), (1, "velocity"), (2, "acceleration")])
+def test_non_finite_values_fail_and_are_never_certified(value, column, name):
+    schedule = _with_profile_values(Exact().schedule(route_of(*SWAP), LIMITS), 1, column, value)
+    report = verify(schedule)
+    assert not report.passed
+    assert any(f.startswith(f"{name} is not finite") for f in report.failures), report.failures
+    with pytest.raises(VerificationError, match="is not finite"):
+        certify(schedule)
+
+
+def test_a_non_finite_duration_fails_without_sampling():
+    schedule = Exact().schedule(route_of(*SWAP), LIMITS)
+    section = schedule.sections[-1]
+    profiles = list(section.kinematics.vehicles)
+    times = np.array(profiles[0].times)
+    times[-1] = math.nan
+    profiles[0] = PiecewiseCubic(times, profiles[0].initial, profiles[0].jerk)
+    broken = dataclasses.replace(
+        schedule,
+        sections=(
+            *schedule.sections[:-1],
+            dataclasses.replace(section, kinematics=CubicKinematics(tuple(profiles))),
+        ),
+    )
+    report = verify(broken)
+    assert report.failures == ("schedule duration is nan s: expected finite, >= 0",)
+
+
+def test_a_certificate_is_bound_to_its_own_schedule():
+    good = Exact().schedule(route_of(*SWAP), LIMITS)
+    other = Exact(jerk=False).schedule(route_of(*SWAP), LIMITS)
+    with pytest.raises(UnverifiedScheduleError, match="not this schedule's verification report"):
+        VerifiedSchedule(other, verify(good))
+    assert VerifiedSchedule(good, verify(good)).report.passed
+
+
+def test_concurrent_callers_get_one_report():
+    import threading
+
+    schedule = Exact().schedule(route_of(*SWAP), LIMITS)
+    reports = []
+    threads = [threading.Thread(target=lambda: reports.append(verify(schedule))) for _ in range(6)]
+    for thread in threads:
+        thread.start()
+    for thread in threads:
+        thread.join()
+    assert len({id(report) for report in reports}) == 1
+
+
+def test_a_schedule_that_does_not_limit_jerk_reports_no_jerk_ratio():
+    from trajgen import Toppra
+
+    report = verify(Toppra().schedule(route_of(*SWAP), LIMITS))
+    assert report.jerk_ratio is None
+    assert report.summary()["jerk_ratio"] is None
+    assert report == verify(Toppra().schedule(route_of(*SWAP), LIMITS))

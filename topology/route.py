@@ -12,7 +12,7 @@ import itertools
 from dataclasses import dataclass, field
 
 from topology.cycle import ANTIPODAL_TOLERANCE, as_indexed, retract_indexed
-from topology.errors import OptionError, SeparationError
+from topology.errors import OptionError, PositionError, SeparationError
 from topology.graph import YGraph
 from topology.indexed import (
     JUNCTION_INDEX,
@@ -124,6 +124,10 @@ class Route:
     arc_length : float
         Signed length of the trip round the boundary circle, metres,
         positive counterclockwise.
+    indexed_waypoints : tuple of IndexedConfiguration
+        The waypoints in the indexed form ``(leg1, s1, leg2, s2)``, shape (n,).
+    cumulative_travel : tuple of float
+        Travel ``|ds1| + |ds2|`` from the start to each waypoint, metres, shape (n,).
     """
 
     graph: YGraph
@@ -131,8 +135,17 @@ class Route:
     waypoints: tuple[Configuration, ...]
     min_separation: float
     arc_length: float
-    indexed_waypoints: tuple[IndexedConfiguration, ...] = field(repr=False, compare=False)
-    cumulative_travel: tuple[float, ...] = field(repr=False, compare=False)
+    indexed_waypoints: tuple[IndexedConfiguration, ...] = field(repr=False)
+    cumulative_travel: tuple[float, ...] = field(repr=False)
+
+    def __post_init__(self) -> None:
+        count = len(self.waypoints)
+        if count < 1 or len(self.indexed_waypoints) != count or len(self.cumulative_travel) != count:
+            raise PositionError(
+                f"a route needs one indexed waypoint and one cumulative travel per waypoint, got "
+                f"{count}, {len(self.indexed_waypoints)} and {len(self.cumulative_travel)}: "
+                "build routes with plan()"
+            )
 
     @property
     def start(self) -> Configuration:

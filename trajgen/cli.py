@@ -78,7 +78,7 @@ def _add_method(parser: argparse.ArgumentParser) -> None:
         "--method",
         default=METHODS.default,
         metavar="|".join(METHODS.names),
-        help=f"timing method; {METHODS.help()}",
+        help=f"timing method, one of:\n{METHODS.help()}",
     )
 
 
@@ -99,7 +99,11 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("-v", "--verbose", action="store_true", help="log progress to stderr")
     commands = parser.add_subparsers(dest="command", required=True, parser_class=_ArgumentParser)
 
-    demo = commands.add_parser("demo", help="run the built-in swap scenario end to end")
+    demo = commands.add_parser(
+        "demo",
+        help="run the built-in swap scenario end to end",
+        formatter_class=argparse.RawTextHelpFormatter,
+    )
     demo.add_argument("--output", default="trajgen-demo", help="folder for CSV and plots (trajgen-demo)")
     _add_method(demo)
     demo.set_defaults(run=_command_demo)
@@ -109,7 +113,11 @@ def build_parser() -> argparse.ArgumentParser:
     plan_parser.add_argument("--json", action="store_true", help="print a machine-readable summary")
     plan_parser.set_defaults(run=_command_plan)
 
-    schedule = commands.add_parser("schedule", help="schedule, verify and export a scenario")
+    schedule = commands.add_parser(
+        "schedule",
+        help="schedule, verify and export a scenario",
+        formatter_class=argparse.RawTextHelpFormatter,
+    )
     schedule.add_argument("scenario", help="scenario TOML file")
     _add_method(schedule)
     schedule.add_argument("--csv", metavar="DIR", help="write DIR/<vehicle name>.csv per vehicle")

@@ -79,6 +79,8 @@ class RunResult:
     Attributes
     ----------
     scenario : Scenario
+    method : TimingMethod
+        The method asked for (the schedule's own ``method`` is ``exact`` after a fallback).
     route : Route
     verified : VerifiedSchedule
         The schedule, certified by the verifier.
@@ -89,6 +91,7 @@ class RunResult:
     """
 
     scenario: Scenario
+    method: TimingMethod
     route: Route
     verified: VerifiedSchedule
     files: tuple[Path, ...]
@@ -99,7 +102,8 @@ class RunResult:
         schedule, report = self.verified.schedule, self.verified.report
         return {
             "scenario": self.scenario.source,
-            "method": schedule.method.name,
+            "method": self.method.name,
+            "computed_by": schedule.method.name,
             "duration_s": schedule.duration,
             "jerk_limited": schedule.jerk_limited,
             "verified": report.passed,
@@ -112,13 +116,17 @@ class RunResult:
         }
 
 
-def _comparison(route: Route, scenario: Scenario, chosen: VerifiedSchedule) -> tuple[dict, list[str]]:
-    """Every registered method's verified schedule of ``route`` for the coordination plot."""
-    verified = {}
+def _comparison(
+    route: Route, scenario: Scenario, chosen: TimingMethod, verified_chosen: VerifiedSchedule
+) -> tuple[dict, list[str]]:
+    """Every registered method's verified schedule of ``route`` for the coordination plot.
+
+    The run's own schedule stands for the method asked for (also after a fallback).
+    """
+    verified = {chosen.name: verified_chosen}
     notes = []
     for method in METHODS:
-        if method.name == chosen.schedule.method.name:
-            verified[method.name] = chosen
+        if method.name == chosen.name:
             continue
         try:
             verified[method.name] = certify(make_schedule(route, scenario.limits, method=method()))
@@ -165,10 +173,10 @@ def run(
         for vehicle, path in enumerate(profile_paths(scenario.names, outputs.csv_dir)):
             files[path] = render_profile(verified, vehicle, outputs.csv)
     if outputs.plot_dir is not None:
-        compared, notes = _comparison(route, scenario, verified)
+        compared, notes = _comparison(route, scenario, chosen, verified)
         speed, separation, coordination = (outputs.plot_dir / name for name in PLOT_NAMES)
         files[speed] = render_speed(verified, names=scenario.names)
         files[separation] = render_separation(verified)
         files[coordination] = render_coordination(compared)
     written = commit_files(files) if files else ()
-    return RunResult(scenario, route, verified, written, tuple(notes))
+    return RunResult(scenario, chosen, route, verified, written, tuple(notes))

@@ -22,7 +22,7 @@ from topology import JUNCTION_INDEX, Configuration, Position, Route
 from topology.validation import finite_real
 from trajgen.errors import InputError
 from trajgen.profiles import PiecewiseCubic
-from trajgen.values import ArrayValue, readonly
+from trajgen.values import ArrayValue, frozen, readonly
 
 __all__ = [
     "AxisMap",
@@ -250,7 +250,7 @@ class ScheduleState(ArrayValue):
 
     def __post_init__(self) -> None:
         for name in ("t", "axis", "velocity", "acceleration", "jerk", "leg", "s"):
-            getattr(self, name).flags.writeable = False
+            object.__setattr__(self, name, frozen(np.asarray(getattr(self, name))))
 
 
 @dataclass(frozen=True, slots=True, weakref_slot=True)
@@ -322,6 +322,8 @@ class Schedule:
             kin[:, :, mask] = values
             for vehicle in range(2):
                 leg[vehicle, mask], s[vehicle, mask] = section.maps[vehicle].locate(values[vehicle, 0])
+        for array in (t, kin, leg, s):  # freeze the buffers, so the state's views are safe as they are
+            array.flags.writeable = False
         return ScheduleState(t, kin[:, 0], kin[:, 1], kin[:, 2], kin[:, 3], leg, s)
 
     def sample(self, period: float) -> ScheduleState:

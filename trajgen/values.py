@@ -6,7 +6,21 @@ import dataclasses
 
 import numpy as np
 
-__all__ = ["ArrayValue", "readonly"]
+__all__ = ["ArrayValue", "frozen", "readonly"]
+
+
+def frozen(array: np.ndarray) -> np.ndarray:
+    """``array`` itself if nothing can write to it any more, else a read-only copy.
+
+    An array is safe when it and every array it is a view of are read-only
+    (numpy then refuses to make it writeable again).
+    """
+    base = array
+    while isinstance(base, np.ndarray):
+        if base.flags.writeable:
+            return readonly(array)
+        base = base.base
+    return array
 
 
 def readonly(values, dtype=None) -> np.ndarray:
@@ -25,17 +39,16 @@ def readonly(values, dtype=None) -> np.ndarray:
 
 def _same(a: object, b: object) -> bool:
     if isinstance(a, np.ndarray) or isinstance(b, np.ndarray):
-        return (
-            isinstance(a, np.ndarray)
-            and isinstance(b, np.ndarray)
-            and a.dtype == b.dtype
-            and np.array_equal(a, b)
-        )
+        if not (isinstance(a, np.ndarray) and isinstance(b, np.ndarray)) or a.dtype != b.dtype:
+            return False
+        return bool(np.array_equal(a, b, equal_nan=a.dtype.kind in "fc"))
     return bool(a == b)
 
 
 def _hash_key(value: object) -> object:
     if isinstance(value, np.ndarray):
+        if value.dtype.kind in "fc":  # as equality sees them: -0.0 is 0.0, every NaN is one NaN
+            value = np.where(np.isnan(value), np.nan, value + 0.0)
         return (value.shape, value.dtype.str, value.tobytes())
     return value
 

@@ -29,6 +29,7 @@ from __future__ import annotations
 
 import collections
 import logging
+import math
 import threading
 import time
 import weakref
@@ -85,8 +86,10 @@ class VerificationReport:
         Smallest track distance between the vehicles, metres.
     separation_margin : float
         ``min_separation - required``, metres (negative: violated).
-    velocity_ratio, acceleration_ratio, jerk_ratio : tuple of 2 float
+    velocity_ratio, acceleration_ratio : tuple of 2 float
         Per vehicle, largest ``|value| / limit`` (1.0 is at the limit).
+    jerk_ratio : tuple of 2 float or None
+        The same for jerk; ``None`` when the schedule does not limit jerk.
     start_error, goal_error : float
         Track distance of the schedule's first and last positions from the route's, metres.
     regions_match : bool
@@ -101,7 +104,7 @@ class VerificationReport:
     separation_margin: float
     velocity_ratio: tuple[float, float]
     acceleration_ratio: tuple[float, float]
-    jerk_ratio: tuple[float, float]
+    jerk_ratio: tuple[float, float] | None
     start_error: float
     goal_error: float
     regions_match: bool
@@ -122,7 +125,7 @@ class VerificationReport:
             "separation_margin_m": self.separation_margin,
             "velocity_ratio": list(self.velocity_ratio),
             "acceleration_ratio": list(self.acceleration_ratio),
-            "jerk_ratio": list(self.jerk_ratio),
+            "jerk_ratio": None if self.jerk_ratio is None else list(self.jerk_ratio),
             "start_error_m": self.start_error,
             "goal_error_m": self.goal_error,
             "regions_match": self.regions_match,
@@ -150,6 +153,8 @@ class VerifiedSchedule:
             raise UnverifiedScheduleError("a VerifiedSchedule holds a Schedule and its VerificationReport")
         if not self.report.passed:
             raise VerificationError("schedule failed verification: " + "; ".join(self.report.failures))
+        if verify(self.schedule, period=self.report.period) != self.report:
+            raise UnverifiedScheduleError("the report given is not this schedule's verification report")
 
 
 def _sample_times(schedule: Schedule, period: float) -> np.ndarray:
@@ -166,13 +171,30 @@ _reports: collections.OrderedDict[tuple[int, float], tuple[weakref.ref, Verifica
     collections.OrderedDict()
 )
 _reports_lock = threading.Lock()
+#: One lock per schedule being verified, so that concurrent callers wait for one verification.
+_in_progress: dict[tuple[int, float], threading.Lock] = {}
+#: Finest sampling the verifier accepts, seconds.
+MIN_PERIOD = 1e-6
+#: Most samples one verification takes (memory grows with them: about 200 bytes each).
+MAX_SAMPLES = 20_000_000
 
 
 def _check_period(period: object) -> float:
     value = finite_real(period, "verifier sample period (seconds)", InputError)
-    if not 0.0 < value <= MAX_PERIOD:
-        raise InputError(f"verifier sample period must be > 0 s and at most {MAX_PERIOD:g} s, got {value!r}")
+    if not MIN_PERIOD <= value <= MAX_PERIOD:
+        raise InputError(
+            f"verifier sample period must be between {MIN_PERIOD:g} s and {MAX_PERIOD:g} s, got {value!r}"
+        )
     return value
+
+
+def _remembered(key: tuple[int, float], schedule: Schedule) -> VerificationReport | None:
+    with _reports_lock:
+        remembered = _reports.get(key)
+        if remembered is not None and remembered[0]() is schedule:
+            _reports.move_to_end(key)
+            return remembered[1]
+    return None
 
 
 def verify(schedule: Schedule, *, period: float = MAX_PERIOD) -> VerificationReport:
@@ -192,30 +214,49 @@ def verify(schedule: Schedule, *, period: float = MAX_PERIOD) -> VerificationRep
     Raises
     ------
     InputError
-        ``period`` not finite, not > 0 or above 1 ms; ``schedule`` not a Schedule.
+        ``period`` not finite or outside [1e-6, 1e-3] s, more than :data:`MAX_SAMPLES`
+        samples, or ``schedule`` not a Schedule.
     """
     period = _check_period(period)
     if not isinstance(schedule, Schedule):
         raise InputError(f"verify expects a Schedule, got {type(schedule).__name__}")
+    if not math.isfinite(schedule.duration) or schedule.duration < 0.0:
+        return _unusable(
+            schedule, period, f"schedule duration is {schedule.duration!r} s: expected finite, >= 0"
+        )
+    samples = schedule.duration / period
+    if samples > MAX_SAMPLES:
+        raise InputError(
+            f"verifying a {schedule.duration:.6g} s schedule every {period:g} s takes {samples:.3g} samples: "
+            f"expected at most {MAX_SAMPLES:,} (use a coarser period)"
+        )
     key = (id(schedule), period)
+    report = _remembered(key, schedule)
+    if report is not None:
+        return report
     with _reports_lock:
-        remembered = _reports.get(key)
-        if remembered is not None and remembered[0]() is schedule:
-            _reports.move_to_end(key)
-            return remembered[1]
-    began = time.perf_counter()
-    report = _verify(schedule, period)
-    logger.debug(
-        "verified a %s schedule (%d samples) in %.1f ms: %s",
-        schedule.method,
-        report.samples,
-        1e3 * (time.perf_counter() - began),
-        "passed" if report.passed else "FAILED",
-    )
-    with _reports_lock:
-        _reports[key] = (weakref.ref(schedule), report)
-        while len(_reports) > _REMEMBERED:
-            _reports.popitem(last=False)
+        working = _in_progress.setdefault(key, threading.Lock())
+    with working:  # one thread verifies a schedule; the others wait for its report
+        report = _remembered(key, schedule)
+        if report is not None:
+            return report
+        began = time.perf_counter()
+        try:
+            report = _verify(schedule, period)
+        finally:
+            with _reports_lock:
+                _in_progress.pop(key, None)
+        logger.debug(
+            "verified a %s schedule (%d samples) in %.1f ms: %s",
+            schedule.method,
+            report.samples,
+            1e3 * (time.perf_counter() - began),
+            "passed" if report.passed else "FAILED",
+        )
+        with _reports_lock:
+            _reports[key] = (weakref.ref(schedule), report)
+            while len(_reports) > _REMEMBERED:
+                _reports.popitem(last=False)
     return report
 
 
@@ -258,7 +299,7 @@ def _check_limits(
     ]
     if schedule.jerk_limited:
         checks.append(("jerk", state.jerk, "max_jerk", "m/s^3"))
-    ratios = {"jerk": (float("nan"), float("nan"))}
+    ratios: dict[str, tuple[float, float] | None] = {"jerk": None}
     for name, values, limit_name, unit in checks:
         per_vehicle = []
         for vehicle in range(2):
@@ -331,11 +372,47 @@ def _check_class(state: ScheduleState, route, failures: list[str]) -> bool:
     return False
 
 
+def _unusable(schedule: Schedule, period: float, failure: str) -> VerificationReport:
+    """A failed report for a schedule that cannot even be sampled."""
+    logger.warning("schedule (%s) failed verification: %s", schedule.method, failure)
+    nan = float("nan")
+    return VerificationReport(
+        passed=False,
+        failures=(failure,),
+        samples=0,
+        period=period,
+        min_separation=nan,
+        separation_margin=nan,
+        velocity_ratio=(nan, nan),
+        acceleration_ratio=(nan, nan),
+        jerk_ratio=None,
+        start_error=nan,
+        goal_error=nan,
+        regions_match=False,
+    )
+
+
+def _check_finite(state: ScheduleState, failures: list[str]) -> None:
+    """Every sampled time, position and derivative is a finite number."""
+    for name in ("t", "axis", "velocity", "acceleration", "jerk", "s"):
+        values = getattr(state, name)
+        bad = ~np.isfinite(values)
+        if bad.any():
+            where = np.argwhere(bad)[0]
+            k = int(where[-1])
+            failures.append(
+                f"{name} is not finite ({values[tuple(where)]!r}) at t={state.t[k]!r} s "
+                f"({int(bad.sum())} samples in all): expected finite numbers"
+            )
+
+
 def _verify(schedule: Schedule, period: float) -> VerificationReport:
     route = schedule.route
     required = max(schedule.limits.min_separation, route.min_separation)
-    state = schedule.state(_sample_times(schedule, period))
+    with np.errstate(invalid="ignore", over="ignore"):  # non-finite values are reported below
+        state = schedule.state(_sample_times(schedule, period))
     failures: list[str] = []
+    _check_finite(state, failures)
     closest = _check_separation(state, required, failures)
     _check_on_track(state, route.graph, failures)
     ratios = _check_limits(state, schedule, failures)

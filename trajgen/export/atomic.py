@@ -36,12 +36,13 @@ def check_output_paths(paths) -> tuple[Path, ...]:
         A target is a folder, a parent is a file, or a path is empty or given twice.
     """
     checked: list[Path] = []
-    seen: set[Path] = set()
+    seen: set[tuple[str, str]] = set()
     for given in paths:
         path = Path(given)
-        if not path.name:
-            raise OutputError(f"output file path {str(given)!r} names no file")
-        key = Path(os.path.abspath(path))
+        if not path.name or path.name in (".", ".."):
+            raise OutputError(f"output file path {_short(path)!r} names no file")
+        # the same file however spelled: through links, and on file systems that ignore case
+        key = (os.path.realpath(path.parent), path.name.casefold())
         if key in seen:
             raise OutputError(f"output file {_short(path)!r} is asked for twice in one run")
         seen.add(key)
@@ -77,10 +78,22 @@ def _sync_folder(folder: Path) -> None:
             os.close(handle)
 
 
-def _umask() -> int:
-    mask = os.umask(0)
+def _read_umask() -> int:
+    """The process's umask, read without changing it where the system tells it (Linux)."""
+    try:
+        with open("/proc/self/status", encoding="ascii") as status:
+            for line in status:
+                if line.startswith("Umask:"):
+                    return int(line.split()[1], 8)
+    except (OSError, ValueError):
+        pass
+    mask = os.umask(0o022)  # elsewhere: read it once, at import, before any thread writes files
     os.umask(mask)
     return mask
+
+
+#: Permissions of the files written: what a plain ``open`` would give them.
+_FILE_MODE = 0o666 & ~_read_umask()
 
 
 def _stage(path: Path, data: bytes, mode: int) -> str:
@@ -98,14 +111,17 @@ def _stage(path: Path, data: bytes, mode: int) -> str:
 
 
 def _keep_previous(path: Path) -> Path | None:
-    """A hidden copy of ``path``'s current content beside it (a hard link where possible)."""
-    if not path.exists():
+    """A hidden copy of what ``path`` is now (a hard link where possible; a link stays a link)."""
+    if not os.path.lexists(path):
         return None
     backup = path.with_name(f".{path.name}.{uuid.uuid4().hex}.bak")
     try:
-        os.link(path, backup)
+        os.link(path, backup, follow_symlinks=False)
     except OSError:
-        shutil.copy2(path, backup)
+        if path.is_symlink():
+            os.symlink(os.readlink(path), backup)
+        else:
+            shutil.copy2(path, backup)
     return backup
 
 
@@ -155,13 +171,12 @@ def commit_files(contents: Mapping[Path | str, bytes]) -> tuple[Path, ...]:
     data = [contents[key] for key in contents]
     created: list[Path] = []
     staged: list[tuple[str, Path]] = []
-    mode = 0o666 & ~_umask()
     succeeded = False
     try:
         try:
             for path, payload in zip(paths, data, strict=True):
                 _make_folders(path.parent, created)
-                staged.append((_stage(path, payload, mode), path))
+                staged.append((_stage(path, payload, _FILE_MODE), path))
             _replace_all(staged)
         except OSError as error:
             where = _short(Path(error.filename)) if error.filename else "the output folder"

@@ -77,7 +77,7 @@ class MethodRegistry:
 
     def help(self) -> str:
         """One line per method for help texts: ``name: summary``."""
-        return "; ".join(
+        return "\n".join(
             f"{name}: {cls.summary}" + (" (default)" if name == self.default else "")
             for name, cls in self._by_name.items()
         )

@@ -209,11 +209,14 @@ class SolverCache:
             entry = self._cached(shape)
             if entry is not None:
                 return entry, False
-            entry = build(shape)
+            try:
+                entry = build(shape)
+            finally:
+                with self._lock:
+                    self._building.pop(shape, None)
             logger.info("built the optimal-control NLP for %d phase(s)", shape.phase_count)
             with self._lock:
                 self._entries[shape] = entry
-                self._building.pop(shape, None)
                 while len(self._entries) > self.maxsize:
                     self._entries.popitem(last=False)
             return entry, True
