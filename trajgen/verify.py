@@ -37,10 +37,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from topology import Region, reduce_regions
+from topology import Region, RegionKey, reduce_regions
 from topology.indexed import JUNCTION_INDEX, region_keys, track_distance
 from topology.validation import finite_real
+from trajgen import polynomials
 from trajgen.errors import InputError, UnverifiedScheduleError, VerificationError
+from trajgen.pieces import Pieces, UncheckableKinematicsError, schedule_pieces
 from trajgen.schedule import Schedule, ScheduleState
 
 __all__ = [
@@ -80,6 +82,8 @@ class VerificationReport:
         One message per failed check, naming the quantity, value and limit.
     samples : int
         Number of time samples checked.
+    pieces : int
+        Number of polynomial pieces checked in closed form (between the samples too).
     period : float
         Sample period, seconds.
     min_separation : float
@@ -99,6 +103,7 @@ class VerificationReport:
     passed: bool
     failures: tuple[str, ...]
     samples: int
+    pieces: int
     period: float
     min_separation: float
     separation_margin: float
@@ -120,6 +125,7 @@ class VerificationReport:
             "verified": self.passed,
             "failures": list(self.failures),
             "samples": self.samples,
+            "pieces": self.pieces,
             "sample_period_s": self.period,
             "min_separation_m": self.min_separation,
             "separation_margin_m": self.separation_margin,
@@ -380,6 +386,7 @@ def _unusable(schedule: Schedule, period: float, failure: str) -> VerificationRe
         passed=False,
         failures=(failure,),
         samples=0,
+        pieces=0,
         period=period,
         min_separation=nan,
         separation_margin=nan,
@@ -406,6 +413,184 @@ def _check_finite(state: ScheduleState, failures: list[str]) -> None:
             )
 
 
+@dataclass(frozen=True, slots=True)
+class _PieceFigures:
+    """What the closed-form check of the pieces found."""
+
+    count: int
+    closest: float
+    ratios: dict
+    regions_match: bool
+
+
+def _piece_extrema(c: np.ndarray, h: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    return polynomials.extrema(c, h)
+
+
+def _check_piece_limits(pieces: Pieces, schedule: Schedule, failures: list[str]) -> dict:
+    """Largest ``|v|``, ``|a|`` (and ``|j|``) / limit per vehicle over every piece, in closed form."""
+    names = [("velocity", "max_velocity", "m/s"), ("acceleration", "max_acceleration", "m/s^2")]
+    if schedule.jerk_limited:
+        names.append(("jerk", "max_jerk", "m/s^3"))
+    ratios: dict[str, tuple[float, float] | None] = {"jerk": None}
+    for vehicle in range(2):
+        c = pieces.axis[vehicle]
+        for order, (name, limit_name, unit) in enumerate(names, start=1):
+            for _ in range(order):
+                c = polynomials.derivative(c)
+            low, t_low, high, t_high = _piece_extrema(c, pieces.length)
+            peak = np.maximum(np.abs(low), np.abs(high))
+            limit = getattr(schedule.limits.vehicles[vehicle], limit_name)
+            k = int(np.argmax(peak)) if peak.size else 0
+            ratio = float(peak[k] / limit) if peak.size else 0.0
+            previous = ratios.get(name) or (0.0, 0.0)
+            ratios[name] = (ratio, previous[1]) if vehicle == 0 else (previous[0], ratio)
+            if ratio > 1.0 + RELATIVE_TOLERANCE:
+                when = pieces.start[k] + (t_high[k] if abs(high[k]) >= abs(low[k]) else t_low[k])
+                failures.append(
+                    f"vehicle {vehicle + 1} {name} reaches {peak[k]:.9g} {unit} at t={when:.6f} s "
+                    f"(closed form, between samples too): exceeds its {limit_name} {limit:g} {unit}"
+                )
+            c = pieces.axis[vehicle]
+    return ratios
+
+
+def _check_piece_track(pieces: Pieces, graph, failures: list[str]) -> np.ndarray:
+    """Each vehicle stays within its leg and its map's range; returns s polynomials, shape (2, n, d + 1)."""
+    track = pieces.track()
+    lengths = np.array(graph.lengths)
+    for vehicle in range(2):
+        low, t_low, high, t_high = _piece_extrema(track[vehicle], pieces.length)
+        on_leg = pieces.leg[vehicle] != JUNCTION_INDEX
+        length = np.where(on_leg, lengths[np.where(on_leg, pieces.leg[vehicle], 0)], 0.0)
+        over = np.nonzero(on_leg & (high > length + TRACK_END_TOLERANCE))[0]
+        if over.size:
+            k = int(over[0])
+            failures.append(
+                f"vehicle {vehicle + 1} is {high[k] - length[k]:.3g} m past the end of leg "
+                f"{graph.names[pieces.leg[vehicle, k]]!r} at t={pieces.start[k] + t_high[k]:.6f} s "
+                "(closed form)"
+            )
+        under = np.nonzero(low < -TRACK_END_TOLERANCE)[0]
+        if under.size:
+            k = int(under[0])
+            failures.append(
+                f"vehicle {vehicle + 1} passes the junction inside a piece (s = {low[k]:.3g} m) "
+                f"at t={pieces.start[k] + t_low[k]:.6f} s: its position map does not cover it"
+            )
+        axis_low, _, axis_high, _ = _piece_extrema(pieces.axis[vehicle], pieces.length)
+        outside = np.nonzero(
+            (axis_low < pieces.axis_low[vehicle] - TRACK_END_TOLERANCE)
+            | (axis_high > pieces.axis_high[vehicle] + TRACK_END_TOLERANCE)
+        )[0]
+        if outside.size:
+            k = int(outside[0])
+            failures.append(
+                f"vehicle {vehicle + 1} leaves the range of its position map at t={pieces.start[k]:.6f} s "
+                f"(axis {axis_low[k]:.6g} to {axis_high[k]:.6g} m, map {pieces.axis_low[vehicle, k]:.6g} to "
+                f"{pieces.axis_high[vehicle, k]:.6g} m)"
+            )
+    return track
+
+
+def _check_piece_separation(
+    pieces: Pieces, track: np.ndarray, required: float, failures: list[str]
+) -> tuple[float, list]:
+    """Smallest track distance over every piece (closed form) and each piece's region."""
+    same = (pieces.leg[0] == pieces.leg[1]) & (pieces.leg[0] != JUNCTION_INDEX)
+    gap = np.where(same[:, None], track[0] - track[1], track[0] + track[1])
+    low, t_low, high, t_high = _piece_extrema(gap, pieces.length)
+    crossing = same & (low < 0.0) & (high > 0.0)
+    closest = np.where(same, np.where(high <= 0.0, -high, low), low)
+    closest = np.where(crossing, 0.0, closest)
+    when = np.where(same & (high <= 0.0), t_high, t_low)
+    regions: list = []
+    middle = polynomials.evaluate(gap, 0.5 * pieces.length)
+    for k in range(pieces.count):
+        first, second = int(pieces.leg[0, k]), int(pieces.leg[1, k])
+        if first == JUNCTION_INDEX or second == JUNCTION_INDEX:
+            regions.append(None)
+        else:
+            regions.append(RegionKey(first, second, 0 if first != second else (1 if middle[k] < 0.0 else 2)))
+    if not pieces.count:
+        return float("inf"), regions
+    k = int(np.argmin(closest))
+    if crossing[k]:
+        failures.append(
+            f"vehicles pass each other on one leg between t={pieces.start[k]:.6f} s and the next piece"
+        )
+    elif closest[k] < required - POSITION_TOLERANCE:
+        failures.append(
+            f"separation {closest[k]:.9g} m at t={pieces.start[k] + when[k]:.6f} s is below the minimum "
+            f"{required:g} m (closed form, between samples too)"
+        )
+    return float(closest[k]), regions
+
+
+def _check_piece_continuity(
+    pieces: Pieces, track: np.ndarray, schedule: Schedule, failures: list[str]
+) -> None:
+    """Position, velocity (and for jerk-limited schedules acceleration) continuous from piece to piece."""
+    if pieces.count < 2:
+        return
+    h = pieces.length[:-1]
+    for vehicle in range(2):
+        end_s = polynomials.evaluate(track[vehicle, :-1], h)
+        start_s = track[vehicle, 1:, 0]
+        jump = track_distance(pieces.leg[vehicle, :-1], end_s, pieces.leg[vehicle, 1:], start_s)
+        limits = schedule.limits.vehicles[vehicle]
+        checks = [("position", jump, TRACK_END_TOLERANCE, "m")]
+        velocity = polynomials.derivative(pieces.axis[vehicle])
+        dv = np.abs(polynomials.evaluate(velocity[:-1], h) - velocity[1:, 0])
+        checks.append(("velocity", dv, RELATIVE_TOLERANCE * limits.max_velocity, "m/s"))
+        if schedule.jerk_limited:
+            acceleration = polynomials.derivative(velocity)
+            da = np.abs(polynomials.evaluate(acceleration[:-1], h) - acceleration[1:, 0])
+            checks.append(("acceleration", da, RELATIVE_TOLERANCE * limits.max_acceleration, "m/s^2"))
+        for name, values, tolerance, unit in checks:
+            jumps = np.nonzero(~(values <= tolerance))[0]
+            if jumps.size:
+                k = int(jumps[0])
+                failures.append(
+                    f"vehicle {vehicle + 1} {name} jumps by {values[k]:.3g} {unit} "
+                    f"at t={pieces.start[k + 1]:.6f} s "
+                    f"(tolerance {tolerance:.3g} {unit})"
+                )
+
+
+def _check_pieces(schedule: Schedule, required: float, failures: list[str]) -> _PieceFigures | None:
+    """The closed-form checks: limits, track, separation, continuity and class over every piece."""
+    try:
+        with np.errstate(invalid="ignore", over="ignore"):  # non-finite values are reported by the samples
+            pieces = schedule_pieces(schedule)
+    except UncheckableKinematicsError as error:
+        failures.append(f"cannot be checked between samples: {error}")
+        return None
+    if not np.all(np.isfinite(pieces.axis)) or not np.all(np.isfinite(pieces.length)):
+        return None  # reported by the finiteness check of the samples
+    ratios = _check_piece_limits(pieces, schedule, failures)
+    track = _check_piece_track(pieces, schedule.route.graph, failures)
+    closest, regions = _check_piece_separation(pieces, track, required, failures)
+    _check_piece_continuity(pieces, track, schedule, failures)
+    expected = schedule.route.region_keys
+    sequence = reduce_regions(regions)
+    if sequence != expected:
+        failures.append(
+            "homotopy class differs (closed form): schedule visits ["
+            + " ".join(str(Region.from_key(schedule.route.graph, key)) for key in sequence)
+            + "], route ["
+            + " ".join(str(Region.from_key(schedule.route.graph, key)) for key in expected)
+            + "]"
+        )
+    return _PieceFigures(pieces.count, closest, ratios, sequence == expected)
+
+
+def _worse(sampled, certified):
+    if sampled is None or certified is None:
+        return sampled if certified is None else certified
+    return (max(sampled[0], certified[0]), max(sampled[1], certified[1]))
+
+
 def _verify(schedule: Schedule, period: float) -> VerificationReport:
     route = schedule.route
     required = max(schedule.limits.min_separation, route.min_separation)
@@ -419,12 +604,18 @@ def _verify(schedule: Schedule, period: float) -> VerificationReport:
     start_error, goal_error = _check_ends(state, schedule, failures)
     _check_consistency(state, schedule, failures)
     regions_match = _check_class(state, route, failures)
+    figures = _check_pieces(schedule, required, failures)
+    if figures is not None:
+        closest = min(closest, figures.closest)
+        ratios = {name: _worse(ratios.get(name), figures.ratios.get(name)) for name in ratios}
+        regions_match = regions_match and figures.regions_match
     if failures:
         logger.warning("schedule (%s) failed verification: %s", schedule.method, "; ".join(failures))
     return VerificationReport(
         passed=not failures,
         failures=tuple(failures),
         samples=int(state.t.size),
+        pieces=0 if figures is None else figures.count,
         period=period,
         min_separation=closest,
         separation_margin=closest - required,

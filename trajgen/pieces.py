@@ -1,0 +1,250 @@
+"""A schedule as polynomial pieces: on each, both axes are single polynomials and each vehicle on one leg.
+
+The verifier checks these pieces in closed form (:mod:`trajgen.polynomials`), so
+nothing can hide between samples, and its cost grows with the number of
+pieces, not with the duration.
+"""
+
+from __future__ import annotations
+
+import itertools
+from dataclasses import dataclass
+from math import comb
+
+import numpy as np
+
+from topology import JUNCTION_INDEX
+from trajgen.polynomials import evaluate, root_in
+from trajgen.schedule import AxisMap, CubicKinematics, Schedule, Section
+from trajgen.values import ArrayValue, readonly
+
+__all__ = ["DEGREE", "Pieces", "UncheckableKinematicsError", "schedule_pieces", "shift"]
+
+#: Highest power of the axis polynomials (TOPPRA sections: a quadratic path of a quadratic s(t)).
+DEGREE = 4
+
+
+class UncheckableKinematicsError(TypeError):
+    """A section's kinematics have no polynomial form the verifier knows."""
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class Pieces(ArrayValue):
+    """The polynomial pieces of a schedule, in time order.
+
+    Attributes
+    ----------
+    start : ndarray, shape (n,)
+        Start of each piece, seconds from the start of the schedule.
+    length : ndarray, shape (n,)
+        Duration of each piece, seconds (> 0).
+    axis : ndarray, shape (2, n, DEGREE + 1)
+        Per vehicle, the signed axis on the piece as a polynomial of the time
+        since the piece's start (increasing powers; metres, seconds).
+    leg : ndarray of int, shape (2, n)
+        Leg of each vehicle on the piece (``JUNCTION_INDEX``: parked at the junction).
+    s_offset, s_sign : ndarray, shape (2, n)
+        Distance from the junction ``s = s_offset + s_sign * axis`` (metres; ``s_sign`` is +1, -1 or 0).
+    axis_low, axis_high : ndarray, shape (2, n)
+        The axis range the section's map covers, metres (outside it the map would clip).
+    section : ndarray of int, shape (n,)
+        Index of the section each piece belongs to.
+    """
+
+    start: np.ndarray
+    length: np.ndarray
+    axis: np.ndarray
+    leg: np.ndarray
+    s_offset: np.ndarray
+    s_sign: np.ndarray
+    axis_low: np.ndarray
+    axis_high: np.ndarray
+    section: np.ndarray
+
+    def __post_init__(self) -> None:
+        for name in ("start", "length", "axis", "s_offset", "s_sign", "axis_low", "axis_high"):
+            object.__setattr__(self, name, readonly(getattr(self, name), float))
+        for name in ("leg", "section"):
+            object.__setattr__(self, name, readonly(getattr(self, name), int))
+
+    @property
+    def count(self) -> int:
+        """Number of pieces."""
+        return int(self.length.size)
+
+    def track(self) -> np.ndarray:
+        """Distance from the junction of each vehicle as polynomials, shape (2, n, DEGREE + 1)."""
+        s = self.axis * self.s_sign[:, :, None]
+        s[:, :, 0] += self.s_offset
+        return s
+
+
+def shift(c: np.ndarray, delta: np.ndarray) -> np.ndarray:
+    """The same polynomials re-expanded about ``t = delta`` (Taylor shift), shape of ``c``.
+
+    Examples
+    --------
+    >>> shift(np.array([[0.0, 0.0, 1.0]]), np.array([2.0]))  # t^2 about t = 2: 4 + 4 u + u^2
+    array([[4., 4., 1.]])
+    """
+    out = np.zeros_like(c)
+    degree = c.shape[-1] - 1
+    for j in range(degree + 1):
+        for i in range(j, degree + 1):
+            out[..., j] += c[..., i] * comb(i, j) * delta ** (i - j)
+    return out
+
+
+def _cubic_section(kinematics: CubicKinematics) -> tuple[np.ndarray, np.ndarray]:
+    """Breakpoints (m + 1,) and axis polynomials (2, m, DEGREE + 1) of a piecewise-cubic section."""
+    duration = kinematics.duration
+    times = np.unique(
+        np.concatenate([np.clip(p.times, 0.0, duration) for p in kinematics.vehicles] + [[0.0]])
+    )
+    times = np.append(times[times < duration], duration) if duration > 0 else np.array([0.0, 0.0])
+    begin = times[:-1]
+    coefficients = np.zeros((2, begin.size, DEGREE + 1))
+    for vehicle, profile in enumerate(kinematics.vehicles):
+        k = np.clip(np.searchsorted(profile.times, begin, side="right") - 1, 0, len(profile.jerk) - 1)
+        delta = begin - profile.times[k]
+        p0, v0, a0 = profile.initial[k, 0], profile.initial[k, 1], profile.initial[k, 2]
+        j = profile.jerk[k]
+        ended = begin >= profile.times[-1]
+        end_p = profile.initial[-1, 0] + (h := profile.times[-1] - profile.times[-2]) * (
+            profile.initial[-1, 1] + h * (profile.initial[-1, 2] / 2.0 + h * profile.jerk[-1] / 6.0)
+        )
+        coefficients[vehicle, :, 0] = np.where(
+            ended, end_p, p0 + delta * (v0 + delta * (a0 / 2.0 + delta * j / 6.0))
+        )
+        coefficients[vehicle, :, 1] = np.where(ended, 0.0, v0 + delta * (a0 + delta * j / 2.0))
+        coefficients[vehicle, :, 2] = np.where(ended, 0.0, (a0 + delta * j) / 2.0)
+        coefficients[vehicle, :, 3] = np.where(ended, 0.0, j / 6.0)
+    return times, coefficients
+
+
+def _toppra_section(kinematics) -> tuple[np.ndarray, np.ndarray]:
+    """Breakpoints and axis polynomials of a TOPPRA section: q(s(t)), quadratic of a quadratic."""
+    grid, speed, times, path = kinematics.grid, kinematics.speed, kinematics.times, kinematics.path
+    width = np.diff(grid)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        accel = np.where(width > 0.0, (speed[1:] ** 2 - speed[:-1] ** 2) / (2.0 * width), 0.0)
+    piece = path.piece(grid[:-1])
+    piece_start = path.breakpoints[piece]
+    alpha = grid[:-1] - piece_start  # s - s_piece at the interval start
+    beta, gamma = speed[:-1], 0.5 * accel
+    p0 = path.on_piece(piece, piece_start, 0)  # (m, 2): the piece's polynomial at its own start
+    d1 = path.on_piece(piece, piece_start, 1)
+    d2 = path.on_piece(piece, piece_start, 2)
+    coefficients = np.zeros((2, grid.size - 1, DEGREE + 1))
+    for vehicle in range(2):
+        a, b, c = p0[:, vehicle], d1[:, vehicle], 0.5 * d2[:, vehicle]  # q = a + b u + c u^2
+        coefficients[vehicle, :, 0] = a + b * alpha + c * alpha**2
+        coefficients[vehicle, :, 1] = b * beta + 2.0 * c * alpha * beta
+        coefficients[vehicle, :, 2] = b * gamma + c * (beta**2 + 2.0 * alpha * gamma)
+        coefficients[vehicle, :, 3] = 2.0 * c * beta * gamma
+        coefficients[vehicle, :, 4] = c * gamma**2
+    return np.asarray(times, dtype=float), coefficients
+
+
+def _section_polynomials(section: Section) -> tuple[np.ndarray, np.ndarray]:
+    kinematics = section.kinematics
+    if isinstance(kinematics, CubicKinematics):
+        return _cubic_section(kinematics)
+    if all(hasattr(kinematics, name) for name in ("grid", "speed", "times", "path")):
+        return _toppra_section(kinematics)
+    raise UncheckableKinematicsError(
+        f"section kinematics {type(kinematics).__name__} have no polynomial form the verifier knows"
+    )
+
+
+def _split_at_map_boundaries(times: np.ndarray, axis: np.ndarray, maps: tuple[AxisMap, AxisMap]):
+    """Split pieces where an axis crosses from one sub-range of its map to the next."""
+    splits = [[] for _ in range(times.size - 1)]
+    for vehicle, axis_map in enumerate(maps):
+        if axis_map.legs.size < 2:
+            continue
+        bounds = np.unique(np.concatenate([axis_map.axis_start, axis_map.axis_end]))[1:-1]
+        h = np.diff(times)
+        for value in bounds:
+            c = axis[vehicle].copy()
+            c[:, 0] -= value
+            roots = root_in(c, np.zeros_like(h), h)
+            inside = np.isfinite(roots) & (roots > 0.0) & (roots < h)
+            for k in np.nonzero(inside)[0]:
+                splits[k].append(float(roots[k]))
+    if not any(splits):
+        return times[:-1], np.diff(times), axis
+    starts, lengths, rows = [], [], []
+    for k, points in enumerate(splits):
+        cuts = [0.0, *sorted(points), float(times[k + 1] - times[k])]
+        for a, b in itertools.pairwise(cuts):
+            if b > a:
+                starts.append(times[k] + a)
+                lengths.append(b - a)
+                rows.append((k, a))
+    index = np.array([r[0] for r in rows])
+    offset = np.array([r[1] for r in rows])
+    return np.array(starts), np.array(lengths), shift(axis[:, index], offset[None, :])
+
+
+def _map_of(axis_map: AxisMap, middle: np.ndarray):
+    """Leg, s offset and s sign per piece (the sub-range of the piece's mid-axis), and the map's range."""
+    low = np.minimum(axis_map.axis_start, axis_map.axis_end)
+    high = np.maximum(axis_map.axis_start, axis_map.axis_end)
+    if axis_map.legs.size == 1:
+        r = np.zeros(middle.size, dtype=int)
+        low_all, high_all = -np.inf, np.inf  # one leg: the affine map holds everywhere
+    else:
+        gap = np.maximum(low[:, None] - middle[None, :], 0.0) + np.maximum(
+            middle[None, :] - high[:, None], 0.0
+        )
+        r = np.argmin(gap, axis=0)
+        low_all, high_all = float(low.min()), float(high.max())
+    sign = axis_map.outward[r].astype(float)
+    offset = axis_map.s_start[r] - sign * axis_map.axis_start[r]
+    leg = np.where((sign == 0.0) & (axis_map.s_start[r] == 0.0), JUNCTION_INDEX, axis_map.legs[r])
+    return leg, offset, sign, np.full(middle.size, low_all), np.full(middle.size, high_all)
+
+
+def schedule_pieces(schedule: Schedule) -> Pieces:
+    """Every polynomial piece of ``schedule``, in time order.
+
+    Raises
+    ------
+    UncheckableKinematicsError
+        A section's kinematics are neither piecewise cubic nor TOPPRA's.
+    """
+    parts = []
+    for index, section in enumerate(schedule.sections):
+        times, axis = _section_polynomials(section)
+        starts, lengths, axis = _split_at_map_boundaries(times, axis, section.maps)
+        keep = lengths > 0.0
+        starts, lengths, axis = starts[keep], lengths[keep], axis[:, keep]
+        columns = [_map_of(section.maps[v], evaluate(axis[v], 0.5 * lengths)) for v in range(2)]
+        parts.append((section.start_time + starts, lengths, axis, columns, np.full(lengths.size, index)))
+    if not parts or sum(p[1].size for p in parts) == 0:
+        empty = np.zeros((2, 0))
+        return Pieces(
+            np.zeros(0),
+            np.zeros(0),
+            np.zeros((2, 0, DEGREE + 1)),
+            empty,
+            empty,
+            empty,
+            empty,
+            empty,
+            np.zeros(0),
+        )
+    start = np.concatenate([p[0] for p in parts])
+    length = np.concatenate([p[1] for p in parts])
+    axis = np.concatenate([p[2] for p in parts], axis=1)
+    stacked = [
+        np.stack([np.concatenate([p[3][v][field] for p in parts]) for v in range(2)]) for field in range(5)
+    ]
+    section = np.concatenate([p[4] for p in parts])
+    leg, offset, sign = stacked[0], stacked[1], stacked[2]
+    # a vehicle standing exactly at the junction for a whole piece is on no leg (as Schedule.state says)
+    track = axis * sign[:, :, None]
+    track[:, :, 0] += offset
+    leg = np.where(np.all(track == 0.0, axis=2), JUNCTION_INDEX, leg)
+    return Pieces(start, length, axis, leg, offset, sign, stacked[3], stacked[4], section)

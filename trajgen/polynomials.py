@@ -1,0 +1,115 @@
+"""Vectorized extrema of many low-degree polynomials, each on its own interval.
+
+Coefficients are in increasing powers, one row per polynomial: ``c[:, 0] +
+c[:, 1] t + ... + c[:, d] t^d`` on ``0 <= t <= h``, ``d <= 4``. The extrema
+are exact up to round-off: the critical points are the roots of the
+derivative, found by bisection on intervals where the derivative is monotone
+(split at the roots of the second derivative, in closed form), so no extremum
+is missed however close two of them are.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+__all__ = ["derivative", "evaluate", "extrema", "root_in"]
+
+_BISECTIONS = 80
+
+
+def evaluate(c: np.ndarray, t: np.ndarray) -> np.ndarray:
+    """Values at ``t`` (shape (n,) or (n, k)) of the polynomials ``c`` (shape (n, d + 1))."""
+    t = np.asarray(t, dtype=float)
+    shape = (-1,) + (1,) * (t.ndim - 1)
+    out = np.zeros(np.broadcast_shapes(t.shape, (c.shape[0],) + (1,) * (t.ndim - 1)))
+    for power in range(c.shape[1] - 1, -1, -1):
+        out = out * t + c[:, power].reshape(shape)
+    return out
+
+
+def derivative(c: np.ndarray) -> np.ndarray:
+    """Coefficients of the derivatives, shape (n, d) (a column of zeros for constants)."""
+    if c.shape[1] == 1:
+        return np.zeros_like(c)
+    return c[:, 1:] * np.arange(1, c.shape[1])
+
+
+def _quadratic_roots(c: np.ndarray) -> np.ndarray:
+    """Real roots of ``c0 + c1 t + c2 t^2``, shape (n, 2), NaN where there are none."""
+    c = np.pad(c, ((0, 0), (0, max(0, 3 - c.shape[1]))))[:, :3]
+    c0, c1, c2 = c[:, 0], c[:, 1], c[:, 2]
+    out = np.full((c.shape[0], 2), np.nan)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        linear = c2 == 0.0
+        out[:, 0] = np.where(linear & (c1 != 0.0), -c0 / c1, np.nan)
+        disc = c1 * c1 - 4.0 * c2 * c0
+        root = np.sqrt(np.where(disc >= 0.0, disc, np.nan))
+        q = -0.5 * (c1 + np.where(c1 >= 0.0, root, -root))  # the stable form
+        first = np.where(q != 0.0, c0 / q, 0.0)
+        second = np.where(c2 != 0.0, q / c2, np.nan)
+        out[:, 0] = np.where(linear, out[:, 0], first)
+        out[:, 1] = np.where(linear, np.nan, second)
+    return out
+
+
+def root_in(c: np.ndarray, low: np.ndarray, high: np.ndarray) -> np.ndarray:
+    """A root of each polynomial between ``low`` and ``high`` where the values there differ in sign, else NaN.
+
+    Bisection: the root found is within round-off of a true root when the
+    polynomial is monotone on the bracket.
+    """
+    f_low, f_high = evaluate(c, low), evaluate(c, high)
+    bracketed = np.isfinite(f_low) & np.isfinite(f_high) & (np.sign(f_low) * np.sign(f_high) <= 0.0)
+    a, b = np.where(bracketed, low, np.nan), np.where(bracketed, high, np.nan)
+    rising = f_high >= f_low
+    for _ in range(_BISECTIONS):
+        middle = 0.5 * (a + b)
+        value = evaluate(c, middle)
+        below = (value < 0.0) == rising
+        a = np.where(below, middle, a)
+        b = np.where(below, b, middle)
+    return 0.5 * (a + b)
+
+
+def _critical_points(c: np.ndarray, h: np.ndarray) -> np.ndarray:
+    """Roots of the derivative inside ``[0, h]``, shape (n, 3), NaN where there are fewer."""
+    first = derivative(c)
+    second = derivative(first)
+    splits = _quadratic_roots(second[:, :3]) if second.shape[1] <= 3 else None
+    if splits is None:  # degree above 4 is not used
+        raise ValueError("polynomials of degree above 4 are not supported")
+    splits = np.where((splits > 0.0) & (splits < h[:, None]), splits, np.nan)
+    bounds = np.sort(np.column_stack([np.zeros_like(h), splits, h]), axis=1)  # NaN sort last
+    bounds = np.where(np.isnan(bounds), h[:, None], bounds)
+    roots = np.column_stack([root_in(first, bounds[:, k], bounds[:, k + 1]) for k in range(3)])
+    return roots
+
+
+def extrema(c: np.ndarray, h: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Minimum and maximum of each polynomial on ``[0, h]``, and where they are.
+
+    Parameters
+    ----------
+    c : ndarray, shape (n, d + 1), d <= 4
+        Coefficients in increasing powers.
+    h : ndarray, shape (n,)
+        Interval lengths (>= 0).
+
+    Returns
+    -------
+    (low, t_low, high, t_high) : ndarrays, shape (n,)
+        NaN where a coefficient or ``h`` is not finite.
+    """
+    c = np.asarray(c, dtype=float)
+    h = np.asarray(h, dtype=float)
+    candidates = np.column_stack([np.zeros_like(h), h, _critical_points(c, h)])
+    values = evaluate(c, candidates)
+    values = np.where(np.isnan(candidates), np.nan, values)
+    finite = np.all(np.isfinite(c), axis=1) & np.isfinite(h)
+    with np.errstate(invalid="ignore"):
+        k_low = np.nanargmin(np.where(np.isnan(values), np.inf, values), axis=1)
+        k_high = np.nanargmax(np.where(np.isnan(values), -np.inf, values), axis=1)
+    rows = np.arange(c.shape[0])
+    low = np.where(finite, values[rows, k_low], np.nan)
+    high = np.where(finite, values[rows, k_high], np.nan)
+    return low, candidates[rows, k_low], high, candidates[rows, k_high]
