@@ -7,6 +7,7 @@ import pytest
 
 from tests.helpers import LIMITS, route_of
 from tests.mutants import between_samples, free_window, with_bump
+from tests.sampled_verifier import sampled_verify
 from topology.indexed import track_distance
 from trajgen import Exact, Optimal, verify
 from trajgen.analysis import travelled
@@ -51,7 +52,8 @@ def test_a_one_percent_velocity_spike_between_samples_is_caught(exact):
     mutant = with_bump(exact, vehicle, t, 4 * h, 0.01 * 1.0 * h)  # peak |dv| = height / h
     report = verify(mutant)
     assert not report.passed
-    assert any("velocity reaches 1.01" in f and "closed form" in f for f in report.failures), report.failures
+    assert any("velocity reaches 1.01" in f for f in report.failures), report.failures
+    assert sampled_verify(mutant).passed  # the second opinion, sampling every 1 ms, does not see it
     assert report.velocity_ratio[vehicle] == pytest.approx(1.01, rel=1e-6)
 
 
@@ -64,7 +66,9 @@ def test_a_dip_or_a_collision_between_samples_is_caught(optimal, dip, below):
     mutant = with_bump(optimal, vehicle, t, 0.8e-3, sign * dip)
     report = verify(mutant)
     assert not report.passed
-    assert any("below the minimum 1.5 m (closed form" in f for f in report.failures), report.failures
+    assert any("below the minimum 1.5 m" in f for f in report.failures), report.failures
+    if dip < 1.0:
+        assert sampled_verify(mutant).passed  # between the samples: only the closed form sees it
     assert report.min_separation < below
 
 

@@ -18,27 +18,22 @@ from trajgen.schedule import CubicKinematics
 SWAP = ((10.0, 10.0, 10.0), ("A:10", "B:10"), ("B:10", "A:10"))
 
 
-@pytest.mark.parametrize(
-    ("period", "match"),
-    [
-        pytest.param(-1.0, r"must be between 1e-06 s and 0\.001 s, got -1\.0", id="negative"),
-        pytest.param(0.0, r"must be between 1e-06 s and 0\.001 s, got 0\.0", id="zero"),
-        pytest.param(math.inf, r"verifier sample period \(seconds\) must be finite, got inf", id="inf"),
-        pytest.param(math.nan, "must be finite, got nan", id="nan"),
-        pytest.param(0.002, r"between 1e-06 s and 0\.001 s, got 0\.002", id="coarse"),
-        pytest.param(5e-324, r"between 1e-06 s and 0\.001 s, got 5e-324", id="subnormal"),
-        pytest.param("1e-3", "must be a real number, got '1e-3'", id="string"),
-    ],
-)
-def test_bad_periods_are_input_errors(period, match):
-    schedule = Exact().schedule(route_of(*SWAP), LIMITS)
-    with pytest.raises(InputError, match=match):
-        verify(schedule, period=period)
+def test_verification_cost_grows_with_pieces_not_with_duration():
+    import time
 
+    from limits import VehicleLimits
+    from trajgen import Limits
 
-def test_a_finer_period_is_accepted_and_sees_more_samples():
-    schedule = Exact().schedule(route_of(*SWAP), LIMITS)
-    assert verify(schedule, period=5e-4).samples > 1.9 * verify(schedule).samples
+    # the same route at a thousandth of the speed: a thousand times longer, the same pieces
+    slow = VehicleLimits(max_velocity=1e-3, max_acceleration=5e-4, max_jerk=1e-3)
+    fast_schedule = Exact().schedule(route_of(*SWAP), LIMITS)
+    slow_schedule = Exact().schedule(route_of(*SWAP), Limits((slow, slow), min_separation=1.5))
+    assert slow_schedule.duration > 500 * fast_schedule.duration
+    began = time.perf_counter()
+    report = verify(slow_schedule)
+    assert time.perf_counter() - began < 1.0
+    assert report.passed, report.failures
+    assert report.pieces == verify(fast_schedule).pieces
 
 
 def test_each_schedule_is_verified_once(caplog):
@@ -49,6 +44,7 @@ def test_each_schedule_is_verified_once(caplog):
         certified = certify(schedule)
     assert first is second is certified.report
     assert len([r for r in caplog.records if r.message.startswith("verified a")]) == 1
+    assert first.pieces == 24  # 3 straight pieces of 7 phases, split where a vehicle passes the junction
     # an equal but distinct schedule object is verified on its own
     copy = dataclasses.replace(schedule)
     assert verify(copy) is not first
@@ -65,12 +61,6 @@ def test_a_failing_report_cannot_make_a_certificate():
         VerifiedSchedule(broken, "passed")  # type: ignore[arg-type]
     with pytest.raises(InputError, match="verify expects a Schedule, got str"):
         verify("schedule")  # type: ignore[arg-type]
-
-
-def test_too_many_samples_are_refused_up_front():
-    schedule = Exact().schedule(route_of(*SWAP), LIMITS)  # 67.5 s
-    with pytest.raises(InputError, match=r"takes 6\.75e\+07 samples: expected at most 20,000,000"):
-        verify(schedule, period=1e-6)
 
 
 def _with_profile_values(schedule, vehicle: int, column: int, value: float):
@@ -90,7 +80,7 @@ def test_non_finite_values_fail_and_are_never_certified(value, column, name):
     schedule = _with_profile_values(Exact().schedule(route_of(*SWAP), LIMITS), 1, column, value)
     report = verify(schedule)
     assert not report.passed
-    assert any(f.startswith(f"{name} is not finite") for f in report.failures), report.failures
+    assert any("is not finite" in f for f in report.failures), report.failures
     with pytest.raises(VerificationError, match="is not finite"):
         certify(schedule)
 

@@ -1,28 +1,28 @@
 """Independent verifier: nothing leaves the library unless it passes.
 
-Each schedule object is verified once: the report is kept (for the last
-:data:`_REMEMBERED` schedules) and returned again for the same schedule and
-period. :func:`certify` turns a passing schedule into a :class:`VerifiedSchedule`,
-the only kind of schedule that exporters and plots accept.
-
-The verifier re-samples a schedule on a fine time grid (1 ms or finer, plus
-every section boundary) and checks, from the sampled track positions and
-kinematics alone:
+The verifier takes a schedule apart into polynomial pieces
+(:mod:`trajgen.pieces`: on each piece both vehicles' signed axes are single
+polynomials and each vehicle is on one leg) and checks every piece in closed
+form (:mod:`trajgen.polynomials`: extrema at the ends and at the roots of the
+derivative), so nothing can hide between samples, and its cost grows with the
+number of pieces, not with the duration. It checks:
 
 - the track distance between the vehicles never drops below the minimum
-  separation;
+  separation (and they never pass each other on a leg);
 - ``|v|``, ``|a|`` (and ``|j|`` where the method limits it) stay within each
-  vehicle's limits, to a relative tolerance;
+  vehicle's limits, to a relative tolerance of 1e-6;
+- every position is on its leg (at most 1e-6 m past its end) and within the
+  range its section's position map covers;
+- position, velocity (and, where jerk is limited, acceleration) are
+  continuous from piece to piece, and the pieces tile ``[0, duration]``;
 - the start and the goal are the route's, to 1e-9 m, at rest (1e-6 m/s);
-- every position is on the track (at most 1e-6 m past a leg's end);
-- the positions move no faster than the sampled velocities allow (the track
-  positions and the kinematics tell one story);
-- the sequence of regions visited (the homotopy class) is the route's.
+- the sequence of regions visited (the homotopy class) is the route's;
+- every number is finite.
 
-Tolerance: 1e-6 relative for every method. The ``toppra`` method enforces its
-limits at grid points only and therefore plans with a small headroom
-(:data:`trajgen.methods.toppra.HEADROOM`), so the true limits hold between
-grid points too; the verifier checks them at the same 1e-6.
+Each schedule object is verified once: the report is kept (for the last
+:data:`_REMEMBERED` schedules) and returned again, also to concurrent callers.
+:func:`certify` turns a passing schedule into a :class:`VerifiedSchedule`, the
+only kind of schedule that exporters and plots accept.
 """
 
 from __future__ import annotations
@@ -38,17 +38,17 @@ from dataclasses import dataclass
 import numpy as np
 
 from topology import Region, RegionKey, reduce_regions
-from topology.indexed import JUNCTION_INDEX, region_keys, track_distance
-from topology.validation import finite_real
+from topology.indexed import JUNCTION_INDEX, track_distance
 from trajgen import polynomials
 from trajgen.errors import InputError, UnverifiedScheduleError, VerificationError
 from trajgen.pieces import Pieces, UncheckableKinematicsError, schedule_pieces
-from trajgen.schedule import Schedule, ScheduleState
+from trajgen.schedule import Schedule
 
 __all__ = [
-    "MAX_PERIOD",
     "POSITION_TOLERANCE",
     "RELATIVE_TOLERANCE",
+    "REST_TOLERANCE",
+    "TRACK_END_TOLERANCE",
     "VerificationReport",
     "VerifiedSchedule",
     "certify",
@@ -64,10 +64,14 @@ RELATIVE_TOLERANCE = 1e-6
 POSITION_TOLERANCE = 1e-9
 #: At rest at the start and goal: |v| in m/s (plus |a| in m/s² for jerk-limited methods) at most this.
 REST_TOLERANCE = 1e-6
-#: How far past the end of its leg a sampled position may be (solver round-off), metres.
+#: How far past the end of its leg a position may be (solver round-off), metres; also the largest jump.
 TRACK_END_TOLERANCE = 1e-6
-#: Coarsest sampling the verifier accepts, seconds.
-MAX_PERIOD = 1e-3
+#: Reports kept for schedules already verified (by identity).
+_REMEMBERED = 64
+_reports: collections.OrderedDict[int, tuple[weakref.ref, VerificationReport]] = collections.OrderedDict()
+_reports_lock = threading.Lock()
+#: One lock per schedule being verified, so that concurrent callers wait for one verification.
+_in_progress: dict[int, threading.Lock] = {}
 
 
 @dataclass(frozen=True, slots=True)
@@ -80,12 +84,8 @@ class VerificationReport:
         Whether every check passed.
     failures : tuple of str
         One message per failed check, naming the quantity, value and limit.
-    samples : int
-        Number of time samples checked.
     pieces : int
-        Number of polynomial pieces checked in closed form (between the samples too).
-    period : float
-        Sample period, seconds.
+        Number of polynomial pieces checked.
     min_separation : float
         Smallest track distance between the vehicles, metres.
     separation_margin : float
@@ -102,9 +102,7 @@ class VerificationReport:
 
     passed: bool
     failures: tuple[str, ...]
-    samples: int
     pieces: int
-    period: float
     min_separation: float
     separation_margin: float
     velocity_ratio: tuple[float, float]
@@ -124,9 +122,7 @@ class VerificationReport:
         return {
             "verified": self.passed,
             "failures": list(self.failures),
-            "samples": self.samples,
             "pieces": self.pieces,
-            "sample_period_s": self.period,
             "min_separation_m": self.min_separation,
             "separation_margin_m": self.separation_margin,
             "velocity_ratio": list(self.velocity_ratio),
@@ -159,103 +155,58 @@ class VerifiedSchedule:
             raise UnverifiedScheduleError("a VerifiedSchedule holds a Schedule and its VerificationReport")
         if not self.report.passed:
             raise VerificationError("schedule failed verification: " + "; ".join(self.report.failures))
-        if verify(self.schedule, period=self.report.period) != self.report:
+        if verify(self.schedule) != self.report:
             raise UnverifiedScheduleError("the report given is not this schedule's verification report")
 
 
-def _sample_times(schedule: Schedule, period: float) -> np.ndarray:
-    duration = schedule.duration
-    count = max(int(np.ceil(duration / period)), 1)
-    grid = np.linspace(0.0, duration, count + 1)
-    boundaries = np.array([section.start_time for section in schedule.sections] + [duration])
-    return np.unique(np.concatenate([grid, boundaries]))
-
-
-#: Reports kept for schedules already verified (by identity and period).
-_REMEMBERED = 64
-_reports: collections.OrderedDict[tuple[int, float], tuple[weakref.ref, VerificationReport]] = (
-    collections.OrderedDict()
-)
-_reports_lock = threading.Lock()
-#: One lock per schedule being verified, so that concurrent callers wait for one verification.
-_in_progress: dict[tuple[int, float], threading.Lock] = {}
-#: Finest sampling the verifier accepts, seconds.
-MIN_PERIOD = 1e-6
-#: Most samples one verification takes (memory grows with them: about 200 bytes each).
-MAX_SAMPLES = 20_000_000
-
-
-def _check_period(period: object) -> float:
-    value = finite_real(period, "verifier sample period (seconds)", InputError)
-    if not MIN_PERIOD <= value <= MAX_PERIOD:
-        raise InputError(
-            f"verifier sample period must be between {MIN_PERIOD:g} s and {MAX_PERIOD:g} s, got {value!r}"
-        )
-    return value
-
-
-def _remembered(key: tuple[int, float], schedule: Schedule) -> VerificationReport | None:
+def _remembered(schedule: Schedule) -> VerificationReport | None:
     with _reports_lock:
-        remembered = _reports.get(key)
+        remembered = _reports.get(id(schedule))
         if remembered is not None and remembered[0]() is schedule:
-            _reports.move_to_end(key)
+            _reports.move_to_end(id(schedule))
             return remembered[1]
     return None
 
 
-def verify(schedule: Schedule, *, period: float = MAX_PERIOD) -> VerificationReport:
-    """Check a schedule independently of how it was computed.
+def verify(schedule: Schedule) -> VerificationReport:
+    """Check a schedule independently of how it was computed, between any two instants too.
 
     Parameters
     ----------
     schedule : Schedule
-    period : float, optional
-        Sample period in seconds, ``0 < period <= 1e-3``.
 
     Returns
     -------
     VerificationReport
-        The same report object for the same schedule and period, computed once.
+        The same report object for the same schedule, computed once.
 
     Raises
     ------
     InputError
-        ``period`` not finite or outside [1e-6, 1e-3] s, more than :data:`MAX_SAMPLES`
-        samples, or ``schedule`` not a Schedule.
+        ``schedule`` is not a Schedule.
     """
-    period = _check_period(period)
     if not isinstance(schedule, Schedule):
         raise InputError(f"verify expects a Schedule, got {type(schedule).__name__}")
-    if not math.isfinite(schedule.duration) or schedule.duration < 0.0:
-        return _unusable(
-            schedule, period, f"schedule duration is {schedule.duration!r} s: expected finite, >= 0"
-        )
-    samples = schedule.duration / period
-    if samples > MAX_SAMPLES:
-        raise InputError(
-            f"verifying a {schedule.duration:.6g} s schedule every {period:g} s takes {samples:.3g} samples: "
-            f"expected at most {MAX_SAMPLES:,} (use a coarser period)"
-        )
-    key = (id(schedule), period)
-    report = _remembered(key, schedule)
+    report = _remembered(schedule)
     if report is not None:
         return report
+    key = id(schedule)
     with _reports_lock:
         working = _in_progress.setdefault(key, threading.Lock())
     with working:  # one thread verifies a schedule; the others wait for its report
-        report = _remembered(key, schedule)
+        report = _remembered(schedule)
         if report is not None:
             return report
         began = time.perf_counter()
         try:
-            report = _verify(schedule, period)
+            report = _verify(schedule)
         finally:
             with _reports_lock:
                 _in_progress.pop(key, None)
         logger.debug(
-            "verified a %s schedule (%d samples) in %.1f ms: %s",
+            "verified a %s schedule (%d pieces) in %.1f ms: %s",
             schedule.method,
-            report.samples,
+            report.pieces,
             1e3 * (time.perf_counter() - began),
             "passed" if report.passed else "FAILED",
         )
@@ -266,65 +217,29 @@ def verify(schedule: Schedule, *, period: float = MAX_PERIOD) -> VerificationRep
     return report
 
 
-def _check_separation(state: ScheduleState, required: float, failures: list[str]) -> float:
-    """Smallest track distance between the vehicles, metres; records a violation of ``required``."""
-    separation = track_distance(state.leg[0], state.s[0], state.leg[1], state.s[1])
-    worst = int(np.argmin(separation))
-    if separation[worst] < required - POSITION_TOLERANCE:
-        failures.append(
-            f"separation {separation[worst]:.9g} m at t={state.t[worst]:.4f} s "
-            f"is below the minimum {required:g} m"
-        )
-    if separation[worst] <= 0.0:
-        failures.append(f"vehicles collide at t={state.t[worst]:.4f} s")
-    return float(separation[worst])
+def _failed(schedule: Schedule, failures: list[str], pieces: int = 0) -> VerificationReport:
+    """A failed report for a schedule that cannot even be taken apart."""
+    logger.warning("schedule (%s) failed verification: %s", schedule.method, "; ".join(failures))
+    nan = float("nan")
+    return VerificationReport(
+        passed=False,
+        failures=tuple(failures),
+        pieces=pieces,
+        min_separation=nan,
+        separation_margin=nan,
+        velocity_ratio=(nan, nan),
+        acceleration_ratio=(nan, nan),
+        jerk_ratio=None,
+        start_error=nan,
+        goal_error=nan,
+        regions_match=False,
+    )
 
 
-def _check_on_track(state: ScheduleState, graph, failures: list[str]) -> None:
-    """Every sampled position within its leg (to :data:`TRACK_END_TOLERANCE`)."""
-    lengths = np.array(graph.lengths)
-    on_leg = state.leg != JUNCTION_INDEX
-    overrun = np.where(on_leg, state.s - lengths[np.where(on_leg, state.leg, 0)], 0.0)
-    worst_overrun = float(overrun.max())
-    if worst_overrun > TRACK_END_TOLERANCE:
-        vehicle, k = np.unravel_index(int(np.argmax(overrun)), overrun.shape)
-        failures.append(
-            f"vehicle {vehicle + 1} is {worst_overrun:.3g} m past the end of leg "
-            f"{graph.names[state.leg[vehicle, k]]!r} at t={state.t[k]:.4f} s "
-            f"(tolerance {TRACK_END_TOLERANCE:g} m)"
-        )
-
-
-def _check_limits(
-    state: ScheduleState, schedule: Schedule, failures: list[str]
-) -> dict[str, tuple[float, float]]:
-    """Largest ``|value| / limit`` per vehicle of velocity, acceleration and (if limited) jerk."""
-    checks = [
-        ("velocity", state.velocity, "max_velocity", "m/s"),
-        ("acceleration", state.acceleration, "max_acceleration", "m/s^2"),
-    ]
-    if schedule.jerk_limited:
-        checks.append(("jerk", state.jerk, "max_jerk", "m/s^3"))
-    ratios: dict[str, tuple[float, float] | None] = {"jerk": None}
-    for name, values, limit_name, unit in checks:
-        per_vehicle = []
-        for vehicle in range(2):
-            limit = getattr(schedule.limits.vehicles[vehicle], limit_name)
-            k = int(np.argmax(np.abs(values[vehicle])))
-            ratio = float(abs(values[vehicle, k]) / limit)
-            per_vehicle.append(ratio)
-            if ratio > 1.0 + RELATIVE_TOLERANCE:
-                failures.append(
-                    f"vehicle {vehicle + 1} {name} {values[vehicle, k]:.9g} {unit} at t={state.t[k]:.4f} s "
-                    f"exceeds its {limit_name} {limit:g} {unit}"
-                )
-        ratios[name] = (per_vehicle[0], per_vehicle[1])
-    return ratios
-
-
-def _check_ends(state: ScheduleState, schedule: Schedule, failures: list[str]) -> tuple[float, float]:
-    """Distance of the first and last sample from the route's start and goal, metres; both at rest."""
+def _check_ends(schedule: Schedule, failures: list[str]) -> tuple[float, float, float]:
+    """Start and goal errors (metres), at rest; and the separation at the start, metres."""
     route, graph = schedule.route, schedule.route.graph
+    state = schedule.state([0.0, schedule.duration])
     errors = []
     for label, index, expected in (("start", 0, route.start), ("goal", -1, route.goal)):
         error = 0.0
@@ -337,90 +252,78 @@ def _check_ends(state: ScheduleState, schedule: Schedule, failures: list[str]) -
             residue = abs(state.velocity[vehicle, index])
             if schedule.jerk_limited:
                 residue += abs(state.acceleration[vehicle, index])
-            if residue > REST_TOLERANCE:
+            if not residue <= REST_TOLERANCE:
                 failures.append(
                     f"vehicle {vehicle + 1} is not at rest at the {label} (|v| + |a| = {residue:.3g})"
                 )
-        if error > POSITION_TOLERANCE:
+        if not error <= POSITION_TOLERANCE:
             failures.append(f"{label} is off the route's {label} by {error:.3g} m (expected <= 1e-9 m)")
         errors.append(error)
-    return errors[0], errors[1]
+    start_gap = float(track_distance(state.leg[0, 0], state.s[0, 0], state.leg[1, 0], state.s[1, 0]))
+    return errors[0], errors[1], start_gap
 
 
-def _check_consistency(state: ScheduleState, schedule: Schedule, failures: list[str]) -> None:
-    """Positions move no faster than the vehicles' velocity limits allow (track and kinematics agree)."""
-    dt = np.diff(state.t)
-    for vehicle in range(2):
-        moved = track_distance(
-            state.leg[vehicle, :-1], state.s[vehicle, :-1], state.leg[vehicle, 1:], state.s[vehicle, 1:]
+def _check_tiling(pieces: Pieces, duration: float, failures: list[str]) -> None:
+    """The pieces follow one another without gaps from 0 to the duration."""
+    if not pieces.count:
+        return
+    ends = pieces.start + pieces.length
+    gaps = np.abs(np.concatenate([[pieces.start[0]], pieces.start[1:] - ends[:-1], [duration - ends[-1]]]))
+    k = int(np.argmax(gaps))
+    if not gaps[k] <= 1e-9 * max(1.0, duration):
+        failures.append(f"the motion has a gap of {gaps[k]:.3g} s in time (piece {k}): expected none")
+
+
+def _verify(schedule: Schedule) -> VerificationReport:
+    duration = schedule.duration
+    if not math.isfinite(duration) or duration < 0.0:
+        return _failed(schedule, [f"schedule duration is {duration!r} s: expected finite, >= 0"])
+    route = schedule.route
+    required = max(schedule.limits.min_separation, route.min_separation)
+    try:
+        with np.errstate(invalid="ignore", over="ignore"):  # non-finite numbers are reported below
+            pieces = schedule_pieces(schedule)
+    except UncheckableKinematicsError as error:
+        return _failed(schedule, [f"cannot be checked: {error}"])
+    if not (np.all(np.isfinite(pieces.axis)) and np.all(np.isfinite(pieces.start))):
+        bad = int(np.argmax(~np.all(np.isfinite(pieces.axis), axis=(0, 2)) | ~np.isfinite(pieces.start)))
+        return _failed(
+            schedule,
+            [f"the motion is not finite in piece {bad} (from t={pieces.start[bad]!r} s): expected finite"],
+            pieces.count,
         )
-        limit = schedule.limits.vehicles[vehicle].max_velocity
-        jumps = np.nonzero(moved > limit * dt * (1.0 + RELATIVE_TOLERANCE) + POSITION_TOLERANCE)[0]
-        if jumps.size:
-            k = int(jumps[0])
-            failures.append(
-                f"vehicle {vehicle + 1} jumps {moved[k]:.6g} m in {dt[k]:.3g} s at t={state.t[k]:.4f} s "
-                f"(faster than its max_velocity)"
-            )
-
-
-def _check_class(state: ScheduleState, route, failures: list[str]) -> bool:
-    """Whether the sampled region sequence (homotopy class) is the route's."""
+    failures: list[str] = []
+    start_error, goal_error, start_gap = _check_ends(schedule, failures)
+    _check_tiling(pieces, duration, failures)
+    ratios = _check_piece_limits(pieces, schedule, failures)
+    track = _check_piece_track(pieces, route.graph, failures)
+    closest, regions = _check_piece_separation(pieces, track, required, failures)
+    closest = min(closest, start_gap)
+    if not pieces.count and start_gap < required - POSITION_TOLERANCE:
+        failures.append(f"separation {start_gap:.9g} m at rest is below the minimum {required:g} m")
+    _check_piece_continuity(pieces, track, schedule, failures)
     expected = route.region_keys
-    sampled = reduce_regions(region_keys(state.leg[0], state.s[0], state.leg[1], state.s[1]))
-    if sampled == expected:
-        return True
-
-    def show(keys):
-        return " ".join(str(Region.from_key(route.graph, key)) for key in keys)
-
-    failures.append(f"homotopy class differs: schedule visits [{show(sampled)}], route [{show(expected)}]")
-    return False
-
-
-def _unusable(schedule: Schedule, period: float, failure: str) -> VerificationReport:
-    """A failed report for a schedule that cannot even be sampled."""
-    logger.warning("schedule (%s) failed verification: %s", schedule.method, failure)
-    nan = float("nan")
+    sequence = reduce_regions(regions)
+    if sequence != expected:
+        show = lambda keys: " ".join(str(Region.from_key(route.graph, key)) for key in keys)  # noqa: E731
+        failures.append(
+            f"homotopy class differs: schedule visits [{show(sequence)}], route [{show(expected)}]"
+        )
+    if failures:
+        logger.warning("schedule (%s) failed verification: %s", schedule.method, "; ".join(failures))
     return VerificationReport(
-        passed=False,
-        failures=(failure,),
-        samples=0,
-        pieces=0,
-        period=period,
-        min_separation=nan,
-        separation_margin=nan,
-        velocity_ratio=(nan, nan),
-        acceleration_ratio=(nan, nan),
-        jerk_ratio=None,
-        start_error=nan,
-        goal_error=nan,
-        regions_match=False,
+        passed=not failures,
+        failures=tuple(failures),
+        pieces=pieces.count,
+        min_separation=closest,
+        separation_margin=closest - required,
+        velocity_ratio=ratios["velocity"],
+        acceleration_ratio=ratios["acceleration"],
+        jerk_ratio=ratios["jerk"],
+        start_error=start_error,
+        goal_error=goal_error,
+        regions_match=sequence == expected,
     )
-
-
-def _check_finite(state: ScheduleState, failures: list[str]) -> None:
-    """Every sampled time, position and derivative is a finite number."""
-    for name in ("t", "axis", "velocity", "acceleration", "jerk", "s"):
-        values = getattr(state, name)
-        bad = ~np.isfinite(values)
-        if bad.any():
-            where = np.argwhere(bad)[0]
-            k = int(where[-1])
-            failures.append(
-                f"{name} is not finite ({values[tuple(where)]!r}) at t={state.t[k]!r} s "
-                f"({int(bad.sum())} samples in all): expected finite numbers"
-            )
-
-
-@dataclass(frozen=True, slots=True)
-class _PieceFigures:
-    """What the closed-form check of the pieces found."""
-
-    count: int
-    closest: float
-    ratios: dict
-    regions_match: bool
 
 
 def _piece_extrema(c: np.ndarray, h: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
@@ -432,7 +335,11 @@ def _check_piece_limits(pieces: Pieces, schedule: Schedule, failures: list[str])
     names = [("velocity", "max_velocity", "m/s"), ("acceleration", "max_acceleration", "m/s^2")]
     if schedule.jerk_limited:
         names.append(("jerk", "max_jerk", "m/s^3"))
-    ratios: dict[str, tuple[float, float] | None] = {"jerk": None}
+    ratios: dict[str, tuple[float, float] | None] = {
+        "velocity": (0.0, 0.0),
+        "acceleration": (0.0, 0.0),
+        "jerk": None,
+    }
     for vehicle in range(2):
         c = pieces.axis[vehicle]
         for order, (name, limit_name, unit) in enumerate(names, start=1):
@@ -449,7 +356,7 @@ def _check_piece_limits(pieces: Pieces, schedule: Schedule, failures: list[str])
                 when = pieces.start[k] + (t_high[k] if abs(high[k]) >= abs(low[k]) else t_low[k])
                 failures.append(
                     f"vehicle {vehicle + 1} {name} reaches {peak[k]:.9g} {unit} at t={when:.6f} s "
-                    f"(closed form, between samples too): exceeds its {limit_name} {limit:g} {unit}"
+                    f"exceeds its {limit_name} {limit:g} {unit}"
                 )
             c = pieces.axis[vehicle]
     return ratios
@@ -468,8 +375,7 @@ def _check_piece_track(pieces: Pieces, graph, failures: list[str]) -> np.ndarray
             k = int(over[0])
             failures.append(
                 f"vehicle {vehicle + 1} is {high[k] - length[k]:.3g} m past the end of leg "
-                f"{graph.names[pieces.leg[vehicle, k]]!r} at t={pieces.start[k] + t_high[k]:.6f} s "
-                "(closed form)"
+                f"{graph.names[pieces.leg[vehicle, k]]!r} at t={pieces.start[k] + t_high[k]:.6f} s"
             )
         under = np.nonzero(low < -TRACK_END_TOLERANCE)[0]
         if under.size:
@@ -496,7 +402,7 @@ def _check_piece_track(pieces: Pieces, graph, failures: list[str]) -> np.ndarray
 def _check_piece_separation(
     pieces: Pieces, track: np.ndarray, required: float, failures: list[str]
 ) -> tuple[float, list]:
-    """Smallest track distance over every piece (closed form) and each piece's region."""
+    """Smallest track distance over every piece and each piece's region."""
     same = (pieces.leg[0] == pieces.leg[1]) & (pieces.leg[0] != JUNCTION_INDEX)
     gap = np.where(same[:, None], track[0] - track[1], track[0] + track[1])
     low, t_low, high, t_high = _piece_extrema(gap, pieces.length)
@@ -522,7 +428,7 @@ def _check_piece_separation(
     elif closest[k] < required - POSITION_TOLERANCE:
         failures.append(
             f"separation {closest[k]:.9g} m at t={pieces.start[k] + when[k]:.6f} s is below the minimum "
-            f"{required:g} m (closed form, between samples too)"
+            f"{required:g} m"
         )
     return float(closest[k]), regions
 
@@ -558,77 +464,7 @@ def _check_piece_continuity(
                 )
 
 
-def _check_pieces(schedule: Schedule, required: float, failures: list[str]) -> _PieceFigures | None:
-    """The closed-form checks: limits, track, separation, continuity and class over every piece."""
-    try:
-        with np.errstate(invalid="ignore", over="ignore"):  # non-finite values are reported by the samples
-            pieces = schedule_pieces(schedule)
-    except UncheckableKinematicsError as error:
-        failures.append(f"cannot be checked between samples: {error}")
-        return None
-    if not np.all(np.isfinite(pieces.axis)) or not np.all(np.isfinite(pieces.length)):
-        return None  # reported by the finiteness check of the samples
-    ratios = _check_piece_limits(pieces, schedule, failures)
-    track = _check_piece_track(pieces, schedule.route.graph, failures)
-    closest, regions = _check_piece_separation(pieces, track, required, failures)
-    _check_piece_continuity(pieces, track, schedule, failures)
-    expected = schedule.route.region_keys
-    sequence = reduce_regions(regions)
-    if sequence != expected:
-        failures.append(
-            "homotopy class differs (closed form): schedule visits ["
-            + " ".join(str(Region.from_key(schedule.route.graph, key)) for key in sequence)
-            + "], route ["
-            + " ".join(str(Region.from_key(schedule.route.graph, key)) for key in expected)
-            + "]"
-        )
-    return _PieceFigures(pieces.count, closest, ratios, sequence == expected)
-
-
-def _worse(sampled, certified):
-    if sampled is None or certified is None:
-        return sampled if certified is None else certified
-    return (max(sampled[0], certified[0]), max(sampled[1], certified[1]))
-
-
-def _verify(schedule: Schedule, period: float) -> VerificationReport:
-    route = schedule.route
-    required = max(schedule.limits.min_separation, route.min_separation)
-    with np.errstate(invalid="ignore", over="ignore"):  # non-finite values are reported below
-        state = schedule.state(_sample_times(schedule, period))
-    failures: list[str] = []
-    _check_finite(state, failures)
-    closest = _check_separation(state, required, failures)
-    _check_on_track(state, route.graph, failures)
-    ratios = _check_limits(state, schedule, failures)
-    start_error, goal_error = _check_ends(state, schedule, failures)
-    _check_consistency(state, schedule, failures)
-    regions_match = _check_class(state, route, failures)
-    figures = _check_pieces(schedule, required, failures)
-    if figures is not None:
-        closest = min(closest, figures.closest)
-        ratios = {name: _worse(ratios.get(name), figures.ratios.get(name)) for name in ratios}
-        regions_match = regions_match and figures.regions_match
-    if failures:
-        logger.warning("schedule (%s) failed verification: %s", schedule.method, "; ".join(failures))
-    return VerificationReport(
-        passed=not failures,
-        failures=tuple(failures),
-        samples=int(state.t.size),
-        pieces=0 if figures is None else figures.count,
-        period=period,
-        min_separation=closest,
-        separation_margin=closest - required,
-        velocity_ratio=ratios["velocity"],
-        acceleration_ratio=ratios["acceleration"],
-        jerk_ratio=ratios["jerk"],
-        start_error=start_error,
-        goal_error=goal_error,
-        regions_match=regions_match,
-    )
-
-
-def certify(schedule: Schedule, *, period: float = MAX_PERIOD) -> VerifiedSchedule:
+def certify(schedule: Schedule) -> VerifiedSchedule:
     """Verify ``schedule`` and return it certified, or raise.
 
     Raises
@@ -636,7 +472,7 @@ def certify(schedule: Schedule, *, period: float = MAX_PERIOD) -> VerifiedSchedu
     VerificationError
         The schedule failed; the message lists every failure.
     """
-    report = verify(schedule, period=period)
+    report = verify(schedule)
     report.raise_if_failed()
     return VerifiedSchedule(schedule, report)
 
