@@ -176,5 +176,3 @@ def _check_finite(state: ScheduleState, failures: list[str]) -> None:
                 f"{name} is not finite ({values[tuple(where)]!r}) at t={state.t[k]!r} s "
                 f"({int(bad.sum())} samples in all): expected finite numbers"
             )
-
-

@@ -139,8 +139,30 @@ def _write(tmp_path, text):
         pytest.param(
             'name = "agv2"',
             'name = "../agv2"',
-            "name '../agv2' is not usable as a file name",
+            "name '../agv2' is not a portable file name",
             id="unsafe-name",
+        ),
+        pytest.param(
+            'name = "agv2"', 'name = "agv2\\n"', r"name 'agv2\\n' is not a portable file name", id="newline"
+        ),
+        pytest.param(
+            'name = "agv2"', 'name = "NUL"', "'NUL' is a reserved device name on Windows", id="reserved"
+        ),
+        pytest.param(
+            'name = "agv2"', 'name = "AGV1"', r"'AGV1' is used by both vehicles \(case ignored\)", id="case"
+        ),
+        pytest.param('name = "agv2"', 'name = "x"', "", id="fine-name"),
+        pytest.param(
+            "A = 10.0,",
+            "A = 1e-300,",
+            r"leg 'A' is 1e-300 m long: expected 0\.001 to 100000 m",
+            id="tiny-leg",
+        ),
+        pytest.param(
+            "max_velocity = 1.0",
+            "max_velocity = 1e9",
+            r"max_velocity is 1000000000\.0: expected 0\.0001 to 100",
+            id="fast",
         ),
         pytest.param("[track]", "[track", "not valid TOML", id="bad-toml"),
     ],
@@ -148,6 +170,9 @@ def _write(tmp_path, text):
 def test_bad_scenario_files(tmp_path, old, new, match):
     assert old in GOOD
     path = _write(tmp_path, GOOD.replace(old, new, 1) if "agv2" not in old else _replace_last(GOOD, old, new))
+    if not match:  # a control: the edit alone is fine
+        assert load_scenario(path).names[1] == "x"
+        return
     with pytest.raises(ScenarioError, match=match) as caught:
         load_scenario(path)
     assert str(path) in str(caught.value)  # the message names the file

@@ -9,7 +9,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from topology.errors import PositionError
-from topology.validation import finite_real
+from topology.validation import finite_real, short_repr
 
 __all__ = ["JUNCTION", "JUNCTION_NAME", "Configuration", "Position"]
 
@@ -52,7 +52,7 @@ class Position:
                 f"position with leg None must be the junction (s == 0), got s={s!r} m; name the leg"
             )
         if not isinstance(self.leg, str) or not self.leg:
-            raise PositionError(f"position leg must be a non-empty string, got {self.leg!r}")
+            raise PositionError(f"position leg must be a non-empty string, got {short_repr(self.leg)}")
         object.__setattr__(self, "s", s)
 
     @classmethod
@@ -78,20 +78,21 @@ class Position:
         Position(leg='A', s=2.5)
         """
         if not isinstance(text, str):
-            raise PositionError(f"position must be a string like 'A:10.0' or 'O', got {text!r}")
+            raise PositionError(f"position must be a string like 'A:10.0' or 'O', got {short_repr(text)}")
         stripped = text.strip()
         if stripped == JUNCTION_NAME:
             return JUNCTION
         leg, colon, metres = stripped.partition(":")
         if not colon or not leg.strip() or not metres.strip():
             raise PositionError(
-                f"position {text!r} is malformed: expected 'LEG:metres' (e.g. 'A:10.0') or 'O'"
+                f"position {short_repr(text)} is malformed: expected 'LEG:metres' (e.g. 'A:10.0') or 'O'"
             )
         try:
             s = float(metres)
         except ValueError:
             raise PositionError(
-                f"position {text!r} has distance {metres.strip()!r}, expected a number of metres"
+                f"position {short_repr(text)} has distance {short_repr(metres.strip())}, "
+                "expected a number of metres"
             ) from None
         return cls(leg.strip(), s)
 

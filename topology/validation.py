@@ -5,7 +5,7 @@ from __future__ import annotations
 import math
 from numbers import Real
 
-__all__ = ["finite_real"]
+__all__ = ["finite_real", "short_repr"]
 
 
 def finite_real(value: object, quantity: str, error: type[Exception]) -> float:
@@ -32,14 +32,20 @@ def finite_real(value: object, quantity: str, error: type[Exception]) -> float:
     if type(value) is float and math.isfinite(value):
         return value
     if isinstance(value, bool) or not isinstance(value, Real):
-        raise error(f"{quantity} must be a real number, got {_short(value)} ({type(value).__name__})")
+        raise error(f"{quantity} must be a real number, got {short_repr(value)} ({type(value).__name__})")
     number = float(value)
     if not math.isfinite(number):
         raise error(f"{quantity} must be finite, got {number!r}")
     return number
 
 
-def _short(value: object, limit: int = 60) -> str:
-    """``repr`` of a value, cut to ``limit`` characters."""
+def short_repr(value: object, limit: int = 60) -> str:
+    """``repr`` of a value, cut to ``limit`` characters: what error messages quote.
+
+    Examples
+    --------
+    >>> short_repr("x" * 100, 12)
+    "'xxxxxxxx..."
+    """
     text = repr(value)
     return text if len(text) <= limit else text[: limit - 3] + "..."

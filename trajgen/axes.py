@@ -168,6 +168,11 @@ def piece_profiles(
         S-curve (jerk-limited) if True, else trapezoid (velocity and acceleration only).
     """
     delta = end - start
+    if not np.any(delta):  # nothing moves (start is the goal): at rest, zero duration
+        return (
+            PiecewiseCubic.from_phases(float(start[0]), []),
+            PiecewiseCubic.from_phases(float(start[1]), []),
+        )
     v, a, j = _progress_limits(delta, limits)
     if jerk:
         phases = [(d, np.nan, value) for d, value in scurve_phases(1.0, v, a, j)]

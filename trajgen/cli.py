@@ -13,7 +13,7 @@ import sys
 from collections.abc import Sequence
 
 from trajgen.errors import InputError
-from trajgen.export import CsvOptions, Units
+from trajgen.export import DEFAULT_MAX_ROWS, CsvOptions, Units
 from trajgen.methods import METHODS
 from trajgen.pipeline import Outputs, run
 from trajgen.scenario import Scenario, default_scenario, load_scenario
@@ -52,6 +52,7 @@ def _csv_options(args: argparse.Namespace) -> CsvOptions:
         delimiter=delimiter,
         decimal=args.decimal,
         units=Units.lookup(args.units),
+        max_rows=args.max_rows,
     )
 
 
@@ -88,6 +89,12 @@ def _add_csv_options(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--decimal", default=".", choices=[".", ","], help="decimal mark ('.')")
     parser.add_argument(
         "--units", default="m", choices=[u.value for u in Units], help="length unit of the CSV (m)"
+    )
+    parser.add_argument(
+        "--max-rows",
+        type=int,
+        default=DEFAULT_MAX_ROWS,
+        help=f"refuse a CSV profile of more rows than this ({DEFAULT_MAX_ROWS:,})",
     )
 
 

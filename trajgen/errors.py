@@ -28,6 +28,7 @@ __all__ = [
     "LimitsError",
     "OptionError",
     "OutputError",
+    "OutputLimitError",
     "PositionError",
     "ScenarioError",
     "ScheduleError",
@@ -46,6 +47,10 @@ class ScenarioError(InputError):
 
 class OutputError(InputError):
     """An output path cannot take the files asked for (a file where a folder must be, ...)."""
+
+
+class OutputLimitError(OutputError):
+    """An output would exceed a documented size limit (for example the rows of a CSV profile)."""
 
 
 class UnverifiedScheduleError(TrajgenError, TypeError):

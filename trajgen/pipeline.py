@@ -13,8 +13,16 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from topology import Route
+from trajgen.analysis import lower_bound
 from trajgen.errors import InputError, VerificationError
-from trajgen.export import CsvOptions, check_output_paths, commit_files, profile_paths, render_profile
+from trajgen.export import (
+    CsvOptions,
+    check_output_paths,
+    check_row_limit,
+    commit_files,
+    profile_chunks,
+    profile_paths,
+)
 from trajgen.methods import METHODS, make_schedule
 from trajgen.plots import render_coordination, render_separation, render_speed
 from trajgen.scenario import Scenario
@@ -156,7 +164,8 @@ def run(
     Raises
     ------
     InputError
-        Bad method or output paths (checked before anything is computed); nothing written.
+        Bad method or output paths (checked before anything is computed), or a
+        CSV profile longer than ``outputs.csv.max_rows`` rows; nothing written.
     VerificationError
         The schedule failed the verifier; nothing written.
     """
@@ -166,12 +175,14 @@ def run(
     chosen = METHODS.create(method)
     check_output_paths(outputs.paths(scenario.names))
     route = scenario.plan()
+    if outputs.csv_dir is not None:  # refuse a profile too long for any schedule before computing one
+        check_row_limit(lower_bound(route, scenario.limits), outputs.csv, lower_bound=True)
     verified = certify(make_schedule(route, scenario.limits, method=chosen))
-    files: dict[Path, bytes] = {}
+    files: dict[Path, object] = {}
     notes: list[str] = []
-    if outputs.csv_dir is not None:
+    if outputs.csv_dir is not None:  # streamed into the commit, a block of rows at a time
         for vehicle, path in enumerate(profile_paths(scenario.names, outputs.csv_dir)):
-            files[path] = render_profile(verified, vehicle, outputs.csv)
+            files[path] = profile_chunks(verified, vehicle, outputs.csv)
     if outputs.plot_dir is not None:
         compared, notes = _comparison(route, scenario, chosen, verified)
         speed, separation, coordination = (outputs.plot_dir / name for name in PLOT_NAMES)

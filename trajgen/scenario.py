@@ -23,7 +23,8 @@ Example (``examples/swap.toml``)::
 
 from __future__ import annotations
 
-import re
+import os
+import stat
 import tomllib
 from dataclasses import dataclass
 from importlib import resources
@@ -31,13 +32,30 @@ from pathlib import Path
 
 from limits import Limits, VehicleLimits
 from topology import Configuration, Position, Route, YGraph, plan
+from topology.validation import short_repr
 from trajgen.errors import InputError, ScenarioError
+from trajgen.naming import check_vehicle_name, check_vehicle_names
 
-__all__ = ["DEFAULT_SCENARIO_NAME", "Scenario", "default_scenario", "load_scenario", "parse_scenario"]
+__all__ = [
+    "DEFAULT_SCENARIO_NAME",
+    "MAX_SCENARIO_BYTES",
+    "PLAUSIBLE",
+    "Scenario",
+    "default_scenario",
+    "load_scenario",
+    "parse_scenario",
+]
 
 DEFAULT_SCENARIO_NAME = "swap.toml"
-
-_VEHICLE_NAME = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_.-]{0,63}$")
+#: Largest scenario file read, bytes; a larger one is refused unread.
+MAX_SCENARIO_BYTES = 1 << 20
+#: Plausible range of each quantity of a scenario (SI units): outside it a scenario is refused.
+PLAUSIBLE = {
+    "leg length": (1e-3, 1e5),
+    "max_velocity": (1e-4, 100.0),
+    "max_acceleration": (1e-4, 1000.0),
+    "max_jerk": (1e-4, 1e6),
+}
 _TOP_KEYS = {"track": True, "safety": True, "vehicle": True}
 _TRACK_KEYS = {"legs": True, "angles_deg": False}
 _SAFETY_KEYS = {"min_separation": True}
@@ -74,16 +92,41 @@ class Scenario:
     goal: Configuration
     source: str
 
+    def __post_init__(self) -> None:
+        if not isinstance(self.track, YGraph):
+            raise InputError(f"scenario track must be a YGraph, got {type(self.track).__name__}")
+        if not isinstance(self.limits, Limits):
+            raise InputError(f"scenario limits must be Limits, got {type(self.limits).__name__}")
+        object.__setattr__(self, "names", check_vehicle_names(self.names))
+        _check_plausible_track(self.track)
+        for k, vehicle in enumerate(self.limits.vehicles, start=1):
+            _check_plausible_vehicle(vehicle, f"vehicle {k}")
+
     def plan(self) -> Route:
         """The planner's route from start to goal, keeping the scenario's minimum separation."""
         return plan(self.track, self.start, self.goal, min_separation=self.limits.min_separation)
+
+
+def _check_plausible_track(track: YGraph) -> None:
+    low, high = PLAUSIBLE["leg length"]
+    for name, length in zip(track.names, track.lengths, strict=True):
+        if not low <= length <= high:
+            raise InputError(f"leg {name!r} is {length!r} m long: expected {low:g} to {high:g} m")
+
+
+def _check_plausible_vehicle(vehicle: VehicleLimits, where: str) -> None:
+    for key in ("max_velocity", "max_acceleration", "max_jerk"):
+        low, high = PLAUSIBLE[key]
+        value = getattr(vehicle, key)
+        if not low <= value <= high:
+            raise InputError(f"{where} {key} is {value!r}: expected {low:g} to {high:g} (SI units)")
 
 
 def _check_keys(table: dict, allowed: dict[str, bool], where: str, source: str) -> None:
     unknown = sorted(set(table) - set(allowed))
     if unknown:
         raise ScenarioError(
-            f"{source}: {where} has unknown key(s) {unknown!r}: expected only {sorted(allowed)!r}"
+            f"{source}: {where} has unknown key(s) {short_repr(unknown)}: expected only {sorted(allowed)!r}"
         )
     missing = [key for key, required in allowed.items() if required and key not in table]
     if missing:
@@ -92,13 +135,17 @@ def _check_keys(table: dict, allowed: dict[str, bool], where: str, source: str) 
 
 def _table(value: object, where: str, source: str) -> dict:
     if not isinstance(value, dict):
-        raise ScenarioError(f"{source}: {where} must be a table, got {type(value).__name__} {value!r}")
+        raise ScenarioError(
+            f"{source}: {where} must be a table, got {type(value).__name__} {short_repr(value)}"
+        )
     return value
 
 
 def _number(value: object, where: str, source: str) -> float:
     if isinstance(value, bool) or not isinstance(value, (int, float)):
-        raise ScenarioError(f"{source}: {where} must be a number, got {type(value).__name__} {value!r}")
+        raise ScenarioError(
+            f"{source}: {where} must be a number, got {type(value).__name__} {short_repr(value)}"
+        )
     return float(value)
 
 
@@ -112,7 +159,9 @@ def _parse_track(data: dict, source: str) -> YGraph:
         angle_table = _table(track_table["angles_deg"], "[track] angles_deg", source)
         angles = {name: _number(a, f"[track] angles_deg.{name}", source) for name, a in angle_table.items()}
     try:
-        return YGraph(lengths, angles_deg=angles)
+        track = YGraph(lengths, angles_deg=angles)
+        _check_plausible_track(track)
+        return track
     except InputError as error:
         raise ScenarioError(f"{source}: [track]: {error}") from None
 
@@ -123,14 +172,14 @@ def _parse_vehicle(vehicle: object, k: int, track: YGraph, taken: list[str], sou
     vehicle = _table(vehicle, where, source)
     _check_keys(vehicle, _VEHICLE_KEYS, where, source)
     name = vehicle["name"]
-    if not isinstance(name, str) or not _VEHICLE_NAME.match(name):
+    try:
+        check_vehicle_name(name)
+    except InputError as error:
+        raise ScenarioError(f"{source}: {where} name: {error}") from None
+    if any(name.casefold() == other.casefold() for other in taken):
         raise ScenarioError(
-            f"{source}: {where} name {name!r} is not usable as a file name: "
-            "expected 1-64 letters, digits, '_', '.' or '-', starting with a letter or digit"
-        )
-    if name in taken:
-        raise ScenarioError(
-            f"{source}: {where} name {name!r} is used by both vehicles: expected distinct names"
+            f"{source}: {where} name {name!r} is used by both vehicles (case ignored): "
+            "expected distinct names"
         )
     numbers = {
         key: _number(vehicle[key], f"{where} {key}", source)
@@ -138,6 +187,7 @@ def _parse_vehicle(vehicle: object, k: int, track: YGraph, taken: list[str], sou
     }
     try:
         limits = VehicleLimits(**numbers)
+        _check_plausible_vehicle(limits, "vehicle")
     except InputError as error:
         raise ScenarioError(f"{source}: {where}: {error}") from None
     ends = []
@@ -146,7 +196,7 @@ def _parse_vehicle(vehicle: object, k: int, track: YGraph, taken: list[str], sou
         if not isinstance(text, str):
             raise ScenarioError(
                 f"{source}: {where} {key} must be a string like 'A:10.0' or 'O', "
-                f"got {type(text).__name__} {text!r}"
+                f"got {type(text).__name__} {short_repr(text)}"
             )
         try:
             ends.append(track.check(Position.parse(text)))
@@ -197,23 +247,50 @@ def parse_scenario(data: dict, *, source: str = "<scenario>") -> Scenario:
                 f"{source}: the vehicles' {label} positions {configuration} are {distance!r} m apart: "
                 f"expected at least [safety] min_separation {separation!r} m"
             )
-    return Scenario(track, limits, (names[0], names[1]), start, goal, source)
+    try:
+        return Scenario(track, limits, (names[0], names[1]), start, goal, source)
+    except InputError as error:
+        raise ScenarioError(f"{source}: {error}") from None
+
+
+def _read_scenario_file(path: Path) -> str:
+    """The text of a scenario file: a regular file of at most :data:`MAX_SCENARIO_BYTES`, UTF-8."""
+    try:
+        info = os.stat(path)
+        if not stat.S_ISREG(info.st_mode):
+            raise ScenarioError(f"{path}: is not a regular file: expected a scenario TOML file")
+        if info.st_size > MAX_SCENARIO_BYTES:
+            raise ScenarioError(
+                f"{path}: is {info.st_size:,} bytes: "
+                f"expected a scenario file of at most {MAX_SCENARIO_BYTES:,} bytes"
+            )
+        with open(path, "rb") as stream:
+            data = stream.read(MAX_SCENARIO_BYTES + 1)
+    except OSError as error:
+        raise ScenarioError(f"{path}: cannot read the scenario file: {error.strerror or error}") from None
+    if len(data) > MAX_SCENARIO_BYTES:
+        raise ScenarioError(f"{path}: is longer than {MAX_SCENARIO_BYTES:,} bytes: expected a scenario file")
+    try:
+        return data.decode("utf-8")
+    except UnicodeDecodeError as error:
+        hint = " (it looks like UTF-16: save it as UTF-8)" if data[:2] in (b"\xff\xfe", b"\xfe\xff") else ""
+        raise ScenarioError(
+            f"{path}: is not UTF-8 text: byte {data[error.start]:#04x} at offset {error.start}{hint}"
+        ) from None
 
 
 def load_scenario(path: str | Path) -> Scenario:
-    """Read a scenario TOML file.
+    """Read a scenario TOML file (UTF-8, at most :data:`MAX_SCENARIO_BYTES`).
 
     Raises
     ------
     ScenarioError
-        The file cannot be read, is not TOML, or is not a valid scenario.
+        The file cannot be read, is too large, not UTF-8, not TOML, or not a valid scenario.
     """
+    if not isinstance(path, (str, Path)) or str(path) == "":
+        raise ScenarioError(f"scenario path must name a file, got {short_repr(path)}")
     path = Path(path)
-    try:
-        text = path.read_text(encoding="utf-8")
-    except OSError as error:
-        raise ScenarioError(f"{path}: cannot read the scenario file: {error.strerror or error}") from None
-    return _parse_text(text, str(path))
+    return _parse_text(_read_scenario_file(path), str(path))
 
 
 def _parse_text(text: str, source: str) -> Scenario:
@@ -221,6 +298,8 @@ def _parse_text(text: str, source: str) -> Scenario:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as error:
         raise ScenarioError(f"{source}: not valid TOML: {error}") from None
+    except RecursionError:
+        raise ScenarioError(f"{source}: not a scenario: arrays or tables nested too deeply") from None
     return parse_scenario(data, source=source)
 
 

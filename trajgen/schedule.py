@@ -35,6 +35,9 @@ __all__ = [
     "Section",
     "TimingMethod",
     "check_period",
+    "check_request",
+    "sample_block",
+    "sample_rows",
 ]
 
 
@@ -50,6 +53,39 @@ def check_period(period: float) -> float:
     if value <= 0.0:
         raise InputError(f"sample period must be > 0 s, got {value!r}")
     return value
+
+
+def sample_rows(duration: float, period: float) -> int:
+    """Number of samples every ``period`` seconds from 0 to ``duration``, the last exactly at the end."""
+    count = int(np.floor(duration / period + 1e-9))
+    return count + 2 if duration - count * period > 1e-9 * max(1.0, duration) else count + 1
+
+
+def sample_block(duration: float, period: float, start: int, stop: int) -> np.ndarray:
+    """Sample times ``start`` to ``stop - 1`` of the grid of :func:`sample_rows`, seconds."""
+    rows = sample_rows(duration, period)
+    times = np.arange(start, min(stop, rows)) * period
+    if times.size and min(stop, rows) == rows:
+        times[-1] = duration  # the last sample is the goal
+    return times
+
+
+def check_request(route: object, limits: object) -> tuple[Route, Limits]:
+    """Return ``(route, limits)`` if a timing method can serve them, else raise InputError.
+
+    The route must be a :class:`~topology.Route` planned for at least the
+    separation the limits ask for.
+    """
+    if not isinstance(route, Route):
+        raise InputError(f"route must be a topology.Route, got {type(route).__name__}")
+    if not isinstance(limits, Limits):
+        raise InputError(f"limits must be a limits.Limits, got {type(limits).__name__}")
+    if route.min_separation < limits.min_separation:
+        raise InputError(
+            f"the route was planned for a min_separation of {route.min_separation!r} m but the limits ask "
+            f"{limits.min_separation!r} m: plan it with plan(..., min_separation={limits.min_separation!r})"
+        )
+    return route, limits
 
 
 class FallbackReason(enum.Enum):
@@ -329,13 +365,7 @@ class Schedule:
     def sample(self, period: float) -> ScheduleState:
         """States every ``period`` seconds from t = 0, plus a last sample exactly at the goal."""
         period = check_period(period)
-        count = int(np.floor(self.duration / period + 1e-9))
-        times = np.arange(count + 1) * period
-        if self.duration - times[-1] > 1e-9 * max(1.0, self.duration):
-            times = np.append(times, self.duration)
-        else:
-            times[-1] = self.duration
-        return self.state(times)
+        return self.state(sample_block(self.duration, period, 0, sample_rows(self.duration, period)))
 
     def configuration_at(self, t: float) -> Configuration:
         """The two vehicles' positions at time ``t`` (seconds) as a Configuration."""

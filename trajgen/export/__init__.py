@@ -1,14 +1,27 @@
 """Outputs for controllers: CSV profiles, and the atomic commit of all files of a run."""
 
 from trajgen.export.atomic import check_output_paths, commit_files
-from trajgen.export.csv import HEADER_NAMES, CsvOptions, Units, profile_paths, render_profile, write_profiles
+from trajgen.export.csv import (
+    DEFAULT_MAX_ROWS,
+    HEADER_NAMES,
+    CsvOptions,
+    Units,
+    check_row_limit,
+    profile_chunks,
+    profile_paths,
+    render_profile,
+    write_profiles,
+)
 
 __all__ = [
+    "DEFAULT_MAX_ROWS",
     "HEADER_NAMES",
     "CsvOptions",
     "Units",
     "check_output_paths",
+    "check_row_limit",
     "commit_files",
+    "profile_chunks",
     "profile_paths",
     "render_profile",
     "write_profiles",

@@ -14,7 +14,7 @@ import os
 import shutil
 import tempfile
 import uuid
-from collections.abc import Mapping
+from collections.abc import Iterable, Mapping
 from pathlib import Path
 
 from trajgen.errors import OutputError
@@ -96,12 +96,13 @@ def _read_umask() -> int:
 _FILE_MODE = 0o666 & ~_read_umask()
 
 
-def _stage(path: Path, data: bytes, mode: int) -> str:
+def _stage(path: Path, data: bytes | Iterable[bytes], mode: int) -> str:
     handle, temporary = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
     try:
         os.chmod(temporary, mode)  # mkstemp makes 0600; the files are for other tools too
         with os.fdopen(handle, "wb") as stream:
-            stream.write(data)
+            for chunk in [data] if isinstance(data, bytes | bytearray) else data:
+                stream.write(chunk)
             stream.flush()
             os.fsync(stream.fileno())
     except BaseException:
@@ -149,13 +150,14 @@ def _replace_all(staged: list[tuple[str, Path]]) -> None:
             previous.unlink(missing_ok=True)
 
 
-def commit_files(contents: Mapping[Path | str, bytes]) -> tuple[Path, ...]:
+def commit_files(contents: Mapping[Path | str, bytes | Iterable[bytes]]) -> tuple[Path, ...]:
     """Write several files so that either all appear complete or nothing changes.
 
     Parameters
     ----------
-    contents : mapping of path to bytes
-        Every file of the run and its content. Missing folders are made.
+    contents : mapping of path to bytes or iterable of bytes
+        Every file of the run and its content, whole or as chunks streamed to
+        disk one at a time (memory stays bounded). Missing folders are made.
 
     Returns
     -------

@@ -7,19 +7,38 @@ Renderers return bytes and take only a :class:`~trajgen.verify.VerifiedSchedule`
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
 from topology import JUNCTION_INDEX, Option
-from trajgen.errors import InputError, OptionError
+from topology.validation import short_repr
+from trajgen.errors import InputError, OptionError, OutputLimitError
 from trajgen.export.atomic import commit_files
-from trajgen.schedule import Schedule, ScheduleState, check_period
+from trajgen.naming import check_vehicle_names
+from trajgen.schedule import Schedule, ScheduleState, check_period, sample_block, sample_rows
 from trajgen.verify import VerifiedSchedule, require_verified
 
-__all__ = ["HEADER_NAMES", "CsvOptions", "Units", "profile_paths", "render_profile", "write_profiles"]
+__all__ = [
+    "DEFAULT_MAX_ROWS",
+    "HEADER_NAMES",
+    "ROWS_PER_CHUNK",
+    "CsvOptions",
+    "Units",
+    "check_row_limit",
+    "profile_chunks",
+    "profile_paths",
+    "profile_rows",
+    "render_profile",
+    "write_profiles",
+]
+
+#: Most rows of one CSV profile unless ``CsvOptions.max_rows`` says otherwise (a day at 10 ms: 8.64 million).
+DEFAULT_MAX_ROWS = 10_000_000
+#: Rows sampled and formatted at a time while streaming a profile.
+ROWS_PER_CHUNK = 20_000
 
 
 class Units(Option):
@@ -60,32 +79,44 @@ class CsvOptions:
         Decimal mark, ``.`` or ``,`` (default ``.``); must differ from the delimiter.
     units : Units
         ``m`` (default) or ``mm`` for lengths; time in seconds either way.
+    max_rows : int
+        Most rows of one profile (default :data:`DEFAULT_MAX_ROWS`); a longer one is refused.
     """
 
     sample_period: float = 0.01
     delimiter: str = ";"
     decimal: str = "."
     units: Units = Units.METRES
+    max_rows: int = DEFAULT_MAX_ROWS
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "sample_period", check_period(self.sample_period))
-        if (
-            not isinstance(self.delimiter, str)
-            or len(self.delimiter) != 1
-            or self.delimiter in '\r\n"0123456789-+'
-        ):
+        if isinstance(self.max_rows, bool) or not isinstance(self.max_rows, int) or self.max_rows < 1:
+            raise OptionError(f"CSV max_rows must be an integer >= 1, got {short_repr(self.max_rows)}")
+        if not _usable_delimiter(self.delimiter):
             raise OptionError(
-                f"CSV delimiter {self.delimiter!r} is not usable: expected one character, not a digit, sign, "
-                "quote or line break (e.g. ';', ',', tab)"
+                f"CSV delimiter {short_repr(self.delimiter)} is not usable: expected one ASCII character "
+                "that is no letter, digit, sign, '_', '.', quote or line break (e.g. ';', ',', tab)"
             )
         if self.decimal not in (".", ","):
-            raise OptionError(f"CSV decimal mark {self.decimal!r} is not supported: expected '.' or ','")
+            raise OptionError(
+                f"CSV decimal mark {short_repr(self.decimal)} is not supported: expected '.' or ','"
+            )
         if self.decimal == self.delimiter:
             raise OptionError(
                 f"CSV decimal mark and delimiter are both {self.decimal!r}: expected different characters"
             )
         if not isinstance(self.units, Units):
             object.__setattr__(self, "units", Units.lookup(self.units))
+
+
+def _usable_delimiter(value: object) -> bool:
+    """One ASCII character that occurs in no header and no number: tab, space or punctuation."""
+    if not isinstance(value, str) or len(value) != 1:
+        return False
+    return value in "\t " or (
+        value.isascii() and value.isprintable() and not value.isalnum() and value not in "_.-+\"'"
+    )
 
 
 def _xy(schedule: Schedule, state: ScheduleState, vehicle: int) -> tuple[np.ndarray, np.ndarray]:
@@ -96,40 +127,91 @@ def _xy(schedule: Schedule, state: ScheduleState, vehicle: int) -> tuple[np.ndar
     return s * np.cos(angle), s * np.sin(angle)
 
 
-def _rows(schedule: Schedule, vehicle: int, options: CsvOptions) -> list[str]:
-    """The lines of one vehicle's CSV profile (header first), without line ends."""
-    state = schedule.sample(options.sample_period)
+def _lines(schedule: Schedule, state: ScheduleState, vehicle: int, options: CsvOptions) -> list[str]:
+    """Rows of one vehicle's CSV profile for the sampled ``state``, without line ends."""
     scale = options.units.scale
+    decimals = options.units.decimals
     x, y = _xy(schedule, state, vehicle)
     columns = [
         (state.t, 6),
-        (state.axis[vehicle] * scale, options.units.decimals),
-        (state.velocity[vehicle] * scale, options.units.decimals),
-        (state.acceleration[vehicle] * scale, options.units.decimals),
-        (state.jerk[vehicle] * scale, options.units.decimals),
+        (state.axis[vehicle] * scale, decimals),
+        (state.velocity[vehicle] * scale, decimals),
+        (state.acceleration[vehicle] * scale, decimals),
+        (state.jerk[vehicle] * scale, decimals),
         None,  # leg
-        (state.s[vehicle] * scale, options.units.decimals),
-        (x * scale, options.units.decimals),
-        (y * scale, options.units.decimals),
+        (state.s[vehicle] * scale, decimals),
+        (x * scale, decimals),
+        (y * scale, decimals),
     ]
-    legs = (state.leg[vehicle] + 1).tolist()  # 1-based leg index, 0 at the junction
     formatted = []
     for column in columns:
         if column is None:
-            formatted.append([str(v) for v in legs])
+            formatted.append(
+                [str(v) for v in (state.leg[vehicle] + 1).tolist()]
+            )  # 1-based, 0 at the junction
             continue
-        values, decimals = column
-        text = [f"{round(float(v), decimals) + 0.0:.{decimals}f}" for v in values]  # + 0.0: no "-0"
+        values, places = column
+        text = [f"{round(float(v), places) + 0.0:.{places}f}" for v in values]  # + 0.0: no "-0"
         if options.decimal != ".":
             text = [t.replace(".", options.decimal) for t in text]
         formatted.append(text)
-    lines = [options.delimiter.join(HEADER_NAMES[options.units])]
-    lines += [options.delimiter.join(fields) for fields in zip(*formatted, strict=True)]
-    return lines
+    return [options.delimiter.join(fields) for fields in zip(*formatted, strict=True)]
+
+
+def profile_rows(duration: float, options: CsvOptions) -> int:
+    """Rows (header excluded) of a profile of a ``duration``-second schedule."""
+    return sample_rows(duration, options.sample_period)
+
+
+def check_row_limit(duration: float, options: CsvOptions, *, lower_bound: bool = False) -> int:
+    """Rows of a profile of ``duration`` seconds, if within ``options.max_rows``; else raise.
+
+    Raises
+    ------
+    OutputLimitError
+        More rows than ``options.max_rows`` (say which option to change).
+    """
+    rows = duration / options.sample_period
+    if not rows <= options.max_rows:
+        what = "at least " if lower_bound else ""
+        raise OutputLimitError(
+            f"a CSV profile of this {'scenario' if lower_bound else 'schedule'} has {what}{rows:,.0f} rows "
+            f"({duration:.6g} s every {options.sample_period:g} s): expected at most max_rows "
+            f"{options.max_rows:,} (raise --max-rows, or a longer --sample-period)"
+        )
+    return profile_rows(duration, options)
+
+
+def profile_chunks(
+    verified: VerifiedSchedule, vehicle: int, options: CsvOptions | None = None
+) -> Iterator[bytes]:
+    """One vehicle's CSV profile as chunks of ASCII bytes: header, one row per sample, CRLF after every line.
+
+    Memory is bounded by :data:`ROWS_PER_CHUNK` rows, whatever the duration.
+
+    Raises
+    ------
+    OutputLimitError
+        The profile would have more than ``options.max_rows`` rows (raised at once, not when iterating).
+    """
+    schedule = require_verified(verified, "profile_chunks").schedule
+    if vehicle not in (0, 1):
+        raise InputError(f"vehicle must be 0 or 1, got {short_repr(vehicle)}")
+    options = options or CsvOptions()
+    rows = check_row_limit(schedule.duration, options)
+
+    def chunks() -> Iterator[bytes]:
+        yield (options.delimiter.join(HEADER_NAMES[options.units]) + "\r\n").encode("ascii")
+        for first in range(0, rows, ROWS_PER_CHUNK):
+            times = sample_block(schedule.duration, options.sample_period, first, first + ROWS_PER_CHUNK)
+            lines = _lines(schedule, schedule.state(times), vehicle, options)
+            yield ("\r\n".join(lines) + "\r\n").encode("ascii")
+
+    return chunks()
 
 
 def render_profile(verified: VerifiedSchedule, vehicle: int, options: CsvOptions | None = None) -> bytes:
-    """One vehicle's CSV profile: header, one row per sample period, CRLF after every line.
+    """One vehicle's whole CSV profile as bytes (see :func:`profile_chunks` to stream it).
 
     Parameters
     ----------
@@ -143,10 +225,7 @@ def render_profile(verified: VerifiedSchedule, vehicle: int, options: CsvOptions
     bytes
         ASCII text.
     """
-    schedule = require_verified(verified, "render_profile").schedule
-    if vehicle not in (0, 1):
-        raise InputError(f"vehicle must be 0 or 1, got {vehicle!r}")
-    return ("\r\n".join(_rows(schedule, vehicle, options or CsvOptions())) + "\r\n").encode("ascii")
+    return b"".join(profile_chunks(verified, vehicle, options))
 
 
 def profile_paths(names: Sequence[str], directory: str | Path) -> tuple[Path, Path]:
@@ -155,12 +234,13 @@ def profile_paths(names: Sequence[str], directory: str | Path) -> tuple[Path, Pa
     Raises
     ------
     InputError
-        Not two distinct names.
+        Not two portable, distinct file names (:func:`trajgen.naming.check_vehicle_names`).
     """
-    if isinstance(names, str) or len(names) != 2 or names[0] == names[1]:
-        raise InputError(f"vehicle names must be two distinct names, got {names!r}")
+    first, second = check_vehicle_names(names)
+    if not isinstance(directory, (str, Path)) or str(directory) == "":
+        raise InputError(f"CSV folder must name a folder, got {short_repr(directory)}")
     directory = Path(directory)
-    return (directory / f"{names[0]}.csv", directory / f"{names[1]}.csv")
+    return (directory / f"{first}.csv", directory / f"{second}.csv")
 
 
 def write_profiles(
@@ -196,5 +276,5 @@ def write_profiles(
     """
     require_verified(verified, "write_profiles")
     paths = profile_paths(names, directory)
-    commit_files({path: render_profile(verified, vehicle, options) for vehicle, path in enumerate(paths)})
+    commit_files({path: profile_chunks(verified, vehicle, options) for vehicle, path in enumerate(paths)})
     return paths

@@ -17,7 +17,7 @@ from limits import Limits
 from topology import Route
 from trajgen.axes import piece_maps, piece_profiles, route_axes, straight_pieces
 from trajgen.errors import InputError
-from trajgen.schedule import CubicKinematics, Schedule, Section, TimingMethod
+from trajgen.schedule import CubicKinematics, Schedule, Section, TimingMethod, check_request
 
 __all__ = ["Exact"]
 
@@ -56,6 +56,7 @@ class Exact(TimingMethod):
 
     def schedule(self, route: Route, limits: Limits) -> Schedule:
         """The exact schedule of ``route`` under ``limits``."""
+        check_request(route, limits)
         axes = route_axes(route)
         sections = []
         clock = 0.0

@@ -6,7 +6,7 @@ from collections.abc import Iterator, Sequence
 
 from limits import Limits
 from topology import Route
-from trajgen.errors import InputError, OptionError
+from trajgen.errors import OptionError
 from trajgen.schedule import Schedule, TimingMethod
 
 __all__ = ["MethodRegistry"]
@@ -94,8 +94,4 @@ class MethodRegistry:
             smaller separation than ``limits`` asks.
         """
         chosen = self.create(method)
-        if not isinstance(route, Route):
-            raise InputError(f"route must be a topology.Route, got {type(route).__name__}")
-        if not isinstance(limits, Limits):
-            raise InputError(f"limits must be a limits.Limits, got {type(limits).__name__}")
         return chosen.schedule(route, limits)

@@ -33,7 +33,15 @@ from topology.indexed import region_keys, track_distance
 from trajgen.axes import RouteAxes, piece_maps, piece_profiles, route_axes, straight_pieces
 from trajgen.errors import InputError, SolverError
 from trajgen.methods.exact import Exact
-from trajgen.schedule import AxisMap, CubicKinematics, Kinematics, Schedule, Section, TimingMethod
+from trajgen.schedule import (
+    AxisMap,
+    CubicKinematics,
+    Kinematics,
+    Schedule,
+    Section,
+    TimingMethod,
+    check_request,
+)
 from trajgen.values import ArrayValue, readonly
 
 __all__ = ["HEADROOM", "BlendedPath", "Toppra", "ToppraKinematics"]
@@ -461,4 +469,5 @@ class Toppra(TimingMethod):
 
     def schedule(self, route: Route, limits: Limits) -> Schedule:
         """The TOPPRA schedule of ``route`` under ``limits``."""
+        check_request(route, limits)
         return _toppra_schedule(self, route, limits)

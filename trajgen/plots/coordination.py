@@ -11,7 +11,7 @@ from trajgen.analysis import travelled
 from trajgen.errors import InputError
 from trajgen.methods import METHODS
 from trajgen.plots.figure import new_figure, png_bytes
-from trajgen.plots.speed import PLOT_PERIOD
+from trajgen.plots.speed import plot_period
 from trajgen.schedule import Schedule
 from trajgen.verify import VerifiedSchedule, require_verified
 
@@ -24,7 +24,7 @@ METHOD_COLOURS = {name: _PALETTE[k % len(_PALETTE)] for k, name in enumerate(MET
 
 def _forbidden(schedule: Schedule, required: float, resolution: int = 240):
     """Grid over both vehicles' travelled distances; True where their positions are too close."""
-    _, distance, leg, s = travelled(schedule, PLOT_PERIOD)
+    _, distance, leg, s = travelled(schedule, plot_period(schedule.duration))
     axes = []
     for vehicle in range(2):
         total = distance[vehicle, -1]
@@ -52,7 +52,9 @@ def render_coordination(verified: Mapping[str, VerifiedSchedule]) -> bytes:
     if not verified:
         raise InputError("the coordination plot needs at least one schedule")
     schedules = {name: require_verified(v, "render_coordination").schedule for name, v in verified.items()}
-    distances = {name: travelled(schedule, PLOT_PERIOD)[1] for name, schedule in schedules.items()}
+    distances = {
+        name: travelled(schedule, plot_period(schedule.duration))[1] for name, schedule in schedules.items()
+    }
     groups: dict[tuple, list[str]] = {}
     for name, distance in distances.items():
         key = tuple(np.round(distance[:, -1], 6))  # same paths drive the same distances

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from topology.indexed import track_distance
 from trajgen.plots.figure import new_figure, png_bytes
-from trajgen.plots.speed import PLOT_PERIOD
+from trajgen.plots.speed import plot_period
 from trajgen.verify import VerifiedSchedule, require_verified
 
 __all__ = ["render_separation"]
@@ -13,7 +13,7 @@ __all__ = ["render_separation"]
 def render_separation(verified: VerifiedSchedule) -> bytes:
     """Track distance between the vehicles over time with the minimum line, as PNG bytes."""
     schedule = require_verified(verified, "render_separation").schedule
-    state = schedule.sample(PLOT_PERIOD)
+    state = schedule.sample(plot_period(schedule.duration))
     distance = track_distance(state.leg[0], state.s[0], state.leg[1], state.s[1])
     required = max(schedule.limits.min_separation, schedule.route.min_separation)
     figure = new_figure(figsize=(9, 4))

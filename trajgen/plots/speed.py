@@ -5,10 +5,19 @@ from __future__ import annotations
 from trajgen.plots.figure import new_figure, png_bytes
 from trajgen.verify import VerifiedSchedule, require_verified
 
-__all__ = ["PLOT_PERIOD", "VEHICLE_COLOURS", "render_speed"]
+__all__ = ["MAX_PLOT_POINTS", "PLOT_PERIOD", "VEHICLE_COLOURS", "plot_period", "render_speed"]
 
-#: Sample period of the plotted curves, seconds.
+#: Sample period of the plotted curves, seconds (longer for long schedules: see :func:`plot_period`).
 PLOT_PERIOD = 0.01
+#: Most samples a curve is drawn from, whatever the duration.
+MAX_PLOT_POINTS = 20_000
+
+
+def plot_period(duration: float) -> float:
+    """The sample period of the curves of a ``duration``-second schedule: 10 ms, or coarser past 200 s."""
+    return max(PLOT_PERIOD, duration / MAX_PLOT_POINTS)
+
+
 #: Line colours of vehicle 1 and vehicle 2.
 VEHICLE_COLOURS = ("tab:blue", "tab:orange")
 
@@ -23,7 +32,7 @@ def render_speed(verified: VerifiedSchedule, *, names: tuple[str, str] = ("vehic
         Legend labels.
     """
     schedule = require_verified(verified, "render_speed").schedule
-    state = schedule.sample(PLOT_PERIOD)
+    state = schedule.sample(plot_period(schedule.duration))
     figure = new_figure(figsize=(9, 7.5))
     axes = figure.subplots(3, 1, sharex=True)
     rows = [

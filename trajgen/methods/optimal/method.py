@@ -18,7 +18,7 @@ from trajgen.methods.optimal.guess import initial_guess
 from trajgen.methods.optimal.phases import NlpShape, route_phases
 from trajgen.methods.optimal.solve import Outcome, Solver, SolverAttempt, SolverCache, solve
 from trajgen.methods.optimal.transcription import ParameterLayout
-from trajgen.schedule import FallbackReason, MethodInfo, Schedule, TimingMethod
+from trajgen.schedule import FallbackReason, MethodInfo, Schedule, TimingMethod, check_request
 from trajgen.verify import verify
 
 __all__ = ["DEFAULT_NODES", "Optimal", "OptimalInfo", "Source"]
@@ -173,6 +173,7 @@ class Optimal(TimingMethod):
 
     def schedule(self, route: Route, limits: Limits) -> Schedule:
         """The optimal schedule of ``route`` under ``limits`` (verified), or the flagged ``exact`` one."""
+        check_request(route, limits)
         exact_method = Exact()
         exact = exact_method.schedule(route, limits)
         if len(route.waypoints) == 1:  # nothing moves: the exact schedule is optimal

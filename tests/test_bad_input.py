@@ -1,0 +1,126 @@
+"""Every bad input is a clean error: exit 2 from the CLI with a short message naming what was expected.
+
+Nothing is written by a run that exits non-zero; the same checks hold in the Python API.
+"""
+
+from __future__ import annotations
+
+import pytest
+
+from tests.conftest import REPO
+from tests.helpers import LIMITS, route_of
+from trajgen import Exact, certify, make_schedule, write_profiles
+from trajgen.cli import EXIT_BAD_INPUT, EXIT_OK, main
+from trajgen.errors import InputError
+
+SWAP_FILE = REPO / "examples" / "swap.toml"
+GOOD = SWAP_FILE.read_text(encoding="utf-8")
+
+
+def _scenario(tmp_path, content: bytes | str) -> str:
+    path = tmp_path / "scenario.toml"
+    path.write_bytes(content if isinstance(content, bytes) else content.encode("utf-8"))
+    return str(path)
+
+
+FILE_CASES = [
+    pytest.param(GOOD.encode("utf-16"), "it looks like UTF-16: save it as UTF-8", id="utf-16"),
+    pytest.param(
+        GOOD.replace("agv1", "agv\xe9").encode("latin-1"), "is not UTF-8 text: byte 0xe9", id="latin-1"
+    ),
+    pytest.param("x = " + "[" * 100_000 + "]" * 100_000, "nested too deeply", id="deep-nesting"),
+    pytest.param(
+        GOOD + "#" * (1 << 20), r"is 1,04\d,\d{3} bytes: expected a scenario file of at most", id="huge"
+    ),
+    pytest.param(GOOD.replace("A = 10.0,", "A = 1e-300,"), r"leg 'A' is 1e-300 m long", id="tiny-leg"),
+    pytest.param(
+        GOOD.replace('name = "agv1"', 'name = "' + "n" * 100_000 + '"'),
+        "is not a portable file name",
+        id="long-name",
+    ),
+]
+
+
+@pytest.mark.parametrize(("content", "match"), FILE_CASES)
+def test_bad_scenario_files_exit_2_with_a_short_message(tmp_path, capsys, content, match):
+    import re
+
+    output = tmp_path / "out"
+    assert main(["schedule", _scenario(tmp_path, content), "--csv", str(output)]) == EXIT_BAD_INPUT
+    err = capsys.readouterr().err
+    assert re.search(match, err), err[:500]
+    assert len(err) < 600  # a long value is quoted by a short prefix only
+    assert not output.exists()
+
+
+def test_a_device_is_not_read_as_a_scenario(tmp_path, capsys):
+    assert main(["plan", "/dev/zero"]) == EXIT_BAD_INPUT
+    assert "/dev/zero: is not a regular file" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize(
+    ("options", "match"),
+    [
+        pytest.param(["--delimiter", "é"], "delimiter 'é' is not usable", id="non-ascii"),
+        pytest.param(["--delimiter", "_"], "delimiter '_' is not usable", id="underscore"),
+        pytest.param(["--delimiter", "s"], "delimiter 's' is not usable", id="letter-s"),
+        pytest.param(["--delimiter", "e"], "delimiter 'e' is not usable", id="letter-e"),
+        pytest.param(["--sample-period", "1e-6"], "at least 22,500,000 rows", id="period-1e-6"),
+        pytest.param(["--sample-period", "5e-324"], "at least inf rows", id="period-subnormal"),
+        pytest.param(["--max-rows", "0"], "max_rows must be an integer >= 1, got 0", id="max-rows-0"),
+        pytest.param(["--max-rows", "3000"], "schedule has 6,750 rows", id="max-rows-after-scheduling"),
+    ],
+)
+def test_bad_csv_options_exit_2_and_write_nothing(tmp_path, capsys, options, match):
+    output = tmp_path / "out"
+    argv = ["schedule", str(SWAP_FILE), "--method", "exact", "--csv", str(output), *options]
+    assert main(argv) == EXIT_BAD_INPUT
+    assert match in capsys.readouterr().err
+    assert not output.exists()
+
+
+def test_an_unwritable_folder_exits_2(tmp_path, capsys):
+    assert (
+        main(["schedule", str(SWAP_FILE), "--method", "exact", "--csv", "/proc/trajgen-out"])
+        == EXIT_BAD_INPUT
+    )
+    assert "cannot write" in capsys.readouterr().err
+
+
+def test_start_equal_to_goal_is_a_valid_request_of_zero_motion(tmp_path, capsys):
+    # each vehicle's goal is its start: vehicle 1 stays at the end of A, vehicle 2 at the end of B
+    path = _scenario(
+        tmp_path,
+        GOOD.replace('goal = "B:10.0"', 'goal = "A:X"')
+        .replace('goal = "A:10.0"', 'goal = "B:10.0"')
+        .replace('goal = "A:X"', 'goal = "A:10.0"'),
+    )
+    output = tmp_path / "out"
+    for method in ("exact", "toppra", "optimal"):
+        assert main(["schedule", path, "--method", method, "--csv", str(output), "--json"]) == EXIT_OK
+        assert '"duration_s": 0.0' in capsys.readouterr().out
+        rows = (output / "agv1.csv").read_text().splitlines()
+        assert len(rows) == 2  # the header and one row at t = 0, at rest
+        assert rows[1].startswith("0.000000;0.000000000;0.000000000;0.000000000;0.000000000;1;10.000000000")
+
+
+def test_the_api_refuses_names_that_leave_the_folder(tmp_path):
+    verified = certify(
+        Exact().schedule(route_of((10.0, 10.0, 10.0), ("A:10", "B:10"), ("B:10", "A:10")), LIMITS)
+    )
+    with pytest.raises(InputError, match=r"vehicle name '\.\./x' is not a portable file name"):
+        write_profiles(verified, ("../x", "/abs/y"), tmp_path)
+    with pytest.raises(InputError, match="vehicle names must be a pair of names, got 5"):
+        write_profiles(verified, 5, tmp_path)  # type: ignore[arg-type]
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_the_api_refuses_a_route_planned_for_a_smaller_separation():
+    route = route_of((10.0, 10.0, 10.0), ("A:10", "B:10"), ("B:10", "A:10"), separation=0.5)
+    for method in ("exact", "toppra", "optimal"):
+        with pytest.raises(
+            InputError, match=r"planned for a min_separation of 0\.5 m but the limits ask 1\.5 m"
+        ):
+            make_schedule(route, LIMITS, method=method)
+    with pytest.raises(InputError, match=r"route must be a topology\.Route, got str"):
+        Exact().schedule("route", LIMITS)  # type: ignore[arg-type]
