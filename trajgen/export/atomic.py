@@ -1,15 +1,23 @@
-"""All files of one run committed together or not at all.
+"""All files of one run committed together or not at all, also across processes and crashes.
 
-Every file is first written to a temporary file beside its target and
-flushed to disk; only then are the targets replaced, one rename each. If any
-step fails, the files already replaced get their previous content back, new
-files and the folders made for them are removed, and no temporary file is
-left: the output folders look as they did before the run.
+A commit locks every output folder (``flock`` on the folder itself, in one
+order, so concurrent runs take turns), writes every file to a hidden
+temporary file beside its target and flushes it to disk, keeps a hidden
+backup (a hard link) of each file it will replace, writes a journal of what
+it is about to do into each folder, then renames the files into place. Once
+all renames are done the journals are removed: that is the commit. A failure
+before that puts every target back as it was; a crash (even SIGKILL) is
+undone by the next commit into any of those folders, or by
+:func:`recover_folder`, which finds the journal and restores the backups.
+Hidden files a crashed run left (``*.trajgen-tmp``, ``*.trajgen-bak``) are
+removed then too.
 """
 
 from __future__ import annotations
 
 import contextlib
+import fcntl
+import json
 import os
 import shutil
 import tempfile
@@ -19,7 +27,12 @@ from pathlib import Path
 
 from trajgen.errors import OutputError
 
-__all__ = ["check_output_paths", "commit_files"]
+__all__ = ["JOURNAL_NAME", "check_output_paths", "commit_files", "recover_folder"]
+
+#: Name of the journal an unfinished commit leaves in each of its folders.
+JOURNAL_NAME = ".trajgen-journal"
+_TMP_SUFFIX = ".trajgen-tmp"
+_BAK_SUFFIX = ".trajgen-bak"
 
 
 def _short(path: Path) -> str:
@@ -97,7 +110,7 @@ _FILE_MODE = 0o666 & ~_read_umask()
 
 
 def _stage(path: Path, data: bytes | Iterable[bytes], mode: int) -> str:
-    handle, temporary = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+    handle, temporary = tempfile.mkstemp(prefix=f".{path.name}.", suffix=_TMP_SUFFIX, dir=path.parent)
     try:
         os.chmod(temporary, mode)  # mkstemp makes 0600; the files are for other tools too
         with os.fdopen(handle, "wb") as stream:
@@ -115,7 +128,7 @@ def _keep_previous(path: Path) -> Path | None:
     """A hidden copy of what ``path`` is now (a hard link where possible; a link stays a link)."""
     if not os.path.lexists(path):
         return None
-    backup = path.with_name(f".{path.name}.{uuid.uuid4().hex}.bak")
+    backup = path.with_name(f".{path.name}.{uuid.uuid4().hex}{_BAK_SUFFIX}")
     try:
         os.link(path, backup, follow_symlinks=False)
     except OSError:
@@ -126,26 +139,137 @@ def _keep_previous(path: Path) -> Path | None:
     return backup
 
 
-def _replace_all(staged: list[tuple[str, Path]]) -> None:
-    """Rename every staged file onto its target; on failure put every target back as it was."""
-    done: list[tuple[Path, Path | None]] = []
-    backup = None
+def _write_journal(
+    folder: str, entries: list[tuple[Path, Path | None]], folders: list[str], key: str
+) -> None:
+    """Record, durably, which targets of ``folder`` a commit replaces and where their backups are."""
+    record = {
+        "commit": key,
+        "folders": folders,
+        "entries": [[path.name, None if backup is None else backup.name] for path, backup in entries],
+    }
+    journal = Path(folder) / JOURNAL_NAME
+    temporary = journal.with_name(f"{JOURNAL_NAME}.{key}{_TMP_SUFFIX}")
+    with open(temporary, "w", encoding="utf-8") as stream:
+        json.dump(record, stream)
+        stream.flush()
+        os.fsync(stream.fileno())
+    os.replace(temporary, journal)
+    _sync_folder(Path(folder))
+
+
+def _read_journal(folder: str) -> dict | None:
     try:
-        for temporary, path in staged:
-            backup = _keep_previous(path)
+        with open(Path(folder) / JOURNAL_NAME, encoding="utf-8") as stream:
+            return json.load(stream)
+    except FileNotFoundError:
+        return None
+    except (OSError, ValueError):  # a journal cut short: its commit never renamed anything
+        return {"folders": [folder], "entries": []}
+
+
+def _undo(folder: str, record: dict) -> None:
+    """Put every target of an unfinished commit in ``folder`` back as it was."""
+    base = Path(folder)
+    for name, backup in record.get("entries", []):
+        target = base / name
+        if backup is not None:
+            if os.path.lexists(base / backup):
+                os.replace(base / backup, target)
+        else:
+            target.unlink(missing_ok=True)
+    (base / JOURNAL_NAME).unlink(missing_ok=True)
+    _sync_folder(base)
+
+
+def _remove_leftovers(folder: str) -> None:
+    """Remove hidden temporary files and backups that a crashed commit left (call with the lock held)."""
+    for entry in os.scandir(folder):
+        if entry.name.startswith(".") and entry.name.endswith((_TMP_SUFFIX, _BAK_SUFFIX)):
+            with contextlib.suppress(FileNotFoundError):
+                os.unlink(entry.path)
+
+
+class _FolderLocks:
+    """Exclusive locks on folders, taken in one order; also on every folder an unfinished commit names."""
+
+    def __init__(self, folders) -> None:
+        self.folders = sorted(set(folders))
+        self.handles: list[int] = []
+
+    def __enter__(self) -> _FolderLocks:
+        while True:
+            for folder in self.folders:
+                handle = os.open(folder, os.O_RDONLY)
+                self.handles.append(handle)
+                fcntl.flock(handle, fcntl.LOCK_EX)
+            named = {
+                f for folder in self.folders if (record := _read_journal(folder)) for f in record["folders"]
+            }
+            named = {f for f in named if os.path.isdir(f)}
+            if named <= set(self.folders):
+                return self
+            self._release()
+            self.folders = sorted(set(self.folders) | named)
+
+    def _release(self) -> None:
+        for handle in self.handles:
+            os.close(handle)  # closing the descriptor releases its flock
+        self.handles = []
+
+    def __exit__(self, *exc) -> None:
+        self._release()
+
+    def recover(self) -> None:
+        """Undo every unfinished commit in the locked folders and remove what crashed runs left."""
+        for folder in self.folders:
+            record = _read_journal(folder)
+            if record is not None:
+                _undo(folder, record)
+        for folder in self.folders:
+            _remove_leftovers(folder)
+
+
+def recover_folder(folder: str | Path) -> None:
+    """Undo an unfinished commit that a crashed run left in ``folder`` (and in its other folders).
+
+    Commits do this themselves for every folder they write to; call it to
+    tidy a folder that no later run writes to.
+    """
+    with _FolderLocks([os.path.realpath(folder)]) as locks:
+        locks.recover()
+
+
+def _replace_all(staged: list[tuple[str, Path]]) -> None:
+    """Rename every staged file onto its target, journalled; on failure put every target back as it was."""
+    backups = [(path, _keep_previous(path)) for _, path in staged]
+    key = uuid.uuid4().hex
+    by_folder: dict[str, list[tuple[Path, Path | None]]] = {}
+    for path, backup in backups:
+        by_folder.setdefault(os.path.realpath(path.parent), []).append((path, backup))
+    folders = sorted(by_folder)
+    done: list[tuple[Path, Path | None]] = []
+    try:
+        for folder, entries in by_folder.items():
+            _write_journal(folder, entries, folders, key)
+        for (temporary, path), (_, backup) in zip(staged, backups, strict=True):
             os.replace(temporary, path)
             done.append((path, backup))
-            backup = None
+        for folder in folders:  # the commit point: from here on the new files stand
+            (Path(folder) / JOURNAL_NAME).unlink()
     except BaseException:
-        if backup is not None:
-            backup.unlink(missing_ok=True)
         for path, previous in reversed(done):
             if previous is not None:
                 os.replace(previous, path)
             else:
                 path.unlink(missing_ok=True)
+        for folder in folders:
+            (Path(folder) / JOURNAL_NAME).unlink(missing_ok=True)
+        for _, previous in backups:
+            if previous is not None:
+                previous.unlink(missing_ok=True)
         raise
-    for _, previous in done:
+    for _, previous in backups:
         if previous is not None:
             previous.unlink(missing_ok=True)
 
@@ -176,16 +300,19 @@ def commit_files(contents: Mapping[Path | str, bytes | Iterable[bytes]]) -> tupl
     succeeded = False
     try:
         try:
-            for path, payload in zip(paths, data, strict=True):
+            for path in paths:
                 _make_folders(path.parent, created)
-                staged.append((_stage(path, payload, _FILE_MODE), path))
-            _replace_all(staged)
+            with _FolderLocks(os.path.realpath(path.parent) for path in paths) as locks:
+                locks.recover()
+                for path, payload in zip(paths, data, strict=True):
+                    staged.append((_stage(path, payload, _FILE_MODE), path))
+                _replace_all(staged)
+                succeeded = True
+                for folder in locks.folders:
+                    _sync_folder(Path(folder))
         except OSError as error:
             where = _short(Path(error.filename)) if error.filename else "the output folder"
             raise OutputError(f"cannot write {where!r}: {error.strerror or error}") from error
-        succeeded = True
-        for folder in {path.parent for path in paths}:
-            _sync_folder(folder)
     finally:
         if not succeeded:
             for temporary, _ in staged:
