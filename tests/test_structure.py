@@ -89,8 +89,12 @@ def _cycles(graph: dict[str, set[str]]) -> list[list[str]]:
     return found
 
 
+#: Standard-library names that start with an underscore but are public API.
+_PUBLIC_UNDERSCORE = {"_exit", "_asdict", "_replace", "_fields", "_make"}
+
+
 def _private(name: str) -> bool:
-    return name.startswith("_") and not name.startswith("__")
+    return name.startswith("_") and not name.startswith("__") and name not in _PUBLIC_UNDERSCORE
 
 
 def _defined_private_names(tree: ast.AST) -> set[str]:
