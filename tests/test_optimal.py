@@ -213,3 +213,30 @@ def test_coordination_plot_is_rendered_for_verified_schedules():
     assert (exact_distance[:, 1:] >= exact_distance[:, :-1]).all()
     assert exact_distance[1, -1] == pytest.approx(40.0, abs=1e-6)
     assert optimal_distance[1, -1] < exact_distance[1, -1]
+
+
+@pytest.mark.parametrize(("a", "b"), [("A", "B"), ("B", "C"), ("C", "A")])
+def test_a_separation_equal_to_the_shortest_leg_is_solved_not_fallen_back(a, b):
+    # degenerate: the waiting vehicle must park at the very end of the 8 m leg while the other
+    # passes the junction; with the full planning margin there is no solution at all
+    track = YGraph({"A": 12.0, "B": 8.0, "C": 15.0})
+    start = conf(f"{a}:{track.length(a)}", f"{b}:{track.length(b)}")
+    limits = Limits(vehicles=LIMITS.vehicles, min_separation=track.shortest_leg)
+    route = plan(track, start, start.swapped(), min_separation=track.shortest_leg)
+    schedule = optimal_schedule(route, limits, cache=SolverCache())
+    assert schedule.fallback_reason is None, schedule.notes
+    report = verify(schedule)
+    assert report.passed, report.failures
+    assert report.separation_margin >= -1e-9
+    assert schedule.duration < exact_schedule(route, limits).duration
+
+
+def test_a_spent_time_budget_returns_the_verified_exact_schedule_flagged():
+    route = route_of(UNEQUAL, ("A:12", "B:8"), ("B:8", "A:12"))
+    schedule = optimal_schedule(route, LIMITS, time_budget=1e-4, cache=SolverCache())
+    assert schedule.fallback_reason is FallbackReason.TIME_BUDGET
+    assert schedule.method == Exact()
+    assert verify(schedule).passed
+    assert "not tried: the time budget is spent" in schedule.notes[0]
+    with pytest.raises(InputError, match="time_budget must be a finite number of seconds > 0, got 0"):
+        Optimal(time_budget=0)

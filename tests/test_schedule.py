@@ -223,3 +223,40 @@ def test_the_closed_form_verifier_agrees_with_the_sampled_second_opinion(scenari
     for name in ("velocity", "acceleration"):
         closed = getattr(certified, f"{name}_ratio")
         assert all(c >= s - 1e-12 for c, s in zip(closed, sampled.ratios[name], strict=True))
+
+
+def test_a_toppra_failure_falls_back_to_exact_without_jerk_limits_flagged(monkeypatch):
+    import toppra.algorithm
+
+    from trajgen import FallbackReason
+
+    def broken(*args, **kwargs):
+        raise RuntimeError("simulated TOPPRA failure")
+
+    monkeypatch.setattr(toppra.algorithm, "TOPPRA", broken)
+    route = route_of(*SWAP)
+    schedule = toppra_schedule(route, LIMITS)
+    assert schedule.fallback_reason is FallbackReason.SOLVER_FAILED
+    assert schedule.method == Exact(jerk=False)
+    assert "simulated TOPPRA failure" in schedule.notes[0]
+    assert schedule.duration == exact_schedule(route, LIMITS, jerk=False).duration
+    assert verify(schedule).passed
+
+
+def test_a_toppra_section_it_cannot_time_keeps_its_stops(monkeypatch):
+    import toppra.algorithm
+
+    real = toppra.algorithm.TOPPRA
+
+    class Uncontrollable(real):
+        def compute_parameterization(self, *args, **kwargs):
+            super().compute_parameterization(*args, **kwargs)
+            self.problem_data.sd_vec = None  # what TOPPRA returns when it finds the path uncontrollable
+
+    monkeypatch.setattr(toppra.algorithm, "TOPPRA", Uncontrollable)
+    route = route_of(*SWAP)
+    schedule = toppra_schedule(route, LIMITS)
+    assert schedule.fallback_reason is None
+    assert any("TOPPRA failed on a section" in note for note in schedule.notes)
+    assert schedule.duration == pytest.approx(exact_schedule(route, LIMITS, jerk=False).duration)
+    assert verify(schedule).passed

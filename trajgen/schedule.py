@@ -94,6 +94,7 @@ class FallbackReason(enum.Enum):
     SOLVER_FAILED = "solver-failed"  #: no solver converged
     VERIFICATION_FAILED = "verification-failed"  #: the solution failed the verifier
     SETUP_FAILED = "setup-failed"  #: the problem could not be set up (initial guess, parameters)
+    TIME_BUDGET = "time-budget"  #: the solvers did not finish within the method's time budget
 
 
 class MethodInfo(abc.ABC):

@@ -21,6 +21,7 @@ the headroom) takes the trapezoids, so ``toppra`` is never slower than
 
 from __future__ import annotations
 
+import dataclasses
 import logging
 from dataclasses import dataclass, field
 from typing import ClassVar
@@ -36,6 +37,7 @@ from trajgen.methods.exact import Exact
 from trajgen.schedule import (
     AxisMap,
     CubicKinematics,
+    FallbackReason,
     Kinematics,
     Schedule,
     Section,
@@ -43,6 +45,7 @@ from trajgen.schedule import (
     check_request,
 )
 from trajgen.values import ArrayValue, readonly
+from trajgen.verify import verify
 
 __all__ = ["HEADROOM", "BlendedPath", "Toppra", "ToppraKinematics"]
 
@@ -405,6 +408,7 @@ def _toppra_schedule(method: Toppra, route: Route, limits: Limits) -> Schedule:
     sections: list[Section] = []
     clock = 0.0
     rounded = toppra_sections = 0
+    failed: list[str] = []
     for start, stop in _groups(axes, pieces, blends):
         group = pieces[start:stop]
         trapezoids = [
@@ -414,8 +418,12 @@ def _toppra_schedule(method: Toppra, route: Route, limits: Limits) -> Schedule:
         if len(group) > 1:
             vertices = axes.axes[[group[0][0]] + [b for _, b in group]]
             path = BlendedPath(vertices, (None, *blends[start + 1 : stop], None))
-            timed = _toppra_section(path, limits, grid_points)
-            if timed.duration >= sum(k.duration for k in trapezoids):
+            try:
+                timed = _toppra_section(path, limits, grid_points)
+            except SolverError as error:  # keep this section's stops, flagged in the notes
+                logger.warning("TOPPRA failed on a section, its corners are stops: %s", error)
+                failed.append(str(error))
+            if timed is not None and timed.duration >= sum(k.duration for k in trapezoids):
                 logger.info("TOPPRA section is not faster than stopping at its corners; keeping the stops")
                 timed = None
         if timed is not None:
@@ -430,6 +438,7 @@ def _toppra_schedule(method: Toppra, route: Route, limits: Limits) -> Schedule:
     notes = (
         f"{rounded} of {len(pieces) - 1} corners rounded; {toppra_sections} section(s) timed by TOPPRA",
         "jerk is not limited by this method",
+        *(f"TOPPRA failed on a section ({reason}); its corners are stops" for reason in failed),
     )
     logger.info("toppra schedule: %s", notes[0])
     return Schedule(route, limits, method, tuple(sections), jerk_limited=False, notes=notes)
@@ -468,6 +477,30 @@ class Toppra(TimingMethod):
         return False
 
     def schedule(self, route: Route, limits: Limits) -> Schedule:
-        """The TOPPRA schedule of ``route`` under ``limits``."""
+        """The TOPPRA schedule of ``route`` under ``limits``, verified; else ``Exact(jerk=False)``, flagged.
+
+        Like ``optimal``, a result that cannot be computed or fails the
+        verifier is replaced by the exact schedule without jerk limits (which
+        this method is never slower than), with ``fallback_reason`` set.
+        """
         check_request(route, limits)
-        return _toppra_schedule(self, route, limits)
+        try:
+            schedule = _toppra_schedule(self, route, limits)
+        except InputError:
+            raise
+        except Exception as error:  # TOPPRA's own failures must not leave the library as a crash
+            return _fallback(route, limits, FallbackReason.SOLVER_FAILED, f"{type(error).__name__}: {error}")
+        report = verify(schedule)
+        if not report.passed:
+            return _fallback(route, limits, FallbackReason.VERIFICATION_FAILED, "; ".join(report.failures))
+        return schedule
+
+
+def _fallback(route: Route, limits: Limits, reason: FallbackReason, detail: str) -> Schedule:
+    logger.warning("toppra schedule fell back to exact without jerk limits (%s): %s", reason.value, detail)
+    exact = Exact(jerk=False).schedule(route, limits)
+    return dataclasses.replace(
+        exact,
+        notes=(f"fallback to exact without jerk limits ({reason.value}): {detail}",),
+        fallback_reason=reason,
+    )

@@ -5,6 +5,7 @@ from __future__ import annotations
 import dataclasses
 import enum
 import logging
+import math
 import time
 from dataclasses import dataclass, field
 from typing import ClassVar
@@ -32,6 +33,12 @@ _POSITIVE_SEPARATION = 1e-3
 #: Planned clearance above the minimum separation, metres: the solvers meet constraints to ~1e-8 m,
 #: the verifier demands the minimum to 1e-9 m.
 _SEPARATION_MARGIN = 1e-6
+#: Where the separation (nearly) fills the shortest leg, the waiting vehicle must park at the very end
+#: of a leg while the other passes the junction: no strict interior, and with the full margin no
+#: solution. There the margin shrinks to this and the legs are planned this much longer (the verifier
+#: allows 1e-6 m past a leg's end), so a thin interior exists.
+_TIGHT_MARGIN = 2e-7
+_LEG_SLACK = 5e-7
 
 
 class Source(enum.Enum):
@@ -117,6 +124,9 @@ class Optimal(TimingMethod):
         Iteration limit of Ipopt (and of fatrop, with ``fatrop_iterations``).
     fatrop_iterations : int, optional
         Iteration limit of fatrop (default 500; it converges in < 150 when it converges).
+    time_budget : float, optional
+        Seconds the solvers may take (default 2.0): no solver starts after it is spent and Ipopt
+        stops by itself; the verified ``exact`` schedule is returned then, flagged ``time-budget``.
     cache : SolverCache or None, optional
         Where compiled NLPs are kept; ``None`` (default) uses the process-wide
         :meth:`shared_cache`.
@@ -130,6 +140,7 @@ class Optimal(TimingMethod):
     segments: int = 1
     max_iterations: int = 3000
     fatrop_iterations: int = 500
+    time_budget: float = 2.0
     cache: SolverCache | None = field(default=None, compare=False, repr=False)
 
     def __post_init__(self) -> None:
@@ -137,6 +148,11 @@ class Optimal(TimingMethod):
         _positive_int(self.segments, "segments")
         _positive_int(self.max_iterations, "max_iterations")
         _positive_int(self.fatrop_iterations, "fatrop_iterations")
+        budget = self.time_budget
+        if isinstance(budget, bool) or not isinstance(budget, (int, float)) or not 0.0 < budget < math.inf:
+            raise InputError(
+                f"optimal option time_budget must be a finite number of seconds > 0, got {budget!r}"
+            )
         if self.cache is not None and not isinstance(self.cache, SolverCache):
             raise InputError(
                 f"optimal option cache must be a SolverCache or None, got {type(self.cache).__name__}"
@@ -163,6 +179,7 @@ class Optimal(TimingMethod):
             segments=self.segments,
             max_iterations=self.max_iterations,
             fatrop_iterations=self.fatrop_iterations,
+            time_budget=float(self.time_budget),
         )
 
     def warm_up(self, route: Route) -> bool:
@@ -190,14 +207,14 @@ class Optimal(TimingMethod):
         except Exception as error:  # a malformed guess is a bug, but must not leak an unverified schedule
             info = OptimalInfo(time.perf_counter() - began, built, source=Source.EXACT)
             return _fallback(exact, FallbackReason.SETUP_FAILED, f"{type(error).__name__}: {error}", info)
-        result = solve(compiled, guess, parameters)
+        result = solve(compiled, guess, parameters, deadline=began + self.time_budget)
         elapsed = time.perf_counter() - began
         info = OptimalInfo(elapsed, built, result.attempts)
         if result.solution is None:
             detail = "; ".join(str(a) for a in result.attempts)
-            return _fallback(
-                exact, FallbackReason.SOLVER_FAILED, detail, dataclasses.replace(info, source=Source.EXACT)
-            )
+            late = time.perf_counter() - began > self.time_budget
+            reason = FallbackReason.TIME_BUDGET if late else FallbackReason.SOLVER_FAILED
+            return _fallback(exact, reason, detail, dataclasses.replace(info, source=Source.EXACT))
         grid = f"{len(phases)} phase(s) x {self.segments} segments x {self.nodes} intervals"
         note = f"{grid}; {result.attempts[-1]}"
         solution = sections(route, limits, phases, unpack(result.solution, phases, shape))
@@ -230,14 +247,18 @@ class Optimal(TimingMethod):
 
 def _parameters(route: Route, limits: Limits, phases) -> object:
     graph = route.graph
+    required = max(limits.min_separation, route.min_separation)
+    separation = max(required, _POSITIVE_SEPARATION) + _SEPARATION_MARGIN
+    slack = 0.0
+    if separation > graph.shortest_leg - _SEPARATION_MARGIN:  # degenerate: see _TIGHT_MARGIN
+        separation = max(required, min(_POSITIVE_SEPARATION, 0.5 * graph.shortest_leg)) + _TIGHT_MARGIN
+        slack = _LEG_SLACK
     lengths = [
-        graph.lengths[leg] if not phase.parked(v) else 0.0
+        graph.lengths[leg] + slack if not phase.parked(v) else 0.0
         for phase in phases
         for v, leg in enumerate(phase.legs)
     ]
     vehicles = limits.vehicles
-    # plan 1 micrometre clear of the minimum: the solvers meet constraints to ~1e-8 m
-    separation = max(limits.min_separation, route.min_separation, _POSITIVE_SEPARATION) + _SEPARATION_MARGIN
     return ParameterLayout(len(phases)).pack(
         lengths=lengths,
         max_velocity=[v.max_velocity for v in vehicles],

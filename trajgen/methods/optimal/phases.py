@@ -120,6 +120,8 @@ class NlpShape:
         Iteration limit of Ipopt.
     fatrop_iterations : int
         Iteration limit of fatrop.
+    time_budget : float
+        Wall time Ipopt may take per attempt, seconds.
     """
 
     kinds: tuple[PhaseKind, ...]
@@ -127,6 +129,7 @@ class NlpShape:
     segments: int
     max_iterations: int
     fatrop_iterations: int
+    time_budget: float = 2.0
 
     @classmethod
     def of(
@@ -137,10 +140,11 @@ class NlpShape:
         segments: int,
         max_iterations: int,
         fatrop_iterations: int,
+        time_budget: float = 2.0,
     ) -> NlpShape:
         """The shape of the problem for ``phases`` with these options."""
         kinds = tuple(PhaseKind((p.parked(0), p.parked(1)), p.nearer, p.switching) for p in phases)
-        return cls(kinds, nodes, segments, max_iterations, fatrop_iterations)
+        return cls(kinds, nodes, segments, max_iterations, fatrop_iterations, time_budget)
 
     @property
     def phase_count(self) -> int:

@@ -14,6 +14,7 @@ import collections
 import enum
 import logging
 import threading
+import time
 from collections.abc import Callable
 from dataclasses import dataclass
 
@@ -44,6 +45,7 @@ class Outcome(enum.Enum):
     SOLVED = "solved"
     NOT_CONVERGED = "not-converged"
     RAISED = "raised"
+    OUT_OF_TIME = "out-of-time"  #: not tried: the time budget was spent
 
 
 @dataclass(frozen=True, slots=True)
@@ -70,6 +72,8 @@ class SolverAttempt:
             return f"{self.solver.value} solved in {self.iterations} iterations"
         if self.outcome is Outcome.RAISED:
             return f"{self.solver.value} raised: {self.status}"
+        if self.outcome is Outcome.OUT_OF_TIME:
+            return f"{self.solver.value} not tried: {self.status}"
         return f"{self.solver.value} did not converge ({self.status}, {self.iterations} iterations)"
 
 
@@ -130,6 +134,7 @@ class CompiledNlp:
             "ipopt.constr_viol_tol": 1e-10,
             "ipopt.mu_strategy": "monotone",
             "ipopt.mu_init": 1e-2,
+            "ipopt.max_wall_time": self.shape.time_budget,
         }
         if warm:
             options.update(
@@ -243,13 +248,22 @@ class SolveResult:
         return self.attempts[-1].solver if self.solution is not None else None
 
 
-def solve(compiled: CompiledNlp, guess: np.ndarray, parameters: np.ndarray) -> SolveResult:
-    """Try fatrop, then the warm Ipopt polish of its last iterate, then Ipopt from ``guess``."""
+def solve(
+    compiled: CompiledNlp, guess: np.ndarray, parameters: np.ndarray, *, deadline: float = float("inf")
+) -> SolveResult:
+    """Try fatrop, then the warm Ipopt polish of its last iterate, then Ipopt from ``guess``.
+
+    No solver is started after ``deadline`` (a ``time.perf_counter()`` value);
+    each Ipopt run stops by itself after the shape's time budget.
+    """
     attempts: list[SolverAttempt] = []
     previous = None  # the last solver's finite result, to warm-start the polish
     bounds = compiled.transcription.bounds
     with compiled.lock:
         for which in Solver:
+            if time.perf_counter() > deadline:
+                attempts.append(SolverAttempt(which, Outcome.OUT_OF_TIME, 0, "the time budget is spent"))
+                break
             if which is Solver.IPOPT_POLISH:
                 if previous is None:
                     continue
