@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 import random
 from dataclasses import dataclass
 
@@ -9,7 +10,14 @@ from limits import Limits, VehicleLimits
 from topology import Configuration, Position, YGraph
 from trajgen.scenario import Scenario
 
-__all__ = ["ReferenceSet", "random_configuration", "random_position", "random_scenarios", "reference_sets"]
+__all__ = [
+    "ReferenceSet",
+    "campaign_scenarios",
+    "random_configuration",
+    "random_position",
+    "random_scenarios",
+    "reference_sets",
+]
 
 
 def random_position(rng: random.Random, track: YGraph) -> Position:
@@ -102,3 +110,33 @@ def reference_sets(random_count: int = 50) -> tuple[ReferenceSet, ...]:
         ReferenceSet("c", unequal, same, randoms),
         ReferenceSet("d", unequal, mixed, randoms),
     )
+
+
+def campaign_scenarios(count: int, *, seed: int) -> list[Scenario]:
+    """Seeded random scenarios over the whole plausible range, for robustness campaigns.
+
+    Legs 0.5 to 5000 m (log-uniform, so short and long are both common), each
+    vehicle's limits drawn independently (0.05-5 m/s, 0.05-5 m/s², 0.05-20 m/s³,
+    log-uniform), the separation from 0 up to the shortest leg (a fifth of
+    the scenarios exactly the shortest leg), and a swap for every fourth
+    scenario, random start and goal otherwise.
+    """
+    rng = random.Random(seed)
+
+    def log_uniform(low: float, high: float) -> float:
+        return math.exp(rng.uniform(math.log(low), math.log(high)))
+
+    scenarios = []
+    for k in range(count):
+        track = YGraph({name: log_uniform(0.5, 5000.0) for name in "ABC"})
+        vehicles = tuple(
+            VehicleLimits(log_uniform(0.05, 5.0), log_uniform(0.05, 5.0), log_uniform(0.05, 20.0))
+            for _ in range(2)
+        )
+        shortest = track.shortest_leg
+        separation = shortest if k % 5 == 0 else rng.uniform(0.0, shortest)
+        limits = Limits(vehicles=vehicles, min_separation=separation)
+        start = random_configuration(rng, track, separation)
+        goal = start.swapped() if k % 4 == 0 else random_configuration(rng, track, separation)
+        scenarios.append(Scenario(track, limits, ("agv1", "agv2"), start, goal, f"<campaign {seed}:{k}>"))
+    return scenarios

@@ -121,7 +121,7 @@ class NlpShape:
     fatrop_iterations : int
         Iteration limit of fatrop.
     time_budget : float
-        Wall time Ipopt may take per attempt, seconds.
+        Wall time of the whole solve, seconds (each Ipopt attempt may take half of it).
     """
 
     kinds: tuple[PhaseKind, ...]

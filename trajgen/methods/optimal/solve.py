@@ -134,7 +134,7 @@ class CompiledNlp:
             "ipopt.constr_viol_tol": 1e-10,
             "ipopt.mu_strategy": "monotone",
             "ipopt.mu_init": 1e-2,
-            "ipopt.max_wall_time": self.shape.time_budget,
+            "ipopt.max_wall_time": 0.5 * self.shape.time_budget,  # fatrop and the build take the rest
         }
         if warm:
             options.update(
