@@ -124,3 +124,29 @@ def test_the_api_refuses_a_route_planned_for_a_smaller_separation():
             make_schedule(route, LIMITS, method=method)
     with pytest.raises(InputError, match=r"route must be a topology\.Route, got str"):
         Exact().schedule("route", LIMITS)  # type: ignore[arg-type]
+
+
+@pytest.mark.parametrize("value", [None, 5, "x", 1.5, [], {}, b"x", (1, 2)], ids=repr)
+def test_wrong_types_in_the_api_are_type_or_value_errors(value):
+    from trajgen import CsvOptions, Optimal, Outputs, default_scenario, run, verify
+    from trajgen.plots import render_coordination
+
+    scenario = default_scenario()
+    route = scenario.plan()
+    calls = [
+        lambda: make_schedule(value, LIMITS),
+        lambda: make_schedule(route, value),
+        lambda: make_schedule(route, scenario.limits, method=value if value is not None else 0),
+        lambda: verify(value),
+        lambda: certify(value),
+        lambda: run(value),
+        lambda: run(scenario, outputs=value if value is not None else 0),
+        lambda: Outputs(csv_dir=value) if not isinstance(value, str | None) else Outputs(csv=value),
+        lambda: CsvOptions(delimiter=value),
+        lambda: Optimal(nodes=value if not isinstance(value, int) else -value),
+        lambda: render_coordination(value),
+        lambda: write_profiles(value, ("a", "b"), "unused"),
+    ]
+    for call in calls:
+        with pytest.raises((TypeError, ValueError)):
+            call()

@@ -170,6 +170,8 @@ def run(
         The schedule failed the verifier; nothing written.
     """
     outputs = outputs if outputs is not None else Outputs()
+    if not isinstance(outputs, Outputs):
+        raise InputError(f"outputs must be Outputs, got {type(outputs).__name__}")
     if not isinstance(scenario, Scenario):
         raise InputError(f"run expects a Scenario, got {type(scenario).__name__}")
     chosen = METHODS.create(method)

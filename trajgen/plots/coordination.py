@@ -49,8 +49,11 @@ def render_coordination(verified: Mapping[str, VerifiedSchedule]) -> bytes:
     verified : mapping of method name to VerifiedSchedule
         At least one.
     """
-    if not verified:
-        raise InputError("the coordination plot needs at least one schedule")
+    if not isinstance(verified, Mapping) or not verified:
+        raise InputError(
+            "the coordination plot needs a mapping of method name to VerifiedSchedule, "
+            f"got {type(verified).__name__}"
+        )
     schedules = {name: require_verified(v, "render_coordination").schedule for name, v in verified.items()}
     distances = {
         name: travelled(schedule, plot_period(schedule.duration))[1] for name, schedule in schedules.items()
