@@ -148,9 +148,11 @@ def _toppra_section(kinematics) -> tuple[np.ndarray, np.ndarray]:
 
 def _section_polynomials(section: Section) -> tuple[np.ndarray, np.ndarray]:
     kinematics = section.kinematics
-    if isinstance(kinematics, CubicKinematics):
+    kind = type(kinematics)
+    # exact types only: a subclass could evaluate (and so export) something else than this form
+    if kind is CubicKinematics:
         return _cubic_section(kinematics)
-    if all(hasattr(kinematics, name) for name in ("grid", "speed", "times", "path")):
+    if (kind.__module__, kind.__qualname__) == ("trajgen.methods.toppra", "ToppraKinematics"):
         return _toppra_section(kinematics)
     raise UncheckableKinematicsError(
         f"section kinematics {type(kinematics).__name__} have no polynomial form the verifier knows"

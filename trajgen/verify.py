@@ -263,6 +263,31 @@ def _check_ends(schedule: Schedule, failures: list[str]) -> tuple[float, float, 
     return errors[0], errors[1], start_gap
 
 
+def _check_exported_ends(pieces: Pieces, schedule: Schedule, failures: list[str]) -> None:
+    """What the schedule reports at 0 and at the end (what is exported) is where its pieces start and end."""
+    if not pieces.count:
+        return
+    state = schedule.state([0.0, schedule.duration])
+    track = pieces.track()
+    for vehicle in range(2):
+        ends = (
+            ("start", 0, int(pieces.leg[vehicle, 0]), float(track[vehicle, 0, 0])),
+            (
+                "goal",
+                -1,
+                int(pieces.leg[vehicle, -1]),
+                float(polynomials.evaluate(track[vehicle, -1:], pieces.length[-1:])[0]),
+            ),
+        )
+        for label, index, leg, s in ends:
+            gap = float(track_distance(state.leg[vehicle, index], state.s[vehicle, index], leg, s))
+            if not gap <= _allowance(schedule, vehicle, "position"):
+                failures.append(
+                    f"vehicle {vehicle + 1} is {gap:.3g} m from where its motion puts it at the {label}: "
+                    "the schedule reports a position its motion does not reach"
+                )
+
+
 def _check_tiling(pieces: Pieces, duration: float, failures: list[str]) -> None:
     """The pieces follow one another without gaps from 0 to the duration."""
     if not pieces.count:
@@ -293,8 +318,13 @@ def _verify(schedule: Schedule) -> VerificationReport:
             pieces.count,
         )
     failures: list[str] = []
+    _check_maps(schedule, failures)
+    if failures:  # the pieces are read through the maps: a broken map makes them meaningless
+        return _failed(schedule, failures, pieces.count)
     start_error, goal_error, start_gap = _check_ends(schedule, failures)
+    _check_exported_ends(pieces, schedule, failures)
     _check_tiling(pieces, duration, failures)
+    _check_parked(pieces, schedule, failures)
     ratios = _check_piece_limits(pieces, schedule, failures)
     track = _check_piece_track(pieces, route.graph, failures)
     closest, regions = _check_piece_separation(pieces, track, required, failures)
@@ -330,6 +360,28 @@ def _piece_extrema(c: np.ndarray, h: np.ndarray) -> tuple[np.ndarray, np.ndarray
     return polynomials.extrema(c, h)
 
 
+def _time_resolution(schedule: Schedule) -> float:
+    """The time round-off of the schedule, seconds: breakpoints are floats of its duration's size."""
+    return 8.0 * float(np.spacing(max(schedule.duration, 1.0)))
+
+
+def _allowance(schedule: Schedule, vehicle: int, name: str) -> float:
+    """What a quantity may exceed its limit or jump by, in its units.
+
+    1e-6 of the limit, plus what the next derivative's limit allows within the
+    time round-off (a jerk of 1e6 m/s^3 moves the acceleration 1e-8 m/s^2 in 1e-14 s).
+    """
+    limits = schedule.limits.vehicles[vehicle]
+    eps = _time_resolution(schedule)
+    if name == "position":
+        return TRACK_END_TOLERANCE + limits.max_velocity * eps
+    if name == "velocity":
+        return RELATIVE_TOLERANCE * limits.max_velocity + limits.max_acceleration * eps
+    if name == "acceleration":
+        return RELATIVE_TOLERANCE * limits.max_acceleration + limits.max_jerk * eps
+    return RELATIVE_TOLERANCE * limits.max_jerk
+
+
 def _check_piece_limits(pieces: Pieces, schedule: Schedule, failures: list[str]) -> dict:
     """Largest ``|v|``, ``|a|`` (and ``|j|``) / limit per vehicle over every piece, in closed form."""
     names = [("velocity", "max_velocity", "m/s"), ("acceleration", "max_acceleration", "m/s^2")]
@@ -352,7 +404,7 @@ def _check_piece_limits(pieces: Pieces, schedule: Schedule, failures: list[str])
             ratio = float(peak[k] / limit) if peak.size else 0.0
             previous = ratios.get(name) or (0.0, 0.0)
             ratios[name] = (ratio, previous[1]) if vehicle == 0 else (previous[0], ratio)
-            if ratio > 1.0 + RELATIVE_TOLERANCE:
+            if peak.size and not peak[k] <= limit + _allowance(schedule, vehicle, name):
                 when = pieces.start[k] + (t_high[k] if abs(high[k]) >= abs(low[k]) else t_low[k])
                 failures.append(
                     f"vehicle {vehicle + 1} {name} reaches {peak[k]:.9g} {unit} at t={when:.6f} s "
@@ -436,7 +488,12 @@ def _check_piece_separation(
 def _check_piece_continuity(
     pieces: Pieces, track: np.ndarray, schedule: Schedule, failures: list[str]
 ) -> None:
-    """Position, velocity (and for jerk-limited schedules acceleration) continuous from piece to piece."""
+    """Position, velocity (and for jerk-limited schedules acceleration) continuous from piece to piece.
+
+    Velocity and acceleration are compared along the track (``ds/dt``) where a
+    vehicle stays on one leg, so a reversal hidden in a map change is a jump;
+    through the junction (where ``s`` changes leg) along its own axis.
+    """
     if pieces.count < 2:
         return
     h = pieces.length[:-1]
@@ -444,24 +501,74 @@ def _check_piece_continuity(
         end_s = polynomials.evaluate(track[vehicle, :-1], h)
         start_s = track[vehicle, 1:, 0]
         jump = track_distance(pieces.leg[vehicle, :-1], end_s, pieces.leg[vehicle, 1:], start_s)
-        limits = schedule.limits.vehicles[vehicle]
-        checks = [("position", jump, TRACK_END_TOLERANCE, "m")]
-        velocity = polynomials.derivative(pieces.axis[vehicle])
-        dv = np.abs(polynomials.evaluate(velocity[:-1], h) - velocity[1:, 0])
-        checks.append(("velocity", dv, RELATIVE_TOLERANCE * limits.max_velocity, "m/s"))
-        if schedule.jerk_limited:
-            acceleration = polynomials.derivative(velocity)
-            da = np.abs(polynomials.evaluate(acceleration[:-1], h) - acceleration[1:, 0])
-            checks.append(("acceleration", da, RELATIVE_TOLERANCE * limits.max_acceleration, "m/s^2"))
-        for name, values, tolerance, unit in checks:
+        same_leg = (pieces.leg[vehicle, :-1] == pieces.leg[vehicle, 1:]) & (
+            pieces.leg[vehicle, 1:] != JUNCTION_INDEX
+        )
+        sign_before = np.where(same_leg, pieces.s_sign[vehicle, :-1], 1.0)
+        sign_after = np.where(same_leg, pieces.s_sign[vehicle, 1:], 1.0)
+        checks = [("position", jump)]
+        derivative = pieces.axis[vehicle]
+        names = ["velocity", "acceleration"] if schedule.jerk_limited else ["velocity"]
+        for name in names:
+            derivative = polynomials.derivative(derivative)
+            before = sign_before * polynomials.evaluate(derivative[:-1], h)
+            after = sign_after * derivative[1:, 0]
+            checks.append((name, np.abs(before - after)))
+        for name, values in checks:
+            tolerance = _allowance(schedule, vehicle, name)
+            unit = {"position": "m", "velocity": "m/s", "acceleration": "m/s^2"}[name]
             jumps = np.nonzero(~(values <= tolerance))[0]
             if jumps.size:
                 k = int(jumps[0])
                 failures.append(
                     f"vehicle {vehicle + 1} {name} jumps by {values[k]:.3g} {unit} "
-                    f"at t={pieces.start[k + 1]:.6f} s "
-                    f"(tolerance {tolerance:.3g} {unit})"
+                    f"at t={pieces.start[k + 1]:.6f} s (tolerance {tolerance:.3g} {unit})"
                 )
+
+
+def _check_maps(schedule: Schedule, failures: list[str]) -> None:
+    """Each section's position maps are well formed: known legs, unit slopes, contiguous sub-ranges."""
+    legs = len(schedule.route.graph.lengths)
+    for index, section in enumerate(schedule.sections):
+        for vehicle, axis_map in enumerate(section.maps):
+            where = f"section {index} vehicle {vehicle + 1}"
+            if not np.all(np.isin(axis_map.outward, (-1, 0, 1))):
+                failures.append(f"{where}: map slopes {axis_map.outward.tolist()} are not -1, 0 or +1")
+            if not np.all((axis_map.legs >= JUNCTION_INDEX) & (axis_map.legs < legs)):
+                failures.append(f"{where}: map legs {axis_map.legs.tolist()} are not track legs")
+                continue
+            at_junction = axis_map.legs == JUNCTION_INDEX
+            if np.any(at_junction & ((axis_map.outward != 0) | (axis_map.s_start != 0.0))):
+                failures.append(f"{where}: a map sub-range at the junction moves or lies off it")
+            if np.any(~at_junction & (axis_map.s_start < -TRACK_END_TOLERANCE)):
+                failures.append(f"{where}: a map sub-range starts before the junction (s < 0)")
+            if axis_map.legs.size > 1:
+                s_end = axis_map.s_start + axis_map.outward * (axis_map.axis_end - axis_map.axis_start)
+                scale = max(1.0, float(np.max(np.abs(axis_map.axis_end))))
+                gaps = np.abs(axis_map.axis_end[:-1] - axis_map.axis_start[1:])
+                same = axis_map.legs[:-1] == axis_map.legs[1:]
+                broken = np.where(
+                    same, np.abs(s_end[:-1] - axis_map.s_start[1:]), s_end[:-1] + axis_map.s_start[1:]
+                )
+                if np.any(gaps > 1e-12 * scale) or np.any(broken > TRACK_END_TOLERANCE):
+                    failures.append(f"{where}: map sub-ranges do not join (axis or track gap)")
+
+
+def _check_parked(pieces: Pieces, schedule: Schedule, failures: list[str]) -> None:
+    """A vehicle whose map says it stands still (slope 0) does not move its axis."""
+    for vehicle in range(2):
+        parked = pieces.s_sign[vehicle] == 0.0
+        if not parked.any():
+            continue
+        low, _, high, _ = polynomials.extrema(
+            polynomials.derivative(pieces.axis[vehicle][parked]), pieces.length[parked]
+        )
+        moving = np.maximum(np.abs(low), np.abs(high)) > _allowance(schedule, vehicle, "velocity")
+        if moving.any():
+            k = int(np.nonzero(parked)[0][np.argmax(moving)])
+            failures.append(
+                f"vehicle {vehicle + 1} moves at t={pieces.start[k]:.6f} s where its map says it stands"
+            )
 
 
 def certify(schedule: Schedule) -> VerifiedSchedule:
