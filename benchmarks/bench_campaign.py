@@ -1,4 +1,4 @@
-"""A seeded random campaign over the whole plausible range: verification failures, fallbacks, worst times.
+"""A seeded random campaign over a wide range of scenarios: verification failures, fallbacks, worst times.
 
 Run: ``python benchmarks/bench_campaign.py [--scenarios 300] [--seed 9]``.
 

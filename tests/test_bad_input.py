@@ -65,10 +65,10 @@ def test_a_device_is_not_read_as_a_scenario(tmp_path, capsys):
         pytest.param(["--delimiter", "_"], "delimiter '_' is not usable", id="underscore"),
         pytest.param(["--delimiter", "s"], "delimiter 's' is not usable", id="letter-s"),
         pytest.param(["--delimiter", "e"], "delimiter 'e' is not usable", id="letter-e"),
-        pytest.param(["--sample-period", "1e-6"], "at least 22,500,000 rows", id="period-1e-6"),
+        pytest.param(["--sample-period", "1e-6"], "at least 22,500,001 rows", id="period-1e-6"),
         pytest.param(["--sample-period", "5e-324"], "at least inf rows", id="period-subnormal"),
         pytest.param(["--max-rows", "0"], "max_rows must be an integer >= 1, got 0", id="max-rows-0"),
-        pytest.param(["--max-rows", "3000"], "schedule has 6,750 rows", id="max-rows-after-scheduling"),
+        pytest.param(["--max-rows", "3000"], "schedule has 6,751 rows", id="max-rows-after-scheduling"),
     ],
 )
 def test_bad_csv_options_exit_2_and_write_nothing(tmp_path, capsys, options, match):
@@ -150,3 +150,35 @@ def test_wrong_types_in_the_api_are_type_or_value_errors(value):
     for call in calls:
         with pytest.raises((TypeError, ValueError)):
             call()
+
+
+def test_a_long_leg_name_is_quoted_short(tmp_path, capsys):
+    long_leg = "X" * 5000
+    content = GOOD.replace("A = 10.0,", f"{long_leg} = 10.0,").replace("A = 90.0,", f"{long_leg} = 90.0,")
+    assert main(["schedule", _scenario(tmp_path, content), "--csv", str(tmp_path / "out")]) == EXIT_BAD_INPUT
+    assert len(capsys.readouterr().err) < 400
+
+
+def test_a_folder_name_the_file_system_refuses_exits_2(tmp_path, capsys):
+    folder = tmp_path / ("d" * 300)
+    assert main(["schedule", str(SWAP_FILE), "--method", "exact", "--csv", str(folder)]) == EXIT_BAD_INPUT
+    assert "File name too long" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize(("limit", "code"), [(6750, EXIT_BAD_INPUT), (6751, EXIT_OK)])
+def test_the_row_limit_counts_rows(tmp_path, capsys, limit, code):
+    output = tmp_path / "out"
+    argv = ["schedule", str(SWAP_FILE), "--method", "exact", "--csv", str(output), "--max-rows", str(limit)]
+    assert main(argv) == code
+    if code == EXIT_OK:  # 67.5 s every 10 ms: rows at 0, 0.01, ..., 67.5
+        assert len((output / "agv1.csv").read_text().splitlines()) == 1 + 6751
+
+
+def test_csv_options_of_the_wrong_type_are_an_option_error(tmp_path):
+    from trajgen.errors import OptionError
+
+    verified = certify(
+        Exact().schedule(route_of((10.0, 10.0, 10.0), ("A:10", "B:10"), ("B:10", "A:10")), LIMITS)
+    )
+    with pytest.raises(OptionError, match="CSV options must be CsvOptions, got str"):
+        write_profiles(verified, ("a", "b"), tmp_path, options="x")  # type: ignore[arg-type]

@@ -1,4 +1,4 @@
-"""A seeded random campaign over the whole plausible range: every schedule of every method verifies.
+"""A seeded random campaign over a wide range of scenarios: every schedule of every method verifies.
 
 300 scenarios from :func:`trajgen.sampling.campaign_scenarios` (legs 0.5-5000 m,
 independent limits, separations up to the shortest leg, swaps and random

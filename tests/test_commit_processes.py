@@ -96,3 +96,64 @@ def test_sigkill_while_writing_leaves_nothing_under_the_target_names_and_is_clea
     commit_files({tmp_path / "agv2.csv": b"next run"})
     assert _hidden(tmp_path) == []
     assert (tmp_path / "agv1.csv").read_bytes() == b"old"
+
+
+def _crash_at_the_commit_point(first: str, second: str) -> None:
+    import pathlib
+
+    real = pathlib.Path.unlink
+
+    def unlink(self, *args, **kwargs):
+        if self.name == JOURNAL_NAME and str(self.parent) == second:
+            os._exit(9)  # the primary journal is gone (committed), the other folder's is not yet
+        return real(self, *args, **kwargs)
+
+    pathlib.Path.unlink = unlink
+    commit_files({os.path.join(first, "agv1.csv"): b"new 1", os.path.join(second, "agv2.csv"): b"new 2"})
+
+
+def test_a_crash_after_the_commit_point_keeps_every_new_file(tmp_path):
+    first, second = tmp_path / "a", tmp_path / "b"
+    commit_files({first / "agv1.csv": b"old 1", second / "agv2.csv": b"old 2"})
+    child = FORK.Process(target=_crash_at_the_commit_point, args=(str(first), str(second)))
+    child.start()
+    child.join(timeout=60)
+    assert child.exitcode == 9
+    assert (second / JOURNAL_NAME).exists()
+    recover_folder(second)  # its journal's commit had reached its commit point: finish, do not undo
+    assert (first / "agv1.csv").read_bytes() == b"new 1"
+    assert (second / "agv2.csv").read_bytes() == b"new 2"
+    assert _hidden(second) == []
+
+
+@pytest.mark.parametrize(
+    "journal",
+    [
+        pytest.param("[1]", id="not-an-object"),
+        pytest.param('{"folders": 5, "entries": []}', id="bad-folders"),
+        pytest.param(
+            '{"commit": "x", "primary": "/", "folders": [], "entries": [["../victim", null]]}', id="escape"
+        ),
+        pytest.param("{not json", id="cut-short"),
+    ],
+)
+def test_a_damaged_or_hostile_journal_stops_the_commit_and_touches_nothing(tmp_path, journal):
+    from trajgen.errors import OutputError
+
+    (tmp_path / "victim").write_bytes(b"keep me")
+    folder = tmp_path / "out"
+    folder.mkdir()
+    (folder / JOURNAL_NAME).write_text(journal)
+    (folder / ".agv1.csv.0123.trajgen-bak").write_bytes(b"a backup")
+    with pytest.raises(OutputError, match="restore its folder by hand"):
+        commit_files({folder / "agv1.csv": b"new"})
+    assert (tmp_path / "victim").read_bytes() == b"keep me"
+    assert (folder / ".agv1.csv.0123.trajgen-bak").read_bytes() == b"a backup"
+    assert not (folder / "agv1.csv").exists()
+
+
+def test_recovering_a_missing_folder_is_an_output_error(tmp_path):
+    from trajgen.errors import OutputError
+
+    with pytest.raises(OutputError, match="is not a folder: nothing to recover"):
+        recover_folder(tmp_path / "missing")

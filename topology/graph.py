@@ -14,7 +14,7 @@ from types import MappingProxyType
 from topology.boundary import BoundaryCycle
 from topology.errors import PositionError, TrackError
 from topology.positions import JUNCTION, JUNCTION_NAME, Configuration, Position
-from topology.validation import finite_real
+from topology.validation import finite_real, short_repr
 
 __all__ = ["YGraph"]
 
@@ -25,11 +25,13 @@ def _leg_pairs(legs: object) -> list[tuple[object, object]]:
     if isinstance(legs, Mapping):
         return list(legs.items())
     if isinstance(legs, (str, bytes)) or not isinstance(legs, Iterable):
-        raise TrackError(f"legs must map leg name -> length in metres, got {legs!r} ({type(legs).__name__})")
+        raise TrackError(
+            f"legs must map leg name -> length in metres, got {short_repr(legs)} ({type(legs).__name__})"
+        )
     pairs = []
     for item in legs:
         if not isinstance(item, tuple) or len(item) != 2:
-            raise TrackError(f"legs must be (name, length) pairs, got item {item!r}")
+            raise TrackError(f"legs must be (name, length) pairs, got item {short_repr(item)}")
         pairs.append(item)
     return pairs
 
@@ -75,17 +77,17 @@ class YGraph:
         lengths: list[float] = []
         for name, length in pairs:
             if not isinstance(name, str) or not name.strip():
-                raise TrackError(f"leg name must be a non-empty string, got {name!r}")
+                raise TrackError(f"leg name must be a non-empty string, got {short_repr(name)}")
             if name != name.strip() or name == JUNCTION_NAME or ":" in name:
                 raise TrackError(
-                    f"leg name {name!r} is not allowed: expected no surrounding spaces, "
+                    f"leg name {short_repr(name)} is not allowed: expected no surrounding spaces, "
                     f"no ':' and not {JUNCTION_NAME!r} (the junction)"
                 )
             if name in names:
-                raise TrackError(f"leg names must be distinct, got {name!r} twice")
-            value = finite_real(length, f"length of leg {name!r} (metres)", TrackError)
+                raise TrackError(f"leg names must be distinct, got {short_repr(name)} twice")
+            value = finite_real(length, f"length of leg {short_repr(name)} (metres)", TrackError)
             if value <= 0.0:
-                raise TrackError(f"length of leg {name!r} must be > 0 m, got {value!r}")
+                raise TrackError(f"length of leg {short_repr(name)} must be > 0 m, got {value!r}")
             names.append(name)
             lengths.append(value)
         angles = self._check_angles(names, angles_deg)
@@ -100,7 +102,7 @@ class YGraph:
         if angles_deg is None:
             return _DEFAULT_ANGLES_DEG
         if not isinstance(angles_deg, Mapping):
-            raise TrackError(f"angles_deg must map leg name -> degrees, got {angles_deg!r}")
+            raise TrackError(f"angles_deg must map leg name -> degrees, got {short_repr(angles_deg)}")
         if set(angles_deg) != set(names):
             raise TrackError(
                 f"angles_deg must give exactly the legs {names!r}, got {sorted(map(str, angles_deg))!r}"
@@ -136,7 +138,9 @@ class YGraph:
         try:
             return self._index[leg]
         except (KeyError, TypeError):
-            raise PositionError(f"unknown leg {leg!r}: expected one of {list(self.names)!r}") from None
+            raise PositionError(
+                f"unknown leg {short_repr(leg)}: expected one of {short_repr(list(self.names), 200)}"
+            ) from None
 
     def length(self, leg: str) -> float:
         """Length of a leg, metres."""

@@ -113,7 +113,10 @@ def reference_sets(random_count: int = 50) -> tuple[ReferenceSet, ...]:
 
 
 def campaign_scenarios(count: int, *, seed: int) -> list[Scenario]:
-    """Seeded random scenarios over the whole plausible range, for robustness campaigns.
+    """Seeded random scenarios over a wide range of tracks and vehicles, for robustness campaigns.
+
+    Not the whole :data:`trajgen.scenario.PLAUSIBLE` range (which allows even more
+    extreme ratios); the extremes of that are tested separately.
 
     Legs 0.5 to 5000 m (log-uniform, so short and long are both common), each
     vehicle's limits drawn independently (0.05-5 m/s, 0.05-5 m/s², 0.05-20 m/s³,

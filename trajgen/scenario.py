@@ -111,7 +111,7 @@ def _check_plausible_track(track: YGraph) -> None:
     low, high = PLAUSIBLE["leg length"]
     for name, length in zip(track.names, track.lengths, strict=True):
         if not low <= length <= high:
-            raise InputError(f"leg {name!r} is {length!r} m long: expected {low:g} to {high:g} m")
+            raise InputError(f"leg {short_repr(name)} is {length!r} m long: expected {low:g} to {high:g} m")
 
 
 def _check_plausible_vehicle(vehicle: VehicleLimits, where: str) -> None:
@@ -130,7 +130,7 @@ def _check_keys(table: dict, allowed: dict[str, bool], where: str, source: str) 
         )
     missing = [key for key, required in allowed.items() if required and key not in table]
     if missing:
-        raise ScenarioError(f"{source}: {where} is missing required key(s) {missing!r}")
+        raise ScenarioError(f"{source}: {where} is missing required key(s) {short_repr(missing)}")
 
 
 def _table(value: object, where: str, source: str) -> dict:
@@ -153,11 +153,16 @@ def _parse_track(data: dict, source: str) -> YGraph:
     track_table = _table(data["track"], "[track]", source)
     _check_keys(track_table, _TRACK_KEYS, "[track]", source)
     legs = _table(track_table["legs"], "[track] legs", source)
-    lengths = {name: _number(length, f"[track] legs.{name}", source) for name, length in legs.items()}
+    lengths = {
+        name: _number(length, f"[track] legs.{short_repr(name)}", source) for name, length in legs.items()
+    }
     angles = None
     if "angles_deg" in track_table:
         angle_table = _table(track_table["angles_deg"], "[track] angles_deg", source)
-        angles = {name: _number(a, f"[track] angles_deg.{name}", source) for name, a in angle_table.items()}
+        angles = {
+            name: _number(a, f"[track] angles_deg.{short_repr(name)}", source)
+            for name, a in angle_table.items()
+        }
     try:
         track = YGraph(lengths, angles_deg=angles)
         _check_plausible_track(track)
@@ -253,29 +258,29 @@ def parse_scenario(data: dict, *, source: str = "<scenario>") -> Scenario:
         raise ScenarioError(f"{source}: {error}") from None
 
 
-def _read_scenario_file(path: Path) -> str:
+def _read_scenario_file(path: Path, label: str) -> str:
     """The text of a scenario file: a regular file of at most :data:`MAX_SCENARIO_BYTES`, UTF-8."""
     try:
         info = os.stat(path)
         if not stat.S_ISREG(info.st_mode):
-            raise ScenarioError(f"{path}: is not a regular file: expected a scenario TOML file")
+            raise ScenarioError(f"{label}: is not a regular file: expected a scenario TOML file")
         if info.st_size > MAX_SCENARIO_BYTES:
             raise ScenarioError(
-                f"{path}: is {info.st_size:,} bytes: "
+                f"{label}: is {info.st_size:,} bytes: "
                 f"expected a scenario file of at most {MAX_SCENARIO_BYTES:,} bytes"
             )
         with open(path, "rb") as stream:
             data = stream.read(MAX_SCENARIO_BYTES + 1)
     except OSError as error:
-        raise ScenarioError(f"{path}: cannot read the scenario file: {error.strerror or error}") from None
+        raise ScenarioError(f"{label}: cannot read the scenario file: {error.strerror or error}") from None
     if len(data) > MAX_SCENARIO_BYTES:
-        raise ScenarioError(f"{path}: is longer than {MAX_SCENARIO_BYTES:,} bytes: expected a scenario file")
+        raise ScenarioError(f"{label}: is longer than {MAX_SCENARIO_BYTES:,} bytes: expected a scenario file")
     try:
         return data.decode("utf-8")
     except UnicodeDecodeError as error:
         hint = " (it looks like UTF-16: save it as UTF-8)" if data[:2] in (b"\xff\xfe", b"\xfe\xff") else ""
         raise ScenarioError(
-            f"{path}: is not UTF-8 text: byte {data[error.start]:#04x} at offset {error.start}{hint}"
+            f"{label}: is not UTF-8 text: byte {data[error.start]:#04x} at offset {error.start}{hint}"
         ) from None
 
 
@@ -290,7 +295,8 @@ def load_scenario(path: str | Path) -> Scenario:
     if not isinstance(path, (str, Path)) or str(path) == "":
         raise ScenarioError(f"scenario path must name a file, got {short_repr(path)}")
     path = Path(path)
-    return _parse_text(_read_scenario_file(path), str(path))
+    label = str(path) if len(str(path)) <= 120 else str(path)[:117] + "..."
+    return _parse_text(_read_scenario_file(path, label), label)
 
 
 def _parse_text(text: str, source: str) -> Scenario:

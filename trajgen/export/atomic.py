@@ -48,6 +48,14 @@ def check_output_paths(paths) -> tuple[Path, ...]:
     OutputError
         A target is a folder, a parent is a file, or a path is empty or given twice.
     """
+    try:
+        return _check_output_paths(paths)
+    except OSError as error:  # a name the file system refuses (too long, ...)
+        where = _short(Path(error.filename)) if error.filename else "an output path"
+        raise OutputError(f"cannot use output path {where!r}: {error.strerror or error}") from None
+
+
+def _check_output_paths(paths) -> tuple[Path, ...]:
     checked: list[Path] = []
     seen: set[tuple[str, str]] = set()
     for given in paths:
@@ -145,6 +153,7 @@ def _write_journal(
     """Record, durably, which targets of ``folder`` a commit replaces and where their backups are."""
     record = {
         "commit": key,
+        "primary": folders[0],
         "folders": folders,
         "entries": [[path.name, None if backup is None else backup.name] for path, backup in entries],
     }
@@ -158,14 +167,64 @@ def _write_journal(
     _sync_folder(Path(folder))
 
 
+def _plain(name: object, suffix: str = "") -> bool:
+    return (
+        isinstance(name, str)
+        and name not in ("", ".", "..")
+        and "/" not in name
+        and os.sep not in name
+        and "\0" not in name
+        and name.endswith(suffix)
+    )
+
+
 def _read_journal(folder: str) -> dict | None:
+    """The journal an unfinished commit left in ``folder``, checked; ``None`` if there is none.
+
+    Raises
+    ------
+    OutputError
+        The journal is damaged or names files outside its folder: nothing is touched.
+    """
+    path = Path(folder) / JOURNAL_NAME
     try:
-        with open(Path(folder) / JOURNAL_NAME, encoding="utf-8") as stream:
-            return json.load(stream)
+        with open(path, encoding="utf-8") as stream:
+            record = json.load(stream)
     except FileNotFoundError:
         return None
-    except (OSError, ValueError):  # a journal cut short: its commit never renamed anything
-        return {"folders": [folder], "entries": []}
+    except (OSError, ValueError) as error:
+        raise OutputError(f"{_short(path)!r} is damaged ({error}): restore its folder by hand") from None
+    entries = record.get("entries") if isinstance(record, dict) else None
+    folders = record.get("folders") if isinstance(record, dict) else None
+    valid = (
+        isinstance(entries, list)
+        and isinstance(folders, list)
+        and all(isinstance(f, str) and os.path.isabs(f) for f in folders)
+        and isinstance(record.get("commit"), str)
+        and isinstance(record.get("primary"), str)
+        and all(
+            isinstance(e, list)
+            and len(e) == 2
+            and _plain(e[0])
+            and (e[1] is None or (_plain(e[1], _BAK_SUFFIX) and e[1].startswith(".")))
+            for e in entries
+        )
+    )
+    if not valid:
+        raise OutputError(f"{_short(path)!r} is not a trajgen commit journal: restore its folder by hand")
+    return record
+
+
+def _committed(record: dict) -> bool:
+    """Whether the commit of ``record`` reached its commit point (its primary journal is gone)."""
+    primary = _read_journal(record["primary"]) if os.path.isdir(record["primary"]) else None
+    return primary is None or primary.get("commit") != record["commit"]
+
+
+def _finish(folder: str) -> None:
+    """A commit that reached its commit point: its new files stand; drop the journal (backups go later)."""
+    (Path(folder) / JOURNAL_NAME).unlink(missing_ok=True)
+    _sync_folder(Path(folder))
 
 
 def _undo(folder: str, record: dict) -> None:
@@ -199,13 +258,20 @@ class _FolderLocks:
 
     def __enter__(self) -> _FolderLocks:
         while True:
-            for folder in self.folders:
-                handle = os.open(folder, os.O_RDONLY)
-                self.handles.append(handle)
-                fcntl.flock(handle, fcntl.LOCK_EX)
-            named = {
-                f for folder in self.folders if (record := _read_journal(folder)) for f in record["folders"]
-            }
+            try:
+                for folder in self.folders:
+                    handle = os.open(folder, os.O_RDONLY)
+                    self.handles.append(handle)
+                    fcntl.flock(handle, fcntl.LOCK_EX)
+                named = {
+                    f
+                    for folder in self.folders
+                    if (record := _read_journal(folder))
+                    for f in record["folders"]
+                }
+            except BaseException:
+                self._release()
+                raise
             named = {f for f in named if os.path.isdir(f)}
             if named <= set(self.folders):
                 return self
@@ -221,11 +287,22 @@ class _FolderLocks:
         self._release()
 
     def recover(self) -> None:
-        """Undo every unfinished commit in the locked folders and remove what crashed runs left."""
-        for folder in self.folders:
-            record = _read_journal(folder)
-            if record is not None:
-                _undo(folder, record)
+        """Finish or undo every interrupted commit in the locked folders; remove what crashed runs left.
+
+        A commit whose primary journal is gone had reached its commit point: its
+        other folders keep the new files. Otherwise every folder is put back.
+        """
+        records = {folder: _read_journal(folder) for folder in self.folders}
+        decisions = {
+            folder: _committed(record) and folder != record["primary"]
+            for folder, record in records.items()
+            if record is not None
+        }
+        for folder, finished in decisions.items():
+            if finished:
+                _finish(folder)
+            else:
+                _undo(folder, records[folder])
         for folder in self.folders:
             _remove_leftovers(folder)
 
@@ -236,6 +313,8 @@ def recover_folder(folder: str | Path) -> None:
     Commits do this themselves for every folder they write to; call it to
     tidy a folder that no later run writes to.
     """
+    if not os.path.isdir(folder):
+        raise OutputError(f"{_short(Path(folder))!r} is not a folder: nothing to recover")
     with _FolderLocks([os.path.realpath(folder)]) as locks:
         locks.recover()
 
@@ -255,7 +334,9 @@ def _replace_all(staged: list[tuple[str, Path]]) -> None:
         for (temporary, path), (_, backup) in zip(staged, backups, strict=True):
             os.replace(temporary, path)
             done.append((path, backup))
-        for folder in folders:  # the commit point: from here on the new files stand
+        # the commit point: the primary (first) folder's journal goes first; from then on the new
+        # files stand, and recovery finishes the other folders instead of undoing them
+        for folder in folders:
             (Path(folder) / JOURNAL_NAME).unlink()
     except BaseException:
         for path, previous in reversed(done):
@@ -293,7 +374,12 @@ def commit_files(contents: Mapping[Path | str, bytes | Iterable[bytes]]) -> tupl
     OutputError
         A target cannot be a file (see :func:`check_output_paths`) or cannot be written.
     """
-    paths = check_output_paths(contents)
+    try:
+        paths = check_output_paths(contents)
+    except OSError as error:
+        raise OutputError(
+            f"cannot use output path {_short(Path(error.filename or ''))!r}: {error.strerror}"
+        ) from None
     data = [contents[key] for key in contents]
     created: list[Path] = []
     staged: list[tuple[str, Path]] = []

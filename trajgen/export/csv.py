@@ -7,6 +7,7 @@ Renderers return bytes and take only a :class:`~trajgen.verify.VerifiedSchedule`
 
 from __future__ import annotations
 
+import math
 from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -171,15 +172,22 @@ def check_row_limit(duration: float, options: CsvOptions, *, lower_bound: bool =
     OutputLimitError
         More rows than ``options.max_rows`` (say which option to change).
     """
-    rows = duration / options.sample_period
-    if not rows <= options.max_rows:
+    ratio = duration / options.sample_period
+    rows = math.floor(ratio + 1e-9) + 1 if math.isfinite(ratio) else math.inf
+    if not rows <= options.max_rows:  # the rows at 0, every period, and the goal's (rows of the sample grid)
         what = "at least " if lower_bound else ""
         raise OutputLimitError(
             f"a CSV profile of this {'scenario' if lower_bound else 'schedule'} has {what}{rows:,.0f} rows "
             f"({duration:.6g} s every {options.sample_period:g} s): expected at most max_rows "
             f"{options.max_rows:,} (raise --max-rows, or a longer --sample-period)"
         )
-    return profile_rows(duration, options)
+    rows = profile_rows(duration, options)
+    if rows > options.max_rows:  # the last row at the goal, after the grid
+        raise OutputLimitError(
+            f"a CSV profile of this schedule has {rows:,} rows: "
+            f"expected at most max_rows {options.max_rows:,} (raise --max-rows, or a longer --sample-period)"
+        )
+    return rows
 
 
 def profile_chunks(
@@ -197,7 +205,9 @@ def profile_chunks(
     schedule = require_verified(verified, "profile_chunks").schedule
     if vehicle not in (0, 1):
         raise InputError(f"vehicle must be 0 or 1, got {short_repr(vehicle)}")
-    options = options or CsvOptions()
+    options = CsvOptions() if options is None else options
+    if not isinstance(options, CsvOptions):
+        raise OptionError(f"CSV options must be CsvOptions, got {type(options).__name__}")
     rows = check_row_limit(schedule.duration, options)
 
     def chunks() -> Iterator[bytes]:
