@@ -27,19 +27,22 @@ def test_commit_writes_every_file_and_leaves_no_temporary(tmp_path):
     assert _hidden(tmp_path / "a") == _hidden(tmp_path / "b") == []
 
 
-def test_a_failed_rename_puts_every_earlier_file_back(tmp_path, monkeypatch):
-    (tmp_path / "agv1.csv").write_bytes(b"old 1")
-    (tmp_path / "agv2.csv").write_bytes(b"old 2")
+def _fail_renames_onto(monkeypatch, name: str) -> None:
+    """Make every rename onto a file called ``name`` fail, as a full or read-only disk would."""
     real = os.replace
-    calls = []
 
-    def fail_on_second(source, target):
-        calls.append(target)
-        if str(target).endswith("agv2.csv"):
+    def replace(source, target):
+        if str(target).endswith(name):
             raise PermissionError(13, "Permission denied", str(target))
         return real(source, target)
 
-    monkeypatch.setattr(atomic.os, "replace", fail_on_second)
+    monkeypatch.setattr(atomic.os, "replace", replace)
+
+
+def test_a_failed_rename_puts_every_earlier_file_back(tmp_path, monkeypatch):
+    (tmp_path / "agv1.csv").write_bytes(b"old 1")
+    (tmp_path / "agv2.csv").write_bytes(b"old 2")
+    _fail_renames_onto(monkeypatch, "agv2.csv")
     with pytest.raises(OutputError, match=r"cannot write '.*agv2\.csv': Permission denied"):
         commit_files({tmp_path / "agv1.csv": b"new 1", tmp_path / "agv2.csv": b"new 2"})
     assert (tmp_path / "agv1.csv").read_bytes() == b"old 1"
@@ -179,16 +182,7 @@ def test_one_file_asked_for_twice_under_two_spellings_is_refused(tmp_path, secon
 
 def test_rollback_keeps_a_dangling_link_that_was_there(tmp_path, monkeypatch):
     (tmp_path / "a.csv").symlink_to(tmp_path / "nowhere")
-    real = os.replace
-    calls = []
-
-    def fail_on_second(source, target):
-        calls.append(target)
-        if str(target).endswith("b.csv"):
-            raise PermissionError(13, "Permission denied", str(target))
-        return real(source, target)
-
-    monkeypatch.setattr(atomic.os, "replace", fail_on_second)
+    _fail_renames_onto(monkeypatch, "b.csv")
     with pytest.raises(OutputError):
         commit_files({tmp_path / "a.csv": b"a", tmp_path / "b.csv": b"b"})
     assert (tmp_path / "a.csv").is_symlink()
