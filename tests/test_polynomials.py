@@ -1,0 +1,53 @@
+"""Exact extrema of low-degree polynomials on intervals: the verifier's closed form."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from hypothesis import given
+from hypothesis import strategies as st
+
+from trajgen.polynomials import evaluate, extrema
+
+coefficient = st.floats(-10.0, 10.0, allow_nan=False)
+
+
+@given(st.lists(coefficient, min_size=1, max_size=5), st.floats(0.01, 20.0))
+def test_extrema_bound_a_dense_sampling_and_are_attained(coefficients, length):
+    c = np.array([coefficients])
+    h = np.array([length])
+    low, t_low, high, t_high = extrema(c, h)
+    dense = evaluate(c, np.linspace(0.0, length, 20001)[None, :])[0]
+    # never better than any instant (certified), and attained where it says (exact)
+    assert low[0] <= dense.min() + 1e-9 * max(1.0, abs(dense.min()))
+    assert high[0] >= dense.max() - 1e-9 * max(1.0, abs(dense.max()))
+    assert evaluate(c, t_low)[0] == pytest.approx(low[0], rel=1e-12, abs=1e-12)
+    assert 0.0 <= t_low[0] <= length
+    assert 0.0 <= t_high[0] <= length
+
+
+def test_a_dip_between_two_samples_is_found():
+    # 1e10 (t - 0.5005)^2 - 1 dips to -1 at 0.5005 s, but is +2499 at the samples 0.500 s and 0.501 s
+    c = np.array([[1e10 * 0.5005**2 - 1.0, -2e10 * 0.5005, 1e10, 0.0, 0.0]])
+    samples = evaluate(c, np.linspace(0.0, 1.0, 1001)[None, :])[0]
+    assert samples.min() > 0.0
+    low, t_low, _, _ = extrema(c, np.array([1.0]))
+    assert low[0] == pytest.approx(-1.0, abs=1e-4)
+    assert t_low[0] == pytest.approx(0.5005, abs=1e-12)
+
+
+def test_closed_form_cases():
+    # 1 + t - t^2 on [0, 2]: maximum 1.25 at 0.5, minimum -1 at 2; a constant; a line
+    c = np.array([[1.0, 1.0, -1.0, 0.0, 0.0], [3.0, 0.0, 0.0, 0.0, 0.0], [0.0, -2.0, 0.0, 0.0, 0.0]])
+    low, t_low, high, t_high = extrema(c, np.array([2.0, 5.0, 1.0]))
+    assert high[0] == pytest.approx(1.25)
+    assert t_high[0] == pytest.approx(0.5)
+    assert low[0] == pytest.approx(-1.0)
+    assert (low[1], high[1]) == (3.0, 3.0)
+    assert (low[2], t_low[2], high[2]) == (-2.0, 1.0, 0.0)
+
+
+def test_non_finite_coefficients_give_nan():
+    low, _, high, _ = extrema(np.array([[1.0, np.nan, 0.0]]), np.array([1.0]))
+    assert np.isnan(low[0])
+    assert np.isnan(high[0])
