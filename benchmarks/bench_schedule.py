@@ -65,8 +65,8 @@ def main() -> None:
             )
     print("targets: exact <= 5 ms median, toppra <= 50 ms median per scenario")
     print(
-        "each schedule is verified once: optimal verifies its own result (inside its time), "
-        "so its verify column is the look-up of that report"
+        "each schedule is verified once: optimal and toppra verify their own results (inside their time), "
+        "so their verify column is the look-up of that report"
     )
     print(f"verification failures: {failures}")
     if failures:
