@@ -40,7 +40,8 @@ def _quadratic_roots(c: np.ndarray) -> np.ndarray:
     c = np.pad(c, ((0, 0), (0, max(0, 3 - c.shape[1]))))[:, :3]
     c0, c1, c2 = c[:, 0], c[:, 1], c[:, 2]
     out = np.full((c.shape[0], 2), np.nan)
-    with np.errstate(divide="ignore", invalid="ignore"):
+    # an infinite root lies outside every interval, where it is discarded
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
         linear = c2 == 0.0
         out[:, 0] = np.where(linear & (c1 != 0.0), -c0 / c1, np.nan)
         disc = c1 * c1 - 4.0 * c2 * c0
