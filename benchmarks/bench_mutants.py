@@ -18,25 +18,12 @@ sys.path.insert(0, str(Path(__file__).resolve().parent.parent))  # the tests' he
 
 from limits import Limits, VehicleLimits
 from tests.helpers import LIMITS, route_of, too_close
-from tests.mutants import between_samples, free_window, with_bump
+from tests.mutants import between_samples, free_window, with_bump, with_coefficient
 from tests.sampled_verifier import sampled_verify
 from topology.indexed import track_distance
 from trajgen import Exact, Optimal, Schedule, verify
-from trajgen.profiles import PiecewiseCubic
-from trajgen.schedule import CubicKinematics
 
 SWAP = ((10.0, 10.0, 10.0), ("A:10", "B:10"), ("B:10", "A:10"))
-
-
-def with_coefficient(schedule: Schedule, vehicle: int, column: int, value: float) -> Schedule:
-    """One initial-state coefficient (0 position, 1 velocity, 2 acceleration) of section 0 replaced."""
-    section = schedule.sections[0]
-    profiles = list(section.kinematics.vehicles)
-    initial = np.array(profiles[vehicle].initial)
-    initial[len(initial) // 2, column] = value
-    profiles[vehicle] = PiecewiseCubic(profiles[vehicle].times, initial, profiles[vehicle].jerk)
-    changed = dataclasses.replace(section, kinematics=CubicKinematics(tuple(profiles)))
-    return dataclasses.replace(schedule, sections=(changed, *schedule.sections[1:]))
 
 
 def with_section(schedule: Schedule, index: int, **changes) -> Schedule:

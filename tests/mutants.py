@@ -92,3 +92,14 @@ def free_window(
             if not np.any((local > start) & (local < start + width)):
                 return start
     raise ValueError("no free window")
+
+
+def with_coefficient(schedule: Schedule, vehicle: int, column: int, value: float) -> Schedule:
+    """One initial-state coefficient (0 position, 1 velocity, 2 acceleration) of section 0 replaced."""
+    section = schedule.sections[0]
+    profiles = list(section.kinematics.vehicles)
+    initial = np.array(profiles[vehicle].initial)
+    initial[len(initial) // 2, column] = value
+    profiles[vehicle] = PiecewiseCubic(profiles[vehicle].times, initial, profiles[vehicle].jerk)
+    changed = dataclasses.replace(section, kinematics=CubicKinematics(tuple(profiles)))
+    return dataclasses.replace(schedule, sections=(changed, *schedule.sections[1:]))

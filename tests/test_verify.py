@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 
 from tests.helpers import LIMITS, route_of, too_close
+from tests.mutants import with_coefficient
 from trajgen import Exact, VerifiedSchedule, certify, verify
 from trajgen.errors import InputError, UnverifiedScheduleError, VerificationError
 from trajgen.profiles import PiecewiseCubic
@@ -63,21 +64,10 @@ def test_a_failing_report_cannot_make_a_certificate():
         verify("schedule")  # type: ignore[arg-type]
 
 
-def _with_profile_values(schedule, vehicle: int, column: int, value: float):
-    """``schedule`` with one initial-state coefficient of the first section replaced (a mutant)."""
-    section = schedule.sections[0]
-    profiles = list(section.kinematics.vehicles)
-    initial = np.array(profiles[vehicle].initial)
-    initial[len(initial) // 2, column] = value
-    profiles[vehicle] = PiecewiseCubic(profiles[vehicle].times, initial, profiles[vehicle].jerk)
-    changed = dataclasses.replace(section, kinematics=CubicKinematics(tuple(profiles)))
-    return dataclasses.replace(schedule, sections=(changed, *schedule.sections[1:]))
-
-
 @pytest.mark.parametrize("value", [math.nan, math.inf, -math.inf], ids=["nan", "inf", "-inf"])
 @pytest.mark.parametrize(("column", "name"), [(0, "axis"), (1, "velocity"), (2, "acceleration")])
 def test_non_finite_values_fail_and_are_never_certified(value, column, name):
-    schedule = _with_profile_values(Exact().schedule(route_of(*SWAP), LIMITS), 1, column, value)
+    schedule = with_coefficient(Exact().schedule(route_of(*SWAP), LIMITS), 1, column, value)
     report = verify(schedule)
     assert not report.passed
     assert any("is not finite" in f for f in report.failures), report.failures

@@ -236,10 +236,12 @@ def _failed(schedule: Schedule, failures: list[str], pieces: int = 0) -> Verific
     )
 
 
-def _check_ends(schedule: Schedule, failures: list[str]) -> tuple[float, float, float]:
-    """Start and goal errors (metres), at rest; and the separation at the start, metres."""
+def _check_ends(schedule: Schedule, state, failures: list[str]) -> tuple[float, float, float]:
+    """Start and goal errors (metres), at rest; and the separation at the start, metres.
+
+    ``state`` is the schedule's state at 0 and at its end (what is exported there).
+    """
     route, graph = schedule.route, schedule.route.graph
-    state = schedule.state([0.0, schedule.duration])
     errors = []
     for label, index, expected in (("start", 0, route.start), ("goal", -1, route.goal)):
         error = 0.0
@@ -263,12 +265,12 @@ def _check_ends(schedule: Schedule, failures: list[str]) -> tuple[float, float, 
     return errors[0], errors[1], start_gap
 
 
-def _check_exported_ends(pieces: Pieces, schedule: Schedule, failures: list[str]) -> None:
+def _check_exported_ends(
+    pieces: Pieces, track: np.ndarray, schedule: Schedule, state, failures: list[str]
+) -> None:
     """What the schedule reports at 0 and at the end (what is exported) is where its pieces start and end."""
     if not pieces.count:
         return
-    state = schedule.state([0.0, schedule.duration])
-    track = pieces.track()
     for vehicle in range(2):
         ends = (
             ("start", 0, int(pieces.leg[vehicle, 0]), float(track[vehicle, 0, 0])),
@@ -321,12 +323,14 @@ def _verify(schedule: Schedule) -> VerificationReport:
     _check_maps(schedule, failures)
     if failures:  # the pieces are read through the maps: a broken map makes them meaningless
         return _failed(schedule, failures, pieces.count)
-    start_error, goal_error, start_gap = _check_ends(schedule, failures)
-    _check_exported_ends(pieces, schedule, failures)
+    ends = schedule.state([0.0, duration])
+    track = pieces.track()
+    start_error, goal_error, start_gap = _check_ends(schedule, ends, failures)
+    _check_exported_ends(pieces, track, schedule, ends, failures)
     _check_tiling(pieces, duration, failures)
     _check_parked(pieces, schedule, failures)
     ratios = _check_piece_limits(pieces, schedule, failures)
-    track = _check_piece_track(pieces, route.graph, failures)
+    _check_piece_track(pieces, track, route.graph, failures)
     closest, regions = _check_piece_separation(pieces, track, required, failures)
     closest = min(closest, start_gap)
     if not pieces.count and start_gap < required - POSITION_TOLERANCE:
@@ -354,10 +358,6 @@ def _verify(schedule: Schedule) -> VerificationReport:
         goal_error=goal_error,
         regions_match=sequence == expected,
     )
-
-
-def _piece_extrema(c: np.ndarray, h: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    return polynomials.extrema(c, h)
 
 
 def _time_resolution(schedule: Schedule) -> float:
@@ -397,7 +397,7 @@ def _check_piece_limits(pieces: Pieces, schedule: Schedule, failures: list[str])
         for order, (name, limit_name, unit) in enumerate(names, start=1):
             for _ in range(order):
                 c = polynomials.derivative(c)
-            low, t_low, high, t_high = _piece_extrema(c, pieces.length)
+            low, t_low, high, t_high = polynomials.extrema(c, pieces.length)
             peak = np.maximum(np.abs(low), np.abs(high))
             limit = getattr(schedule.limits.vehicles[vehicle], limit_name)
             k = int(np.argmax(peak)) if peak.size else 0
@@ -414,12 +414,11 @@ def _check_piece_limits(pieces: Pieces, schedule: Schedule, failures: list[str])
     return ratios
 
 
-def _check_piece_track(pieces: Pieces, graph, failures: list[str]) -> np.ndarray:
-    """Each vehicle stays within its leg and its map's range; returns s polynomials, shape (2, n, d + 1)."""
-    track = pieces.track()
+def _check_piece_track(pieces: Pieces, track: np.ndarray, graph, failures: list[str]) -> None:
+    """Each vehicle stays on its leg and in its map's range; ``track``: s polynomials, shape (2, n, 5)."""
     lengths = np.array(graph.lengths)
     for vehicle in range(2):
-        low, t_low, high, t_high = _piece_extrema(track[vehicle], pieces.length)
+        low, t_low, high, t_high = polynomials.extrema(track[vehicle], pieces.length)
         on_leg = pieces.leg[vehicle] != JUNCTION_INDEX
         length = np.where(on_leg, lengths[np.where(on_leg, pieces.leg[vehicle], 0)], 0.0)
         over = np.nonzero(on_leg & (high > length + TRACK_END_TOLERANCE))[0]
@@ -436,7 +435,7 @@ def _check_piece_track(pieces: Pieces, graph, failures: list[str]) -> np.ndarray
                 f"vehicle {vehicle + 1} passes the junction inside a piece (s = {low[k]:.3g} m) "
                 f"at t={pieces.start[k] + t_low[k]:.6f} s: its position map does not cover it"
             )
-        axis_low, _, axis_high, _ = _piece_extrema(pieces.axis[vehicle], pieces.length)
+        axis_low, _, axis_high, _ = polynomials.extrema(pieces.axis[vehicle], pieces.length)
         outside = np.nonzero(
             (axis_low < pieces.axis_low[vehicle] - TRACK_END_TOLERANCE)
             | (axis_high > pieces.axis_high[vehicle] + TRACK_END_TOLERANCE)
@@ -448,7 +447,6 @@ def _check_piece_track(pieces: Pieces, graph, failures: list[str]) -> np.ndarray
                 f"(axis {axis_low[k]:.6g} to {axis_high[k]:.6g} m, map {pieces.axis_low[vehicle, k]:.6g} to "
                 f"{pieces.axis_high[vehicle, k]:.6g} m)"
             )
-    return track
 
 
 def _check_piece_separation(
@@ -457,7 +455,7 @@ def _check_piece_separation(
     """Smallest track distance over every piece and each piece's region."""
     same = (pieces.leg[0] == pieces.leg[1]) & (pieces.leg[0] != JUNCTION_INDEX)
     gap = np.where(same[:, None], track[0] - track[1], track[0] + track[1])
-    low, t_low, high, t_high = _piece_extrema(gap, pieces.length)
+    low, t_low, high, t_high = polynomials.extrema(gap, pieces.length)
     crossing = same & (low < 0.0) & (high > 0.0)
     closest = np.where(same, np.where(high <= 0.0, -high, low), low)
     closest = np.where(crossing, 0.0, closest)
