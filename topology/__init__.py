@@ -38,7 +38,7 @@ from topology.graph import YGraph
 from topology.indexed import JUNCTION_INDEX, RegionKey, reduce_regions
 from topology.options import Option
 from topology.positions import JUNCTION, JUNCTION_NAME, Configuration, Position
-from topology.route import Instruction, Region, Route, plan, region_sequence
+from topology.route import Homotopy, Instruction, Region, Route, WayRound, plan, region_sequence
 
 __all__ = [
     "ANTIPODAL_TOLERANCE",
@@ -48,6 +48,7 @@ __all__ = [
     "BoundaryCycle",
     "Cell",
     "Configuration",
+    "Homotopy",
     "InputError",
     "Instruction",
     "Option",
@@ -60,6 +61,7 @@ __all__ = [
     "SeparationError",
     "TrackError",
     "TrajgenError",
+    "WayRound",
     "YGraph",
     "as_indexed",
     "boundary_angle",

@@ -30,7 +30,7 @@ from topology.options import Option
 from topology.positions import Configuration
 from topology.validation import finite_real
 
-__all__ = ["Instruction", "Region", "Route", "plan", "region_sequence"]
+__all__ = ["Homotopy", "Instruction", "Region", "Route", "WayRound", "plan", "region_sequence"]
 
 
 class Instruction(Option):
@@ -38,6 +38,21 @@ class Instruction(Option):
 
     SHORTEST = "shortest"  #: paper Instruction 2: the shorter way round the boundary
     COUNTERCLOCKWISE = "counterclockwise"  #: paper Instruction 1: half a turn, for swaps
+
+
+class Homotopy(Option):
+    """Which of the two shortest homotopy classes :func:`plan` takes."""
+
+    PAPER = "paper"  #: the class of the paper's instruction (ALGORITHM.md section 5)
+    OTHER = "other"  #: the other way round the boundary circle
+
+
+class WayRound(Option):
+    """The direction a route goes round the boundary circle (its homotopy class)."""
+
+    COUNTERCLOCKWISE = "counterclockwise"
+    CLOCKWISE = "clockwise"
+    NONE = "none"  #: start and goal retract to the same boundary point
 
 
 @dataclass(frozen=True, slots=True)
@@ -128,6 +143,9 @@ class Route:
         The waypoints in the indexed form ``(leg1, s1, leg2, s2)``, shape (n,).
     cumulative_travel : tuple of float
         Travel ``|ds1| + |ds2|`` from the start to each waypoint, metres, shape (n,).
+    homotopy : Homotopy
+        ``PAPER`` if the route takes the class of the paper's instruction, ``OTHER`` if it goes the
+        other way round the boundary circle (``plan(..., homotopy=Homotopy.OTHER)``).
     """
 
     graph: YGraph
@@ -137,6 +155,7 @@ class Route:
     arc_length: float
     indexed_waypoints: tuple[IndexedConfiguration, ...] = field(repr=False)
     cumulative_travel: tuple[float, ...] = field(repr=False)
+    homotopy: Homotopy = Homotopy.PAPER
 
     def __post_init__(self) -> None:
         count = len(self.waypoints)
@@ -146,6 +165,15 @@ class Route:
                 f"{count}, {len(self.indexed_waypoints)} and {len(self.cumulative_travel)}: "
                 "build routes with plan()"
             )
+
+    @property
+    def way_round(self) -> WayRound:
+        """The direction the route goes round the boundary circle (from the sign of ``arc_length``)."""
+        if self.arc_length > 0.0:
+            return WayRound.COUNTERCLOCKWISE
+        if self.arc_length < 0.0:
+            return WayRound.CLOCKWISE
+        return WayRound.NONE
 
     @property
     def start(self) -> Configuration:
@@ -243,7 +271,14 @@ def _between(s_a: float, s_b: float, fraction: float) -> float:
     return min(max(s, min(s_a, s_b)), max(s_a, s_b))
 
 
-def plan(graph: YGraph, start: Configuration, goal: Configuration, *, min_separation: float = 0.0) -> Route:
+def plan(
+    graph: YGraph,
+    start: Configuration,
+    goal: Configuration,
+    *,
+    min_separation: float = 0.0,
+    homotopy: Homotopy | str = Homotopy.PAPER,
+) -> Route:
     """Plan a collision-free route from ``start`` to ``goal`` (ALGORITHM.md section 5).
 
     Parameters
@@ -262,11 +297,19 @@ def plan(graph: YGraph, start: Configuration, goal: Configuration, *, min_separa
     Route
         The route; the track distance along it never drops below
         ``min(dist(start), dist(goal), shortest leg) >= min_separation``.
+    homotopy : Homotopy or str, optional
+        ``"paper"`` (default): the class the paper's instruction takes.
+        ``"other"``: the same retractions, but the other way round the
+        boundary circle (the second of the two shortest classes).
+        ``Route.instruction`` names the paper's instruction either way.
 
     Raises
     ------
     PositionError
         A position is not on the track.
+    OptionError
+        An unknown ``homotopy``, or ``"other"`` where start and goal retract to
+        the same boundary point (the other way would be a full turn).
     SeparationError
         ``min_separation`` out of range, or the vehicles closer than it at
         the start or at the goal.
@@ -274,6 +317,7 @@ def plan(graph: YGraph, start: Configuration, goal: Configuration, *, min_separa
     if not isinstance(graph, YGraph):
         raise TypeError(f"graph must be a YGraph, got {graph!r} ({type(graph).__name__})")
     required = _check_min_separation(graph, min_separation)
+    homotopy = Homotopy.lookup(homotopy)
     a = as_indexed(graph, start)
     b = as_indexed(graph, goal)
     for name, config, c in (("start", start, a), ("goal", goal, b)):
@@ -295,6 +339,13 @@ def plan(graph: YGraph, start: Configuration, goal: Configuration, *, min_separa
         instruction, counterclockwise = Instruction.COUNTERCLOCKWISE, True
     else:
         instruction, counterclockwise = Instruction.SHORTEST, delta < half
+    if homotopy is Homotopy.OTHER:
+        if delta == 0.0:
+            raise OptionError(
+                f"homotopy 'other' from {start} to {goal}: both retract to the same boundary point, so "
+                "the other way round is a full turn; expected a query whose retractions differ"
+            )
+        counterclockwise = not counterclockwise
     arc_length = delta if counterclockwise else -(perimeter - delta)
     candidates = to_boundary + cycle.arc(origin, target, counterclockwise) + from_boundary[::-1]
 
@@ -318,6 +369,7 @@ def plan(graph: YGraph, start: Configuration, goal: Configuration, *, min_separa
         arc_length=arc_length,
         indexed_waypoints=tuple(kept),
         cumulative_travel=tuple(cumulative),
+        homotopy=homotopy,
     )
 
 

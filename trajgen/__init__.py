@@ -19,7 +19,7 @@ from topology import Configuration, Instruction, Position, Route, YGraph, plan
 from trajgen.analysis import lower_bound
 from trajgen.errors import InputError, TrajgenError, VerificationError
 from trajgen.export import CsvOptions, Units, write_profiles
-from trajgen.methods import METHODS, Exact, Optimal, SolverCache, Toppra, make_schedule
+from trajgen.methods import METHODS, Exact, HomotopyChoice, Optimal, SolverCache, Toppra, make_schedule
 from trajgen.pipeline import Outputs, RunResult, run
 from trajgen.scenario import Scenario, default_scenario, load_scenario, parse_scenario
 from trajgen.schedule import FallbackReason, Schedule, TimingMethod
@@ -31,6 +31,7 @@ __all__ = [
     "CsvOptions",
     "Exact",
     "FallbackReason",
+    "HomotopyChoice",
     "InputError",
     "Instruction",
     "Limits",

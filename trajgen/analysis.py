@@ -2,15 +2,17 @@
 
 from __future__ import annotations
 
+import itertools
+
 import numpy as np
 
 from limits import Limits
 from topology import Route
-from topology.indexed import track_distance
+from topology.indexed import JUNCTION_INDEX, track_distance
 from trajgen.profiles import rest_to_rest_time
 from trajgen.schedule import Schedule
 
-__all__ = ["lower_bound", "travelled"]
+__all__ = ["class_lower_bound", "class_travel", "lower_bound", "travelled"]
 
 
 def lower_bound(route: Route, limits: Limits) -> float:
@@ -32,6 +34,63 @@ def lower_bound(route: Route, limits: Limits) -> float:
             )
         )
     return max(times)
+
+
+def class_travel(route: Route, min_separation: float) -> tuple[float, float]:
+    """Least distance each vehicle drives on any motion in the route's homotopy class, metres.
+
+    Every motion in the class passes the route's reduced region sequence in
+    order (ALGORITHM.md section 6). Between two consecutive regions one vehicle
+    crosses the junction while the other stays on its leg at least
+    ``min_separation`` from it. Per vehicle, these checkpoints in order (at the
+    junction; at least ``min_separation`` out on a leg), from its start to its
+    goal, are met with least travel by moving, at each, only as far as it
+    demands (on a half-line, projecting onto each successive interval is
+    shortest).
+
+    Parameters
+    ----------
+    route : Route
+    min_separation : float
+        Metres, >= 0.
+    """
+    keys = route.region_keys
+    first, last = route.indexed_waypoints[0], route.indexed_waypoints[-1]
+    out = []
+    for vehicle in range(2):
+        leg, s = first[2 * vehicle], first[2 * vehicle + 1]
+        travel = 0.0
+        for key, following in itertools.pairwise(keys):
+            here = (key.first_leg, key.second_leg)[vehicle]
+            there = (following.first_leg, following.second_leg)[vehicle]
+            if leg == JUNCTION_INDEX:
+                leg = here
+            if here != there:  # this vehicle crosses the junction onto its next leg
+                travel += s
+                leg, s = there, 0.0
+            elif s < min_separation:  # the other crosses: keep clear of the junction
+                travel += min_separation - s
+                s = min_separation
+        travel += float(track_distance(leg, s, last[2 * vehicle], last[2 * vehicle + 1]))
+        out.append(travel)
+    return out[0], out[1]
+
+
+def class_lower_bound(route: Route, limits: Limits) -> float:
+    """A lower bound on the makespan of every motion in the route's homotopy class, seconds.
+
+    The larger of :func:`lower_bound` and, per vehicle, the least time to drive
+    its :func:`class_travel` from rest to rest under its velocity and
+    acceleration limits (valid whatever the reversals: the speed ``|v|`` rises
+    and falls at most at ``max_acceleration``). Used to skip a class that
+    cannot beat a schedule already in hand.
+    """
+    travel = class_travel(route, max(route.min_separation, limits.min_separation))
+    bounds = [
+        rest_to_rest_time(distance, vehicle.max_velocity, vehicle.max_acceleration)
+        for distance, vehicle in zip(travel, limits.vehicles, strict=True)
+    ]
+    return max(lower_bound(route, limits), *bounds)
 
 
 def travelled(schedule: Schedule, period: float = 0.01):

@@ -7,16 +7,18 @@ written), 1 on an internal failure (nothing written).
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import json
 import logging
 import sys
 from collections.abc import Sequence
 
-from trajgen.errors import InputError
+from trajgen.errors import InputError, OptionError
 from trajgen.export import DEFAULT_MAX_ROWS, CsvOptions, Units
-from trajgen.methods import METHODS
+from trajgen.methods import METHODS, HomotopyChoice, Optimal
 from trajgen.pipeline import Outputs, run
 from trajgen.scenario import Scenario, default_scenario, load_scenario
+from trajgen.schedule import TimingMethod
 from trajgen.summary import format_route, format_run, route_summary
 
 __all__ = ["EXIT_BAD_INPUT", "EXIT_FAILURE", "EXIT_OK", "build_parser", "main"]
@@ -59,14 +61,14 @@ def _csv_options(args: argparse.Namespace) -> CsvOptions:
 def _command_schedule(args: argparse.Namespace) -> int:
     scenario = _load(args.scenario)
     outputs = Outputs(csv_dir=args.csv, plot_dir=args.plot, csv=_csv_options(args))
-    summary = run(scenario, method=args.method, outputs=outputs).summary()
+    summary = run(scenario, method=_method(args), outputs=outputs).summary()
     print(json.dumps(summary, indent=2) if args.json else format_run(summary))
     return EXIT_OK
 
 
 def _command_demo(args: argparse.Namespace) -> int:
     scenario = default_scenario()
-    result = run(scenario, method=args.method, outputs=Outputs(csv_dir=args.output, plot_dir=args.output))
+    result = run(scenario, method=_method(args), outputs=Outputs(csv_dir=args.output, plot_dir=args.output))
     print(f"Demo: the built-in scenario {scenario.source} (two AGVs swap ends of legs A and B).")
     print(format_route(result.route))
     print(format_run(result.summary()))
@@ -81,6 +83,27 @@ def _add_method(parser: argparse.ArgumentParser) -> None:
         metavar="|".join(METHODS.names),
         help=f"timing method, one of:\n{METHODS.help()}",
     )
+    parser.add_argument(
+        "--homotopy",
+        metavar="|".join(c.value for c in HomotopyChoice),
+        help="optimal only: 'fastest' (default) solves both ways round the configuration circle and\n"
+        "keeps the faster; 'paper' keeps the class of the paper's instruction",
+    )
+
+
+def _method(args: argparse.Namespace) -> TimingMethod:
+    """The method object of ``--method`` with ``--homotopy`` applied."""
+    method = METHODS.create(args.method)
+    if args.homotopy is None:
+        return method
+    choice = HomotopyChoice.lookup(args.homotopy)
+    if not isinstance(method, Optimal):
+        raise OptionError(
+            f"--homotopy {args.homotopy!r} applies to the method 'optimal' only, "
+            f"got --method {method.name!r} "
+            "(exact and toppra always take the paper's class)"
+        )
+    return dataclasses.replace(method, homotopy=choice)
 
 
 def _add_csv_options(parser: argparse.ArgumentParser) -> None:

@@ -192,4 +192,5 @@ def run(
         files[separation] = render_separation(verified)
         files[coordination] = render_coordination(compared)
     written = commit_files(files) if files else ()
-    return RunResult(scenario, chosen, route, verified, written, tuple(notes))
+    # the schedule's route: optimal may have taken the other homotopy class
+    return RunResult(scenario, chosen, verified.schedule.route, verified, written, tuple(notes))

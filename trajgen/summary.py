@@ -2,9 +2,15 @@
 
 from __future__ import annotations
 
-from topology import Route
+from topology import Homotopy, Route
 
-__all__ = ["format_route", "format_run", "route_summary"]
+__all__ = ["class_label", "format_route", "format_run", "route_summary"]
+
+
+def class_label(route: Route) -> str:
+    """The route's homotopy class for people: its way round and whether it is the paper's."""
+    whose = "the paper's instruction" if route.homotopy is Homotopy.PAPER else "not the paper's: faster"
+    return f"{route.way_round.value} ({whose})"
 
 
 def route_summary(route: Route) -> dict:
@@ -13,6 +19,10 @@ def route_summary(route: Route) -> dict:
         "instruction": route.instruction.value,
         "waypoints": [[{"leg": p.leg, "s_m": p.s} for p in (w.first, w.second)] for w in route.waypoints],
         "regions": [str(r) for r in route.regions],
+        "homotopy": route.homotopy.value,
+        "paper_class": route.homotopy is Homotopy.PAPER,
+        "way_round": route.way_round.value,
+        "arc_length_m": route.arc_length,
         "travel_m": list(route.travel),
         "min_separation_m": route.min_separation,
     }
@@ -22,7 +32,8 @@ def format_route(route: Route) -> str:
     """Human-readable multi-line description of a route."""
     lines = [
         f"instruction: {route.instruction.value}",
-        f"homotopy class (regions): {' '.join(str(r) for r in route.regions) or '(one ray)'}",
+        f"homotopy class: {class_label(route)}, regions "
+        f"{' '.join(str(r) for r in route.regions) or '(one ray)'}",
         f"travel: vehicle 1 {route.travel[0]:g} m, vehicle 2 {route.travel[1]:g} m",
         "waypoints (vehicle 1, vehicle 2):",
     ]

@@ -16,14 +16,16 @@ from __future__ import annotations
 from limits import Limits
 from topology import Route
 from trajgen.methods.exact import Exact
-from trajgen.methods.optimal import Optimal, OptimalInfo, SolverCache
+from trajgen.methods.optimal import ClassComparison, HomotopyChoice, Optimal, OptimalInfo, SolverCache
 from trajgen.methods.registry import MethodRegistry
 from trajgen.methods.toppra import Toppra
 from trajgen.schedule import Schedule, TimingMethod
 
 __all__ = [
     "METHODS",
+    "ClassComparison",
     "Exact",
+    "HomotopyChoice",
     "MethodRegistry",
     "Optimal",
     "OptimalInfo",

@@ -5,6 +5,7 @@ from __future__ import annotations
 from topology.indexed import track_distance
 from trajgen.plots.figure import new_figure, png_bytes
 from trajgen.plots.speed import plot_period
+from trajgen.summary import class_label
 from trajgen.verify import VerifiedSchedule, require_verified
 
 __all__ = ["render_separation"]
@@ -24,7 +25,10 @@ def render_separation(verified: VerifiedSchedule) -> bytes:
     axis.set_xlabel("t [s]")
     axis.set_ylabel("separation [m]")
     axis.set_ylim(bottom=0)
-    axis.set_title(f"{schedule.method.name} schedule: separation along the track")
+    axis.set_title(
+        f"{schedule.method.name} schedule: separation along the track\nclass {class_label(schedule.route)}",
+        fontsize=10,
+    )
     axis.legend(loc="upper right")
     axis.grid(True, alpha=0.3)
     figure.tight_layout()

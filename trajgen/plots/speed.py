@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from trajgen.plots.figure import new_figure, png_bytes
+from trajgen.summary import class_label
 from trajgen.verify import VerifiedSchedule, require_verified
 
 __all__ = ["MAX_PLOT_POINTS", "PLOT_PERIOD", "VEHICLE_COLOURS", "plot_period", "render_speed"]
@@ -53,7 +54,11 @@ def render_speed(verified: VerifiedSchedule, *, names: tuple[str, str] = ("vehic
     if not schedule.jerk_limited:
         axes[2].set_title("jerk not limited by this method (steps in a)", fontsize=9)
     axes[0].legend(loc="upper right")
-    axes[0].set_title(f"{schedule.method.name} schedule, {schedule.duration:.2f} s (dashed: limits)")
+    axes[0].set_title(
+        f"{schedule.method.name} schedule, {schedule.duration:.2f} s, class {class_label(schedule.route)}"
+        "\n(dashed: limits)",
+        fontsize=10,
+    )
     axes[-1].set_xlabel("t [s]")
     figure.tight_layout()
     return png_bytes(figure)

@@ -15,11 +15,20 @@ Modules: :mod:`~.phases` (phases from the route, the stage layout),
 schedule), :mod:`~.method` (the :class:`Optimal` method object).
 """
 
-from trajgen.methods.optimal.method import DEFAULT_NODES, Optimal, OptimalInfo, Source
+from trajgen.methods.optimal.method import (
+    DEFAULT_NODES,
+    ClassComparison,
+    HomotopyChoice,
+    Optimal,
+    OptimalInfo,
+    Source,
+)
 from trajgen.methods.optimal.solve import Outcome, Solver, SolverAttempt, SolverCache
 
 __all__ = [
     "DEFAULT_NODES",
+    "ClassComparison",
+    "HomotopyChoice",
     "Optimal",
     "OptimalInfo",
     "Outcome",

@@ -34,8 +34,12 @@ class PhaseSolution:
     controls: np.ndarray
 
 
-def unpack(solution: np.ndarray, phases: tuple[Phase, ...], shape: NlpShape) -> list[PhaseSolution]:
+def unpack(
+    solution: np.ndarray, phases: tuple[Phase, ...], shape: NlpShape, fractions: np.ndarray
+) -> list[PhaseSolution]:
     """Breakpoint times, node states and controls of each phase, from the stage layout.
+
+    ``fractions`` (phase_count, intervals) is the grid the solution was solved on.
 
     The last node of a phase is the junction crossing, rebuilt from the next
     phase's first node by undoing the sign change of the vehicle that changed leg.
@@ -54,7 +58,7 @@ def unpack(solution: np.ndarray, phases: tuple[Phase, ...], shape: NlpShape) -> 
             )
             states[0] = x[:6]
         k = stage.interval
-        times[k + 1] = times[k] + x[STATE_SIZE - 1] * stage.fraction
+        times[k + 1] = times[k] + x[STATE_SIZE - 1] * fractions[stage.phase, k]
         controls[k] = solution[cursor : cursor + 2]
         cursor += stage.control_size
         x = solution[cursor : cursor + STATE_SIZE]

@@ -5,10 +5,10 @@ from __future__ import annotations
 import numpy as np
 
 from trajgen.errors import SolverError
-from trajgen.methods.optimal.phases import STATE_SIZE, NlpShape, Phase, grid_fractions, stages
+from trajgen.methods.optimal.phases import STATE_SIZE, NlpShape, Phase, stages
 from trajgen.schedule import Schedule
 
-__all__ = ["initial_guess", "phase_windows"]
+__all__ = ["assemble", "initial_guess", "phase_windows"]
 
 #: Shortest phase window of the guess, seconds.
 _MIN_PHASE = 1e-3
@@ -27,12 +27,16 @@ def phase_windows(
     return [(float(edges[p]), float(max(edges[p + 1], edges[p] + _MIN_PHASE))) for p in range(len(phases))]
 
 
-def _phase_states(exact: Schedule, phase: Phase, window: tuple[float, float], shape: NlpShape) -> np.ndarray:
-    """Node states of one phase sampled from the exact schedule, shape (intervals + 1, 7), leg coordinates."""
+def _phase_states(
+    exact: Schedule, phase: Phase, window: tuple[float, float], shape: NlpShape, fractions: np.ndarray
+) -> np.ndarray:
+    """Node states of one phase sampled from the exact schedule, shape (intervals + 1, 7), leg coordinates.
+
+    ``fractions`` (intervals,) is the phase's grid; each segment gets an equal share of the window.
+    """
     begin, end = window
     intervals = shape.intervals
-    fractions = np.tile(grid_fractions(shape.nodes), shape.segments) / shape.segments
-    times = begin + (end - begin) * np.concatenate([[0.0], np.cumsum(fractions)])
+    times = begin + (end - begin) * np.concatenate([[0.0], np.cumsum(fractions / shape.segments)])
     state = exact.state(times)
     columns = []
     for vehicle in range(2):
@@ -46,9 +50,16 @@ def _phase_states(exact: Schedule, phase: Phase, window: tuple[float, float], sh
 
 
 def initial_guess(
-    exact: Schedule, waypoint_times: np.ndarray, phases: tuple[Phase, ...], shape: NlpShape, size: int
+    exact: Schedule,
+    waypoint_times: np.ndarray,
+    phases: tuple[Phase, ...],
+    shape: NlpShape,
+    size: int,
+    fractions: np.ndarray,
 ) -> np.ndarray:
     """Stage-ordered initial guess from the exact schedule, shape (size,).
+
+    ``fractions`` (phase_count, intervals) is the grid the NLP is solved on.
 
     Raises
     ------
@@ -57,8 +68,23 @@ def initial_guess(
     """
     windows = phase_windows(phases, waypoint_times, exact.duration)
     states = [
-        _phase_states(exact, phase, window, shape) for phase, window in zip(phases, windows, strict=True)
+        _phase_states(exact, phase, window, shape, fractions[p])
+        for p, (phase, window) in enumerate(zip(phases, windows, strict=True))
     ]
+    return assemble(states, shape, size)
+
+
+def assemble(states: list[np.ndarray], shape: NlpShape, size: int) -> np.ndarray:
+    """The stage-ordered variable vector from per-phase node states, shape (size,).
+
+    ``states[p]`` (intervals + 1, 7) are phase ``p``'s nodes in leg coordinates
+    with the segment duration last; controls start at 0.
+
+    Raises
+    ------
+    SolverError
+        The vector does not fit the NLP's layout (a bug: the caller falls back to ``exact``).
+    """
     guess = list(states[0][0])
     for stage in stages(shape):
         node = states[stage.phase + 1][0] if stage.phase_end else states[stage.phase][stage.interval + 1]

@@ -25,6 +25,7 @@ __all__ = [
     "Phase",
     "PhaseKind",
     "Stage",
+    "default_fractions",
     "grid_fractions",
     "route_phases",
     "stages",
@@ -122,6 +123,8 @@ class NlpShape:
         Iteration limit of fatrop.
     time_budget : float
         Wall time of the whole solve, seconds (each Ipopt attempt may take half of it).
+    slot : int
+        Which compiled copy: concurrent solves of one shape (two classes) use two copies.
     """
 
     kinds: tuple[PhaseKind, ...]
@@ -130,6 +133,7 @@ class NlpShape:
     max_iterations: int
     fatrop_iterations: int
     time_budget: float = 2.0
+    slot: int = 0
 
     @classmethod
     def of(
@@ -165,8 +169,6 @@ class Stage:
     ----------
     phase, interval : int
         Phase index and interval index within the phase.
-    fraction : float
-        The interval's share of its segment's duration.
     first, last : bool
         The first interval of the problem (from rest at the start) or the last (to rest at the goal).
     new_segment : bool
@@ -177,7 +179,6 @@ class Stage:
 
     phase: int
     interval: int
-    fraction: float
     first: bool
     last: bool
     new_segment: bool
@@ -201,9 +202,13 @@ def grid_fractions(nodes: int) -> np.ndarray:
     return np.diff(grid)
 
 
+def default_fractions(shape: NlpShape) -> np.ndarray:
+    """The starting grid: :func:`grid_fractions` in every segment, shape (phase_count, intervals)."""
+    return np.tile(grid_fractions(shape.nodes), (shape.phase_count, shape.segments))
+
+
 def stages(shape: NlpShape) -> Iterator[Stage]:
     """The stages in variable order: ``x_0, u_0, x_1, u_1, ...`` phase by phase."""
-    fractions = grid_fractions(shape.nodes)
     count, intervals = shape.phase_count, shape.intervals
     for p in range(count):
         for k in range(intervals):
@@ -211,7 +216,6 @@ def stages(shape: NlpShape) -> Iterator[Stage]:
             yield Stage(
                 phase=p,
                 interval=k,
-                fraction=float(fractions[k % shape.nodes]),
                 first=p == 0 and k == 0,
                 last=last,
                 new_segment=(k + 1) % shape.nodes == 0 and not last,

@@ -41,10 +41,14 @@ class ParameterLayout:
     Parameters, in order: per phase the two vehicles' leg lengths (metres,
     0 for a vehicle parked at the junction), then ``max_velocity``,
     ``max_acceleration``, ``max_jerk`` (2 each), ``separation`` (1),
-    ``start`` and ``goal`` (each vehicle's ``s``, 2 each).
+    ``start`` and ``goal`` (each vehicle's ``s``, 2 each), and the grid:
+    per phase and interval its share of its segment's duration
+    (``phase_count * intervals``; each segment's shares sum to 1). The grid
+    is a parameter so that mesh refinement re-solves the same compiled NLP.
     """
 
     phase_count: int
+    intervals: int
 
     @property
     def fields(self) -> tuple[tuple[str, int], ...]:
@@ -57,6 +61,7 @@ class ParameterLayout:
             ("separation", 1),
             ("start", 2),
             ("goal", 2),
+            ("fractions", self.phase_count * self.intervals),
         )
 
     @property
@@ -269,6 +274,7 @@ class _Builder:
             between=not (stage.first or stage.last),
         )
         lengths = parameters["lengths"][2 * stage.phase : 2 * stage.phase + 2]
+        fraction = parameters["fractions"][stage.phase * self.shape.intervals + stage.interval]
         limits = ca.vertcat(
             lengths,
             parameters["max_velocity"],
@@ -276,7 +282,7 @@ class _Builder:
             parameters["max_jerk"],
             parameters["separation"],
         )
-        following, node_path, between, cost = function.function(x, u[:2], stage.fraction, limits)
+        following, node_path, between, cost = function.function(x, u[:2], fraction, limits)
         next_phase = stage.phase + 1 if stage.phase_end else stage.phase
         pinned = (kind.switching,) if stage.phase_end else (0, 1) if stage.last else ()
         x_next = self.state(f"x{stage.phase}_{stage.interval + 1}", next_phase, pinned)
@@ -297,7 +303,7 @@ def transcribe(shape: NlpShape) -> Transcription:
     """Build the parametric NLP of a region-sequence shape, stage by stage."""
     builder = _Builder(shape)
     ca = builder.ca
-    layout = ParameterLayout(shape.phase_count)
+    layout = ParameterLayout(shape.phase_count, shape.intervals)
     symbols = ca.SX.sym("p", layout.size)
     parameters = layout.split(symbols)
     x = builder.state("x0", 0, (0, 1))
