@@ -11,7 +11,7 @@ import pytest
 
 from limits import Limits, VehicleLimits
 from tests.helpers import LIMITS, MIXED, conf, route_of
-from topology import YGraph, plan, region_sequence
+from topology import Homotopy, YGraph, plan, region_sequence
 from trajgen import Exact, FallbackReason, Optimal, SolverCache, certify, lower_bound, make_schedule, verify
 from trajgen.analysis import travelled
 from trajgen.errors import InputError
@@ -53,9 +53,14 @@ def test_swaps_are_at_most_half_of_exact_and_stay_in_the_class(legs, start):
     exact = exact_schedule(route, LIMITS)
     assert schedule.duration <= 0.5 * exact.duration
     assert lower_bound(route, LIMITS) <= schedule.duration
-    # the sampled region sequence is the route's homotopy class
+    # the sampled region sequence is the homotopy class of the schedule's route, one of the two
+    # shortest (on these symmetric swaps the two classes are nearly as fast)
+    assert schedule.route.regions in (route.regions, route_of(legs, start, start[::-1]).regions) or (
+        schedule.route.homotopy is Homotopy.OTHER
+    )
     times = [k * schedule.duration / 2000 for k in range(2001)]
-    assert region_sequence(route.graph, [schedule.configuration_at(t) for t in times]) == route.regions
+    sampled = region_sequence(route.graph, [schedule.configuration_at(t) for t in times])
+    assert sampled == schedule.route.regions
 
 
 def test_equal_legs_swaps_have_equal_makespans():
@@ -105,9 +110,11 @@ def test_nlp_is_built_once_per_shape_and_reused():
     first = method.schedule(route_of(EQUAL, ("A:10", "B:10"), ("B:10", "A:10")), LIMITS)
     second = method.schedule(route_of(EQUAL, ("B:10", "C:10"), ("C:10", "B:10")), LIMITS)
     assert first.info.built is True
-    assert second.info.built is False  # same region-sequence shape, new parameters
+    assert second.info.built is False  # same region-sequence shapes, new parameters (and grids)
     assert second.duration == pytest.approx(first.duration, rel=1e-6)
-    assert len(method.cache) == 1
+    # one compiled copy per class: the swap's two classes are solved concurrently
+    assert [c.makespan is not None for c in first.info.classes] == [True, True]
+    assert len(method.cache) == 2
 
 
 def test_forced_solver_failure_falls_back_to_exact_and_logs(caplog):
@@ -133,10 +140,14 @@ def test_forced_solver_failure_falls_back_to_exact_and_logs(caplog):
 )
 def test_backup_solvers_reach_fatrops_optimum(fatrop_iterations, solved_by):
     route = route_of(UNEQUAL, ("A:12", "B:8"), ("B:8", "A:12"))
-    reference = optimal_schedule(route, LIMITS)
+    # the chain on one class and one grid (no refinement), so that each attempt is one solver's
+    single = {"homotopy": "paper", "refinements": 0}
+    reference = optimal_schedule(route, LIMITS, **single)
     assert reference.info.solver is Solver.FATROP
     # a fresh NLP whose fatrop stops early: the chain must carry on to the same optimum
-    schedule = optimal_schedule(route, LIMITS, fatrop_iterations=fatrop_iterations, cache=SolverCache())
+    schedule = optimal_schedule(
+        route, LIMITS, fatrop_iterations=fatrop_iterations, cache=SolverCache(), **single
+    )
     assert schedule.info.attempts[0].solver is Solver.FATROP
     assert "did not converge" in str(schedule.info.attempts[0])
     assert schedule.info.solver is solved_by
@@ -192,6 +203,24 @@ def test_make_schedule_dispatches_optimal():
         pytest.param({"max_iterations": 0}, "max_iterations must be an integer >= 1, got 0", id="iterations"),
         pytest.param({"fatrop_iterations": 1.5}, "fatrop_iterations must be an integer", id="fatrop"),
         pytest.param({"cache": {}}, "cache must be a SolverCache or None, got dict", id="cache"),
+        pytest.param(
+            {"refinements": -1}, "option refinements must be an integer >= 0, got -1", id="refinements"
+        ),
+        pytest.param(
+            {"refinement_tolerance": 0.0},
+            r"refinement_tolerance must be a number in \(0, 1\), got 0.0",
+            id="tolerance-zero",
+        ),
+        pytest.param(
+            {"refinement_tolerance": "1e-3"},
+            r"refinement_tolerance must be a number in \(0, 1\), got '1e-3'",
+            id="tolerance-text",
+        ),
+        pytest.param(
+            {"homotopy": "both"},
+            r"homotopychoice 'both' is unknown: expected one of \['fastest', 'paper'\]",
+            id="homotopy",
+        ),
     ],
 )
 def test_bad_options(options, match):

@@ -13,9 +13,11 @@ from tests.strategies import configurations, queries, tracks
 from topology import (
     Cell,
     Configuration,
+    Homotopy,
     Instruction,
     Position,
     Region,
+    WayRound,
     YGraph,
     boundary_angle,
     classify,
@@ -23,6 +25,7 @@ from topology import (
     plan,
     retract,
 )
+from topology.errors import OptionError
 
 
 def conf(first: str, second: str) -> Configuration:
@@ -248,11 +251,8 @@ def _segment_samples(graph: YGraph, a: Configuration, b: Configuration, count: i
         )
 
 
-@given(queries())
-def test_route_properties(query):
-    graph, start, goal, separation = query
-    route = plan(graph, start, goal, min_separation=separation)
-    # endpoints exact
+def check_route(graph: YGraph, start: Configuration, goal: Configuration, separation: float, route) -> None:
+    """Exact endpoints, separation along every segment, and retraction + one arc + reversed retraction."""
     assert route.waypoints[0] == start
     assert route.waypoints[-1] == goal
     floor = min(graph.separation(start), graph.separation(goal), graph.shortest_leg)
@@ -261,7 +261,6 @@ def test_route_properties(query):
         assert graph.distance(a.first, b.first) + graph.distance(a.second, b.second) > 0.0
         for sample in _segment_samples(graph, a, b):
             assert graph.separation(sample) >= floor - 1e-9 * graph.perimeter
-    # the route is retraction + one arc + reversed retraction, no detour
     into = retract(graph, start)
     out = retract(graph, goal)
     legs = [
@@ -274,7 +273,46 @@ def test_route_properties(query):
     assert route.length == pytest.approx(
         legs[0] + abs(route.arc_length) + legs[1], abs=1e-9 * graph.perimeter
     )
+
+
+@given(queries())
+def test_route_properties(query):
+    graph, start, goal, separation = query
+    route = plan(graph, start, goal, min_separation=separation)
+    check_route(graph, start, goal, separation, route)
+    assert route.homotopy is Homotopy.PAPER
     assert abs(route.arc_length) <= graph.perimeter / 2 * (1 + 1e-9)
+
+
+@given(queries())
+def test_the_other_class_goes_the_other_way_round_the_circle(query):
+    graph, start, goal, separation = query
+    paper = plan(graph, start, goal, min_separation=separation)
+    assume(paper.arc_length != 0.0)
+    other = plan(graph, start, goal, min_separation=separation, homotopy="other")
+    check_route(graph, start, goal, separation, other)
+    assert other.homotopy is Homotopy.OTHER
+    assert other.instruction is paper.instruction  # the paper's instruction, named either way
+    assert {paper.way_round, other.way_round} == {WayRound.COUNTERCLOCKWISE, WayRound.CLOCKWISE}
+    # the two shortest classes: together once round the circle, the paper's the shorter (or equal)
+    tolerance = 1e-9 * graph.perimeter
+    assert abs(paper.arc_length) + abs(other.arc_length) == pytest.approx(graph.perimeter, abs=tolerance)
+    assert abs(paper.arc_length) <= abs(other.arc_length) + tolerance
+    assert other.regions != paper.regions
+
+
+def test_the_other_class_of_a_query_that_stays_at_one_boundary_point_is_refused():
+    graph = YGraph({"A": 10.0, "B": 10.0, "C": 10.0})
+    start, goal = conf("A:5", "B:5"), conf("A:6", "B:6")  # both retract radially to P(A, B)
+    assert plan(graph, start, goal).arc_length == 0.0
+    with pytest.raises(
+        OptionError, match=r"homotopy 'other' from .* both retract to the same boundary point"
+    ):
+        plan(graph, start, goal, homotopy="other")
+    with pytest.raises(
+        OptionError, match=r"homotopy 'both' is unknown: expected one of \['paper', 'other'\]"
+    ):
+        plan(graph, start, goal, homotopy="both")
 
 
 @given(queries())

@@ -9,8 +9,12 @@ __all__ = ["class_label", "format_route", "format_run", "route_summary"]
 
 def class_label(route: Route) -> str:
     """The route's homotopy class for people: its way round and whether it is the paper's."""
-    whose = "the paper's instruction" if route.homotopy is Homotopy.PAPER else "not the paper's: faster"
-    return f"{route.way_round.value} ({whose})"
+    return _class_text(route.way_round.value, route.homotopy is Homotopy.PAPER)
+
+
+def _class_text(way_round: str, paper: bool) -> str:
+    whose = "the paper's instruction" if paper else "not the paper's: faster"
+    return f"{way_round} ({whose})"
 
 
 def route_summary(route: Route) -> dict:
@@ -54,7 +58,16 @@ def format_run(summary: dict) -> str:
         f"worst margins: separation {margins['min_separation_m']:.4f} m "
         f"(margin {margins['separation_margin_m']:.4f} m), |v|/limit {max(margins['velocity_ratio']):.6f}, "
         f"|a|/limit {max(margins['acceleration_ratio']):.6f}{jerk}",
+        f"homotopy class: {_class_text(summary['route']['way_round'], summary['route']['paper_class'])}",
     ]
+    if summary["solver"] is not None:
+        lines += [
+            f"class {c['way_round']} ({c['homotopy']}): "
+            + (f"{c['makespan_s']:.3f} s" if c["makespan_s"] is not None else "not solved")
+            + f", lower bound {c['lower_bound_s']:.3f} s"
+            + (" <- chosen" if c["chosen"] else "")
+            for c in summary["solver"].get("classes", ())
+        ]
     lines += [f"note: {note}" for note in summary["notes"]]
     if summary["fallback_reason"]:
         lines.append(f"warning: fell back to the exact schedule ({summary['fallback_reason']})")

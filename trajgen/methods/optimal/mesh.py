@@ -18,7 +18,7 @@ import numpy as np
 from trajgen.methods.optimal.decode import PhaseSolution
 from trajgen.methods.optimal.phases import NlpShape
 
-__all__ = ["refine", "switch_spread"]
+__all__ = ["refine"]
 
 #: Share of the nodes spread evenly in time; the rest go to the jerk switches.
 _EVEN_SHARE = 0.5
@@ -31,25 +31,6 @@ def _switch_strength(controls: np.ndarray) -> np.ndarray:
     change = np.abs(np.diff(controls, axis=0)).sum(axis=1)
     change[change < _SWITCH_FLOOR] = 0.0
     return np.concatenate([[0.0], change, [0.0]])
-
-
-def switch_spread(solution: list[PhaseSolution], ramp_time: float) -> float:
-    """Longest interval next to a jerk switch, in units of ``ramp_time`` (0 without switches).
-
-    Parameters
-    ----------
-    solution : list of PhaseSolution
-    ramp_time : float
-        Shortest jerk ramp of the two vehicles (``max_acceleration / max_jerk``), seconds.
-    """
-    worst = 0.0
-    for phase in solution:
-        strength = _switch_strength(phase.controls)
-        h = np.diff(phase.times)
-        near = (strength[:-1] > 0.0) | (strength[1:] > 0.0)
-        if near.any():
-            worst = max(worst, float(h[near].max()))
-    return worst / ramp_time
 
 
 def _phase_nodes(phase: PhaseSolution, intervals: int) -> np.ndarray:

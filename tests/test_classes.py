@@ -1,0 +1,222 @@
+"""``optimal`` over the two shortest homotopy classes, and its accuracy (issue 10).
+
+Closed-form and stored reference values (the issue's swaps and its long track),
+agreement with a converged solve, the class lower bound in both classes, and
+the ``homotopy`` option in Python and on the command line.
+"""
+
+from __future__ import annotations
+
+import json
+import re
+
+import pytest
+
+from limits import Limits, VehicleLimits
+from tests.helpers import AGV, LIMITS, MIXED, SLOW, route_of
+from topology import Homotopy, WayRound, plan
+from trajgen import Optimal, SolverCache, lower_bound, verify
+from trajgen.analysis import class_lower_bound
+from trajgen.cli import EXIT_BAD_INPUT, EXIT_OK, main
+from trajgen.methods.optimal import Source
+from trajgen.sampling import random_scenarios
+
+FAST = VehicleLimits(2.0, 1.0, 2.0)
+QUARTER = VehicleLimits(0.5, 0.25, 0.5)
+#: The issue's swaps: legs, vehicles, the prioritized baseline it measured, optimal at 32 fixed nodes then.
+ISSUE_SWAPS = [
+    pytest.param((10.0, 10.0, 10.0), (FAST, QUARTER), 42.5, 50.56, id="10-10-10-four-times-faster"),
+    pytest.param((12.0, 8.0, 15.0), (AGV, SLOW), 34.24, 37.51, id="12-8-15-mixed"),
+]
+TRACK_LEGS = (12.0, 8.0, 15.0)
+RANDOM = random_scenarios(
+    4, seed=1010, track=route_of(TRACK_LEGS, ("A:1", "B:1"), ("A:2", "B:2")).graph, limits=MIXED
+)
+
+
+def swap_route(legs):
+    return route_of(legs, (f"A:{legs[0]}", f"B:{legs[1]}"), (f"B:{legs[1]}", f"A:{legs[0]}"))
+
+
+@pytest.mark.parametrize(("legs", "vehicles", "baseline", "before"), ISSUE_SWAPS)
+def test_the_faster_class_wins_the_issue_swaps(legs, vehicles, baseline, before):
+    limits = Limits(vehicles, 1.5)
+    route = swap_route(legs)
+    fastest = Optimal().schedule(route, limits)
+    paper = Optimal(homotopy="paper").schedule(route, limits)
+    report = verify(fastest)
+    assert report.passed, report.failures
+    assert report.regions_match  # the regions of the class it says it took
+    assert fastest.fallback_reason is None
+    assert paper.fallback_reason is None
+    assert fastest.route.homotopy is Homotopy.OTHER
+    assert fastest.route.way_round is WayRound.CLOCKWISE  # a swap's paper class is counterclockwise
+    assert fastest.route.regions != route.regions
+    assert paper.route.homotopy is Homotopy.PAPER
+    assert paper.route.regions == route.regions
+    assert fastest.duration <= baseline * (1 + 1e-4)  # never slower than the issue's prioritized baseline
+    assert fastest.duration < 0.93 * paper.duration
+    assert paper.duration < before  # the paper's class is faster too than with the fixed grid
+    classes = fastest.info.classes
+    assert [(c.homotopy, c.chosen) for c in classes] == [(Homotopy.PAPER, False), (Homotopy.OTHER, True)]
+    assert classes[1].makespan == pytest.approx(fastest.duration, rel=1e-12)
+    assert classes[0].makespan == pytest.approx(paper.duration, rel=2e-3)
+    assert all(c.lower_bound <= c.makespan * (1 + 1e-9) for c in classes)
+
+
+def test_the_four_times_faster_swap_reaches_its_closed_form_lower_bound():
+    # the fast vehicle dodges into C while the slow one drives straight through: the slow vehicle's
+    # own rest-to-rest S-curve over 20 m is the lower bound, and the faster class meets it
+    route = swap_route((10.0, 10.0, 10.0))
+    limits = Limits((FAST, QUARTER), 1.5)
+    bound = lower_bound(route, limits)
+    assert bound == pytest.approx(20.0 / 0.5 + 0.5 / 0.25 + 0.25 / 0.5)
+    assert bound <= Optimal().schedule(route, limits).duration <= bound * (1 + 2e-3)
+
+
+@pytest.mark.parametrize("scenario", RANDOM, ids=[s.source for s in RANDOM])
+def test_the_class_lower_bound_holds_in_both_classes(scenario):
+    paper = scenario.plan()
+    if paper.arc_length == 0.0:
+        pytest.skip("start and goal retract to one boundary point: one class only")
+    other = plan(paper.graph, paper.start, paper.goal, min_separation=paper.min_separation, homotopy="other")
+    for route in (paper, other):
+        schedule = Optimal(homotopy="paper").schedule(route, scenario.limits)  # the route's own class
+        assert schedule.route.regions == route.regions
+        assert verify(schedule).passed
+        bound = class_lower_bound(route, scenario.limits)
+        assert lower_bound(route, scenario.limits) <= bound <= schedule.duration * (1 + 1e-9)
+
+
+@pytest.mark.parametrize(
+    ("legs", "start", "goal", "limits"),
+    [
+        pytest.param((12.0, 8.0, 15.0), ("A:3", "B:2"), ("C:4", "C:9"), LIMITS, id="into-one-leg"),
+        pytest.param((12.0, 8.0, 15.0), ("A:12", "C:15"), ("C:15", "A:12"), MIXED, id="swap-CA-mixed"),
+        pytest.param((2.0, 30.0, 5.0), ("A:2", "B:30"), ("B:30", "A:2"), LIMITS, id="2-30-5-swap"),
+    ],
+)
+def test_the_default_agrees_with_a_converged_solve(legs, start, goal, limits):
+    route = route_of(legs, start, goal)
+    default = Optimal().schedule(route, limits)
+    converged = Optimal(
+        nodes=64, refinements=12, refinement_tolerance=1e-5, time_budget=60.0, cache=SolverCache()
+    ).schedule(route, limits)
+    assert default.route.regions == converged.route.regions  # the same class wins
+    assert converged.duration <= default.duration * (1 + 1e-6)
+    assert default.duration <= converged.duration * 1.002
+
+
+def test_mesh_refinement_makes_a_long_track_accurate():
+    # issue 10: on 200/120/80 m the fixed 32-node grid was 1.1 % over the converged 404.00 s
+    route = swap_route((200.0, 120.0, 80.0))
+    refined = Optimal(homotopy="paper").schedule(route, LIMITS)
+    first_grid = Optimal(homotopy="paper", refinements=0).schedule(route, LIMITS)
+    assert verify(refined).passed
+    assert refined.info.refinements >= 1
+    assert refined.info.source is Source.NLP
+    assert 404.0 * (1 - 1e-6) <= refined.duration <= 404.0 * 1.002
+    assert first_grid.duration > 404.0 * 1.005  # what refinement buys
+    assert lower_bound(route, LIMITS) <= refined.duration
+
+
+def test_a_class_that_cannot_beat_the_exact_schedule_is_not_solved():
+    # vehicle 2 drives 5 m out of the junction into B while vehicle 1 stays at the end of A: the
+    # exact S-curve (7.5 s) meets both classes' lower bounds, so no NLP is solved at all
+    route = route_of(TRACK_LEGS, ("A:12", "O"), ("A:12", "B:5"))
+    schedule = Optimal().schedule(route, LIMITS)
+    assert schedule.info.source is Source.EXACT
+    assert schedule.info.attempts == ()
+    assert schedule.duration == pytest.approx(lower_bound(route, LIMITS), rel=1e-12)
+    assert "every class's lower bound" in schedule.notes[0]
+    assert verify(schedule).passed
+
+
+def test_the_returned_diagnostics_are_the_whole_solves():
+    schedule = Optimal().schedule(swap_route((12.0, 8.0, 15.0)), MIXED)
+    info = schedule.info
+    assert info.solve_time > 0.0
+    assert sum(a.solver is not None for a in info.attempts) >= 4  # two classes, refined each
+    assert info.refinements >= 1
+    assert "(mesh refinement)" in schedule.notes[0]
+
+
+SCENARIO = """
+[track]
+legs = {{ A = 12.0, B = 8.0, C = 15.0 }}
+
+[safety]
+min_separation = 1.5
+
+[[vehicle]]
+name = "agv1"
+max_velocity = 1.0
+max_acceleration = 0.5
+max_jerk = 1.0
+start = "A:12"
+goal = "B:8"
+
+[[vehicle]]
+name = "agv2"
+max_velocity = {slow}
+max_acceleration = 0.35
+max_jerk = 0.6
+start = "B:8"
+goal = "A:12"
+"""
+
+
+@pytest.mark.parametrize(
+    ("options", "homotopy", "way_round"),
+    [
+        pytest.param([], "other", "clockwise", id="default-fastest"),
+        pytest.param(["--homotopy", "paper"], "paper", "counterclockwise", id="paper"),
+        pytest.param(["--homotopy", "FASTEST"], "other", "clockwise", id="fastest-any-case"),
+    ],
+)
+def test_cli_reports_the_class_and_keeps_the_papers_on_request(
+    tmp_path, capsys, options, homotopy, way_round
+):
+    scenario = tmp_path / "mixed.toml"
+    scenario.write_text(SCENARIO.format(slow=0.7))
+    assert main(["schedule", str(scenario), "--json", *options]) == EXIT_OK
+    summary = json.loads(capsys.readouterr().out)
+    assert summary["route"]["homotopy"] == homotopy
+    assert summary["route"]["paper_class"] is (homotopy == "paper")
+    assert summary["route"]["way_round"] == way_round
+    assert summary["verified"] is True
+    classes = summary["solver"]["classes"]
+    if options[1:] == ["paper"]:
+        assert classes == []
+    else:
+        assert [c["chosen"] for c in classes] == [False, True]
+        assert classes[1]["makespan_s"] == pytest.approx(summary["duration_s"])
+        assert classes[1]["makespan_s"] < classes[0]["makespan_s"]
+    main(["schedule", str(scenario), *options])
+    human = capsys.readouterr().out
+    expected = "the paper's instruction" if homotopy == "paper" else "not the paper's: faster"
+    assert f"homotopy class: {way_round} ({expected})" in human
+
+
+@pytest.mark.parametrize(
+    ("options", "message"),
+    [
+        pytest.param(
+            ["--homotopy", "both"],
+            r"homotopychoice 'both' is unknown: expected one of \['fastest', 'paper'\]",
+            id="unknown",
+        ),
+        pytest.param(
+            ["--homotopy", "paper", "--method", "exact"],
+            "--homotopy 'paper' applies to the method 'optimal' only, got --method 'exact'",
+            id="not-optimal",
+        ),
+    ],
+)
+def test_cli_bad_homotopy_exits_2_and_writes_nothing(tmp_path, capsys, options, message):
+    scenario = tmp_path / "mixed.toml"
+    scenario.write_text(SCENARIO.format(slow=0.7))
+    out = tmp_path / "out"
+    assert main(["schedule", str(scenario), "--csv", str(out), *options]) == EXIT_BAD_INPUT
+    assert re.search(message, capsys.readouterr().err)
+    assert not out.exists()
