@@ -18,7 +18,7 @@ from topology import Homotopy, WayRound, plan
 from trajgen import Optimal, SolverCache, lower_bound, verify
 from trajgen.analysis import class_lower_bound
 from trajgen.cli import EXIT_BAD_INPUT, EXIT_OK, main
-from trajgen.methods.optimal import Source
+from trajgen.methods.optimal import Solver, Source
 from trajgen.sampling import random_scenarios
 
 FAST = VehicleLimits(2.0, 1.0, 2.0)
@@ -102,9 +102,11 @@ def test_the_default_agrees_with_a_converged_solve(legs, start, goal, limits):
     converged = Optimal(
         nodes=64, refinements=12, refinement_tolerance=1e-5, time_budget=60.0, cache=SolverCache()
     ).schedule(route, limits)
-    assert default.route.regions == converged.route.regions  # the same class wins
     assert converged.duration <= default.duration * (1 + 1e-6)
     assert default.duration <= converged.duration * 1.002
+    makespans = sorted(c.makespan for c in converged.info.classes if c.makespan is not None)
+    if len(makespans) == 2 and makespans[1] > 1.005 * makespans[0]:  # one class clearly faster
+        assert default.route.regions == converged.route.regions
 
 
 def test_mesh_refinement_makes_a_long_track_accurate():
@@ -132,13 +134,18 @@ def test_a_class_that_cannot_beat_the_exact_schedule_is_not_solved():
     assert verify(schedule).passed
 
 
-def test_the_returned_diagnostics_are_the_whole_solves():
+def test_a_clearly_beaten_class_is_not_refined_and_the_diagnostics_cover_both():
     schedule = Optimal().schedule(swap_route((12.0, 8.0, 15.0)), MIXED)
     info = schedule.info
+    paper, other = info.classes
     assert info.solve_time > 0.0
-    assert sum(a.solver is not None for a in info.attempts) >= 4  # two classes, refined each
-    assert info.refinements >= 1
-    assert "(mesh refinement)" in schedule.notes[0]
+    # the paper's class is 10 % slower on its first grid, more than refinement could gain (5 %):
+    # it is not refined; the other class is, once
+    assert paper.makespan > 1.05 * other.makespan
+    assert len(info.attempts) == 3
+    assert all(a.solver is Solver.FATROP for a in info.attempts)
+    assert info.refinements == 1
+    assert "pass 2 of 2 (mesh refinement)" in schedule.notes[0]
 
 
 SCENARIO = """

@@ -28,7 +28,7 @@ def test_readme_python_example_runs_and_its_comments_hold(tmp_path, monkeypatch)
     assert namespace["verified"].report.passed
     assert (tmp_path / "out" / "agv1.csv").is_file()
     assert (tmp_path / "out" / "agv2.csv").is_file()
-    assert namespace["result"].summary()["duration_s"] == pytest.approx(27.53, abs=0.01)
+    assert namespace["result"].summary()["duration_s"] == pytest.approx(27.51, abs=0.01)
     assert sorted(p.name for p in (tmp_path / "run").iterdir()) == [
         "agv1.csv",
         "agv2.csv",

@@ -63,4 +63,4 @@ __all__ = [
     "verify",
     "write_profiles",
 ]
-__version__ = "0.2.0"
+__version__ = "0.3.0"

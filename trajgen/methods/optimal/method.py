@@ -7,6 +7,7 @@ import dataclasses
 import enum
 import logging
 import math
+import threading
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -40,10 +41,9 @@ __all__ = [
 
 logger = logging.getLogger(__name__)
 
-#: Intervals per segment. 24: with mesh refinement the makespan is within 0.2 % of the converged
-#: optimum on every scenario of ``benchmarks/bench_classes.py``; each pass is about a quarter faster
-#: than with 32.
-DEFAULT_NODES = 24
+#: Intervals per segment. 32: with fewer, mesh refinement converges slowly where the optimum is one
+#: vehicle's own S-curve (24 nodes: 0.02 % a pass, still 0.24 % over after the tolerance stopped it).
+DEFAULT_NODES = 32
 #: Smallest separation used when the scenario asks for 0 ("not the same point"), metres.
 _POSITIVE_SEPARATION = 1e-3
 #: Planned clearance above the minimum separation, metres: the solvers meet constraints to ~1e-8 m,
@@ -59,6 +59,16 @@ _LEG_SLACK = 5e-7
 #: one before (measured on the benchmark sets), so stopping after a pass that gained less than 0.15 %
 #: leaves the makespan within about 0.05 % of the converged optimum, well inside issue 10's 0.2 %.
 DEFAULT_REFINEMENT_TOLERANCE = 1.5e-3
+#: Most that refinement can still gain after the first grid, as a share of its makespan: a class
+#: whose first grid is slower than another class's by more is not refined (the largest total gain
+#: measured is 1.8 %, 200/120/80 m at 24 nodes). After a pass, its own gain bounds what is left.
+_FIRST_GRID_GAIN = 0.05
+#: Within this share of its class lower bound a solution is near a single vehicle's own S-curve,
+#: where refinement converges slowly (linearly): there it stops only below a 15x stricter gain.
+_NEAR_BOUND = 0.01
+_NEAR_BOUND_STRICTER = 15.0
+#: Relative makespan difference below which two classes tie (the route's own class is kept).
+_TIE = 1e-6
 
 
 class Source(enum.Enum):
@@ -88,8 +98,9 @@ class ClassComparison:
     lower_bound : float
         :func:`~trajgen.analysis.class_lower_bound`, seconds.
     makespan : float or None
-        Its verified makespan, seconds; ``None`` when skipped (the lower bound
-        could not beat the faster ``exact`` schedule).
+        Its best solved makespan, seconds (verified where ``chosen``; a class that another
+        beat by more than refinement could gain keeps its first grid's); ``None`` when not
+        solved (its lower bound could not beat the faster ``exact`` schedule).
     chosen : bool
         Whether the returned schedule is in this class.
     """
@@ -201,13 +212,14 @@ class Optimal(TimingMethod):
         Seconds the solvers may take (default 2.0): no solver starts after it is spent and Ipopt
         stops by itself; the verified ``exact`` schedule is returned then, flagged ``time-budget``.
     refinements : int, optional
-        Most mesh-refinement passes after the first solve (default 4): the grid's nodes move to the
+        Most mesh-refinement passes after the first solve (default 6): the grid's nodes move to the
         jerk switches of the previous pass and the same compiled NLP is solved again (see
         :mod:`~.mesh`), until a pass shortens the makespan by less than ``refinement_tolerance``.
         0 keeps the first grid.
     refinement_tolerance : float, optional
         Relative makespan gain below which refinement stops (default
-        :data:`DEFAULT_REFINEMENT_TOLERANCE`, 0.15 %), in (0, 1).
+        :data:`DEFAULT_REFINEMENT_TOLERANCE`, 0.15 %), in (0, 1); 15 times smaller for a
+        solution within 1 % of its class lower bound, where refinement converges slowly.
     homotopy : HomotopyChoice or str, optional
         ``"fastest"`` (default): solve the route's class and the other way round the boundary
         circle, return the faster. ``"paper"``: the route's class only.
@@ -227,7 +239,7 @@ class Optimal(TimingMethod):
     max_iterations: int = 3000
     fatrop_iterations: int = 500
     time_budget: float = 2.0
-    refinements: int = 4
+    refinements: int = 6
     refinement_tolerance: float = DEFAULT_REFINEMENT_TOLERANCE
     homotopy: HomotopyChoice = HomotopyChoice.FASTEST
     cache: SolverCache | None = field(default=None, compare=False, repr=False)
@@ -283,10 +295,26 @@ class Optimal(TimingMethod):
         )
 
     def warm_up(self, route: Route) -> bool:
-        """Build the NLP of ``route``'s shape into the cache now; returns whether it was built."""
+        """Build the NLPs that ``route``'s classes need into the cache now; returns whether any was built."""
         if len(route.waypoints) == 1:
             return False
-        return self._cache().get(self.shape(route))[1]
+        built = [
+            self._cache().get(dataclasses.replace(self.shape(r), slot=k))[1]
+            for k, r in enumerate(self.class_routes(route))
+        ]
+        return any(built)
+
+    def class_routes(self, route: Route) -> list[Route]:
+        """The routes of the classes this method considers: ``route``'s own first, then the other way round.
+
+        With ``homotopy="paper"``, or where start and goal retract to one boundary point (the
+        other way would be a full turn), only ``route``.
+        """
+        if self.homotopy is HomotopyChoice.PAPER or route.arc_length == 0.0:
+            return [route]
+        other = Homotopy.OTHER if route.homotopy is Homotopy.PAPER else Homotopy.PAPER
+        graph, start, goal, separation = route.graph, route.start, route.goal, route.min_separation
+        return [route, plan(graph, start, goal, min_separation=separation, homotopy=other)]
 
     def schedule(self, route: Route, limits: Limits) -> Schedule:
         """The optimal schedule from ``route``'s start to its goal (verified), or the flagged ``exact`` one.
@@ -303,32 +331,38 @@ class Optimal(TimingMethod):
         exact = Exact().schedule(route, limits)
         if len(route.waypoints) == 1:  # nothing moves: the exact schedule is optimal
             return self._as_optimal(exact, "start is the goal: nothing moves", None)
-        routes = [route]
-        if self.homotopy is HomotopyChoice.FASTEST and route.arc_length != 0.0:
-            other = Homotopy.OTHER if route.homotopy is Homotopy.PAPER else Homotopy.PAPER
-            routes.append(
-                plan(
-                    route.graph, route.start, route.goal, min_separation=route.min_separation, homotopy=other
-                )
-            )
+        routes = self.class_routes(route)
         exacts = [exact, *(Exact().schedule(r, limits) for r in routes[1:])]
         bounds = [class_lower_bound(r, limits) for r in routes]
         fastest_exact = min(exacts, key=lambda e: e.duration)
         # a class whose bound reaches the fastest exact schedule cannot beat it: not solved
         wanted = [k for k, bound in enumerate(bounds) if bound < fastest_exact.duration * (1.0 - 1e-9)]
         deadline = began + self.time_budget
+        race = _Race(wanted)
         if len(wanted) > 1:
             with concurrent.futures.ThreadPoolExecutor(
                 len(wanted), thread_name_prefix="trajgen-class"
             ) as pool:
                 futures = {
-                    k: pool.submit(self._solve_class, routes[k], limits, exacts[k], slot=k, deadline=deadline)
+                    k: pool.submit(
+                        self._solve_class,
+                        routes[k],
+                        limits,
+                        exacts[k],
+                        slot=k,
+                        deadline=deadline,
+                        race=race,
+                        bound=bounds[k],
+                    )
                     for k in wanted
                 }
                 solved = {k: future.result() for k, future in futures.items()}
         else:
             solved = {
-                k: self._solve_class(routes[k], limits, exacts[k], slot=k, deadline=deadline) for k in wanted
+                k: self._solve_class(
+                    routes[k], limits, exacts[k], slot=k, deadline=deadline, race=race, bound=bounds[k]
+                )
+                for k in wanted
             }
         solve_time = time.perf_counter() - began
         attempts = tuple(a for k in wanted for a in solved[k].attempts)
@@ -397,9 +431,10 @@ class Optimal(TimingMethod):
         ``finish`` gives a candidate its final form (diagnostics) before it is verified.
         """
         failures: list[str] = []
+        # the route's own class (k = 0) wins a tie within round-off: symmetric classes solve alike
         ranked = sorted(
             ((makespan, k, p) for k, c in solved.items() for p, (makespan, _, _) in enumerate(c.passes)),
-            key=lambda item: (item[0], item[1]),
+            key=lambda item: (item[0] * (1.0 + _TIE if item[1] else 1.0), item[1]),
         )
         for makespan, k, p in ranked:
             if makespan >= exact_duration:
@@ -412,53 +447,84 @@ class Optimal(TimingMethod):
         return None, failures
 
     def _solve_class(
-        self, route: Route, limits: Limits, exact: Schedule, *, slot: int, deadline: float
+        self,
+        route: Route,
+        limits: Limits,
+        exact: Schedule,
+        *,
+        slot: int,
+        deadline: float,
+        race: _Race,
+        bound: float,
     ) -> _ClassSolve:
         """Solve ``route``'s own class: the first grid, then refinement passes (unverified).
 
-        ``slot``: which compiled copy of the NLP to use (concurrent classes of one shape use two).
+        ``slot``: which compiled copy of the NLP to use (concurrent classes of one shape use two), and
+        this class's place in ``race``, through which a class that another beats by more than its
+        refinement could still gain stops refining; ``bound`` its lower bound, seconds.
         """
         began = time.perf_counter()
         phases = route_phases(route)
         shape = dataclasses.replace(self.shape(route), slot=slot)
         compiled, built = self._cache().get(shape)
-        size = compiled.transcription.size
         outcome = _ClassSolve(route, limits, phases, shape, built)
         try:
-            fractions = default_fractions(shape)
-            waypoint_times = Exact().waypoint_times(exact)
-            guess = initial_guess(exact, waypoint_times, phases, shape, size, fractions)
-            parameters = _parameters(route, limits, phases, fractions)
-        except Exception as error:  # a malformed guess is a bug, but must not leak an unverified schedule
-            return outcome.failed(FallbackReason.SETUP_FAILED, f"{type(error).__name__}: {error}")
-        result = solve(compiled, guess, parameters, deadline=deadline)
-        outcome.attempts += result.attempts
-        if result.solution is None:
-            late = time.perf_counter() > deadline
-            reason = FallbackReason.TIME_BUDGET if late else FallbackReason.SOLVER_FAILED
-            return outcome.failed(reason, "; ".join(str(a) for a in result.attempts))
-        outcome.add(unpack(result.solution, phases, shape, fractions), result.attempts[-1])
+            self._first_pass(outcome, compiled, exact, deadline)
+        finally:
+            race.first_pass(slot, outcome.makespan, deadline)
+        if not outcome.passes:
+            return outcome
         jerks = tuple(v.max_jerk for v in limits.vehicles)
+        remaining = _FIRST_GRID_GAIN
         while outcome.refinements < self.refinements and time.perf_counter() < deadline:
+            current = outcome.passes[-1][0]
+            if race.beaten(slot, current, remaining):
+                logger.debug(
+                    "optimal: class %d not refined further: another is faster by > %.3g", slot, remaining
+                )
+                break
             fractions, states = refine(outcome.passes[-1][1], shape, jerks)
             try:
-                guess = assemble(states, shape, size)
+                guess = assemble(states, shape, compiled.transcription.size)
             except SolverError:
                 break
             result = solve(compiled, guess, _parameters(route, limits, phases, fractions), deadline=deadline)
             outcome.attempts += result.attempts
             if result.solution is None:
                 break
-            previous = outcome.passes[-1][0]
             outcome.add(unpack(result.solution, phases, shape, fractions), result.attempts[-1])
-            gain = (previous - outcome.passes[-1][0]) / previous
+            race.improved(slot, outcome.passes[-1][0])
+            remaining = (current - outcome.passes[-1][0]) / current
             logger.debug(
-                "optimal: refinement pass %d: %.6f s, gain %.3g", outcome.refinements, previous, gain
+                "optimal: refinement pass %d: %.6f s, gain %.3g", outcome.refinements, current, remaining
             )
-            if gain < self.refinement_tolerance:
+            near = outcome.passes[-1][0] - bound < _NEAR_BOUND * outcome.passes[-1][0]
+            if remaining < self.refinement_tolerance / (_NEAR_BOUND_STRICTER if near else 1.0):
                 break  # converged: a further pass would gain a fraction of this one
-        logger.debug("optimal: class solved in %.3f s", time.perf_counter() - began)
+        logger.debug("optimal: class %d solved in %.3f s", slot, time.perf_counter() - began)
         return outcome
+
+    def _first_pass(self, outcome: _ClassSolve, compiled, exact: Schedule, deadline: float) -> None:
+        """Solve ``outcome``'s class on the first grid, from the exact schedule; records a failure."""
+        route, limits, phases, shape = outcome.route, outcome.limits, outcome.phases, outcome.shape
+        try:
+            fractions = default_fractions(shape)
+            waypoint_times = Exact().waypoint_times(exact)
+            guess = initial_guess(
+                exact, waypoint_times, phases, shape, compiled.transcription.size, fractions
+            )
+            parameters = _parameters(route, limits, phases, fractions)
+        except Exception as error:  # a malformed guess is a bug, but must not leak an unverified schedule
+            outcome.failed(FallbackReason.SETUP_FAILED, f"{type(error).__name__}: {error}")
+            return
+        result = solve(compiled, guess, parameters, deadline=deadline)
+        outcome.attempts += result.attempts
+        if result.solution is None:
+            late = time.perf_counter() > deadline
+            reason = FallbackReason.TIME_BUDGET if late else FallbackReason.SOLVER_FAILED
+            outcome.failed(reason, "; ".join(str(a) for a in result.attempts))
+            return
+        outcome.add(unpack(result.solution, phases, shape, fractions), result.attempts[-1])
 
     def _as_optimal(self, exact: Schedule, note: str, info: OptimalInfo | None) -> Schedule:
         """The exact schedule, returned by this method because it is the fastest known."""
@@ -468,6 +534,41 @@ class Optimal(TimingMethod):
 def _makespan(solution: list[PhaseSolution]) -> float:
     """Duration of a decoded solution, seconds."""
     return float(sum(phase.times[-1] for phase in solution))
+
+
+class _Race:
+    """The classes solved at once, telling each other their best makespans (thread-safe).
+
+    Every class reports its first grid (``None`` if it failed), and waits until all have, so that
+    the decision to refine does not depend on which thread was quicker.
+    """
+
+    __slots__ = ("_best", "_changed", "_count", "_reported")
+
+    def __init__(self, classes: list[int]) -> None:
+        self._count = len(classes)
+        self._best: dict[int, float] = {}
+        self._reported: set[int] = set()
+        self._changed = threading.Condition()
+
+    def first_pass(self, slot: int, makespan: float | None, deadline: float) -> None:
+        with self._changed:
+            self._reported.add(slot)
+            if makespan is not None:
+                self._best[slot] = makespan
+            self._changed.notify_all()
+            wait = max(0.0, deadline - time.perf_counter())
+            self._changed.wait_for(lambda: len(self._reported) >= self._count, timeout=wait)
+
+    def improved(self, slot: int, makespan: float) -> None:
+        with self._changed:
+            self._best[slot] = min(makespan, self._best.get(slot, math.inf))
+
+    def beaten(self, slot: int, makespan: float, remaining: float) -> bool:
+        """Whether another class is already faster than ``makespan`` can become by gaining ``remaining``."""
+        with self._changed:
+            others = [m for k, m in self._best.items() if k != slot]
+        return bool(others) and min(others) < makespan * (1.0 - remaining)
 
 
 class _ClassSolve:

@@ -107,7 +107,9 @@ class CompiledNlp:
                         "print_level": 0,
                         "max_iter": min(shape.max_iterations, shape.fatrop_iterations),
                         "tol": 1e-8,
-                        "mu_init": 1e-2,
+                        # 0.1 rather than 0.01: the first pass from the exact schedule's guess takes
+                        # 20-60 % fewer iterations (103 -> 43 on 200/120/80 m), refinement passes the same
+                        "mu_init": 1e-1,
                     },
                 },
             )
