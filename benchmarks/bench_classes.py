@@ -168,6 +168,12 @@ def _summary(rows: list[dict]) -> None:
             f"the non-paper class wins {len(other)} of {len(rows)}: paper/optimal median "
             f"{statistics.median(gains):.4f}, max {max(gains):.4f}"
         )
+    for key, label in (("zone", "zone locking"), ("prio", "prioritized")):
+        failed = [f"{r['set']} {r['name']}" for r in rows if r[key] == float("inf")]
+        print(
+            f"{label} found no safe motion (unsafe when sampled, deadlocked, or no holding point) in "
+            f"{len(failed)} of {len(rows)}: {', '.join(failed) or '-'} (left out of its ratios)"
+        )
     ordered = sum(r["lower"] <= r["optimal"] * (1 + 1e-9) <= r["exact"] * (1 + 2e-9) for r in rows)
     print(f"lower bound <= optimal <= exact: {ordered} of {len(rows)}")
     for subset, label in (([r for r in rows if r["short"]], "10-15 m sets a-d"), (rows, "all")):

@@ -39,9 +39,8 @@ optimal = verified["optimal"].schedule
 ratio = optimal.duration / verified["exact"].schedule.duration
 print(f"optimal / exact = {ratio:.4f}; solver: {optimal.info.status}")
 for item in optimal.info.classes:  # the two classes it solved, and which it chose
-    print(
-        f"  class {item.way_round.value} ({item.homotopy.value}): {item.makespan:.3f} s, chosen {item.chosen}"
-    )
+    makespan = "not solved" if item.makespan is None else f"{item.makespan:.3f} s"
+    print(f"  class {item.way_round.value} ({item.homotopy.value}): {makespan}, chosen {item.chosen}")
 
 # How deep does the waiting vehicle park? (exact parks it at the end of leg C)
 state = optimal.sample(0.01)

@@ -15,7 +15,7 @@ import pytest
 from limits import Limits, VehicleLimits
 from tests.helpers import AGV, LIMITS, MIXED, SLOW, route_of
 from topology import Homotopy, WayRound, plan
-from trajgen import Optimal, SolverCache, lower_bound, verify
+from trajgen import FallbackReason, Optimal, SolverCache, lower_bound, verify
 from trajgen.analysis import class_lower_bound
 from trajgen.cli import EXIT_BAD_INPUT, EXIT_OK, main
 from trajgen.methods.optimal import Solver, Source
@@ -227,3 +227,42 @@ def test_cli_bad_homotopy_exits_2_and_writes_nothing(tmp_path, capsys, options, 
     assert main(["schedule", str(scenario), "--csv", str(out), *options]) == EXIT_BAD_INPUT
     assert re.search(message, capsys.readouterr().err)
     assert not out.exists()
+
+
+def test_a_class_that_fails_is_reported_and_the_other_class_is_returned(monkeypatch):
+    import trajgen.methods.optimal.method as optimal_method
+
+    real = optimal_method.initial_guess
+
+    def broken_for_the_other_class(exact, *args):
+        if exact.route.homotopy is Homotopy.OTHER:
+            raise RuntimeError("injected setup fault")
+        return real(exact, *args)
+
+    monkeypatch.setattr(optimal_method, "initial_guess", broken_for_the_other_class)
+    route = swap_route((12.0, 8.0, 15.0))
+    schedule = Optimal(cache=SolverCache()).schedule(route, MIXED)
+    assert schedule.fallback_reason is None
+    assert schedule.route.homotopy is Homotopy.PAPER  # the slower class, but the only one solved
+    assert verify(schedule).passed
+    paper, other = schedule.info.classes
+    assert (paper.chosen, paper.failure) == (True, None)
+    assert (other.makespan, other.failure) == (None, FallbackReason.SETUP_FAILED)
+    assert any("not solved (setup-failed): RuntimeError: injected setup fault" in n for n in schedule.notes)
+    assert schedule.info.solver is Solver.FATROP  # the solver of the returned pass
+
+
+def test_a_refinement_that_raises_keeps_the_passes_solved_before(monkeypatch, caplog):
+    import trajgen.methods.optimal.method as optimal_method
+
+    def broken(*args):
+        raise FloatingPointError("injected refinement fault")
+
+    monkeypatch.setattr(optimal_method, "refine", broken)
+    route = swap_route((12.0, 8.0, 15.0))
+    schedule = Optimal(homotopy="paper", cache=SolverCache()).schedule(route, LIMITS)
+    assert schedule.fallback_reason is None
+    assert schedule.info.refinements == 0
+    assert "pass 1 of 1" in schedule.notes[0]
+    assert verify(schedule).passed
+    assert any("keeping its earlier passes" in r.message for r in caplog.records)

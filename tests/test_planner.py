@@ -305,10 +305,15 @@ def test_the_other_class_of_a_query_that_stays_at_one_boundary_point_is_refused(
     graph = YGraph({"A": 10.0, "B": 10.0, "C": 10.0})
     start, goal = conf("A:5", "B:5"), conf("A:6", "B:6")  # both retract radially to P(A, B)
     assert plan(graph, start, goal).arc_length == 0.0
-    with pytest.raises(
-        OptionError, match=r"homotopy 'other' from .* both retract to the same boundary point"
-    ):
+    same_point = r"homotopy 'other' from .* both retract to the same boundary point"
+    with pytest.raises(OptionError, match=same_point):
         plan(graph, start, goal, homotopy="other")
+    # round-off: the paper's arc is -0.0 here, so "the other way" would be a full turn
+    tiny = YGraph({"A": 1.0, "B": 1.0, "C": 1.0})
+    near, far = conf("A:0.1", "B:0.3"), conf(f"A:{1 / 3}", "B:1")
+    assert plan(tiny, near, far).arc_length == 0.0
+    with pytest.raises(OptionError, match=same_point):
+        plan(tiny, near, far, homotopy="other")
     with pytest.raises(
         OptionError, match=r"homotopy 'both' is unknown: expected one of \['paper', 'other'\]"
     ):

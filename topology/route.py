@@ -340,7 +340,7 @@ def plan(
     else:
         instruction, counterclockwise = Instruction.SHORTEST, delta < half
     if homotopy is Homotopy.OTHER:
-        if delta == 0.0:
+        if delta == 0.0 or delta == perimeter:  # the same point (delta == perimeter after round-off)
             raise OptionError(
                 f"homotopy 'other' from {start} to {goal}: both retract to the same boundary point, so "
                 "the other way round is a full turn; expected a query whose retractions differ"

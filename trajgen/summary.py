@@ -12,6 +12,14 @@ def class_label(route: Route) -> str:
     return _class_text(route.way_round.value, route.homotopy is Homotopy.PAPER)
 
 
+def _class_makespan(comparison: dict) -> str:
+    if comparison["makespan_s"] is not None:
+        return f"{comparison['makespan_s']:.3f} s"
+    if comparison["failure"]:
+        return f"failed ({comparison['failure']})"
+    return "not solved (its lower bound cannot beat exact)"
+
+
 def _class_text(way_round: str, paper: bool) -> str:
     whose = "the paper's instruction" if paper else "not the paper's: faster"
     return f"{way_round} ({whose})"
@@ -63,7 +71,7 @@ def format_run(summary: dict) -> str:
     if summary["solver"] is not None:
         lines += [
             f"class {c['way_round']} ({c['homotopy']}): "
-            + (f"{c['makespan_s']:.3f} s" if c["makespan_s"] is not None else "not solved")
+            + _class_makespan(c)
             + f", lower bound {c['lower_bound_s']:.3f} s"
             + (" <- chosen" if c["chosen"] else "")
             for c in summary["solver"].get("classes", ())

@@ -24,7 +24,7 @@ from trajgen.methods.optimal.decode import PhaseSolution, sections, unpack
 from trajgen.methods.optimal.guess import assemble, initial_guess
 from trajgen.methods.optimal.mesh import refine
 from trajgen.methods.optimal.phases import NlpShape, Phase, default_fractions, route_phases
-from trajgen.methods.optimal.solve import Outcome, Solver, SolverAttempt, SolverCache, solve
+from trajgen.methods.optimal.solve import Solver, SolverAttempt, SolverCache, solve
 from trajgen.methods.optimal.transcription import ParameterLayout
 from trajgen.schedule import FallbackReason, MethodInfo, Schedule, TimingMethod, check_request
 from trajgen.verify import verify
@@ -69,6 +69,8 @@ _NEAR_BOUND = 0.01
 _NEAR_BOUND_STRICTER = 15.0
 #: Relative makespan difference below which two classes tie (the route's own class is kept).
 _TIE = 1e-6
+#: After a refinement pass, what the class may still gain is taken as this many times the pass's gain.
+_REMAINING_FACTOR = 4.0
 
 
 class Source(enum.Enum):
@@ -103,6 +105,9 @@ class ClassComparison:
         solved (its lower bound could not beat the faster ``exact`` schedule).
     chosen : bool
         Whether the returned schedule is in this class.
+    failure : FallbackReason or None
+        Why the class has no makespan although it was to be solved (its solvers failed, ran
+        out of time, or its setup raised); ``None`` otherwise.
     """
 
     homotopy: Homotopy
@@ -110,6 +115,7 @@ class ClassComparison:
     lower_bound: float
     makespan: float | None
     chosen: bool
+    failure: FallbackReason | None = None
 
     def summary(self) -> dict:
         """JSON-ready fields."""
@@ -119,6 +125,7 @@ class ClassComparison:
             "lower_bound_s": self.lower_bound,
             "makespan_s": self.makespan,
             "chosen": self.chosen,
+            "failure": None if self.failure is None else self.failure.value,
         }
 
 
@@ -142,6 +149,8 @@ class OptimalInfo(MethodInfo):
         Mesh-refinement passes solved after the first (see :mod:`~.mesh`), the most of any class.
     classes : tuple of ClassComparison
         The homotopy classes considered (empty when only the route's own was).
+    solved_by : SolverAttempt or None
+        The solver attempt that produced the returned solution (its class and pass).
     """
 
     solve_time: float
@@ -150,18 +159,19 @@ class OptimalInfo(MethodInfo):
     source: Source = Source.NLP
     refinements: int = 0
     classes: tuple[ClassComparison, ...] = ()
+    solved_by: SolverAttempt | None = None
 
     @property
     def solver(self) -> Solver | None:
-        """The solver that converged, if any."""
-        if self.attempts and self.attempts[-1].outcome is Outcome.SOLVED:
-            return self.attempts[-1].solver
+        """The solver that converged on the returned solution (None if the motion is not the NLP's)."""
+        if self.source is Source.NLP and self.solved_by is not None:
+            return self.solved_by.solver
         return None
 
     @property
     def iterations(self) -> int:
-        """Iterations of the solver that converged (-1 if none did)."""
-        return self.attempts[-1].iterations if self.solver is not None else -1
+        """Iterations of the solver that converged on the returned solution (-1 if none did)."""
+        return self.solved_by.iterations if self.solver is not None else -1
 
     @property
     def status(self) -> str:
@@ -209,8 +219,10 @@ class Optimal(TimingMethod):
     fatrop_iterations : int, optional
         Iteration limit of fatrop (default 500; it converges in < 150 when it converges).
     time_budget : float, optional
-        Seconds the solvers may take (default 2.0): no solver starts after it is spent and Ipopt
-        stops by itself; the verified ``exact`` schedule is returned then, flagged ``time-budget``.
+        Seconds the solvers may take (default 2.0): no solver starts after it is spent, no
+        refinement pass starts unless the previous one would fit in what is left, and Ipopt stops
+        by itself at half of it (a fatrop run under way finishes: fatrop has no wall-time limit).
+        If no class was solved by then, the ``exact`` schedule is returned, flagged ``time-budget``.
     refinements : int, optional
         Most mesh-refinement passes after the first solve (default 6): the grid's nodes move to the
         jerk switches of the previous pass and the same compiled NLP is solved again (see
@@ -383,17 +395,28 @@ class Optimal(TimingMethod):
                     lower_bound=bounds[k],
                     makespan=solved[k].makespan if k in solved else None,
                     chosen=r is winner,
+                    failure=solved[k].failure if k in solved else None,
                 )
                 for k, r in enumerate(routes)
             )
 
+        unsolved_notes = tuple(
+            f"class {routes[k].way_round.value} ({routes[k].homotopy.value}) not solved "
+            f"({solved[k].failure.value}): {solved[k].detail}"
+            for k in wanted
+            if solved[k].failure is not None
+        )
         # each candidate carries the whole call's diagnostics before it is verified: the object
         # verified is the object returned (a schedule is verified once)
         chosen, failures = self._fastest_verified(
             solved,
             fastest_exact.duration,
             lambda candidate: dataclasses.replace(
-                candidate, info=dataclasses.replace(info, classes=comparisons(candidate.route))
+                candidate,
+                notes=candidate.notes + unsolved_notes,
+                info=dataclasses.replace(
+                    info, classes=comparisons(candidate.route), solved_by=candidate.info.solved_by
+                ),
             ),
         )
         if chosen is not None:
@@ -466,43 +489,55 @@ class Optimal(TimingMethod):
         began = time.perf_counter()
         phases = route_phases(route)
         shape = dataclasses.replace(self.shape(route), slot=slot)
-        compiled, built = self._cache().get(shape)
-        outcome = _ClassSolve(route, limits, phases, shape, built)
+        outcome = _ClassSolve(route, limits, phases, shape, built=False)
         try:
+            compiled, outcome.built = self._cache().get(shape)
             self._first_pass(outcome, compiled, exact, deadline)
+        except Exception as error:  # a bug or a build failure must not lose the other class's result
+            logger.exception("optimal: class %d could not be set up", slot)
+            return outcome.failed(FallbackReason.SETUP_FAILED, f"{type(error).__name__}: {error}")
         finally:
             race.first_pass(slot, outcome.makespan, deadline)
-        if not outcome.passes:
-            return outcome
+        if outcome.passes:
+            try:
+                self._refine(outcome, compiled, slot=slot, deadline=deadline, race=race, bound=bound)
+            except Exception:  # keep the passes solved so far: each is verified before it is returned
+                logger.exception("optimal: refinement of class %d raised; keeping its earlier passes", slot)
+        logger.debug("optimal: class %d solved in %.3f s", slot, time.perf_counter() - began)
+        return outcome
+
+    def _refine(
+        self, outcome: _ClassSolve, compiled, *, slot: int, deadline: float, race: _Race, bound: float
+    ) -> None:
+        """Mesh-refinement passes of one class until they converge, it is beaten, or time runs short."""
+        route, limits, phases, shape = outcome.route, outcome.limits, outcome.phases, outcome.shape
         jerks = tuple(v.max_jerk for v in limits.vehicles)
         remaining = _FIRST_GRID_GAIN
-        while outcome.refinements < self.refinements and time.perf_counter() < deadline:
+        last_pass = 0.0
+        while outcome.refinements < self.refinements and time.perf_counter() + last_pass < deadline:
             current = outcome.passes[-1][0]
             if race.beaten(slot, current, remaining):
-                logger.debug(
-                    "optimal: class %d not refined further: another is faster by > %.3g", slot, remaining
-                )
-                break
+                logger.debug("optimal: class %d not refined: another is faster by > %.3g", slot, remaining)
+                return
+            began = time.perf_counter()
             fractions, states = refine(outcome.passes[-1][1], shape, jerks)
             try:
                 guess = assemble(states, shape, compiled.transcription.size)
             except SolverError:
-                break
+                return
             result = solve(compiled, guess, _parameters(route, limits, phases, fractions), deadline=deadline)
             outcome.attempts += result.attempts
+            last_pass = time.perf_counter() - began
             if result.solution is None:
-                break
+                return
             outcome.add(unpack(result.solution, phases, shape, fractions), result.attempts[-1])
-            race.improved(slot, outcome.passes[-1][0])
-            remaining = (current - outcome.passes[-1][0]) / current
-            logger.debug(
-                "optimal: refinement pass %d: %.6f s, gain %.3g", outcome.refinements, current, remaining
-            )
+            gain = (current - outcome.passes[-1][0]) / current
+            logger.debug("optimal: refinement pass %d: %.6f s, gain %.3g", outcome.refinements, current, gain)
             near = outcome.passes[-1][0] - bound < _NEAR_BOUND * outcome.passes[-1][0]
-            if remaining < self.refinement_tolerance / (_NEAR_BOUND_STRICTER if near else 1.0):
-                break  # converged: a further pass would gain a fraction of this one
-        logger.debug("optimal: class %d solved in %.3f s", slot, time.perf_counter() - began)
-        return outcome
+            if gain < self.refinement_tolerance / (_NEAR_BOUND_STRICTER if near else 1.0):
+                return  # converged: a further pass would gain a fraction of this one
+            # what is left: a few times the last gain where convergence is slow, at most the first bound
+            remaining = min(_FIRST_GRID_GAIN, _REMAINING_FACTOR * max(gain, 0.0))
 
     def _first_pass(self, outcome: _ClassSolve, compiled, exact: Schedule, deadline: float) -> None:
         """Solve ``outcome``'s class on the first grid, from the exact schedule; records a failure."""
@@ -537,10 +572,11 @@ def _makespan(solution: list[PhaseSolution]) -> float:
 
 
 class _Race:
-    """The classes solved at once, telling each other their best makespans (thread-safe).
+    """The classes solved at once, telling each other their first-grid makespans (thread-safe).
 
-    Every class reports its first grid (``None`` if it failed), and waits until all have, so that
-    the decision to refine does not depend on which thread was quicker.
+    Every class reports its first grid (``None`` if it failed) and waits until all have; later
+    decisions compare with those values only, which are fixed by then, so whether a class refines
+    does not depend on which thread was quicker.
     """
 
     __slots__ = ("_best", "_changed", "_count", "_reported")
@@ -560,12 +596,8 @@ class _Race:
             wait = max(0.0, deadline - time.perf_counter())
             self._changed.wait_for(lambda: len(self._reported) >= self._count, timeout=wait)
 
-    def improved(self, slot: int, makespan: float) -> None:
-        with self._changed:
-            self._best[slot] = min(makespan, self._best.get(slot, math.inf))
-
     def beaten(self, slot: int, makespan: float, remaining: float) -> bool:
-        """Whether another class is already faster than ``makespan`` can become by gaining ``remaining``."""
+        """Whether another class's first grid beats ``makespan`` even after a gain of ``remaining``."""
         with self._changed:
             others = [m for k, m in self._best.items() if k != slot]
         return bool(others) and min(others) < makespan * (1.0 - remaining)
@@ -577,7 +609,7 @@ class _ClassSolve:
     __slots__ = ("attempts", "built", "detail", "failure", "limits", "passes", "phases", "route", "shape")
 
     def __init__(
-        self, route: Route, limits: Limits, phases: tuple[Phase, ...], shape: NlpShape, built: bool
+        self, route: Route, limits: Limits, phases: tuple[Phase, ...], shape: NlpShape, *, built: bool
     ) -> None:
         self.route, self.limits, self.phases, self.shape, self.built = route, limits, phases, shape, built
         self.attempts: tuple[SolverAttempt, ...] = ()
@@ -608,7 +640,7 @@ class _ClassSolve:
         _, solution, attempt = self.passes[index]
         grid = f"{len(self.phases)} phase(s) x {method.segments} segments x {method.nodes} intervals"
         note = f"{grid}, pass {index + 1} of {len(self.passes)} (mesh refinement); {attempt}"
-        info = OptimalInfo(0.0, self.built, self.attempts, refinements=self.refinements)
+        info = OptimalInfo(0.0, self.built, self.attempts, refinements=self.refinements, solved_by=attempt)
         return Schedule(
             self.route,
             self.limits,
