@@ -1,4 +1,4 @@
-"""The ``optimal`` method: time-optimal jerk-limited schedules inside the route's homotopy class.
+"""The ``optimal`` method: time-optimal jerk-limited schedules in the two shortest homotopy classes.
 
 Formulation (ALGORITHM.md section 6). The route's reduced region sequence
 ``R_1 ... R_P`` fixes the homotopy class. Phase ``p`` keeps the vehicles in
@@ -12,21 +12,17 @@ the separation is linear in ``(s1, s2)``.
 Modules: :mod:`~.phases` (phases from the route, the stage layout),
 :mod:`~.transcription` (the NLP), :mod:`~.solve` (solvers and their cache),
 :mod:`~.guess` (initial guess from ``exact``), :mod:`~.decode` (solution to
-schedule), :mod:`~.method` (the :class:`Optimal` method object).
+schedule), :mod:`~.mesh` (mesh refinement), :mod:`~.classes` (classes solved side by side),
+:mod:`~.info` (diagnostics), :mod:`~.method` (the :class:`Optimal` method object).
 """
 
-from trajgen.methods.optimal.method import (
-    DEFAULT_NODES,
-    ClassComparison,
-    HomotopyChoice,
-    Optimal,
-    OptimalInfo,
-    Source,
-)
+from trajgen.methods.optimal.info import ClassComparison, HomotopyChoice, OptimalInfo, Source
+from trajgen.methods.optimal.method import DEFAULT_NODES, DEFAULT_REFINEMENT_TOLERANCE, Optimal
 from trajgen.methods.optimal.solve import Outcome, Solver, SolverAttempt, SolverCache
 
 __all__ = [
     "DEFAULT_NODES",
+    "DEFAULT_REFINEMENT_TOLERANCE",
     "ClassComparison",
     "HomotopyChoice",
     "Optimal",

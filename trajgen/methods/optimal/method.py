@@ -4,10 +4,8 @@ from __future__ import annotations
 
 import concurrent.futures
 import dataclasses
-import enum
 import logging
 import math
-import threading
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -16,17 +14,19 @@ from typing import ClassVar
 import numpy as np
 
 from limits import Limits
-from topology import Homotopy, Option, Route, WayRound, plan
+from topology import Homotopy, Route, plan
 from trajgen.analysis import class_lower_bound
 from trajgen.errors import InputError, SolverError
 from trajgen.methods.exact import Exact
-from trajgen.methods.optimal.decode import PhaseSolution, sections, unpack
+from trajgen.methods.optimal.classes import ClassRace, ClassSolve
+from trajgen.methods.optimal.decode import unpack
 from trajgen.methods.optimal.guess import assemble, initial_guess
+from trajgen.methods.optimal.info import ClassComparison, HomotopyChoice, OptimalInfo, Source
 from trajgen.methods.optimal.mesh import refine
-from trajgen.methods.optimal.phases import NlpShape, Phase, default_fractions, route_phases
-from trajgen.methods.optimal.solve import Solver, SolverAttempt, SolverCache, solve
+from trajgen.methods.optimal.phases import NlpShape, default_fractions, route_phases
+from trajgen.methods.optimal.solve import SolverCache, solve
 from trajgen.methods.optimal.transcription import ParameterLayout
-from trajgen.schedule import FallbackReason, MethodInfo, Schedule, TimingMethod, check_request
+from trajgen.schedule import FallbackReason, Schedule, TimingMethod, check_request
 from trajgen.verify import verify
 
 __all__ = [
@@ -55,9 +55,9 @@ _SEPARATION_MARGIN = 1e-6
 #: allows 1e-6 m past a leg's end), so a thin interior exists.
 _TIGHT_MARGIN = 2e-7
 _LEG_SLACK = 5e-7
-#: Default of ``Optimal.refinement_tolerance``. Successive passes gain at most about a quarter of the
-#: one before (measured on the benchmark sets), so stopping after a pass that gained less than 0.15 %
-#: leaves the makespan within about 0.05 % of the converged optimum, well inside issue 10's 0.2 %.
+#: Default of ``Optimal.refinement_tolerance``: far from a vehicle's own S-curve successive passes gain
+#: a quarter or less of the one before (benchmark sets), so stopping after a pass that gained less
+#: than 0.15 % leaves well under issue 10's 0.2 %; near it, see ``_NEAR_BOUND``.
 DEFAULT_REFINEMENT_TOLERANCE = 1.5e-3
 #: Most that refinement can still gain after the first grid, as a share of its makespan: a class
 #: whose first grid is slower than another class's by more is not refined (the largest total gain
@@ -71,125 +71,6 @@ _NEAR_BOUND_STRICTER = 15.0
 _TIE = 1e-6
 #: After a refinement pass, what the class may still gain is taken as this many times the pass's gain.
 _REMAINING_FACTOR = 4.0
-
-
-class Source(enum.Enum):
-    """Where the motion of an ``optimal`` schedule comes from."""
-
-    NLP = "nlp"  #: the solver's solution
-    EXACT = "exact"  #: the exact schedule, faster than the discretized optimum (or a fallback)
-
-
-class HomotopyChoice(Option):
-    """Which homotopy classes ``optimal`` solves."""
-
-    FASTEST = "fastest"  #: the route's class and the other way round; the faster wins
-    PAPER = "paper"  #: the route's class only (the paper's instruction, for a route from ``plan``)
-
-
-@dataclass(frozen=True, slots=True)
-class ClassComparison:
-    """One homotopy class considered by ``optimal`` with ``homotopy="fastest"``.
-
-    Attributes
-    ----------
-    homotopy : Homotopy
-        Whether it is the paper's class or the other way round.
-    way_round : WayRound
-        Its direction round the boundary circle.
-    lower_bound : float
-        :func:`~trajgen.analysis.class_lower_bound`, seconds.
-    makespan : float or None
-        Its best solved makespan, seconds (verified where ``chosen``; a class that another
-        beat by more than refinement could gain keeps its first grid's); ``None`` when not
-        solved (its lower bound could not beat the faster ``exact`` schedule).
-    chosen : bool
-        Whether the returned schedule is in this class.
-    failure : FallbackReason or None
-        Why the class has no makespan although it was to be solved (its solvers failed, ran
-        out of time, or its setup raised); ``None`` otherwise.
-    """
-
-    homotopy: Homotopy
-    way_round: WayRound
-    lower_bound: float
-    makespan: float | None
-    chosen: bool
-    failure: FallbackReason | None = None
-
-    def summary(self) -> dict:
-        """JSON-ready fields."""
-        return {
-            "homotopy": self.homotopy.value,
-            "way_round": self.way_round.value,
-            "lower_bound_s": self.lower_bound,
-            "makespan_s": self.makespan,
-            "chosen": self.chosen,
-            "failure": None if self.failure is None else self.failure.value,
-        }
-
-
-@dataclass(frozen=True, slots=True)
-class OptimalInfo(MethodInfo):
-    """Diagnostics of one ``optimal`` solve.
-
-    Attributes
-    ----------
-    solve_time : float
-        Wall time from the request to the end of the last solve, seconds: the ``exact`` schedules,
-        every class's solves and refinement passes (concurrent), and the build if it was built;
-        verification excluded.
-    built : bool
-        Whether an NLP had to be built (first query of its shape in the cache).
-    attempts : tuple of SolverAttempt
-        Every solver tried, in order (class by class).
-    source : Source
-        Whether the schedule's motion is the solver's or the exact schedule's.
-    refinements : int
-        Mesh-refinement passes solved after the first (see :mod:`~.mesh`), the most of any class.
-    classes : tuple of ClassComparison
-        The homotopy classes considered (empty when only the route's own was).
-    solved_by : SolverAttempt or None
-        The solver attempt that produced the returned solution (its class and pass).
-    """
-
-    solve_time: float
-    built: bool
-    attempts: tuple[SolverAttempt, ...] = ()
-    source: Source = Source.NLP
-    refinements: int = 0
-    classes: tuple[ClassComparison, ...] = ()
-    solved_by: SolverAttempt | None = None
-
-    @property
-    def solver(self) -> Solver | None:
-        """The solver that converged on the returned solution (None if the motion is not the NLP's)."""
-        if self.source is Source.NLP and self.solved_by is not None:
-            return self.solved_by.solver
-        return None
-
-    @property
-    def iterations(self) -> int:
-        """Iterations of the solver that converged on the returned solution (-1 if none did)."""
-        return self.solved_by.iterations if self.solver is not None else -1
-
-    @property
-    def status(self) -> str:
-        """What each solver tried reported, for people."""
-        return "; ".join(str(attempt) for attempt in self.attempts)
-
-    def summary(self) -> dict:
-        """JSON-ready diagnostics."""
-        return {
-            "solve_time_s": self.solve_time,
-            "built": self.built,
-            "solver": None if self.solver is None else self.solver.value,
-            "iterations": self.iterations,
-            "status": self.status,
-            "source": self.source.value,
-            "refinements": self.refinements,
-            "classes": [c.summary() for c in self.classes],
-        }
 
 
 def _positive_int(value: object, name: str, minimum: int = 1) -> None:
@@ -350,7 +231,7 @@ class Optimal(TimingMethod):
         # a class whose bound reaches the fastest exact schedule cannot beat it: not solved
         wanted = [k for k, bound in enumerate(bounds) if bound < fastest_exact.duration * (1.0 - 1e-9)]
         deadline = began + self.time_budget
-        race = _Race(wanted)
+        race = ClassRace(wanted)
         if len(wanted) > 1:
             with concurrent.futures.ThreadPoolExecutor(
                 len(wanted), thread_name_prefix="trajgen-class"
@@ -445,7 +326,7 @@ class Optimal(TimingMethod):
 
     def _fastest_verified(
         self,
-        solved: dict[int, _ClassSolve],
+        solved: dict[int, ClassSolve],
         exact_duration: float,
         finish: Callable[[Schedule], Schedule],
     ) -> tuple[Schedule | None, list[str]]:
@@ -462,7 +343,7 @@ class Optimal(TimingMethod):
         for makespan, k, p in ranked:
             if makespan >= exact_duration:
                 break
-            candidate = finish(solved[k].schedule(self, p))
+            candidate = finish(solved[k].schedule(self, p, segments=self.segments, nodes=self.nodes))
             report = verify(candidate)
             if report.passed:
                 return candidate, failures
@@ -477,9 +358,9 @@ class Optimal(TimingMethod):
         *,
         slot: int,
         deadline: float,
-        race: _Race,
+        race: ClassRace,
         bound: float,
-    ) -> _ClassSolve:
+    ) -> ClassSolve:
         """Solve ``route``'s own class: the first grid, then refinement passes (unverified).
 
         ``slot``: which compiled copy of the NLP to use (concurrent classes of one shape use two), and
@@ -489,7 +370,7 @@ class Optimal(TimingMethod):
         began = time.perf_counter()
         phases = route_phases(route)
         shape = dataclasses.replace(self.shape(route), slot=slot)
-        outcome = _ClassSolve(route, limits, phases, shape, built=False)
+        outcome = ClassSolve(route, limits, phases, shape, built=False)
         try:
             compiled, outcome.built = self._cache().get(shape)
             self._first_pass(outcome, compiled, exact, deadline)
@@ -507,7 +388,7 @@ class Optimal(TimingMethod):
         return outcome
 
     def _refine(
-        self, outcome: _ClassSolve, compiled, *, slot: int, deadline: float, race: _Race, bound: float
+        self, outcome: ClassSolve, compiled, *, slot: int, deadline: float, race: ClassRace, bound: float
     ) -> None:
         """Mesh-refinement passes of one class until they converge, it is beaten, or time runs short."""
         route, limits, phases, shape = outcome.route, outcome.limits, outcome.phases, outcome.shape
@@ -539,7 +420,7 @@ class Optimal(TimingMethod):
             # what is left: a few times the last gain where convergence is slow, at most the first bound
             remaining = min(_FIRST_GRID_GAIN, _REMAINING_FACTOR * max(gain, 0.0))
 
-    def _first_pass(self, outcome: _ClassSolve, compiled, exact: Schedule, deadline: float) -> None:
+    def _first_pass(self, outcome: ClassSolve, compiled, exact: Schedule, deadline: float) -> None:
         """Solve ``outcome``'s class on the first grid, from the exact schedule; records a failure."""
         route, limits, phases, shape = outcome.route, outcome.limits, outcome.phases, outcome.shape
         try:
@@ -564,92 +445,6 @@ class Optimal(TimingMethod):
     def _as_optimal(self, exact: Schedule, note: str, info: OptimalInfo | None) -> Schedule:
         """The exact schedule, returned by this method because it is the fastest known."""
         return dataclasses.replace(exact, method=self, notes=(note,), info=info)
-
-
-def _makespan(solution: list[PhaseSolution]) -> float:
-    """Duration of a decoded solution, seconds."""
-    return float(sum(phase.times[-1] for phase in solution))
-
-
-class _Race:
-    """The classes solved at once, telling each other their first-grid makespans (thread-safe).
-
-    Every class reports its first grid (``None`` if it failed) and waits until all have; later
-    decisions compare with those values only, which are fixed by then, so whether a class refines
-    does not depend on which thread was quicker.
-    """
-
-    __slots__ = ("_best", "_changed", "_count", "_reported")
-
-    def __init__(self, classes: list[int]) -> None:
-        self._count = len(classes)
-        self._best: dict[int, float] = {}
-        self._reported: set[int] = set()
-        self._changed = threading.Condition()
-
-    def first_pass(self, slot: int, makespan: float | None, deadline: float) -> None:
-        with self._changed:
-            self._reported.add(slot)
-            if makespan is not None:
-                self._best[slot] = makespan
-            self._changed.notify_all()
-            wait = max(0.0, deadline - time.perf_counter())
-            self._changed.wait_for(lambda: len(self._reported) >= self._count, timeout=wait)
-
-    def beaten(self, slot: int, makespan: float, remaining: float) -> bool:
-        """Whether another class's first grid beats ``makespan`` even after a gain of ``remaining``."""
-        with self._changed:
-            others = [m for k, m in self._best.items() if k != slot]
-        return bool(others) and min(others) < makespan * (1.0 - remaining)
-
-
-class _ClassSolve:
-    """What solving one homotopy class delivered: its passes, unverified, and how the solvers fared."""
-
-    __slots__ = ("attempts", "built", "detail", "failure", "limits", "passes", "phases", "route", "shape")
-
-    def __init__(
-        self, route: Route, limits: Limits, phases: tuple[Phase, ...], shape: NlpShape, *, built: bool
-    ) -> None:
-        self.route, self.limits, self.phases, self.shape, self.built = route, limits, phases, shape, built
-        self.attempts: tuple[SolverAttempt, ...] = ()
-        #: (makespan, solution, attempt) of each solved pass, the first grid first
-        self.passes: list[tuple[float, list[PhaseSolution], SolverAttempt]] = []
-        self.failure: FallbackReason | None = None
-        self.detail = ""
-
-    @property
-    def refinements(self) -> int:
-        """Refinement passes solved after the first."""
-        return max(len(self.passes) - 1, 0)
-
-    @property
-    def makespan(self) -> float | None:
-        """The fastest pass's makespan, seconds (None if nothing was solved)."""
-        return min(m for m, _, _ in self.passes) if self.passes else None
-
-    def add(self, solution: list[PhaseSolution], attempt: SolverAttempt) -> None:
-        self.passes.append((_makespan(solution), solution, attempt))
-
-    def failed(self, reason: FallbackReason, detail: str) -> _ClassSolve:
-        self.failure, self.detail = reason, detail
-        return self
-
-    def schedule(self, method: Optimal, index: int) -> Schedule:
-        """Pass ``index`` as an (unverified) schedule."""
-        _, solution, attempt = self.passes[index]
-        grid = f"{len(self.phases)} phase(s) x {method.segments} segments x {method.nodes} intervals"
-        note = f"{grid}, pass {index + 1} of {len(self.passes)} (mesh refinement); {attempt}"
-        info = OptimalInfo(0.0, self.built, self.attempts, refinements=self.refinements, solved_by=attempt)
-        return Schedule(
-            self.route,
-            self.limits,
-            method,
-            sections(self.route, self.limits, self.phases, solution),
-            jerk_limited=True,
-            notes=(note,),
-            info=info,
-        )
 
 
 def _parameters(route: Route, limits: Limits, phases, fractions: np.ndarray) -> np.ndarray:

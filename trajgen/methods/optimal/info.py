@@ -1,0 +1,131 @@
+"""Diagnostics and options of ``optimal``: where its motion comes from, which classes it considered."""
+
+from __future__ import annotations
+
+import enum
+from dataclasses import dataclass
+
+from topology import Homotopy, Option, WayRound
+from trajgen.methods.optimal.solve import Solver, SolverAttempt
+from trajgen.schedule import FallbackReason, MethodInfo
+
+__all__ = ["ClassComparison", "HomotopyChoice", "OptimalInfo", "Source"]
+
+
+class Source(enum.Enum):
+    """Where the motion of an ``optimal`` schedule comes from."""
+
+    NLP = "nlp"  #: the solver's solution
+    EXACT = "exact"  #: the exact schedule, faster than the discretized optimum (or a fallback)
+
+
+class HomotopyChoice(Option):
+    """Which homotopy classes ``optimal`` solves."""
+
+    FASTEST = "fastest"  #: the route's class and the other way round; the faster wins
+    PAPER = "paper"  #: the route's class only (the paper's instruction, for a route from ``plan``)
+
+
+@dataclass(frozen=True, slots=True)
+class ClassComparison:
+    """One homotopy class considered by ``optimal`` with ``homotopy="fastest"``.
+
+    Attributes
+    ----------
+    homotopy : Homotopy
+        Whether it is the paper's class or the other way round.
+    way_round : WayRound
+        Its direction round the boundary circle.
+    lower_bound : float
+        :func:`~trajgen.analysis.class_lower_bound`, seconds.
+    makespan : float or None
+        Its best solved makespan, seconds (verified where ``chosen``; a class that another
+        beat by more than refinement could gain keeps its first grid's); ``None`` when not
+        solved (its lower bound could not beat the faster ``exact`` schedule).
+    chosen : bool
+        Whether the returned schedule is in this class.
+    failure : FallbackReason or None
+        Why the class has no makespan although it was to be solved (its solvers failed, ran
+        out of time, or its setup raised); ``None`` otherwise.
+    """
+
+    homotopy: Homotopy
+    way_round: WayRound
+    lower_bound: float
+    makespan: float | None
+    chosen: bool
+    failure: FallbackReason | None = None
+
+    def summary(self) -> dict:
+        """JSON-ready fields."""
+        return {
+            "homotopy": self.homotopy.value,
+            "way_round": self.way_round.value,
+            "lower_bound_s": self.lower_bound,
+            "makespan_s": self.makespan,
+            "chosen": self.chosen,
+            "failure": None if self.failure is None else self.failure.value,
+        }
+
+
+@dataclass(frozen=True, slots=True)
+class OptimalInfo(MethodInfo):
+    """Diagnostics of one ``optimal`` solve.
+
+    Attributes
+    ----------
+    solve_time : float
+        Wall time from the request to the end of the last solve, seconds: the ``exact`` schedules,
+        every class's solves and refinement passes (concurrent), and the build if it was built;
+        verification excluded.
+    built : bool
+        Whether an NLP had to be built (first query of its shape in the cache).
+    attempts : tuple of SolverAttempt
+        Every solver tried, in order (class by class).
+    source : Source
+        Whether the schedule's motion is the solver's or the exact schedule's.
+    refinements : int
+        Mesh-refinement passes solved after the first (see :mod:`~.mesh`), the most of any class.
+    classes : tuple of ClassComparison
+        The homotopy classes considered (empty when only the route's own was).
+    solved_by : SolverAttempt or None
+        The solver attempt that produced the returned solution (its class and pass).
+    """
+
+    solve_time: float
+    built: bool
+    attempts: tuple[SolverAttempt, ...] = ()
+    source: Source = Source.NLP
+    refinements: int = 0
+    classes: tuple[ClassComparison, ...] = ()
+    solved_by: SolverAttempt | None = None
+
+    @property
+    def solver(self) -> Solver | None:
+        """The solver that converged on the returned solution (None if the motion is not the NLP's)."""
+        if self.source is Source.NLP and self.solved_by is not None:
+            return self.solved_by.solver
+        return None
+
+    @property
+    def iterations(self) -> int:
+        """Iterations of the solver that converged on the returned solution (-1 if none did)."""
+        return self.solved_by.iterations if self.solver is not None else -1
+
+    @property
+    def status(self) -> str:
+        """What each solver tried reported, for people."""
+        return "; ".join(str(attempt) for attempt in self.attempts)
+
+    def summary(self) -> dict:
+        """JSON-ready diagnostics."""
+        return {
+            "solve_time_s": self.solve_time,
+            "built": self.built,
+            "solver": None if self.solver is None else self.solver.value,
+            "iterations": self.iterations,
+            "status": self.status,
+            "source": self.source.value,
+            "refinements": self.refinements,
+            "classes": [c.summary() for c in self.classes],
+        }
