@@ -61,7 +61,7 @@ _LEG_SLACK = 5e-7
 DEFAULT_REFINEMENT_TOLERANCE = 1.5e-3
 #: Most that refinement can still gain after the first grid, as a share of its makespan: a class
 #: whose first grid is slower than another class's by more is not refined (the largest total gain
-#: measured is 1.8 %, 200/120/80 m at 24 nodes). After a pass, its own gain bounds what is left.
+#: measured is 1.8 %, 200/120/80 m at 24 nodes). After a pass, see ``_REMAINING_FACTOR``.
 _FIRST_GRID_GAIN = 0.05
 #: Within this share of its class lower bound a solution is near a single vehicle's own S-curve,
 #: where refinement converges slowly (linearly): there it stops only below a 15x stricter gain.
