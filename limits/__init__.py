@@ -10,6 +10,7 @@ Examples
 
 from limits.errors import LimitsError
 from limits.vehicle import (
+    EMERGENCY_FACTOR,
     ILLUSTRATIVE_LIMITS,
     ILLUSTRATIVE_MIN_SEPARATION,
     ILLUSTRATIVE_VEHICLE,
@@ -18,6 +19,7 @@ from limits.vehicle import (
 )
 
 __all__ = [
+    "EMERGENCY_FACTOR",
     "ILLUSTRATIVE_LIMITS",
     "ILLUSTRATIVE_MIN_SEPARATION",
     "ILLUSTRATIVE_VEHICLE",

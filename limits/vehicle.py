@@ -9,12 +9,17 @@ from topology.errors import SeparationError
 from topology.validation import finite_real
 
 __all__ = [
+    "EMERGENCY_FACTOR",
     "ILLUSTRATIVE_LIMITS",
     "ILLUSTRATIVE_MIN_SEPARATION",
     "ILLUSTRATIVE_VEHICLE",
     "Limits",
     "VehicleLimits",
 ]
+
+
+#: Default emergency deceleration as a multiple of ``max_acceleration``.
+EMERGENCY_FACTOR = 2.0
 
 
 @dataclass(frozen=True, slots=True)
@@ -29,16 +34,21 @@ class VehicleLimits:
         Largest ``|a|``, m/s², finite and > 0.
     max_jerk : float
         Largest ``|j|``, m/s³, finite and > 0.
+    emergency_deceleration : float or None, optional
+        Deceleration of an emergency stop, m/s², at least ``max_acceleration``;
+        ``None`` (default) means ``EMERGENCY_FACTOR * max_acceleration``. The
+        online executor assumes the other vehicle may stop this hard at any time.
 
     Raises
     ------
     LimitsError
-        A limit that is not a finite positive number.
+        A limit that is not a finite positive number, or an emergency deceleration below ``max_acceleration``.
     """
 
     max_velocity: float
     max_acceleration: float
     max_jerk: float
+    emergency_deceleration: float | None = None
 
     def __post_init__(self) -> None:
         for name, unit in (("max_velocity", "m/s"), ("max_acceleration", "m/s^2"), ("max_jerk", "m/s^3")):
@@ -46,6 +56,21 @@ class VehicleLimits:
             if value <= 0.0:
                 raise LimitsError(f"{name} must be > 0 {unit}, got {value!r}")
             object.__setattr__(self, name, value)
+        if self.emergency_deceleration is not None:
+            value = finite_real(self.emergency_deceleration, "emergency_deceleration (m/s^2)", LimitsError)
+            if value < self.max_acceleration:
+                raise LimitsError(
+                    f"emergency_deceleration must be >= max_acceleration {self.max_acceleration!r} m/s^2 "
+                    f"(an emergency stop is no gentler than service braking), got {value!r}"
+                )
+            object.__setattr__(self, "emergency_deceleration", value)
+
+    @property
+    def emergency_braking(self) -> float:
+        """Deceleration of an emergency stop, m/s² (the default when none was given)."""
+        if self.emergency_deceleration is not None:
+            return self.emergency_deceleration
+        return EMERGENCY_FACTOR * self.max_acceleration
 
 
 @dataclass(frozen=True, slots=True)

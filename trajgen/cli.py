@@ -1,7 +1,9 @@
 """The ``trajgen`` command line: parses arguments, runs the pipeline, prints the result.
 
 Exit status: 0 on success, 2 on bad input (message on stderr, nothing
-written), 1 on an internal failure (nothing written).
+written), 1 on an internal failure (nothing written). ``trajgen simulate``
+also exits 1 when the simulated run missed its goal or had violations (its
+trace and plot are written: they are the evidence).
 """
 
 from __future__ import annotations
@@ -16,6 +18,7 @@ from collections.abc import Sequence
 from trajgen.errors import InputError, OptionError
 from trajgen.export import DEFAULT_MAX_ROWS, CsvOptions, Units
 from trajgen.methods import METHODS, HomotopyChoice, Optimal
+from trajgen.online.run import format_simulation, run_simulation
 from trajgen.pipeline import Outputs, run
 from trajgen.scenario import Scenario, default_scenario, load_scenario
 from trajgen.schedule import TimingMethod
@@ -47,15 +50,14 @@ def _command_plan(args: argparse.Namespace) -> int:
     return EXIT_OK
 
 
-def _csv_options(args: argparse.Namespace) -> CsvOptions:
+def _csv_dialect(args: argparse.Namespace) -> dict:
+    """``--delimiter``, ``--decimal``, ``--units`` as keyword arguments of CsvOptions."""
     delimiter = "\t" if args.delimiter in ("tab", "\\t") else args.delimiter
-    return CsvOptions(
-        sample_period=args.sample_period,
-        delimiter=delimiter,
-        decimal=args.decimal,
-        units=Units.lookup(args.units),
-        max_rows=args.max_rows,
-    )
+    return {"delimiter": delimiter, "decimal": args.decimal, "units": Units.lookup(args.units)}
+
+
+def _csv_options(args: argparse.Namespace) -> CsvOptions:
+    return CsvOptions(sample_period=args.sample_period, max_rows=args.max_rows, **_csv_dialect(args))
 
 
 def _command_schedule(args: argparse.Namespace) -> int:
@@ -73,6 +75,34 @@ def _command_demo(args: argparse.Namespace) -> int:
     print(format_route(result.route))
     print(format_run(result.summary()))
     print(f"CSV profiles and plots are in {args.output}/")
+    return EXIT_OK
+
+
+def _command_simulate(args: argparse.Namespace) -> int:
+    scenario = _load(args.scenario)
+    result, files = run_simulation(
+        scenario,
+        args.fault,
+        period=args.period,
+        method=args.method,
+        position_margin=args.position_margin,
+        trace_dir=args.trace,
+        plot_dir=args.plot,
+        csv_options=CsvOptions(**_csv_dialect(args)),
+    )
+    summary = {**result.summary(), "files": [str(path) for path in files]}
+    if args.json:
+        print(json.dumps(summary, indent=2))
+    else:
+        print(format_simulation(summary, min_separation=scenario.limits.min_separation))
+    failures = []
+    if not result.reached_goal:
+        failures.append("did not reach the goal")
+    if result.violations:
+        failures.append(f"had {result.violations} violation{'s' if result.violations != 1 else ''}")
+    if failures:
+        print(f"trajgen: the simulated run {' and '.join(failures)}", file=sys.stderr)
+        return EXIT_FAILURE
     return EXIT_OK
 
 
@@ -106,19 +136,24 @@ def _method(args: argparse.Namespace) -> TimingMethod:
     return dataclasses.replace(method, homotopy=choice)
 
 
-def _add_csv_options(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("--sample-period", type=float, default=0.01, help="seconds between CSV rows (0.01)")
+def _add_csv_options(parser: argparse.ArgumentParser, *, sampling: bool = True) -> None:
+    """The CSV dialect options; with ``sampling``, also ``--sample-period`` and ``--max-rows``."""
+    if sampling:
+        parser.add_argument(
+            "--sample-period", type=float, default=0.01, help="seconds between CSV rows (0.01)"
+        )
     parser.add_argument("--delimiter", default=";", help="CSV field separator (';'); 'tab' for a tab")
     parser.add_argument("--decimal", default=".", choices=[".", ","], help="decimal mark ('.')")
     parser.add_argument(
         "--units", default="m", choices=[u.value for u in Units], help="length unit of the CSV (m)"
     )
-    parser.add_argument(
-        "--max-rows",
-        type=int,
-        default=DEFAULT_MAX_ROWS,
-        help=f"refuse a CSV profile of more rows than this ({DEFAULT_MAX_ROWS:,})",
-    )
+    if sampling:
+        parser.add_argument(
+            "--max-rows",
+            type=int,
+            default=DEFAULT_MAX_ROWS,
+            help=f"refuse a CSV profile of more rows than this ({DEFAULT_MAX_ROWS:,})",
+        )
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -157,6 +192,52 @@ def build_parser() -> argparse.ArgumentParser:
     schedule.add_argument("--json", action="store_true", help="print a machine-readable summary")
     _add_csv_options(schedule)
     schedule.set_defaults(run=_command_schedule)
+
+    simulate = commands.add_parser(
+        "simulate",
+        help="run a scenario in closed loop under faults (exit 1 if it misses the goal or has violations)",
+        formatter_class=argparse.RawTextHelpFormatter,
+    )
+    simulate.add_argument("scenario", help="scenario TOML file")
+    simulate.add_argument(
+        "--fault",
+        action="append",
+        default=[],
+        metavar="SPEC",
+        help="a fault of the simulated plant, repeatable:\n"
+        "  stop:NAME@T+D    NAME stops at T s for D s\n"
+        "  slow:NAME@T=V    from T s NAME's drive cannot exceed V m/s (below its max_velocity)\n"
+        "  lag:NAME@T=MS    from T s NAME follows its setpoints MS ms late (at most 200)\n"
+        "  jump:NAME@T=DS   at T s NAME's measured position is corrected by DS m\n"
+        "                   (|DS| at most --position-margin)\n"
+        "  goal:NAME@T=LEG:S  at T s a new goal LEG:S (metres from the junction) is requested",
+    )
+    simulate.add_argument(
+        "--period", type=float, default=0.01, help="control period, seconds (0.002 to 0.1; 0.01)"
+    )
+    simulate.add_argument(
+        "--method",
+        default=METHODS.default,
+        metavar="|".join(METHODS.names),
+        help=f"timing method of the undisturbed plan, one of:\n{METHODS.help()}",
+    )
+    simulate.add_argument(
+        "--position-margin",
+        type=float,
+        default=0.05,
+        help="the executor's position margin, metres (0.05); also the largest jump",
+    )
+    simulate.add_argument(
+        "--trace",
+        metavar="DIR",
+        help="write DIR/<vehicle name>.csv per vehicle: the executed motion, one row per period",
+    )
+    simulate.add_argument(
+        "--plot", metavar="DIR", help="write DIR/simulation.png (planned vs executed speed, separation)"
+    )
+    simulate.add_argument("--json", action="store_true", help="print a machine-readable summary")
+    _add_csv_options(simulate, sampling=False)
+    simulate.set_defaults(run=_command_simulate)
     return parser
 
 

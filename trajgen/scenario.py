@@ -55,6 +55,7 @@ PLAUSIBLE = {
     "max_velocity": (1e-4, 100.0),
     "max_acceleration": (1e-4, 1000.0),
     "max_jerk": (1e-4, 1e6),
+    "emergency_deceleration": (1e-4, 1000.0),
 }
 _TOP_KEYS = {"track": True, "safety": True, "vehicle": True}
 _TRACK_KEYS = {"legs": True, "angles_deg": False}
@@ -64,6 +65,7 @@ _VEHICLE_KEYS = {
     "max_velocity": True,
     "max_acceleration": True,
     "max_jerk": True,
+    "emergency_deceleration": False,
     "start": True,
     "goal": True,
 }
@@ -115,9 +117,11 @@ def _check_plausible_track(track: YGraph) -> None:
 
 
 def _check_plausible_vehicle(vehicle: VehicleLimits, where: str) -> None:
-    for key in ("max_velocity", "max_acceleration", "max_jerk"):
+    for key in ("max_velocity", "max_acceleration", "max_jerk", "emergency_deceleration"):
         low, high = PLAUSIBLE[key]
         value = getattr(vehicle, key)
+        if value is None:
+            continue
         if not low <= value <= high:
             raise InputError(f"{where} {key} is {value!r}: expected {low:g} to {high:g} (SI units)")
 
@@ -188,7 +192,8 @@ def _parse_vehicle(vehicle: object, k: int, track: YGraph, taken: list[str], sou
         )
     numbers = {
         key: _number(vehicle[key], f"{where} {key}", source)
-        for key in ("max_velocity", "max_acceleration", "max_jerk")
+        for key in ("max_velocity", "max_acceleration", "max_jerk", "emergency_deceleration")
+        if key in vehicle
     }
     try:
         limits = VehicleLimits(**numbers)

@@ -14,12 +14,12 @@ from pathlib import Path
 
 import numpy as np
 
-from topology import JUNCTION_INDEX, Option
+from topology import JUNCTION_INDEX, Option, YGraph
 from topology.validation import short_repr
 from trajgen.errors import InputError, OptionError, OutputLimitError
 from trajgen.export.atomic import commit_files
 from trajgen.naming import check_vehicle_names
-from trajgen.schedule import Schedule, ScheduleState, check_period, sample_block, sample_rows
+from trajgen.schedule import ScheduleState, check_period, sample_block, sample_rows
 from trajgen.verify import VerifiedSchedule, require_verified
 
 __all__ = [
@@ -29,6 +29,7 @@ __all__ = [
     "CsvOptions",
     "Units",
     "check_row_limit",
+    "format_rows",
     "profile_chunks",
     "profile_paths",
     "profile_rows",
@@ -120,19 +121,22 @@ def _usable_delimiter(value: object) -> bool:
     )
 
 
-def _xy(schedule: Schedule, state: ScheduleState, vehicle: int) -> tuple[np.ndarray, np.ndarray]:
-    angles = np.radians(np.array(schedule.route.graph.angles_deg))
+def _xy(graph: YGraph, state: ScheduleState, vehicle: int) -> tuple[np.ndarray, np.ndarray]:
+    angles = np.radians(np.array(graph.angles_deg))
     leg = state.leg[vehicle]
     s = state.s[vehicle]
     angle = angles[np.where(leg == JUNCTION_INDEX, 0, leg)]
     return s * np.cos(angle), s * np.sin(angle)
 
 
-def _lines(schedule: Schedule, state: ScheduleState, vehicle: int, options: CsvOptions) -> list[str]:
-    """Rows of one vehicle's CSV profile for the sampled ``state``, without line ends."""
+def format_rows(graph: YGraph, state: ScheduleState, vehicle: int, options: CsvOptions) -> list[str]:
+    """Rows of one vehicle's CSV profile for the sampled ``state`` on ``graph``, without line ends.
+
+    Also the format of executed motion (``trajgen simulate --trace``).
+    """
     scale = options.units.scale
     decimals = options.units.decimals
-    x, y = _xy(schedule, state, vehicle)
+    x, y = _xy(graph, state, vehicle)
     columns = [
         (state.t, 6),
         (state.axis[vehicle] * scale, decimals),
@@ -214,7 +218,7 @@ def profile_chunks(
         yield (options.delimiter.join(HEADER_NAMES[options.units]) + "\r\n").encode("ascii")
         for first in range(0, rows, ROWS_PER_CHUNK):
             times = sample_block(schedule.duration, options.sample_period, first, first + ROWS_PER_CHUNK)
-            lines = _lines(schedule, schedule.state(times), vehicle, options)
+            lines = format_rows(schedule.route.graph, schedule.state(times), vehicle, options)
             yield ("\r\n".join(lines) + "\r\n").encode("ascii")
 
     return chunks()

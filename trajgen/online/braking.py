@@ -1,0 +1,173 @@
+"""The braking check: whether the separation would hold if both vehicles started braking now.
+
+Each vehicle's braking is bounded by two motions along its path: its
+*service* braking from its commanded state (jerk-limited, at its
+``max_acceleration`` and ``max_jerk``: the latest it can stop, computed with
+Ruckig) and its *emergency* braking from its measured state (constant
+``emergency_deceleration`` at once: the earliest). Between the two, the
+vehicle is somewhere in a *tube* along its path. The check certifies that
+at every instant the two tubes stay at least the required track distance
+apart: time is cut into intervals, and on each the range a vehicle can
+cover is widened by the most a motion of bounded acceleration can leave the
+chord between its ends (``a * dt**2 / 8``), so nothing between the instants
+is missed. That covers a leader stopping short in front of a follower (the
+follower's service braking against the leader's emergency braking) and two
+vehicles closing on each other (both at service braking).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+from ruckig import ControlInterface, InputParameter, Result, Ruckig, Trajectory
+
+from limits import VehicleLimits
+from trajgen.online.paths import VehiclePath, set_distance
+
+__all__ = ["BrakingCheck", "PathState", "ServiceBraking", "emergency_position"]
+
+#: Time intervals tried in turn: a coarse pass is enough while the vehicles are far apart.
+_REFINEMENTS = (1, 6, 40)
+
+
+@dataclass(frozen=True, slots=True)
+class PathState:
+    """A vehicle's state along its path: travel (m), its rate (m/s) and acceleration (m/s²)."""
+
+    p: float
+    v: float
+    a: float
+
+
+class ServiceBraking:
+    """Jerk-limited braking to rest along a path (Ruckig's velocity interface, target v = a = 0).
+
+    Parameters
+    ----------
+    limits : VehicleLimits
+    """
+
+    __slots__ = ("_generator", "_input", "_trajectory")
+
+    def __init__(self, limits: VehicleLimits) -> None:
+        self._generator = Ruckig(1)
+        self._input = InputParameter(1)
+        self._input.control_interface = ControlInterface.Velocity
+        self._input.max_velocity = [limits.max_velocity]
+        self._input.max_acceleration = [limits.max_acceleration]
+        self._input.max_jerk = [limits.max_jerk]
+        self._input.target_velocity = [0.0]
+        self._input.target_acceleration = [0.0]
+        self._trajectory = Trajectory(1)
+
+    def plan(self, state: PathState) -> Trajectory:
+        """Braking from ``state``; the returned trajectory is reused by the next call."""
+        self._input.current_position = [state.p]
+        self._input.current_velocity = [state.v]
+        self._input.current_acceleration = [state.a]
+        result = self._generator.calculate(self._input, self._trajectory)
+        if result not in (Result.Working, Result.Finished):
+            raise RuntimeError(f"ruckig could not plan a braking motion from {state}: {result}")
+        return self._trajectory
+
+
+def emergency_position(state: PathState, deceleration: float, t: float) -> float:
+    """Travel ``t`` seconds into an emergency stop at constant ``deceleration`` (m/s²) from ``state``."""
+    v = state.v
+    if v == 0.0:
+        return state.p
+    t = min(t, abs(v) / deceleration)
+    return state.p + v * t - math.copysign(0.5 * deceleration * t * t, v)
+
+
+class BrakingCheck:
+    """Certifies that both vehicles braking now keep a track distance.
+
+    Parameters
+    ----------
+    limits : tuple of 2 VehicleLimits
+    emergency : tuple of 2 float
+        Emergency deceleration of each vehicle, m/s².
+    leg_lengths : tuple of 3 float
+        The track's legs, metres.
+    """
+
+    __slots__ = ("_braking", "_emergency", "_lengths", "_pad_acceleration")
+
+    def __init__(
+        self, limits: tuple[VehicleLimits, VehicleLimits], emergency: tuple[float, float], leg_lengths
+    ) -> None:
+        self._braking = (ServiceBraking(limits[0]), ServiceBraking(limits[1]))
+        self._emergency = emergency
+        self._lengths = tuple(leg_lengths)
+        self._pad_acceleration = tuple(
+            max(lim.max_acceleration, e) for lim, e in zip(limits, emergency, strict=True)
+        )
+
+    def service(self, vehicle: int) -> ServiceBraking:
+        """The service braking of ``vehicle`` (0 or 1)."""
+        return self._braking[vehicle]
+
+    def clearance(
+        self,
+        paths: tuple[VehiclePath, VehiclePath],
+        commanded: tuple[PathState, PathState],
+        measured: tuple[PathState, PathState],
+        required: float,
+    ) -> bool:
+        """Whether the braking tubes stay at least ``required`` metres apart until both are at rest.
+
+        Parameters
+        ----------
+        paths : tuple of 2 VehiclePath
+        commanded : tuple of 2 PathState
+            The states about to be commanded (service braking starts there).
+        measured : tuple of 2 PathState
+            The measured states (emergency braking starts there).
+        required : float
+            Track distance to keep, metres.
+        """
+        trajectories = [braking.plan(state) for braking, state in zip(self._braking, commanded, strict=True)]
+        durations = [t.duration for t in trajectories]
+        ends = [t.at_time(d)[0][0] for t, d in zip(trajectories, durations, strict=True)]
+        horizon = max(
+            *durations,
+            *(abs(m.v) / e for m, e in zip(measured, self._emergency, strict=True)),
+        )
+        # the extra acceleration a measured state may carry beyond the limits widens the pad
+        pads = [
+            max(pad, abs(c.a), abs(m.a))
+            for pad, c, m in zip(self._pad_acceleration, commanded, measured, strict=True)
+        ]
+        for count in _REFINEMENTS:
+            if self._intervals_clear(
+                paths, trajectories, durations, ends, measured, required, horizon, count, pads
+            ):
+                return True
+        return False
+
+    def _intervals_clear(
+        self, paths, trajectories, durations, ends, measured, required, horizon, count, pads
+    ):
+        step = horizon / count
+        previous = None
+        lengths = self._lengths
+        for k in range(count + 1):
+            t = k * step
+            bounds = []
+            for vehicle in (0, 1):
+                upper = ends[vehicle] if t >= durations[vehicle] else trajectories[vehicle].at_time(t)[0][0]
+                lower = emergency_position(measured[vehicle], self._emergency[vehicle], t)
+                bounds.append((min(lower, upper), max(lower, upper)))
+            if previous is not None:
+                sets = []
+                for vehicle in (0, 1):
+                    pad = pads[vehicle] * step * step / 8.0
+                    low = min(previous[vehicle][0], bounds[vehicle][0]) - pad
+                    high = max(previous[vehicle][1], bounds[vehicle][1]) + pad
+                    sets.append(paths[vehicle].sweep(low, high, lengths))
+                if set_distance(sets[0], sets[1]) < required:
+                    return False
+            previous = bounds
+        return True

@@ -1,0 +1,300 @@
+"""Each vehicle's path along a route as a function of the distance it has travelled.
+
+The executor works in *travel* coordinates: ``p`` is the distance a vehicle
+has driven along its own path of the route (``0 <= p <= length``), so both
+vehicles' progress is monotone and a route is a monotone polyline in the
+``(p1, p2)`` plane (:class:`Coordination`). Plain floats and tuples: these
+functions run every control cycle.
+"""
+
+from __future__ import annotations
+
+import bisect
+from dataclasses import dataclass
+
+from topology import JUNCTION_INDEX, Route
+
+__all__ = ["Coordination", "Interval", "VehiclePath", "interval_distance", "set_distance"]
+
+#: Moves of a vehicle shorter than this between two waypoints are ignored, metres.
+MOVE_RESOLUTION = 1e-9
+#: One stretch of track: (leg index, smallest s, largest s), metres.
+Interval = tuple[int, float, float]
+
+
+def interval_distance(first: Interval, second: Interval) -> float:
+    """Track distance between two stretches of track, metres (0 if they overlap)."""
+    leg_a, low_a, high_a = first
+    leg_b, low_b, high_b = second
+    if leg_a == leg_b:
+        return max(0.0, low_b - high_a, low_a - high_b)
+    return low_a + low_b
+
+
+def set_distance(first: tuple[Interval, ...], second: tuple[Interval, ...]) -> float:
+    """Track distance between two unions of stretches, metres."""
+    return min(interval_distance(a, b) for a in first for b in second)
+
+
+@dataclass(frozen=True, slots=True)
+class VehiclePath:
+    """One vehicle's path along a route, parameterised by travelled distance ``p`` (metres).
+
+    The path is a sequence of segments, each on one leg and monotone in ``s``;
+    consecutive segments on different legs pass through the junction. The
+    vehicle's signed axis (its odometer) changes by ``heading * dp``; the
+    heading flips where the path reverses on a leg (the vehicle must be at rest
+    there: :attr:`stops`).
+
+    Attributes
+    ----------
+    legs : tuple of int, shape (m,)
+        Leg index of each segment.
+    s_from, s_to : tuple of float, shape (m,)
+        Distance from the junction at each segment's ends, metres.
+    starts : tuple of float, shape (m,)
+        Travel at each segment's start, metres (``starts[0] == 0``).
+    headings : tuple of int, shape (m,)
+        ``d axis / dp`` on each segment: +1 or -1.
+    axis_starts : tuple of float, shape (m,)
+        Axis value at each segment's start, metres.
+    length : float
+        Total travel, metres.
+    stops : tuple of float
+        Travel at each reversal, ascending, metres.
+    home : tuple of (int, float)
+        ``(leg, s)`` of a path that does not move (``m == 0``).
+    """
+
+    legs: tuple[int, ...]
+    s_from: tuple[float, ...]
+    s_to: tuple[float, ...]
+    starts: tuple[float, ...]
+    headings: tuple[int, ...]
+    axis_starts: tuple[float, ...]
+    length: float
+    stops: tuple[float, ...]
+    home: tuple[int, float]
+
+    @classmethod
+    def from_route(
+        cls, route: Route, vehicle: int, *, axis_start: float = 0.0, orientation: int | None = None
+    ) -> VehiclePath:
+        """The path of ``vehicle`` (0 or 1) along ``route`` (see :meth:`from_waypoints`)."""
+        return cls.from_waypoints(
+            route.indexed_waypoints, vehicle, axis_start=axis_start, orientation=orientation
+        )
+
+    @classmethod
+    def from_waypoints(
+        cls, waypoints, vehicle: int, *, axis_start: float = 0.0, orientation: int | None = None
+    ) -> VehiclePath:
+        """The path of ``vehicle`` (0 or 1) through indexed configurations ``(leg1, s1, leg2, s2)``.
+
+        Between consecutive configurations each vehicle moves within one leg, or through the
+        junction from one leg to another; moves shorter than :data:`MOVE_RESOLUTION` are ignored.
+
+        Parameters
+        ----------
+        waypoints : sequence of tuple, shape (n, 4)
+        vehicle : int
+        axis_start : float, optional
+            Axis value at the start, metres.
+        orientation : int, optional
+            ``ds / d axis`` of the vehicle at the start (+1 if its axis grows
+            away from the junction). ``None``: the axis grows in the direction of
+            the first move (the convention of :class:`~trajgen.schedule.Schedule`).
+        """
+        pieces: list[list] = []  # [leg, s_from, s_to]
+        waypoints = list(waypoints)
+        last = waypoints[0]
+        for b in waypoints[1:]:
+            a = last
+            leg_a, s_a, leg_b, s_b = a[2 * vehicle], a[2 * vehicle + 1], b[2 * vehicle], b[2 * vehicle + 1]
+            if abs(s_a - s_b) <= MOVE_RESOLUTION and (leg_a == leg_b or max(s_a, s_b) <= MOVE_RESOLUTION):
+                continue
+            last = b
+            if leg_a == leg_b or s_b == 0.0 or s_a == 0.0:
+                leg = leg_a if leg_a != JUNCTION_INDEX else leg_b
+                if pieces and pieces[-1][0] == leg and (pieces[-1][2] - pieces[-1][1]) * (s_b - s_a) > 0.0:
+                    pieces[-1][2] = s_b  # the same move, split by the other vehicle's waypoint
+                else:
+                    pieces.append([leg, s_a, s_b])
+            else:  # through the junction within one segment (not produced by plan(), but harmless)
+                pieces.append([leg_a, s_a, 0.0])
+                pieces.append([leg_b, 0.0, s_b])
+        first = waypoints[0]
+        home = (first[2 * vehicle], first[2 * vehicle + 1])
+        legs, s_from, s_to, starts, headings, axis_starts, stops = [], [], [], [], [], [], []
+        travel, axis = 0.0, float(axis_start)
+        heading = 1
+        if pieces and orientation is not None:
+            heading = (1 if pieces[0][2] > pieces[0][1] else -1) * (1 if orientation >= 0 else -1)
+        for k, (leg, s_a, s_b) in enumerate(pieces):
+            if k and leg == legs[-1] and (s_b - s_a) * (s_to[-1] - s_from[-1]) < 0.0:
+                heading = -heading  # a reversal on one leg
+                stops.append(travel)
+            legs.append(leg)
+            s_from.append(float(s_a))
+            s_to.append(float(s_b))
+            starts.append(travel)
+            headings.append(heading)
+            axis_starts.append(axis)
+            travel += abs(s_b - s_a)
+            axis += heading * abs(s_b - s_a)
+        return cls(
+            tuple(legs),
+            tuple(s_from),
+            tuple(s_to),
+            tuple(starts),
+            tuple(headings),
+            tuple(axis_starts),
+            travel,
+            tuple(stops),
+            home,
+        )
+
+    def segment(self, p: float) -> int:
+        """Index of the segment holding travel ``p`` (clipped to the path)."""
+        return min(max(bisect.bisect_right(self.starts, p) - 1, 0), len(self.starts) - 1)
+
+    def locate(self, p: float) -> tuple[int, float]:
+        """``(leg, s)`` at travel ``p`` (clipped to [0, length]); leg is ``JUNCTION_INDEX`` at s = 0."""
+        if not self.legs:
+            return self.home
+        k = self.segment(p)
+        local = min(max(p - self.starts[k], 0.0), abs(self.s_to[k] - self.s_from[k]))
+        s = self.s_from[k] + (local if self.s_to[k] > self.s_from[k] else -local)
+        return (self.legs[k] if s > 0.0 else JUNCTION_INDEX), s
+
+    def outward(self, p: float) -> int:
+        """``ds / dp`` at travel ``p``: +1 away from the junction, -1 towards it (+1 if it never moves)."""
+        if not self.legs:
+            return 1
+        k = self.segment(p)
+        return 1 if self.s_to[k] > self.s_from[k] else -1
+
+    def heading(self, p: float) -> int:
+        """``d axis / dp`` at travel ``p``."""
+        return self.headings[self.segment(p)] if self.legs else 1
+
+    def axis(self, p: float) -> float:
+        """The vehicle's signed axis at travel ``p`` (beyond the ends: extended along the end segments)."""
+        if not self.legs:
+            return self.axis_starts[0] if self.axis_starts else 0.0
+        k = self.segment(p)
+        return self.axis_starts[k] + self.headings[k] * (p - self.starts[k])
+
+    def next_stop(self, p: float, tolerance: float) -> float:
+        """The first reversal ahead of travel ``p`` (more than ``tolerance`` ahead), or the path's end."""
+        k = bisect.bisect_right(self.stops, p + tolerance)
+        return self.stops[k] if k < len(self.stops) else self.length
+
+    def project(self, leg: int, s: float, near: float, slack: float = 1e-9) -> float | None:
+        """The travel at which the path passes ``(leg, s)``, nearest ``near``; ``None`` if it never does.
+
+        A position up to ``slack`` metres beyond the end of a stretch of the path counts as that end.
+        """
+        best = None
+        if not self.legs:
+            home_leg, home_s = self.home
+            same = abs(s - home_s) <= slack and (leg == home_leg or max(s, home_s) <= slack)
+            return 0.0 if same else None
+        for k, seg_leg in enumerate(self.legs):
+            if seg_leg != leg and s != 0.0:
+                continue
+            low, high = min(self.s_from[k], self.s_to[k]), max(self.s_from[k], self.s_to[k])
+            if not low - slack <= s <= high + slack:
+                continue
+            p = self.starts[k] + abs(min(max(s, low), high) - self.s_from[k])
+            if best is None or abs(p - near) < abs(best - near):
+                best = p
+        return best
+
+    def sweep(self, p_low: float, p_high: float, leg_lengths: tuple[float, ...]) -> tuple[Interval, ...]:
+        """The track covered while travel runs over ``[p_low, p_high]``, as stretches per leg.
+
+        Travel before 0 or past ``length`` extends the first or last segment
+        along its leg (clipped to the leg), so a vehicle off the ends of its
+        path is still accounted for.
+        """
+        if not self.legs:
+            leg, s = self.home
+            return ((leg, s, s),)
+        out = []
+        last = len(self.legs) - 1
+        for k, leg in enumerate(self.legs):
+            start = self.starts[k]
+            end = self.starts[k + 1] if k < last else self.length
+            low = start if k else min(start, p_low)
+            high = end if k < last else max(end, p_high)
+            a, b = max(p_low, low), min(p_high, high)
+            if a > b:
+                continue
+            sign = 1.0 if self.s_to[k] > self.s_from[k] else -1.0
+            s_a = self.s_from[k] + sign * (a - start)
+            s_b = self.s_from[k] + sign * (b - start)
+            lo, hi = min(s_a, s_b), max(s_a, s_b)
+            out.append((leg, min(max(lo, 0.0), leg_lengths[leg]), min(max(hi, 0.0), leg_lengths[leg])))
+        if not out:  # an empty or reversed range: the point itself
+            leg, s = self.locate(p_low)
+            return ((leg if leg != JUNCTION_INDEX else self.legs[self.segment(p_low)], s, s),)
+        return tuple(out)
+
+
+@dataclass(frozen=True, slots=True)
+class Coordination:
+    """A route as a monotone polyline in the plane of both vehicles' travel.
+
+    Attributes
+    ----------
+    first, second : tuple of float, shape (n,)
+        Travel of vehicle 1 and vehicle 2 at each waypoint, metres, non-decreasing.
+    """
+
+    first: tuple[float, ...]
+    second: tuple[float, ...]
+
+    @classmethod
+    def from_route(cls, route: Route) -> Coordination:
+        """The polyline of ``route``'s waypoints in travel coordinates."""
+        return cls.from_waypoints(route.indexed_waypoints)
+
+    @classmethod
+    def from_waypoints(cls, waypoints) -> Coordination:
+        """Indexed configurations as a polyline of travel (as in :meth:`VehiclePath.from_waypoints`)."""
+        first, second = [0.0], [0.0]
+        waypoints = list(waypoints)
+        last = [waypoints[0], waypoints[0]]
+        for b in waypoints[1:]:
+            for vehicle, out in ((0, first), (1, second)):
+                a = last[vehicle]
+                leg_a, s_a, leg_b, s_b = (
+                    a[2 * vehicle],
+                    a[2 * vehicle + 1],
+                    b[2 * vehicle],
+                    b[2 * vehicle + 1],
+                )
+                move = abs(s_a - s_b) if leg_a == leg_b else s_a + s_b
+                if abs(s_a - s_b) <= MOVE_RESOLUTION and (leg_a == leg_b or max(s_a, s_b) <= MOVE_RESOLUTION):
+                    move = 0.0
+                else:
+                    last[vehicle] = b
+                out.append(out[-1] + move)
+        return cls(tuple(first), tuple(second))
+
+    def hold(self, vehicle: int, other_travel: float) -> float:
+        """How far ``vehicle`` may travel while the other has travelled ``other_travel``, metres.
+
+        The largest travel of ``vehicle`` on the route among the points where
+        the other vehicle's travel is at most ``other_travel``: the route's
+        order of passage, which keeps both in the route's homotopy class.
+        """
+        own, other = (self.first, self.second) if vehicle == 0 else (self.second, self.first)
+        k = bisect.bisect_right(other, other_travel) - 1
+        if k < 0:
+            return own[0]
+        if k >= len(own) - 1:
+            return own[-1]
+        span = other[k + 1] - other[k]  # > 0: other[k] <= other_travel < other[k + 1]
+        return own[k] + (own[k + 1] - own[k]) * (other_travel - other[k]) / span
