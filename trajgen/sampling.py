@@ -12,7 +12,9 @@ from trajgen.scenario import Scenario
 
 __all__ = [
     "ReferenceSet",
+    "campaign_faults",
     "campaign_scenarios",
+    "online_campaign",
     "random_configuration",
     "random_position",
     "random_scenarios",
@@ -143,3 +145,68 @@ def campaign_scenarios(count: int, *, seed: int) -> list[Scenario]:
         goal = start.swapped() if k % 4 == 0 else random_configuration(rng, track, separation)
         scenarios.append(Scenario(track, limits, ("agv1", "agv2"), start, goal, f"<campaign {seed}:{k}>"))
     return scenarios
+
+
+def online_campaign(count: int, *, seed: int) -> list[Scenario]:
+    """Seeded random scenarios for the closed-loop fault campaign (``trajgen simulate``).
+
+    The range of the random planner tests (legs 0.5 to 30 m, log-uniform), each vehicle's limits
+    drawn independently (0.2-3 m/s, 0.2-3 m/s², 0.5-10 m/s³, log-uniform), the separation from 0
+    up to the shortest leg (a fifth of the scenarios exactly the shortest leg), a swap for every
+    fourth scenario, random start and goal otherwise. Pair with :func:`campaign_faults`.
+    """
+    rng = random.Random(seed)
+
+    def log_uniform(low: float, high: float) -> float:
+        return math.exp(rng.uniform(math.log(low), math.log(high)))
+
+    scenarios = []
+    for k in range(count):
+        track = YGraph({name: log_uniform(0.5, 30.0) for name in "ABC"})
+        vehicles = tuple(
+            VehicleLimits(log_uniform(0.2, 3.0), log_uniform(0.2, 3.0), log_uniform(0.5, 10.0))
+            for _ in range(2)
+        )
+        shortest = track.shortest_leg
+        separation = shortest if k % 5 == 0 else rng.uniform(0.0, shortest)
+        limits = Limits(vehicles=vehicles, min_separation=separation)
+        start = random_configuration(rng, track, separation)
+        goal = start.swapped() if k % 4 == 0 else random_configuration(rng, track, separation)
+        scenarios.append(Scenario(track, limits, ("agv1", "agv2"), start, goal, f"<online {seed}:{k}>"))
+    return scenarios
+
+
+def campaign_faults(scenario: Scenario, duration: float, *, seed: int, margin: float) -> tuple[str, ...]:
+    """One to three random ``--fault`` specs for ``scenario`` (their times within its planned ``duration``).
+
+    Parameters
+    ----------
+    scenario : Scenario
+    duration : float
+        The undisturbed schedule's duration, seconds.
+    seed : int
+    margin : float
+        The executor's position margin in this scenario, metres (jumps stay within it; none if 0).
+    """
+    rng = random.Random(seed)
+    kinds = ["stop", "slow", "lag", "goal"] + (["jump"] if margin > 0.0 else [])
+    specs = []
+    for _ in range(rng.randint(1, 3)):
+        kind = rng.choice(kinds)
+        vehicle = rng.randrange(2)
+        name = scenario.names[vehicle]
+        at = round(rng.uniform(0.0, 0.9) * duration, 3)
+        top = scenario.limits.vehicles[vehicle].max_velocity
+        if kind == "stop":
+            specs.append(f"stop:{name}@{at}+{round(rng.uniform(0.2, 0.3 * duration + 0.5), 3)}")
+        elif kind == "slow":
+            specs.append(f"slow:{name}@{at}={round(rng.uniform(0.2, 0.9) * top, 4)}")
+        elif kind == "lag":
+            specs.append(f"lag:{name}@{at}={rng.randint(10, 200)}")
+        elif kind == "jump":
+            specs.append(f"jump:{name}@{at}={rng.choice((-1, 1)) * round(rng.uniform(0.2, 1.0) * margin, 5)}")
+        else:
+            position = random_position(rng, scenario.track)
+            where = "O" if position.leg is None else f"{position.leg}:{math.floor(position.s * 1e4) / 1e4}"
+            specs.append(f"goal:{name}@{at}={where}")
+    return tuple(specs)

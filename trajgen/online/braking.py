@@ -136,8 +136,9 @@ class BrakingCheck:
             *(abs(m.v) / e for m, e in zip(measured, self._emergency, strict=True)),
         )
         # the extra acceleration a measured state may carry beyond the limits widens the pad
+        # a vehicle at rest in both states does not move at all: no pad
         pads = [
-            max(pad, abs(c.a), abs(m.a))
+            max(pad, abs(c.a), abs(m.a)) if (c.v, c.a, m.v) != (0.0, 0.0, 0.0) else abs(m.a)
             for pad, c, m in zip(self._pad_acceleration, commanded, measured, strict=True)
         ]
         for count in _REFINEMENTS:

@@ -49,6 +49,7 @@ from trajgen.schedule import TimingMethod, check_period
 from trajgen.verify import VerifiedSchedule, certify, require_verified
 
 __all__ = [
+    "SEPARATION_TOLERANCE",
     "Command",
     "Event",
     "Executor",
@@ -56,6 +57,7 @@ __all__ = [
     "Mode",
     "Setpoint",
     "VehicleState",
+    "execution_margin",
     "plan_for_execution",
     "ruckig_jerk",
     "schedule_waypoints",
@@ -68,6 +70,10 @@ PERIOD_RANGE = (0.002, 0.1)
 #: A vehicle within this travel of a point is at it, metres; slower than this speed is at rest, m/s.
 _AT = 1e-6
 _REST = 1e-6
+#: Both vehicles at rest short of their goals this long (s): the executor replans with the planner.
+STUCK_AFTER = 1.0
+#: Track distance by which the separation may be missed (round-off of a schedule parked at the leg's end), m.
+SEPARATION_TOLERANCE = 1e-6
 #: Relative slack on the acceleration limit given to Ruckig (far below the 1e-6 the limits are checked to).
 _SLACK = 1e-9
 
@@ -338,16 +344,29 @@ class _Motion:
         return self.output, jerk
 
 
+def execution_margin(scenario, position_margin: float) -> float:
+    """The position margin an executor can keep for ``scenario``, metres: at most ``position_margin``.
+
+    The plan needs twice the margin on top of the separation (:func:`plan_for_execution`), which must
+    fit the shortest leg and the start and goal; where it does not, the margin shrinks (to 0 when the
+    separation is the shortest leg).
+    """
+    track = scenario.track
+    room = min(track.shortest_leg, track.separation(scenario.start), track.separation(scenario.goal))
+    return max(0.0, min(position_margin, 0.5 * (room - scenario.limits.min_separation)))
+
+
 def plan_for_execution(
     scenario, *, method: TimingMethod | str | None = None, position_margin: float = 0.05
 ) -> VerifiedSchedule:
     """The verified schedule an :class:`Executor` plays for ``scenario``.
 
-    Planned for the separation ``min_separation + 2 * position_margin`` (at most the shortest leg):
-    the executor keeps ``min_separation + position_margin`` under its braking check, and the
-    second margin lets the plan pass that check where it runs closest.
+    Planned for the separation ``min_separation + 2 * margin``, with the margin of
+    :func:`execution_margin`: the executor keeps ``min_separation + margin`` under its braking
+    check, and the second margin lets the plan pass that check where it runs closest.
     """
-    separation = min(scenario.limits.min_separation + 2.0 * position_margin, scenario.track.shortest_leg)
+    margin = execution_margin(scenario, position_margin)
+    separation = scenario.limits.min_separation + 2.0 * margin
     limits = Limits(scenario.limits.vehicles, separation)
     route = plan(scenario.track, scenario.start, scenario.goal, min_separation=separation)
     return certify(make_schedule(route, limits, method=method))
@@ -402,11 +421,16 @@ class Executor:
         for name, value in (
             ("position_tolerance (m)", position_tolerance),
             ("velocity_tolerance (m/s)", velocity_tolerance),
-            ("position_margin (m)", position_margin),
             ("latency (s)", latency),
         ):
             if not (isinstance(value, (int, float)) and math.isfinite(value) and value > 0.0):
                 raise InputError(f"{name} must be a finite number > 0, got {value!r}")
+        if not (
+            isinstance(position_margin, (int, float))
+            and math.isfinite(position_margin)
+            and position_margin >= 0
+        ):
+            raise InputError(f"position_margin (m) must be a finite number >= 0, got {position_margin!r}")
         self.graph = schedule.route.graph
         if min_separation is None:
             min_separation = schedule.limits.min_separation
@@ -456,6 +480,8 @@ class Executor:
         self._command_axis = [axis0[0][0], axis0[1][0]]
         self._pending: str | None = None
         self._goal_changed = False
+        self._idle = 0
+        self._restarted = [-math.inf, -math.inf]
         self.events: list[Event] = []
         self.replans = 0
         self.rejected_goals = 0
@@ -623,7 +649,7 @@ class Executor:
         return Command(self._time, tuple(setpoints), self._mode, (False, False))
 
     # -- recovering ------------------------------------------------------------------------------
-    def _recover(self, measured, reason: str, *, new_goal: bool = False) -> None:
+    def _recover(self, measured, reason: str, *, new_goal: bool = False, fresh: bool = False) -> None:
         """Replan from the measured configuration and continue with Ruckig.
 
         The planner's routes from the measured configuration give both homotopy classes. Where both
@@ -642,10 +668,10 @@ class Executor:
             for v in (0, 1)
         ]
         remainder = None
-        if not new_goal and None not in on_path:
+        if not new_goal and not fresh and None not in on_path:
             remainder = sum(path.length - p for path, p in zip(old_paths, on_path, strict=True))
         configuration = Configuration(*(self._position(state) for state in measured))
-        keep = min(self.limits.min_separation, self.graph.separation(configuration))
+        keep = min(self.limits.min_separation + self.position_margin, self.graph.separation(configuration))
         route = self._choose_route(configuration, keep, remainder)
         self.replans += 1
         if route is None:
@@ -692,8 +718,8 @@ class Executor:
         is on track.
         """
         recent = self._recent[v]
-        if not recent:
-            return False
+        if not recent or self._time - self._restarted[v] < self.latency:
+            return False  # a restart shows in the measurements only after the drive's latency
         tol_p, tol_v = self.position_tolerance, self.velocity_tolerance
         last_axis, last_velocity = recent[-1]
         if abs(axis - last_axis) <= tol_p and abs(velocity - last_velocity) <= tol_v:
@@ -723,6 +749,7 @@ class Executor:
         if self._departed(v, path.axis(p), measured.velocity):
             self._command[v] = self._seed(v, p, v_meas, heading * measured.acceleration)
             self._recent[v].clear()
+            self._restarted[v] = self._time
             self._command_axis[v] = path.axis(p)
         self._travel[v] = p
 
@@ -786,6 +813,7 @@ class Executor:
             if self._departed(v, paths[v].axis(measured_path[v].p), measured[v].velocity):
                 self._command[v] = self._seed(v, measured_path[v].p, measured_path[v].v, measured_path[v].a)
                 self._recent[v].clear()
+                self._restarted[v] = self._time
         for v in (0, 1):  # turning at a reversal: the travel runs on, so its velocity and acceleration flip
             c = self._command[v]
             if abs(c.v) <= _REST and c.a < 0.0 and any(abs(c.p - r) <= 1e-9 for r in paths[v].stops):
@@ -829,6 +857,13 @@ class Executor:
         ):
             self._mode = Mode.DONE
             self._log("done", "both vehicles at their goals")
+        idle = all(abs(self._command[v].v) <= _REST and abs(measured[v].velocity) <= _REST for v in (0, 1))
+        self._idle = self._idle + 1 if idle and self._mode is Mode.RECOVERING else 0
+        if self._idle * self.period >= STUCK_AFTER:
+            # both at rest short of their goals: the coordination along this route is stuck, so the
+            # planner's route from here (which keeps the separation all along) takes over
+            self._idle = 0
+            self._recover(measured, f"both vehicles waited {STUCK_AFTER:g} s", fresh=True)
         return Command(self._time, tuple(setpoints), self._mode, tuple(braking))
 
     def _within_stops(self, v: int, target: float) -> tuple[PathState, float]:
@@ -866,15 +901,14 @@ class Executor:
                 if extrema.min >= min(command.p, high) - 1e-9 and extrema.max <= high + 1e-9:
                     return state
             target = high
+        if target <= command.p + 1e-12 and abs(command.v) <= _REST:
+            return self._brake(v)  # at rest at or past its target: it waits (it never backs up)
         state = motion.next_state(command, target, self.period)
         extrema = motion.trajectory.position_extrema[0]
-        behind = bisect.bisect_right(path.stops, command.p + 1e-9) - 1
-        low = path.stops[behind] if behind >= 0 else 0.0
+        if extrema.min < min(command.p, target) - 1e-9 or target < command.p:
+            return self._brake(v)  # the way there would back up: brake instead, and wait
         if extrema.max > high + 1e-9 and target < high:
             state = motion.next_state(command, high, self.period)
-            extrema = motion.trajectory.position_extrema[0]
-        elif extrema.min < low - 1e-9 and target >= low and command.p >= low:
-            state = motion.next_state(command, low, self.period)
         if turning and state[0].p > high:  # last resort: the setpoint stops at the reversal
             logger.warning("vehicle %d could not stop at its reversal at %.6f m; held there", v + 1, high)
             return PathState(high, 0.0, 0.0), 0.0
@@ -902,9 +936,7 @@ class Executor:
                 own = path.sweep(target, target, lengths)
                 theirs = self._paths[other].sweep(other_travel, need, lengths)
                 if set_distance(own, theirs) < required:
-                    behind = bisect.bisect_right(path.stops, command.p) - 1
-                    floor = path.stops[behind] if behind >= 0 else 0.0
-                    target = max(min(self._coordination.hold(v, other_travel), target), floor)
+                    target = max(min(self._coordination.hold(v, other_travel), target), command.p)
         return target
 
     def _need(self, v: int, travel: float) -> float:
@@ -944,11 +976,15 @@ class Executor:
         return (True, True)
 
     def _brake(self, v: int, *, peek: bool = False) -> tuple[PathState, float]:
-        """The next state of ``v`` under service braking from its last setpoint."""
-        braking = self._check.service(v)
-        trajectory = braking.plan(self._command[v])
+        """The next state of ``v`` under service braking from its last setpoint (to rest, never reversing)."""
+        command = self._command[v]
+        if abs(command.v) <= _REST:
+            return PathState(command.p, 0.0, 0.0), 0.0
+        trajectory = self._check.service(v).plan(command)
         t = min(self.period, trajectory.duration)
         (p,), (velocity,), (a,) = trajectory.at_time(t)
+        if velocity * command.v <= 0.0:  # at rest within this cycle: it stays there
+            return PathState(p, 0.0, 0.0), 0.0
         jerk = ruckig_jerk(trajectory, t) if t < trajectory.duration else 0.0
         return PathState(p, velocity, a), jerk
 
@@ -961,7 +997,7 @@ class Executor:
     def _required(self, measured) -> float:
         """Track distance the braking check keeps: separation + margin (less if a fault left them closer)."""
         apart = indexed_separation((measured[0].leg, measured[0].s, measured[1].leg, measured[1].s))
-        return min(self.limits.min_separation + self.position_margin, apart - 1e-9)
+        return min(self.limits.min_separation + self.position_margin, apart) - SEPARATION_TOLERANCE
 
     def _at_goal(self, measured) -> bool:
         return all(

@@ -3,8 +3,8 @@
 The plant moves each vehicle along the track after its setpoints: it lands on
 each setpoint while it is on track. Faults (:mod:`trajgen.online.faults`) act on the plant only;
 the executor sees their effects through the measurements, and goal requests.
-A drive that is off its setpoint (a jump, the end of a stop) closes the gap at
-most ``0.2 * max_velocity`` faster than the setpoints move.
+A drive that is off its setpoint (after a jump, a stop) closes the gap moving at
+most ``0.2 * max_velocity`` faster or slower than its setpoint.
 
 Every cycle the simulation checks the *true* positions against the minimum
 separation, certified between cycles too (track distance is 1-Lipschitz in
@@ -32,8 +32,17 @@ from topology import JUNCTION_INDEX, YGraph
 from topology.indexed import separation as indexed_separation
 from trajgen.errors import InputError
 from trajgen.export.csv import HEADER_NAMES, CsvOptions, format_rows
-from trajgen.online.executor import Command, Event, Executor, Mode, VehicleState, plan_for_execution
-from trajgen.online.faults import Fault, FaultKind, parse_fault
+from trajgen.online.executor import (
+    SEPARATION_TOLERANCE,
+    Command,
+    Event,
+    Executor,
+    Mode,
+    VehicleState,
+    execution_margin,
+    plan_for_execution,
+)
+from trajgen.online.faults import Fault, FaultError, FaultKind, parse_fault
 from trajgen.scenario import Scenario
 from trajgen.schedule import ScheduleState, TimingMethod
 from trajgen.values import frozen
@@ -190,18 +199,17 @@ class _Plant:
                 body.v = new
                 body.move(step, self.lengths)
                 continue
-            reach = (abs(velocity) + _CORRECTION * self.limits.vehicles[v].max_velocity) * dt
+            correction = _CORRECTION * self.limits.vehicles[v].max_velocity
             wanted = axis - body.axis
-            if abs(wanted - velocity * dt) <= 1e-9 + abs(velocity) * dt or abs(wanted) <= 1e-9:
+            step = min(max(wanted, (velocity - correction) * dt), (velocity + correction) * dt)
+            if step == wanted:  # on track: the vehicle is where its setpoint says
                 body.j, body.a, body.v = jerk, acceleration, velocity
-                body.move(wanted, self.lengths)
-            else:  # off the setpoint (after a fault): close the gap a little faster than the setpoints move
-                step = max(-reach, min(reach, wanted))
+            else:  # off its setpoint (after a fault): the drive closes the gap, a little faster or slower
                 v_new = step / dt
                 a_new = (v_new - body.v) / dt
                 body.j = (a_new - body.a) / dt
                 body.a, body.v = a_new, v_new
-                body.move(step, self.lengths)
+            body.move(step, self.lengths)
 
 
 class Trace:
@@ -433,17 +441,20 @@ def simulate(
     """
     if not isinstance(scenario, Scenario):
         raise InputError(f"simulate expects a Scenario, got {type(scenario).__name__}")
+    margin = execution_margin(scenario, position_margin)
     for fault in faults:
         if not isinstance(fault, Fault):
             raise InputError(f"faults must be Fault objects (parse_faults), got {type(fault).__name__}")
-        if fault.kind is FaultKind.JUMP and abs(fault.value) > position_margin:
-            raise InputError(f"fault {fault.spec!r}: jump beyond the position margin {position_margin!r} m")
+        if fault.kind is FaultKind.JUMP and abs(fault.value) > margin:
+            raise FaultError(
+                f"fault {fault.spec!r}: jump beyond the position margin {margin!r} m kept in this scenario"
+            )
     if verified is None:
         verified = plan_for_execution(scenario, method=method, position_margin=position_margin)
     executor = Executor(
         verified,
         period=period,
-        position_margin=position_margin,
+        position_margin=margin,
         min_separation=scenario.limits.min_separation,
     )
     plant = _Plant(executor, faults, period)
@@ -497,7 +508,7 @@ def simulate(
             between = 0.5 * (separation + now - moved)
             smallest = min(smallest, now)
             certified = min(certified, now, between)
-            if min(now, between) < required - 1e-9:
+            if min(now, between) < required - SEPARATION_TOLERANCE:
                 separation_violations += 1
             separation = now
             if spool is not None:
