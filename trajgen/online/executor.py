@@ -73,7 +73,7 @@ _REST = 1e-6
 #: Both vehicles at rest short of their goals this long (s): the executor replans with the planner.
 STUCK_AFTER = 1.0
 #: Track distance by which the separation may be missed (round-off of a schedule parked at the leg's end), m.
-SEPARATION_TOLERANCE = 1e-6
+SEPARATION_TOLERANCE = 1e-7
 #: Relative slack on the acceleration limit given to Ruckig (far below the 1e-6 the limits are checked to).
 _SLACK = 1e-9
 
@@ -143,12 +143,16 @@ class Command:
     mode : Mode
     braking : tuple of 2 bool
         Whether each vehicle was made to brake by the braking check this cycle.
+    certified : bool
+        Whether the braking check passed for these setpoints. When it does not pass even with both
+        vehicles braking, both brake (the motion the previous cycle's check certified).
     """
 
     time: float
     setpoints: tuple[Setpoint, Setpoint]
     mode: Mode
     braking: tuple[bool, bool]
+    certified: bool = True
 
 
 @dataclass(frozen=True, slots=True)
@@ -693,11 +697,11 @@ class Executor:
             path = VehiclePath.from_route(route, v, axis_start=axis, orientation=orientation)
             new_paths.append(path)
             heading_old = old.heading(self._command[v].p)
-            close = abs(measured[v].velocity - heading_old * self._command[v].v) <= self.velocity_tolerance
-            if close and abs(p_old - self._command[v].p) <= self.position_tolerance:
+            if abs(p_old - self._command[v].p) <= self.position_tolerance:  # continue the setpoints
                 v_axis, a_axis = heading_old * self._command[v].v, heading_old * self._command[v].a
             else:
                 v_axis, a_axis = measured[v].velocity, measured[v].acceleration
+                self._restarted[v] = self._time
             heading = path.heading(0.0)
             seeds.append(self._seed(v, 0.0, heading * v_axis, heading * a_axis))
             axes.append(axis)
@@ -800,6 +804,19 @@ class Executor:
         if None in travel:
             self._recover(measured, f"vehicle {travel.index(None) + 1} is off its route")
             travel = [0.0, 0.0]
+        else:
+            departed = [
+                v
+                for v in (0, 1)
+                if self._departed(
+                    v,
+                    self._paths[v].axis(travel[v]),
+                    measured[v].velocity,
+                )
+            ]
+            if departed:  # replan from here (it restarts the departed vehicle from where it is)
+                self._recover(measured, f"vehicle {departed[0] + 1} is off its setpoints")
+                travel = list(self._travel)
         paths = self._paths
         measured_path = []
         for v in (0, 1):
@@ -809,11 +826,6 @@ class Executor:
             measured_path.append(
                 PathState(p, heading * measured[v].velocity, heading * measured[v].acceleration)
             )
-        for v in (0, 1):  # a vehicle far from its setpoint restarts from where it is
-            if self._departed(v, paths[v].axis(measured_path[v].p), measured[v].velocity):
-                self._command[v] = self._seed(v, measured_path[v].p, measured_path[v].v, measured_path[v].a)
-                self._recent[v].clear()
-                self._restarted[v] = self._time
         for v in (0, 1):  # turning at a reversal: the travel runs on, so its velocity and acceleration flip
             c = self._command[v]
             if abs(c.v) <= _REST and c.a < 0.0 and any(abs(c.p - r) <= 1e-9 for r in paths[v].stops):
@@ -827,6 +839,9 @@ class Executor:
             if choice[v]:
                 braking[v] = True
                 wanted[v] = self._brake(v)
+        certified = choice != (True, True) or self._check.clearance(
+            self._paths, (wanted[0][0], wanted[1][0]), tuple(measured_path), required
+        )
         self._time += self.period
         setpoints = []
         for v in (0, 1):
@@ -864,7 +879,7 @@ class Executor:
             # planner's route from here (which keeps the separation all along) takes over
             self._idle = 0
             self._recover(measured, f"both vehicles waited {STUCK_AFTER:g} s", fresh=True)
-        return Command(self._time, tuple(setpoints), self._mode, tuple(braking))
+        return Command(self._time, tuple(setpoints), self._mode, tuple(braking), certified)
 
     def _within_stops(self, v: int, target: float) -> tuple[PathState, float]:
         """Ruckig's next state towards ``target``, never through a reversal of the path or past its ends.
@@ -901,11 +916,12 @@ class Executor:
                 if extrema.min >= min(command.p, high) - 1e-9 and extrema.max <= high + 1e-9:
                     return state
             target = high
-        if target <= command.p + 1e-12 and abs(command.v) <= _REST:
+        on_path = command.p <= path.length + 1e-9
+        if on_path and target <= command.p + 1e-12 and abs(command.v) <= _REST:
             return self._brake(v)  # at rest at or past its target: it waits (it never backs up)
         state = motion.next_state(command, target, self.period)
         extrema = motion.trajectory.position_extrema[0]
-        if extrema.min < min(command.p, target) - 1e-9 or target < command.p:
+        if on_path and (extrema.min < min(command.p, target) - 1e-9 or target < command.p):
             return self._brake(v)  # the way there would back up: brake instead, and wait
         if extrema.max > high + 1e-9 and target < high:
             state = motion.next_state(command, high, self.period)
@@ -997,7 +1013,8 @@ class Executor:
     def _required(self, measured) -> float:
         """Track distance the braking check keeps: separation + margin (less if a fault left them closer)."""
         apart = indexed_separation((measured[0].leg, measured[0].s, measured[1].leg, measured[1].s))
-        return min(self.limits.min_separation + self.position_margin, apart) - SEPARATION_TOLERANCE
+        # closer than that after a fault: they may only part (to round-off: no ratchet cycle after cycle)
+        return min(self.limits.min_separation + self.position_margin - SEPARATION_TOLERANCE, apart - 1e-12)
 
     def _at_goal(self, measured) -> bool:
         return all(

@@ -10,6 +10,7 @@ functions run every control cycle.
 from __future__ import annotations
 
 import bisect
+import math
 from dataclasses import dataclass
 
 from topology import JUNCTION_INDEX, Route
@@ -142,6 +143,8 @@ class VehiclePath:
             axis_starts.append(axis)
             travel += abs(s_b - s_a)
             axis += heading * abs(s_b - s_a)
+        if not legs:  # a vehicle that does not move keeps its axis value
+            axis_starts.append(axis)
         return cls(
             tuple(legs),
             tuple(s_from),
@@ -193,20 +196,30 @@ class VehiclePath:
     def project(self, leg: int, s: float, near: float, slack: float = 1e-9) -> float | None:
         """The travel at which the path passes ``(leg, s)``, nearest ``near``; ``None`` if it never does.
 
-        A position up to ``slack`` metres beyond the end of a stretch of the path counts as that end.
+        A position up to ``slack`` metres beyond the end of a stretch of the path counts as that end;
+        one on the first or last segment's leg before the start or past the end of the path gives a
+        travel below 0 or above :attr:`length`.
         """
         best = None
         if not self.legs:
             home_leg, home_s = self.home
             same = abs(s - home_s) <= slack and (leg == home_leg or max(s, home_s) <= slack)
             return 0.0 if same else None
+        last = len(self.legs) - 1
         for k, seg_leg in enumerate(self.legs):
             if seg_leg != leg and s != 0.0:
                 continue
             low, high = min(self.s_from[k], self.s_to[k]), max(self.s_from[k], self.s_to[k])
+            outward = self.s_to[k] > self.s_from[k]
+            # the first and last segments run on along their leg: a vehicle before the start or past
+            # the end of its path is at a travel below 0 or above the length
+            if k == 0:
+                low, high = (-math.inf, high) if outward else (low, math.inf)
+            if k == last:
+                low, high = (low, math.inf) if outward else (-math.inf, high)
             if not low - slack <= s <= high + slack:
                 continue
-            p = self.starts[k] + abs(min(max(s, low), high) - self.s_from[k])
+            p = self.starts[k] + (min(max(s, low), high) - self.s_from[k]) * (1.0 if outward else -1.0)
             if best is None or abs(p - near) < abs(best - near):
                 best = p
         return best

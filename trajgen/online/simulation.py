@@ -3,8 +3,9 @@
 The plant moves each vehicle along the track after its setpoints: it lands on
 each setpoint while it is on track. Faults (:mod:`trajgen.online.faults`) act on the plant only;
 the executor sees their effects through the measurements, and goal requests.
-A drive that is off its setpoint (after a jump, a stop) closes the gap moving at
-most ``0.2 * max_velocity`` faster or slower than its setpoint.
+A drive that is off its setpoint (after a jump, a stop) closes the gap gradually:
+its speed is the setpoint's plus twice the gap per second, at most
+``0.2 * max_velocity`` more or less.
 
 Every cycle the simulation checks the *true* positions against the minimum
 separation, certified between cycles too (track distance is 1-Lipschitz in
@@ -22,18 +23,18 @@ import collections
 import logging
 import math
 import tempfile
-from collections.abc import Iterator, Sequence
+from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
 
 from limits import Limits
 from topology import JUNCTION_INDEX, YGraph
+from topology.indexed import leg_travel
 from topology.indexed import separation as indexed_separation
 from trajgen.errors import InputError
 from trajgen.export.csv import HEADER_NAMES, CsvOptions, format_rows
 from trajgen.online.executor import (
-    SEPARATION_TOLERANCE,
     Command,
     Event,
     Executor,
@@ -58,6 +59,10 @@ PLOT_SAMPLES = 20_000
 _ROWS_PER_BLOCK = 5_000
 #: How fast a drive closes a gap to its setpoint beyond the setpoints' own speed (fraction of max_velocity).
 _CORRECTION = 0.2
+#: How fast a drive closes a gap to its setpoint: the gap times this, m/s per m (a 0.5 s time constant).
+_GAIN = 2.0
+#: True track distance below the minimum separation that counts as a violation, metres (1 µm).
+_VIOLATION_TOLERANCE = 1e-6
 #: Relative tolerance on the commanded limits (Ruckig's jerk phases are exactly at the limit).
 _LIMIT_TOLERANCE = 1e-6
 
@@ -190,25 +195,25 @@ class _Plant:
                 )
             body.branch = branch
             slow = self._active(FaultKind.SLOW, v, t)
-            if slow is not None:  # a throttled drive: the commanded velocity, cut at the top speed
-                new = max(-slow.value, min(slow.value, velocity))
-                a_new = (new - body.v) / dt
-                body.j = (a_new - body.a) / dt
-                body.a = a_new
-                step = 0.5 * (body.v + new) * dt
-                body.v = new
-                body.move(step, self.lengths)
-                continue
-            correction = _CORRECTION * self.limits.vehicles[v].max_velocity
+            cap = slow.value if slow is not None else math.inf  # a throttled drive's top speed
             wanted = axis - body.axis
-            step = min(max(wanted, (velocity - correction) * dt), (velocity + correction) * dt)
-            if step == wanted:  # on track: the vehicle is where its setpoint says
+            gap = wanted - velocity * dt  # beyond the setpoint's own motion this cycle
+            on_track = abs(gap) <= abs(acceleration) * dt * dt + abs(jerk) * dt**3 + 1e-12
+            if on_track and abs(velocity) <= cap:
                 body.j, body.a, body.v = jerk, acceleration, velocity
-            else:  # off its setpoint (after a fault): the drive closes the gap, a little faster or slower
-                v_new = step / dt
-                a_new = (v_new - body.v) / dt
-                body.j = (a_new - body.a) / dt
-                body.a, body.v = a_new, v_new
+                body.move(wanted, self.lengths)
+                continue
+            # off its setpoint (after a fault) or throttled: the drive closes the gap gradually,
+            # within its top speed, and never runs past the setpoint
+            correction = _CORRECTION * self.limits.vehicles[v].max_velocity
+            v_new = velocity + max(-correction, min(correction, _GAIN * gap))
+            v_new = max(-cap, min(cap, v_new))
+            step = v_new * dt
+            if wanted * (wanted - step) < 0.0:
+                step, v_new = wanted, min(max(velocity, -cap), cap)
+            a_new = (v_new - body.v) / dt
+            body.j = (a_new - body.a) / dt
+            body.a, body.v = a_new, v_new
             body.move(step, self.lengths)
 
 
@@ -382,17 +387,42 @@ class SimulationResult:
 def parse_faults(
     scenario: Scenario, specs: Sequence[str], *, position_margin: float = 0.05
 ) -> tuple[Fault, ...]:
-    """Parse ``--fault`` specs against a scenario (see :func:`~trajgen.online.faults.parse_fault`)."""
+    """Parse ``--fault`` specs against a scenario (see :func:`~trajgen.online.faults.parse_fault`).
+
+    A jump may be as large as the position margin the executor keeps in this scenario
+    (:func:`~trajgen.online.executor.execution_margin`: at most ``position_margin``).
+    """
+    margin = execution_margin(scenario, position_margin)
     return tuple(
         parse_fault(
             spec,
             names=scenario.names,
             graph=scenario.track,
             max_velocity=tuple(v.max_velocity for v in scenario.limits.vehicles),
-            max_jump=position_margin,
+            max_jump=margin,
         )
         for spec in specs
     )
+
+
+def _between(before, bodies, first: float, second: float, bend: float) -> float:
+    """A lower bound of the true track distance between two cycles, metres.
+
+    While each vehicle stays on its leg, the distance is convex along straight motions (``|s1 - s2|``
+    or ``s1 + s2``), so it is the smaller end value less the bend of the curved motions, or 0 if two
+    vehicles on one leg swapped order. Through the junction: the mean of the two ends less half of
+    how far both drove (track distance is 1-Lipschitz in each position).
+    """
+    stayed = all(
+        old[0] == b.leg and (old[1] > 0.0) == (b.s > 0.0) for old, b in zip(before, bodies, strict=True)
+    )
+    if stayed:
+        same_leg = before[0][0] == before[1][0]
+        if same_leg and (before[0][1] - before[1][1]) * (bodies[0].s - bodies[1].s) < 0.0:
+            return 0.0
+        return min(first, second) - bend
+    moved = sum(leg_travel(old[0], old[1], b.leg, b.s) for old, b in zip(before, bodies, strict=True))
+    return 0.5 * (first + second - moved)
 
 
 def _time_limit(planned: float, faults: Sequence[Fault], limits: Limits, graph: YGraph) -> float:
@@ -415,6 +445,7 @@ def simulate(
     position_margin: float = 0.05,
     trace: CsvOptions | None = None,
     verified: VerifiedSchedule | None = None,
+    observer: Callable[[Executor, tuple[VehicleState, VehicleState], Command], None] | None = None,
 ) -> tuple[SimulationResult, Trace | None]:
     """Run the executor against the simulated plant with ``faults``.
 
@@ -432,7 +463,9 @@ def simulate(
     trace : CsvOptions, optional
         Spool the executed motion as CSV rows in this dialect (its sample period is ignored).
     verified : VerifiedSchedule, optional
-        The plan, if already computed for ``scenario``.
+        The plan, if already computed for ``scenario`` (:func:`~trajgen.online.executor.plan_for_execution`).
+    observer : callable, optional
+        Called every cycle with the executor, the measured states and the command (for tests and tools).
 
     Returns
     -------
@@ -488,6 +521,8 @@ def simulate(
                     logger.info("goal request %s: %s", fault.spec, decision)
             measured = plant.measure()
             command = executor.step(*measured)
+            if observer is not None:
+                observer(executor, measured, command)
             for v, setpoint in enumerate(command.setpoints):
                 vehicle = limits.vehicles[v]
                 ratios = (
@@ -499,16 +534,21 @@ def simulate(
                     limit_violations += 1
                 for k in range(3):
                     worst[k] = max(worst[k], ratios[k])
-            before = [(b.leg, b.s, b.axis) for b in bodies]
+            before = [(b.leg, b.s, b.a) for b in bodies]
             plant.advance(command, t)
             cycle += 1
             t = cycle * period
             now = indexed_separation((bodies[0].leg, bodies[0].s, bodies[1].leg, bodies[1].s))
-            moved = sum(abs(b.axis - old[2]) for b, old in zip(bodies, before, strict=True))
-            between = 0.5 * (separation + now - moved)
+            # how far the motions (acceleration between its values at the two cycles) leave their chords
+            bend = (
+                sum(max(abs(old[2]), abs(b.a)) for old, b in zip(before, bodies, strict=True))
+                * period**2
+                / 8.0
+            )
+            between = _between(before, bodies, separation, now, bend)
             smallest = min(smallest, now)
             certified = min(certified, now, between)
-            if min(now, between) < required - SEPARATION_TOLERANCE:
+            if min(now, between) < required - _VIOLATION_TOLERANCE:
                 separation_violations += 1
             separation = now
             if spool is not None:
