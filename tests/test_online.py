@@ -53,9 +53,11 @@ def test_the_swap_paths_follow_the_route():
         assert path.length == pytest.approx(route.travel[v], abs=1e-12)
         start, goal = route.start[v], route.goal[v]
         leg, s = path.locate(0.0)
-        assert s == pytest.approx(start.s) and scenario.track.names[leg] == start.leg
+        assert s == pytest.approx(start.s)
+        assert scenario.track.names[leg] == start.leg
         leg, s = path.locate(path.length)
-        assert s == pytest.approx(goal.s) and scenario.track.names[leg] == goal.leg
+        assert s == pytest.approx(goal.s)
+        assert scenario.track.names[leg] == goal.leg
         # the axis is continuous and changes by exactly the travel, reversing at each stop
         axes = [path.axis(p) for p in np.linspace(0.0, path.length, 2001)]
         assert np.max(np.abs(np.diff(axes))) <= path.length / 2000 + 1e-12
@@ -104,7 +106,7 @@ def service_distance(v: float, limits: VehicleLimits) -> float:
     return v * v / (2.0 * a) + v * a / (2.0 * j)
 
 
-@pytest.mark.parametrize("offset, safe", [(0.01, True), (-0.01, False)], ids=["room-to-stop", "1cm-short"])
+@pytest.mark.parametrize(("offset", "safe"), [(0.01, True), (-0.01, False)], ids=["room", "1cm-short"])
 def test_a_follower_must_stop_short_of_a_standing_leader(offset, safe):
     track, paths = one_leg_paths()
     check = BrakingCheck((AGV, AGV), (1.0, 1.0), track.lengths)
@@ -114,7 +116,7 @@ def test_a_follower_must_stop_short_of_a_standing_leader(offset, safe):
     assert check.clearance(paths, (follower, leader), (follower, leader), 5.0) is safe
 
 
-@pytest.mark.parametrize("offset, safe", [(0.01, True), (-0.01, False)], ids=["room-to-stop", "1cm-short"])
+@pytest.mark.parametrize(("offset", "safe"), [(0.01, True), (-0.01, False)], ids=["room", "1cm-short"])
 def test_a_follower_must_stop_behind_a_leader_making_an_emergency_stop(offset, safe):
     """Both at 1 m/s; the leader stops in 0.5 m (1 m/s²), the follower needs 1.25 m: 0.75 m more gap."""
     track, paths = one_leg_paths()
@@ -190,17 +192,20 @@ def test_what_the_check_certifies_holds_under_every_braking_of_both(data, fracti
 def test_an_undisturbed_run_follows_the_plan(swap):
     scenario, verified = swap
     result, _ = simulate(scenario, (), verified=verified)
-    assert result.reached_goal and result.violations == 0
+    assert result.reached_goal
+    assert result.violations == 0
     assert result.time_lost_s <= 1.5  # the braking check may take over near the closest approach
     assert result.min_separation_m >= scenario.limits.min_separation
 
 
-@pytest.mark.parametrize("method, lost", [("exact", 0.01), ("toppra", 0.01)], ids=["exact", "toppra"])
+@pytest.mark.parametrize(("method", "lost"), [("exact", 0.01), ("toppra", 0.01)], ids=["exact", "toppra"])
 def test_a_plan_without_close_approaches_is_played_as_it_is(method, lost):
     """Stored reference: the swap's exact and TOPPRA plans keep far apart; played to within one cycle."""
     scenario = default_scenario()
     result, _ = simulate(scenario, (), method=method)
-    assert result.reached_goal and result.violations == 0 and result.replans == 0
+    assert result.reached_goal
+    assert result.violations == 0
+    assert result.replans == 0
     assert 0.0 <= result.time_lost_s <= lost + 1e-9
 
 
@@ -215,7 +220,7 @@ def test_recovery_follows_ruckigs_own_trajectory(swap):
         for v in (0, 1):
             if command.braking[v]:
                 continue
-            inp, trajectory, elapsed = executor.motion(v)
+            inp, _trajectory, elapsed = executor.motion(v)
             if elapsed <= 0.0 or abs(command.setpoints[v].velocity) < 1e-6:
                 continue
             fresh_input = InputParameter(1)
@@ -249,7 +254,8 @@ def test_recovery_follows_ruckigs_own_trajectory(swap):
     result, _ = simulate(
         scenario, parse_faults(scenario, ["stop:agv1@8+3"]), verified=verified, observer=observe
     )
-    assert result.reached_goal and result.violations == 0
+    assert result.reached_goal
+    assert result.violations == 0
     assert compared[0] >= 300
     assert agreed[0] >= 0.95 * compared[0]
 
@@ -263,8 +269,10 @@ def test_every_command_is_certified_or_both_brake(swap):
 
     specs = ["stop:agv2@9+2", "jump:agv1@14=0.04", "lag:agv2@3=150"]
     result, _ = simulate(scenario, parse_faults(scenario, specs), verified=verified, observer=observe)
-    assert result.reached_goal and result.violations == 0
-    assert len(seen) == result.cycles and all(seen)
+    assert result.reached_goal
+    assert result.violations == 0
+    assert len(seen) == result.cycles
+    assert all(seen)
 
 
 def test_replanning_along_the_antipodal_set_does_not_chatter(swap):
@@ -329,7 +337,7 @@ def test_a_goal_too_close_to_the_other_goal_is_refused_with_the_reason(swap):
 
 
 @pytest.mark.parametrize(
-    "call, match",
+    ("call", "match"),
     [
         (lambda e: e.step(VehicleState(0, math.nan), VehicleState(1, 10.0)), "measured s must be a finite"),
         (lambda e: e.step(VehicleState(5, 1.0), VehicleState(1, 10.0)), "measured leg must be"),
@@ -347,7 +355,7 @@ def test_bad_input_to_the_executor(swap, call, match):
 
 
 @pytest.mark.parametrize(
-    "options, match",
+    ("options", "match"),
     [
         ({"period": 0.5}, r"control period must be 0.002 to 0.1 s, got 0.5"),
         ({"min_separation": 3.0}, r"min_separation must be between 0 m and the schedule's"),
@@ -378,7 +386,8 @@ def test_the_margin_shrinks_where_the_track_has_no_room():
     with pytest.raises(InputError, match=r"jump.*out of range: expected 0 < \|DS\| <= 0.0 m"):
         parse_faults(scenario, ["jump:agv1@1=0.01"])
     result, _ = simulate(scenario, (), method="exact")
-    assert result.reached_goal and result.violations == 0
+    assert result.reached_goal
+    assert result.violations == 0
 
 
 # -- a short campaign (the full one: benchmarks/bench_online.py) --------------------------------
@@ -396,7 +405,9 @@ def test_short_fault_campaign(k):
     specs = campaign_faults(scenario, verified.schedule.duration, seed=1000 + k, margin=margin)
     result, _ = simulate(scenario, parse_faults(scenario, specs), verified=verified)
     assert result.reached_goal, (specs, result.summary())
-    assert result.separation_violations == 0 and result.limit_violations == 0, specs
+    assert result.separation_violations == 0, specs
+    assert result.limit_violations == 0, specs
     assert result.certified_separation_m >= scenario.limits.min_separation - 1e-6
-    assert result.jerk_ratio <= 1.0 + 1e-6 and result.acceleration_ratio <= 1.0 + 1e-6
+    assert result.jerk_ratio <= 1.0 + 1e-6
+    assert result.acceleration_ratio <= 1.0 + 1e-6
     assert result.velocity_ratio <= 1.0 + 1e-6
