@@ -804,19 +804,6 @@ class Executor:
         if None in travel:
             self._recover(measured, f"vehicle {travel.index(None) + 1} is off its route")
             travel = [0.0, 0.0]
-        else:
-            departed = [
-                v
-                for v in (0, 1)
-                if self._departed(
-                    v,
-                    self._paths[v].axis(travel[v]),
-                    measured[v].velocity,
-                )
-            ]
-            if departed:  # replan from here (it restarts the departed vehicle from where it is)
-                self._recover(measured, f"vehicle {departed[0] + 1} is off its setpoints")
-                travel = list(self._travel)
         paths = self._paths
         measured_path = []
         for v in (0, 1):
@@ -826,6 +813,11 @@ class Executor:
             measured_path.append(
                 PathState(p, heading * measured[v].velocity, heading * measured[v].acceleration)
             )
+        for v in (0, 1):  # a vehicle far from its setpoints restarts from where it is
+            if self._departed(v, paths[v].axis(travel[v]), measured[v].velocity):
+                self._command[v] = self._seed(v, measured_path[v].p, measured_path[v].v, measured_path[v].a)
+                self._recent[v].clear()
+                self._restarted[v] = self._time
         for v in (0, 1):  # turning at a reversal: the travel runs on, so its velocity and acceleration flip
             c = self._command[v]
             if abs(c.v) <= _REST and c.a < 0.0 and any(abs(c.p - r) <= 1e-9 for r in paths[v].stops):

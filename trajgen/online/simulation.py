@@ -77,16 +77,26 @@ class _Body:
         self.v = self.a = self.j = 0.0
 
     def move(self, d_axis: float, lengths: tuple[float, ...]) -> None:
-        """Drive ``d_axis`` metres along the axis, through the junction onto ``branch``."""
-        self.axis += d_axis
+        """Drive ``d_axis`` metres along the axis, through the junction onto ``branch``.
+
+        The end of a leg (and the junction, when the branch is the same leg) stops the vehicle: it
+        does not get further, and neither does its axis; it is then at rest.
+        """
         s = self.s + self.orientation * d_axis
+        blocked = 0.0
         if s < 0.0:
             if self.branch != self.leg:
                 self.leg, self.orientation = self.branch, -self.orientation
                 s = -s
             else:
-                s = 0.0
-        self.s = min(s, lengths[self.leg])
+                blocked, s = -s, 0.0
+        top = lengths[self.leg]
+        if s > top:
+            blocked, s = s - top, top
+        self.s = s
+        self.axis += d_axis - math.copysign(blocked, d_axis)
+        if blocked:
+            self.v = self.a = 0.0
 
     def state(self) -> VehicleState:
         return VehicleState(self.leg if self.s > 0.0 else JUNCTION_INDEX, self.s, self.v, self.a)
