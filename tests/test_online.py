@@ -302,19 +302,20 @@ def test_replanning_along_the_antipodal_set_does_not_chatter(swap, hysteresis, c
     executor.step(*at_start)
     first_way = executor.route.way_round
     seen = set()
-    for k in range(200):
-        # back to the original goal first, then the other side: every request is a new goal
+    for _ in range(3000):  # a new goal is taken once both commands are at rest: alternate per replan
         executor.request_goal(0, Position("B", 10.0))
         executor.request_goal(1, Position("A", 10.0))
-        vehicle, position = either_side[k % 2]
+        vehicle, position = either_side[executor.replans % 2]
         assert executor.request_goal(vehicle, position).accepted
         executor.step(*at_start)
         seen.add(executor.route.way_round)
-    assert executor.replans >= 200
+        if executor.replans >= 60:
+            break
+    assert executor.replans >= 60
     switches = [e for e in executor.events if e.kind == "switch-class"]
     if chatters:  # without hysteresis the executor flips with the planner: the test can tell
         assert len(seen) == 2
-        assert len(switches) >= 100
+        assert len(switches) >= 25
     else:
         assert seen == {first_way}
         assert not switches

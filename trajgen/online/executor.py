@@ -70,6 +70,8 @@ PERIOD_RANGE = (0.002, 0.1)
 #: A vehicle within this travel of a point is at it, metres; slower than this speed is at rest, m/s.
 _AT = 1e-6
 _REST = 1e-6
+#: A measured speed below this is at rest, m/s.
+_AT_REST = 1e-3
 #: Both vehicles at rest short of their goals this long (s): the executor replans with the planner.
 STUCK_AFTER = 1.0
 #: Track distance by which the separation may be missed (round-off of a schedule parked at the leg's end), m.
@@ -164,8 +166,8 @@ class Event:
     time : float
         Seconds since the executor started.
     kind : str
-        ``recover``, ``replan``, ``switch-class``, ``goal-accepted``, ``goal-refused``,
-        ``speed-limit``, ``done``.
+        ``recover``, ``replan``, ``restart`` (a vehicle off its setpoints restarts from where it is),
+        ``switch-class``, ``goal-accepted``, ``goal-refused``, ``speed-limit``, ``done``.
     detail : str
     """
 
@@ -483,9 +485,10 @@ class Executor:
         self._command = [PathState(0.0, 0.0, 0.0), PathState(0.0, 0.0, 0.0)]
         self._command_axis = [axis0[0][0], axis0[1][0]]
         self._pending: str | None = None
-        self._goal_changed = False
+        self._next_goal: Configuration | None = None
         self._idle = 0
         self._restarted = [-math.inf, -math.inf]
+        self._restarting = [False, False]
         self.events: list[Event] = []
         self.replans = 0
         self.rejected_goals = 0
@@ -533,7 +536,7 @@ class Executor:
             position = self.graph.check(position)
         except InputError as error:
             return self._refuse(f"goal {position} of vehicle {vehicle + 1}: {error}")
-        goal = list(self._goal)
+        goal = list(self._next_goal or self._goal)
         goal[vehicle] = position
         candidate = Configuration(*goal)
         apart = self.graph.separation(candidate)
@@ -543,10 +546,11 @@ class Executor:
                 f"goal {position} of vehicle {vehicle + 1} is {apart:.3f} m from the other vehicle's goal "
                 f"{goal[1 - vehicle]}: expected at least {required:.3f} m (separation + position margin)"
             )
-        self._goal = candidate
-        self._goal_changed = True
-        self._pending = f"new goal {position} for vehicle {vehicle + 1}"
-        self._log("goal-accepted", self._pending)
+        self._next_goal = candidate
+        self._log(
+            "goal-accepted",
+            f"new goal {position} for vehicle {vehicle + 1}: both vehicles stop, then the route changes",
+        )
         return GoalDecision(True)
 
     def request_speed_limit(self, vehicle: int, speed: float) -> None:
@@ -578,10 +582,19 @@ class Executor:
         Command
         """
         measured = (self._checked(first, 1), self._checked(second, 2))
-        if self._pending is not None:
+        if self._next_goal is not None:
+            # a new goal may need a vehicle to turn back: both first brake to rest along the route they
+            # are on (the motion the braking check has certified), then the route changes
+            if self._mode is not Mode.RECOVERING:
+                self._recover(measured, "a new goal: both vehicles stop before the route changes")
+            if all(
+                abs(self._command[v].v) <= _REST and abs(measured[v].velocity) <= _AT_REST for v in (0, 1)
+            ):
+                self._goal, self._next_goal = self._next_goal, None
+                self._recover(measured, f"new goal {self._goal}", new_goal=True)
+        elif self._pending is not None:
             reason, self._pending = self._pending, None
-            self._recover(measured, reason, new_goal=self._goal_changed)
-            self._goal_changed = False
+            self._recover(measured, reason)
         elif self._mode is Mode.FOLLOWING:
             command = self._follow(measured)
             if command is not None:
@@ -815,9 +828,18 @@ class Executor:
             )
         for v in (0, 1):  # a vehicle far from its setpoints restarts from where it is
             if self._departed(v, paths[v].axis(travel[v]), measured[v].velocity):
+                if not self._restarting[v]:  # log the first restart of a departure, not every one
+                    self._log(
+                        "restart",
+                        f"vehicle {v + 1} is {abs(self._command[v].p - travel[v]):.3f} m from its setpoint "
+                        f"at {measured[v].velocity:+.3f} m/s: Ruckig from where it is",
+                    )
+                self._restarting[v] = True
                 self._command[v] = self._seed(v, measured_path[v].p, measured_path[v].v, measured_path[v].a)
                 self._recent[v].clear()
                 self._restarted[v] = self._time
+            elif self._time - self._restarted[v] >= self.latency:
+                self._restarting[v] = False
         for v in (0, 1):  # turning at a reversal: the travel runs on, so its velocity and acceleration flip
             c = self._command[v]
             if abs(c.v) <= _REST and c.a < 0.0 and any(abs(c.p - r) <= 1e-9 for r in paths[v].stops):
@@ -831,6 +853,10 @@ class Executor:
             if choice[v]:
                 braking[v] = True
                 wanted[v] = self._brake(v)
+        if self._next_goal is not None:  # stopping for a new goal
+            choice = (True, True)
+            braking = [True, True]
+            wanted = [self._brake(v) for v in (0, 1)]
         certified = choice != (True, True) or self._check.clearance(
             self._paths, (wanted[0][0], wanted[1][0]), tuple(measured_path), required
         )

@@ -415,11 +415,21 @@ def parse_faults(
     )
 
 
+def _closing_rate(same_leg: bool, s: tuple, v: tuple, orientation: tuple) -> float:
+    """How fast the track distance of two vehicles on their legs changes, m/s."""
+    ds = (orientation[0] * v[0], orientation[1] * v[1])
+    if same_leg:
+        return (ds[0] - ds[1]) * (1.0 if s[0] >= s[1] else -1.0)
+    return ds[0] + ds[1]
+
+
 def _between(before, bodies, first: float, second: float, bend: float) -> float:
     """A lower bound of the true track distance between two cycles, metres.
 
-    While each vehicle stays on its leg, the distance is convex along straight motions (``|s1 - s2|``
-    or ``s1 + s2``), so it is the smaller end value less the bend of the curved motions, or 0 if two
+    ``before``: each vehicle's ``(leg, s, a, v, orientation)`` at the earlier cycle. While each vehicle
+    stays on its leg, the distance (``|s1 - s2|`` or ``s1 + s2``) can dip below both end values only
+    if its rate turns from closing to opening inside the cycle: then the smaller end value less the
+    bend of the two motions (``max |a| * dt**2 / 8`` each), else the smaller end value; 0 if two
     vehicles on one leg swapped order. Through the junction: the mean of the two ends less half of
     how far both drove (track distance is 1-Lipschitz in each position).
     """
@@ -430,7 +440,16 @@ def _between(before, bodies, first: float, second: float, bend: float) -> float:
         same_leg = before[0][0] == before[1][0]
         if same_leg and (before[0][1] - before[1][1]) * (bodies[0].s - bodies[1].s) < 0.0:
             return 0.0
-        return min(first, second) - bend
+        start = _closing_rate(
+            same_leg, (before[0][1], before[1][1]), (before[0][3], before[1][3]), (before[0][4], before[1][4])
+        )
+        end = _closing_rate(
+            same_leg,
+            (bodies[0].s, bodies[1].s),
+            (bodies[0].v, bodies[1].v),
+            (bodies[0].orientation, bodies[1].orientation),
+        )
+        return min(first, second) - (bend if start < 0.0 < end else 0.0)
     moved = sum(leg_travel(old[0], old[1], b.leg, b.s) for old, b in zip(before, bodies, strict=True))
     return 0.5 * (first + second - moved)
 
@@ -544,7 +563,7 @@ def simulate(
                     limit_violations += 1
                 for k in range(3):
                     worst[k] = max(worst[k], ratios[k])
-            before = [(b.leg, b.s, b.a) for b in bodies]
+            before = [(b.leg, b.s, b.a, b.v, b.orientation) for b in bodies]
             plant.advance(command, t)
             cycle += 1
             t = cycle * period

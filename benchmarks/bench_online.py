@@ -1,0 +1,124 @@
+"""Figures of the online executor (issue 11): cycle cost, replan latency, and the fault campaign.
+
+1. Per-cycle cost of :meth:`trajgen.online.Executor.step` for both vehicles (the executor only: the
+   simulated plant and the bookkeeping are not timed), over the first ``--timed`` campaign scenarios,
+   run one at a time in this process: median, 99th percentile, worst, in microseconds.
+2. Replan latency: the cycles in which the executor replanned (planner, route choice, restart of the
+   Ruckig motions; there is no re-optimisation), median and worst, in milliseconds.
+3. The campaign: ``--count`` seeded random scenarios (:func:`trajgen.sampling.online_campaign`), each
+   with 1-3 random faults (:func:`trajgen.sampling.campaign_faults`), simulated closed loop:
+   separation and limit violations, goals reached, and the time lost against the undisturbed
+   schedule (median, worst). Scenarios are spread over ``--workers`` processes.
+
+Run: ``python benchmarks/bench_online.py [--count 200] [--seed 11] [--timed 20] [--workers 2]``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import logging
+import multiprocessing
+import statistics
+import time
+
+from trajgen.online import Executor
+from trajgen.online.executor import execution_margin, plan_for_execution
+from trajgen.online.simulation import parse_faults, simulate
+from trajgen.sampling import campaign_faults, online_campaign
+
+
+def run_case(args: tuple[int, int]) -> dict:
+    """One campaign scenario: its faults and the summary of its simulation."""
+    k, seed = args
+    logging.disable(logging.WARNING)
+    scenario = online_campaign(k + 1, seed=seed)[k]
+    verified = plan_for_execution(scenario)
+    margin = execution_margin(scenario, 0.05)
+    specs = campaign_faults(scenario, verified.schedule.duration, seed=1000 + k, margin=margin)
+    result, _ = simulate(scenario, parse_faults(scenario, specs), verified=verified)
+    return {"k": k, "specs": specs, **result.summary()}
+
+
+def timed_cycles(count: int, seed: int) -> tuple[list[float], list[float]]:
+    """Wall time of every executor step (µs) and of the steps that replanned (ms)."""
+    logging.disable(logging.WARNING)
+    cycles: list[float] = []
+    replans: list[float] = []
+    original = Executor.step
+
+    def step(self, first, second):
+        before = self.replans
+        start = time.perf_counter_ns()
+        command = original(self, first, second)
+        elapsed = time.perf_counter_ns() - start
+        cycles.append(elapsed / 1e3)
+        if self.replans > before:
+            replans.append(elapsed / 1e6)
+        return command
+
+    Executor.step = step
+    try:
+        for k in range(count):
+            run_case((k, seed))
+    finally:
+        Executor.step = original
+    return cycles, replans
+
+
+def percentile(values: list[float], q: float) -> float:
+    ordered = sorted(values)
+    return ordered[min(len(ordered) - 1, int(q * len(ordered)))]
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--count", type=int, default=200)
+    parser.add_argument("--seed", type=int, default=11)
+    parser.add_argument("--timed", type=int, default=20)
+    parser.add_argument("--workers", type=int, default=2)
+    args = parser.parse_args()
+
+    cycles, replans = timed_cycles(args.timed, args.seed)
+    print(f"executor cycle (both vehicles), {len(cycles)} cycles of {args.timed} scenarios:")
+    print(
+        f"  median {statistics.median(cycles):.1f} us, p99 {percentile(cycles, 0.99):.1f} us, "
+        f"worst {max(cycles):.1f} us"
+    )
+    if replans:
+        print(
+            f"replan latency ({len(replans)} replans): median {statistics.median(replans):.2f} ms, "
+            f"worst {max(replans):.2f} ms"
+        )
+
+    started = time.perf_counter()
+    with multiprocessing.Pool(args.workers) as pool:
+        rows = sorted(pool.map(run_case, [(k, args.seed) for k in range(args.count)]), key=lambda r: r["k"])
+    wall = time.perf_counter() - started
+    failed = [r for r in rows if not r["reached_goal"] or r["violations"]]
+    lost = [r["time_lost_s"] for r in rows if r["reached_goal"]]
+    relative = [r["time_lost_s"] / r["planned_s"] for r in rows if r["reached_goal"] and r["planned_s"] > 0]
+    print(f"campaign: {args.count} scenarios (seed {args.seed}), 1-3 faults each, {wall:.0f} s wall")
+    print(f"  goals reached: {sum(r['reached_goal'] for r in rows)}/{len(rows)}")
+    print(f"  separation violations: {sum(r['separation_violations'] for r in rows)} cycles")
+    print(f"  limit violations: {sum(r['limit_violations'] for r in rows)} cycles")
+    print(
+        "  worst ratios to the limits (v, a, j): "
+        f"{max(r['velocity_ratio'] for r in rows):.9f}, {max(r['acceleration_ratio'] for r in rows):.9f}, "
+        f"{max(r['jerk_ratio'] for r in rows):.9f}"
+    )
+    print(f"  rejected goal requests: {sum(r['rejected_goals'] for r in rows)}")
+    if lost:
+        print(
+            f"  time lost against the undisturbed schedule: median {statistics.median(lost):.2f} s "
+            f"({100 * statistics.median(relative):.0f} % of the plan), worst {max(lost):.2f} s"
+        )
+    for r in failed:
+        print(
+            f"  FAILED scenario {r['k']}: {', '.join(r['specs'])}: reached {r['reached_goal']}, "
+            f"separation violations {r['separation_violations']}, limit violations {r['limit_violations']}, "
+            f"closest {r['min_separation_m']:.6f} m"
+        )
+
+
+if __name__ == "__main__":
+    main()
