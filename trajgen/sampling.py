@@ -114,6 +114,42 @@ def reference_sets(random_count: int = 50) -> tuple[ReferenceSet, ...]:
     )
 
 
+def _drawn_scenarios(
+    count: int,
+    seed: int,
+    *,
+    legs: tuple[float, float],
+    velocity: tuple[float, float],
+    acceleration: tuple[float, float],
+    jerk: tuple[float, float],
+    label: str,
+) -> list[Scenario]:
+    """Seeded scenarios: log-uniform legs and per-vehicle limits in the given ranges (SI units).
+
+    The separation is drawn from 0 up to the shortest leg (every fifth scenario exactly the shortest
+    leg); every fourth scenario is a swap, the others have a random start and goal.
+    """
+    rng = random.Random(seed)
+
+    def log_uniform(low: float, high: float) -> float:
+        return math.exp(rng.uniform(math.log(low), math.log(high)))
+
+    scenarios = []
+    for k in range(count):
+        track = YGraph({name: log_uniform(*legs) for name in "ABC"})
+        vehicles = tuple(
+            VehicleLimits(log_uniform(*velocity), log_uniform(*acceleration), log_uniform(*jerk))
+            for _ in range(2)
+        )
+        shortest = track.shortest_leg
+        separation = shortest if k % 5 == 0 else rng.uniform(0.0, shortest)
+        limits = Limits(vehicles=vehicles, min_separation=separation)
+        start = random_configuration(rng, track, separation)
+        goal = start.swapped() if k % 4 == 0 else random_configuration(rng, track, separation)
+        scenarios.append(Scenario(track, limits, ("agv1", "agv2"), start, goal, f"<{label} {seed}:{k}>"))
+    return scenarios
+
+
 def campaign_scenarios(count: int, *, seed: int) -> list[Scenario]:
     """Seeded random scenarios over a wide range of tracks and vehicles, for robustness campaigns.
 
@@ -126,25 +162,15 @@ def campaign_scenarios(count: int, *, seed: int) -> list[Scenario]:
     the scenarios exactly the shortest leg), and a swap for every fourth
     scenario, random start and goal otherwise.
     """
-    rng = random.Random(seed)
-
-    def log_uniform(low: float, high: float) -> float:
-        return math.exp(rng.uniform(math.log(low), math.log(high)))
-
-    scenarios = []
-    for k in range(count):
-        track = YGraph({name: log_uniform(0.5, 5000.0) for name in "ABC"})
-        vehicles = tuple(
-            VehicleLimits(log_uniform(0.05, 5.0), log_uniform(0.05, 5.0), log_uniform(0.05, 20.0))
-            for _ in range(2)
-        )
-        shortest = track.shortest_leg
-        separation = shortest if k % 5 == 0 else rng.uniform(0.0, shortest)
-        limits = Limits(vehicles=vehicles, min_separation=separation)
-        start = random_configuration(rng, track, separation)
-        goal = start.swapped() if k % 4 == 0 else random_configuration(rng, track, separation)
-        scenarios.append(Scenario(track, limits, ("agv1", "agv2"), start, goal, f"<campaign {seed}:{k}>"))
-    return scenarios
+    return _drawn_scenarios(
+        count,
+        seed,
+        legs=(0.5, 5000.0),
+        velocity=(0.05, 5.0),
+        acceleration=(0.05, 5.0),
+        jerk=(0.05, 20.0),
+        label="campaign",
+    )
 
 
 def online_campaign(count: int, *, seed: int) -> list[Scenario]:
@@ -155,25 +181,15 @@ def online_campaign(count: int, *, seed: int) -> list[Scenario]:
     up to the shortest leg (a fifth of the scenarios exactly the shortest leg), a swap for every
     fourth scenario, random start and goal otherwise. Pair with :func:`campaign_faults`.
     """
-    rng = random.Random(seed)
-
-    def log_uniform(low: float, high: float) -> float:
-        return math.exp(rng.uniform(math.log(low), math.log(high)))
-
-    scenarios = []
-    for k in range(count):
-        track = YGraph({name: log_uniform(0.5, 30.0) for name in "ABC"})
-        vehicles = tuple(
-            VehicleLimits(log_uniform(0.2, 3.0), log_uniform(0.2, 3.0), log_uniform(0.5, 10.0))
-            for _ in range(2)
-        )
-        shortest = track.shortest_leg
-        separation = shortest if k % 5 == 0 else rng.uniform(0.0, shortest)
-        limits = Limits(vehicles=vehicles, min_separation=separation)
-        start = random_configuration(rng, track, separation)
-        goal = start.swapped() if k % 4 == 0 else random_configuration(rng, track, separation)
-        scenarios.append(Scenario(track, limits, ("agv1", "agv2"), start, goal, f"<online {seed}:{k}>"))
-    return scenarios
+    return _drawn_scenarios(
+        count,
+        seed,
+        legs=(0.5, 30.0),
+        velocity=(0.2, 3.0),
+        acceleration=(0.2, 3.0),
+        jerk=(0.5, 10.0),
+        label="online",
+    )
 
 
 def campaign_faults(scenario: Scenario, duration: float, *, seed: int, margin: float) -> tuple[str, ...]:
