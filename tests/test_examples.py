@@ -19,6 +19,8 @@ FIGURES = {
     "01_plan_a_swap": (r"vehicle 2 drives ([0-9.]+) m", 48.0, 1e-9),
     "02_schedule_and_export": (r"exact makespan: ([0-9.]+) s", 67.5, 0.005),
     "03_optimal_swap": (r"optimal / exact = ([0-9.]+)", 0.4076, 0.0005),
+    # the plan keeps 1.5 m + twice the 0.05 m margin; the stopped vehicle never gets closer
+    "04_online_stop_in_the_junction": (r"closest approach ([0-9.]+) m", 1.600, 0.003),
 }
 
 
