@@ -194,7 +194,8 @@ def test_an_undisturbed_run_follows_the_plan(swap):
     result, _ = simulate(scenario, (), verified=verified)
     assert result.reached_goal
     assert result.violations == 0
-    assert result.time_lost_s <= 1.5  # the braking check may take over near the closest approach
+    # the braking check takes over where the plan follows closest (a leader may stop short): < 10 %
+    assert 0.0 <= result.time_lost_s <= 0.1 * result.planned_s
     assert result.min_separation_m >= scenario.limits.min_separation
 
 
