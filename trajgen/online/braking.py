@@ -28,7 +28,7 @@ from trajgen.online.paths import VehiclePath, set_distance
 __all__ = ["BrakingCheck", "PathState", "ServiceBraking", "emergency_position"]
 
 #: Time intervals tried in turn: a coarse pass is enough while the vehicles are far apart.
-_REFINEMENTS = (1, 5, 20)
+_REFINEMENTS = (1, 6, 40)
 
 
 @dataclass(frozen=True, slots=True)
@@ -167,15 +167,7 @@ class BrakingCheck:
             if previous is not None:
                 sets = []
                 for vehicle in (0, 1):
-                    # the service braking is monotone over the interval (so it stays within its end
-                    # values) unless its speed is near zero at an end: it cannot turn within the
-                    # interval without passing below a * dt / 2; the emergency stop is monotone
-                    speeds = (previous[vehicle][2], bounds[vehicle][2])
-                    turning = (
-                        min(abs(speeds[0]), abs(speeds[1])) <= pads[vehicle] * step
-                        or speeds[0] * speeds[1] < 0.0
-                    )
-                    pad = pads[vehicle] * step * step / 8.0 if turning else 0.0
+                    pad = pads[vehicle] * step * step / 8.0
                     low = min(previous[vehicle][0], bounds[vehicle][0]) - pad
                     high = max(previous[vehicle][1], bounds[vehicle][1]) + pad
                     sets.append(paths[vehicle].sweep(low, high, lengths))
