@@ -61,6 +61,8 @@ _ROWS_PER_BLOCK = 5_000
 _CORRECTION = 0.2
 #: How fast a drive closes a gap to its setpoint: the gap times this, m/s per m (a 0.5 s time constant).
 _GAIN = 2.0
+#: A vehicle slower than this is at rest, m/s (a drive closing its last gap creeps for a while).
+_AT_REST = 1e-3
 #: True track distance below the minimum separation that counts as a violation, metres (1 µm).
 _VIOLATION_TOLERANCE = 1e-6
 #: Relative tolerance on the commanded limits (Ruckig's jerk phases are exactly at the limit).
@@ -321,7 +323,7 @@ class SimulationResult:
     Attributes
     ----------
     reached_goal : bool
-        Both vehicles at rest at their goals, every fault applied, within the time limit.
+        Both vehicles at rest (under 1 mm/s) at their goals, every fault applied, within the time limit.
     makespan_s : float
         When they got there, seconds (the time limit if they did not).
     planned_s : float
@@ -587,7 +589,7 @@ def simulate(
                 command.mode is Mode.DONE
                 and not pending
                 and t >= settle
-                and all(abs(b.v) <= 1e-9 for b in bodies)
+                and all(abs(b.v) <= _AT_REST for b in bodies)
             )
             if done:
                 makespan = t
