@@ -106,13 +106,17 @@ def _command_simulate(args: argparse.Namespace) -> int:
     return EXIT_OK
 
 
-def _add_method(parser: argparse.ArgumentParser) -> None:
+def _add_method(
+    parser: argparse.ArgumentParser, *, what: str = "timing method", homotopy: bool = True
+) -> None:
     parser.add_argument(
         "--method",
         default=METHODS.default,
         metavar="|".join(METHODS.names),
-        help=f"timing method, one of:\n{METHODS.help()}",
+        help=f"{what}, one of:\n{METHODS.help()}",
     )
+    if not homotopy:
+        return
     parser.add_argument(
         "--homotopy",
         metavar="|".join(c.value for c in HomotopyChoice),
@@ -215,12 +219,7 @@ def build_parser() -> argparse.ArgumentParser:
     simulate.add_argument(
         "--period", type=float, default=0.01, help="control period, seconds (0.002 to 0.1; 0.01)"
     )
-    simulate.add_argument(
-        "--method",
-        default=METHODS.default,
-        metavar="|".join(METHODS.names),
-        help=f"timing method of the undisturbed plan, one of:\n{METHODS.help()}",
-    )
+    _add_method(simulate, what="timing method of the undisturbed plan", homotopy=False)
     simulate.add_argument(
         "--position-margin",
         type=float,

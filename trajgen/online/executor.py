@@ -481,9 +481,7 @@ class Executor:
         self._time = 0.0
         self._plan_time = 0.0
         self._travel = [0.0, 0.0]  # measured travel along the current paths
-        axis0 = self._plan.state(0, 0.0), self._plan.state(1, 0.0)
         self._command = [PathState(0.0, 0.0, 0.0), PathState(0.0, 0.0, 0.0)]
-        self._command_axis = [axis0[0][0], axis0[1][0]]
         self._pending: str | None = None
         self._next_goal: Configuration | None = None
         self._idle = 0
@@ -648,7 +646,6 @@ class Executor:
             axis, velocity, acceleration, jerk, leg, s = states[v]
             self._command[v] = commanded[v]
             self._recent[v].append((axis, velocity))
-            self._command_axis[v] = axis
             setpoints.append(
                 Setpoint(
                     axis,
@@ -697,15 +694,13 @@ class Executor:
                 self._reseed(v, measured[v], on_path[v], old_paths[v])
             return
         self._log("replan", f"{reason}: new route, {self._describe(route)}")
-        seeds, axes, new_paths = [], [], []
+        seeds, new_paths = [], []
         for v in (0, 1):
             old = old_paths[v]
             p_old = on_path[v]
             if p_old is None:
                 p_old = self._command[v].p
-                axis = self._command_axis[v]
-            else:
-                axis = self._command_axis[v] + old.heading(p_old) * (p_old - self._command[v].p)
+            axis = old.axis(p_old)
             orientation = old.outward(p_old) * old.heading(p_old)
             path = VehiclePath.from_route(route, v, axis_start=axis, orientation=orientation)
             new_paths.append(path)
@@ -717,14 +712,12 @@ class Executor:
                 self._restarted[v] = self._time
             heading = path.heading(0.0)
             seeds.append(self._seed(v, 0.0, heading * v_axis, heading * a_axis))
-            axes.append(axis)
         for recent in self._recent:
             recent.clear()  # travel coordinates change with the paths
         self._route = route
         self._paths = tuple(new_paths)
         self._coordination = Coordination.from_route(route)
         self._command = seeds
-        self._command_axis = axes
         self._travel = [0.0, 0.0]
 
     def _departed(self, v: int, axis: float, velocity: float) -> bool:
@@ -767,7 +760,6 @@ class Executor:
             self._command[v] = self._seed(v, p, v_meas, heading * measured.acceleration)
             self._recent[v].clear()
             self._restarted[v] = self._time
-            self._command_axis[v] = path.axis(p)
         self._travel[v] = p
 
     def _choose_route(
@@ -868,7 +860,6 @@ class Executor:
             heading = path.heading(state.p)
             axis = path.axis(state.p)
             self._recent[v].append((axis, heading * state.v))
-            self._command_axis[v] = axis
             leg, s = path.locate(state.p)
             setpoints.append(
                 Setpoint(
@@ -1003,12 +994,12 @@ class Executor:
         order = (0, 1) if ahead[0] >= ahead[1] else (1, 0)
         for v in order:
             trial = list(desired)
-            trial[v] = self._brake(v, peek=True)[0]
+            trial[v] = self._brake(v)[0]
             if self._check.clearance(self._paths, tuple(trial), measured_path, required):
                 return (v == 0, v == 1)
         return (True, True)
 
-    def _brake(self, v: int, *, peek: bool = False) -> tuple[PathState, float]:
+    def _brake(self, v: int) -> tuple[PathState, float]:
         """The next state of ``v`` under service braking from its last setpoint (to rest, never reversing)."""
         command = self._command[v]
         if abs(command.v) <= _REST:

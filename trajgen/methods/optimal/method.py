@@ -29,15 +29,7 @@ from trajgen.methods.optimal.transcription import ParameterLayout
 from trajgen.schedule import FallbackReason, Schedule, TimingMethod, check_request
 from trajgen.verify import verify
 
-__all__ = [
-    "DEFAULT_NODES",
-    "DEFAULT_REFINEMENT_TOLERANCE",
-    "ClassComparison",
-    "HomotopyChoice",
-    "Optimal",
-    "OptimalInfo",
-    "Source",
-]
+__all__ = ["DEFAULT_NODES", "DEFAULT_REFINEMENT_TOLERANCE", "Optimal"]
 
 logger = logging.getLogger(__name__)
 
