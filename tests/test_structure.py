@@ -164,7 +164,7 @@ def test_only_the_figure_module_imports_matplotlib():
 
 def test_the_library_never_prints():
     for module, path in MODULES.items():
-        if module == "trajgen.cli":
+        if module == "trajgen.cli" or module.startswith("trajgen.cli."):
             continue
         calls = [
             node

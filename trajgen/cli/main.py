@@ -1,0 +1,50 @@
+"""The ``trajgen`` command line: parses arguments, runs a command, maps errors to exit codes.
+
+Exit status: 0 on success, 2 on bad input (message on stderr, nothing
+written), 1 on an internal failure (nothing written). ``trajgen simulate``
+also exits 1 when the simulated run missed its goal or had violations (its
+trace and plot are written: they are the evidence).
+"""
+
+from __future__ import annotations
+
+import argparse
+import logging
+import sys
+from collections.abc import Sequence
+
+from trajgen.cli import schedule, simulate
+from trajgen.cli.options import EXIT_BAD_INPUT, EXIT_FAILURE, CommandParser
+from trajgen.errors import InputError
+
+__all__ = ["COMMAND_MODULES", "build_parser", "main"]
+
+logger = logging.getLogger(__name__)
+
+#: The modules whose ``register(commands)`` adds the sub-commands, in help order.
+COMMAND_MODULES = (schedule, simulate)
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """The argument parser of the ``trajgen`` command."""
+    parser = CommandParser(prog="trajgen", description="Collision-free schedules for two AGVs on a Y-track.")
+    parser.add_argument("-v", "--verbose", action="store_true", help="log progress to stderr")
+    commands = parser.add_subparsers(dest="command", required=True, parser_class=CommandParser)
+    for module in COMMAND_MODULES:
+        module.register(commands)
+    return parser
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Run the command line; returns the exit status."""
+    try:
+        args = build_parser().parse_args(argv)
+        logging.basicConfig(level=logging.INFO if args.verbose else logging.WARNING, format="%(message)s")
+        return args.run(args)
+    except InputError as error:
+        print(f"trajgen: error: {error}", file=sys.stderr)
+        return EXIT_BAD_INPUT
+    except Exception as error:
+        logger.debug("internal failure", exc_info=True)
+        print(f"trajgen: internal failure: {type(error).__name__}: {error}", file=sys.stderr)
+        return EXIT_FAILURE

@@ -1,0 +1,114 @@
+"""What the ``trajgen`` commands share: exit codes, the argument parser, common options.
+
+Each command lives in its own module of :mod:`trajgen.cli` with a
+``register(commands)`` function that adds its sub-parser; the parser's
+``run`` default is the function that carries the command out and returns its
+exit status.
+"""
+
+from __future__ import annotations
+
+import argparse
+import dataclasses
+
+from trajgen.errors import InputError, OptionError
+from trajgen.export import DEFAULT_MAX_ROWS, CsvOptions, Units
+from trajgen.methods import METHODS, HomotopyChoice, Optimal
+from trajgen.scenario import Scenario, default_scenario, load_scenario
+from trajgen.schedule import TimingMethod
+
+__all__ = [
+    "EXIT_BAD_INPUT",
+    "EXIT_FAILURE",
+    "EXIT_OK",
+    "CommandParser",
+    "add_csv_options",
+    "add_method",
+    "csv_dialect",
+    "csv_options",
+    "method_from",
+    "scenario_from",
+]
+
+EXIT_OK = 0
+EXIT_FAILURE = 1
+EXIT_BAD_INPUT = 2
+
+
+class CommandParser(argparse.ArgumentParser):
+    """argparse that reports usage errors as bad input (exit 2) through our path."""
+
+    def error(self, message: str):
+        """Raise InputError with the usage message (argparse would exit)."""
+        raise InputError(f"{self.prog}: {message}")
+
+
+def scenario_from(path: str | None) -> Scenario:
+    """The scenario of a file, or the built-in one for ``None``."""
+    return default_scenario() if path is None else load_scenario(path)
+
+
+def csv_dialect(args: argparse.Namespace) -> dict:
+    """``--delimiter``, ``--decimal``, ``--units`` as keyword arguments of CsvOptions."""
+    delimiter = "\t" if args.delimiter in ("tab", "\\t") else args.delimiter
+    return {"delimiter": delimiter, "decimal": args.decimal, "units": Units.lookup(args.units)}
+
+
+def csv_options(args: argparse.Namespace) -> CsvOptions:
+    """The CsvOptions of ``--sample-period``, ``--max-rows`` and the dialect options."""
+    return CsvOptions(sample_period=args.sample_period, max_rows=args.max_rows, **csv_dialect(args))
+
+
+def add_method(
+    parser: argparse.ArgumentParser, *, what: str = "timing method", homotopy: bool = True
+) -> None:
+    """``--method`` (and, with ``homotopy``, ``--homotopy``)."""
+    parser.add_argument(
+        "--method",
+        default=METHODS.default,
+        metavar="|".join(METHODS.names),
+        help=f"{what}, one of:\n{METHODS.help()}",
+    )
+    if not homotopy:
+        return
+    parser.add_argument(
+        "--homotopy",
+        metavar="|".join(c.value for c in HomotopyChoice),
+        help="optimal only: 'fastest' (default) solves both ways round the configuration circle and\n"
+        "keeps the faster; 'paper' keeps the class of the paper's instruction",
+    )
+
+
+def method_from(args: argparse.Namespace) -> TimingMethod:
+    """The method object of ``--method`` with ``--homotopy`` applied."""
+    method = METHODS.create(args.method)
+    if getattr(args, "homotopy", None) is None:
+        return method
+    choice = HomotopyChoice.lookup(args.homotopy)
+    if not isinstance(method, Optimal):
+        raise OptionError(
+            f"--homotopy {args.homotopy!r} applies to the method 'optimal' only, "
+            f"got --method {method.name!r} "
+            "(exact and toppra always take the paper's class)"
+        )
+    return dataclasses.replace(method, homotopy=choice)
+
+
+def add_csv_options(parser: argparse.ArgumentParser, *, sampling: bool = True) -> None:
+    """The CSV dialect options; with ``sampling``, also ``--sample-period`` and ``--max-rows``."""
+    if sampling:
+        parser.add_argument(
+            "--sample-period", type=float, default=0.01, help="seconds between CSV rows (0.01)"
+        )
+    parser.add_argument("--delimiter", default=";", help="CSV field separator (';'); 'tab' for a tab")
+    parser.add_argument("--decimal", default=".", choices=[".", ","], help="decimal mark ('.')")
+    parser.add_argument(
+        "--units", default="m", choices=[u.value for u in Units], help="length unit of the CSV (m)"
+    )
+    if sampling:
+        parser.add_argument(
+            "--max-rows",
+            type=int,
+            default=DEFAULT_MAX_ROWS,
+            help=f"refuse a CSV profile of more rows than this ({DEFAULT_MAX_ROWS:,})",
+        )

@@ -1,0 +1,78 @@
+"""``trajgen plan``, ``trajgen schedule`` and ``trajgen demo``: the planner's route and the pipeline."""
+
+from __future__ import annotations
+
+import argparse
+import json
+
+from trajgen.cli.options import (
+    EXIT_OK,
+    add_csv_options,
+    add_method,
+    csv_options,
+    method_from,
+    scenario_from,
+)
+from trajgen.pipeline import Outputs, run
+from trajgen.scenario import default_scenario
+from trajgen.summary import format_route, format_run, route_summary
+
+__all__ = ["register"]
+
+
+def _command_plan(args: argparse.Namespace) -> int:
+    route = scenario_from(args.scenario).plan()
+    print(json.dumps(route_summary(route), indent=2) if args.json else format_route(route))
+    return EXIT_OK
+
+
+def _command_schedule(args: argparse.Namespace) -> int:
+    scenario = scenario_from(args.scenario)
+    outputs = Outputs(csv_dir=args.csv, plot_dir=args.plot, csv=csv_options(args))
+    summary = run(scenario, method=method_from(args), outputs=outputs).summary()
+    print(json.dumps(summary, indent=2) if args.json else format_run(summary))
+    return EXIT_OK
+
+
+def _command_demo(args: argparse.Namespace) -> int:
+    scenario = default_scenario()
+    result = run(
+        scenario, method=method_from(args), outputs=Outputs(csv_dir=args.output, plot_dir=args.output)
+    )
+    print(f"Demo: the built-in scenario {scenario.source} (two AGVs swap ends of legs A and B).")
+    print(format_route(result.route))
+    print(format_run(result.summary()))
+    print(f"CSV profiles and plots are in {args.output}/")
+    return EXIT_OK
+
+
+def register(commands) -> None:
+    """Add ``demo``, ``plan`` and ``schedule`` to the sub-commands."""
+    demo = commands.add_parser(
+        "demo",
+        help="run the built-in swap scenario end to end",
+        formatter_class=argparse.RawTextHelpFormatter,
+    )
+    demo.add_argument("--output", default="trajgen-demo", help="folder for CSV and plots (trajgen-demo)")
+    add_method(demo)
+    demo.set_defaults(run=_command_demo)
+
+    plan_parser = commands.add_parser("plan", help="print the planner's route for a scenario file")
+    plan_parser.add_argument("scenario", help="scenario TOML file")
+    plan_parser.add_argument("--json", action="store_true", help="print a machine-readable summary")
+    plan_parser.set_defaults(run=_command_plan)
+
+    schedule = commands.add_parser(
+        "schedule",
+        help="schedule, verify and export a scenario",
+        formatter_class=argparse.RawTextHelpFormatter,
+    )
+    schedule.add_argument("scenario", help="scenario TOML file")
+    add_method(schedule)
+    schedule.add_argument("--csv", metavar="DIR", help="write DIR/<vehicle name>.csv per vehicle")
+    schedule.add_argument(
+        "--plot", metavar="DIR", help="write DIR/speed.png, DIR/separation.png, DIR/coordination.png"
+    )
+    schedule.add_argument("--json", action="store_true", help="print a machine-readable summary")
+    add_csv_options(schedule)
+    schedule.set_defaults(run=_command_schedule)
