@@ -30,6 +30,7 @@ __all__ = [
     "OutputError",
     "OutputLimitError",
     "PositionError",
+    "ProfileFileError",
     "ScenarioError",
     "ScheduleError",
     "SeparationError",
@@ -51,6 +52,10 @@ class OutputError(InputError):
 
 class OutputLimitError(OutputError):
     """An output would exceed a documented size limit (for example the rows of a CSV profile)."""
+
+
+class ProfileFileError(InputError):
+    """A profile file (CSV or cam table) cannot be read as its dialect says it is written."""
 
 
 class UnverifiedScheduleError(TrajgenError, TypeError):

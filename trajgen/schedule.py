@@ -313,6 +313,10 @@ class Schedule:
         ``exact`` schedule in its place; ``notes`` say more.
     info : MethodInfo or None
         Method diagnostics (e.g. :class:`trajgen.methods.optimal.OptimalInfo`).
+    continuity : int or None
+        How many derivatives of position are continuous and zero at the start
+        and goal (0: position only, as a linearly interpolated table; 1: also
+        velocity; 2: also acceleration). ``None``: 2 if ``jerk_limited``, else 1.
     """
 
     route: Route
@@ -323,12 +327,20 @@ class Schedule:
     notes: tuple[str, ...] = ()
     fallback_reason: FallbackReason | None = None
     info: MethodInfo | None = field(default=None, compare=False)
+    continuity: int | None = None
     _starts: np.ndarray = field(init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "sections", tuple(self.sections))
         object.__setattr__(self, "notes", tuple(self.notes))
         object.__setattr__(self, "_starts", readonly([section.start_time for section in self.sections]))
+
+    @property
+    def smoothness(self) -> int:
+        """Derivatives of position that are continuous (see ``continuity``): 0, 1 or 2."""
+        if self.continuity is not None:
+            return self.continuity
+        return 2 if self.jerk_limited else 1
 
     @property
     def duration(self) -> float:

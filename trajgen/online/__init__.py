@@ -7,7 +7,7 @@ against a simulated plant with faults (:mod:`trajgen.online.faults`).
 
 from trajgen.online.braking import BrakingCheck, PathState
 from trajgen.online.executor import Command, Event, Executor, GoalDecision, Mode, Setpoint, VehicleState
-from trajgen.online.paths import Coordination, VehiclePath
+from trajgen.paths import Coordination, VehiclePath
 
 __all__ = [
     "BrakingCheck",

@@ -43,7 +43,7 @@ from topology.route import Homotopy, WayRound
 from trajgen.errors import InputError, ScheduleError
 from trajgen.methods import make_schedule
 from trajgen.online.braking import BrakingCheck, PathState
-from trajgen.online.paths import Coordination, VehiclePath, set_distance
+from trajgen.paths import Coordination, VehiclePath, set_distance
 from trajgen.pieces import schedule_pieces
 from trajgen.schedule import TimingMethod, check_period
 from trajgen.verify import VerifiedSchedule, certify, require_verified

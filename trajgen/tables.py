@@ -1,0 +1,510 @@
+"""Profile tables as a controller interpolates them, and their verification along a route.
+
+A PLC does not play a schedule: it plays a table of points and interpolates
+between them (linearly, by a cubic spline, or a velocity linearly in time).
+:class:`ProfileTable` is one vehicle's table with the interpolation its
+controller applies; :class:`TableMotion` turns the two tables into a
+:class:`~trajgen.schedule.Schedule` along the route, so the independent
+verifier (:mod:`trajgen.verify`) checks the separation, the track, the start
+and goal and the homotopy class of exactly what the controllers will drive,
+in closed form between the points too. What a table's interpolation leaves
+undefined (the acceleration of a linear table, the jerk of a linear velocity
+table) is checked from divided differences of its points
+(:func:`divided_differences`), with rest before the first point and after the
+last: for points sampled from any motion within the limits these never exceed
+the limits (mean-value theorem), so a table that fails moves differently.
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+from dataclasses import dataclass
+from typing import ClassVar
+
+import numpy as np
+from scipy.interpolate import CubicSpline
+
+from limits import Limits
+from topology import Option, Route
+from topology.validation import short_repr
+from trajgen.errors import InputError
+from trajgen.paths import VehiclePath
+from trajgen.profiles import PiecewiseCubic
+from trajgen.schedule import AxisMap, CubicKinematics, Schedule, Section, TimingMethod
+from trajgen.values import ArrayValue, readonly
+from trajgen.verify import RELATIVE_TOLERANCE, VerificationReport, verify
+
+__all__ = [
+    "Interpolation",
+    "ProfileTable",
+    "TableCheck",
+    "TableMotion",
+    "check_tables",
+    "divided_differences",
+    "limit_ratios",
+]
+
+#: How close (metres) a table must come to a reversal point of its path to count as having reached it.
+REVERSAL_TOLERANCE = 1e-6
+
+
+class Interpolation(Option):
+    """How a controller interpolates a table between its points."""
+
+    LINEAR = "linear"  #: position linear in time (cam tables): velocity steps at the points
+    CUBIC = "cubic"  #: position a C2 cubic spline through the points, at rest (v = 0) at both ends
+    VELOCITY = "linear-velocity"  #: velocity linear in time, position its integral from the start
+
+    @property
+    def smoothness(self) -> int:
+        """Derivatives of position the interpolation keeps continuous: 0, 1 or 2."""
+        return {Interpolation.LINEAR: 0, Interpolation.VELOCITY: 1, Interpolation.CUBIC: 2}[self]
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class ProfileTable(ArrayValue):
+    """One vehicle's table of points and how its controller interpolates them.
+
+    Attributes
+    ----------
+    times : ndarray, shape (n,)
+        Master values: seconds from the start, from 0, strictly increasing.
+    values : ndarray, shape (n,)
+        Slave values: the signed axis (metres) of position tables, the axis
+        velocity (m/s) of :attr:`Interpolation.VELOCITY` tables.
+    interpolation : Interpolation
+    start : float
+        Axis at t = 0 of a velocity table, metres (position tables start at ``values[0]``).
+    resolution : float
+        Half the step of the numbers as written (metres, or m/s), the round-off
+        the limit checks allow for; 0 for exact values.
+    """
+
+    times: np.ndarray
+    values: np.ndarray
+    interpolation: Interpolation
+    start: float = 0.0
+    resolution: float = 0.0
+
+    def __post_init__(self) -> None:
+        times = readonly(np.atleast_1d(np.asarray(self.times, dtype=float)))
+        values = readonly(np.atleast_1d(np.asarray(self.values, dtype=float)))
+        object.__setattr__(self, "times", times)
+        object.__setattr__(self, "values", values)
+        object.__setattr__(self, "interpolation", Interpolation.lookup(self.interpolation))
+        if times.ndim != 1 or times.shape != values.shape or times.size < 1:
+            raise InputError(
+                f"a profile table needs as many times as values, at least one, got {times.shape} and "
+                f"{values.shape}"
+            )
+        if not (np.all(np.isfinite(times)) and np.all(np.isfinite(values)) and math.isfinite(self.start)):
+            raise InputError("a profile table must hold finite numbers only")
+        if times[0] != 0.0:
+            raise InputError(f"a profile table starts at t = 0 s, got {times[0]!r} s")
+
+    @property
+    def duration(self) -> float:
+        """Time of the last point, seconds."""
+        return float(self.times[-1])
+
+    def decreasing_times(self) -> np.ndarray:
+        """Indices ``i`` (0-based rows of the points) where ``times[i] <= times[i - 1]``."""
+        return np.nonzero(np.diff(self.times) <= 0.0)[0] + 1
+
+    def positions(self) -> np.ndarray:
+        """The axis at every point, metres, shape (n,) (a velocity table integrated exactly)."""
+        if self.interpolation is not Interpolation.VELOCITY:
+            return self.values
+        steps = 0.5 * (self.values[:-1] + self.values[1:]) * np.diff(self.times)
+        return self.start + np.concatenate([[0.0], np.cumsum(steps)])
+
+    def motion(self) -> PiecewiseCubic:
+        """The interpolated motion of the axis as the controller drives it.
+
+        Raises
+        ------
+        InputError
+            The times do not strictly increase.
+        """
+        bad = self.decreasing_times()
+        if bad.size:
+            k = int(bad[0])
+            raise InputError(
+                f"profile table times must strictly increase, got {self.times[k - 1]!r} s then "
+                f"{self.times[k]!r} s at point {k + 1}"
+            )
+        times, values = self.times, self.values
+        if times.size == 1:
+            start = values[0] if self.interpolation is not Interpolation.VELOCITY else self.start
+            return PiecewiseCubic(np.array([0.0, 0.0]), np.array([[start, 0.0, 0.0]]), np.zeros(1))
+        h = np.diff(times)
+        if self.interpolation is Interpolation.LINEAR:
+            initial = np.stack([values[:-1], np.diff(values) / h, np.zeros(h.size)], axis=1)
+            return PiecewiseCubic(times, initial, np.zeros(h.size))
+        if self.interpolation is Interpolation.VELOCITY:
+            initial = np.stack([self.positions()[:-1], values[:-1], np.diff(values) / h], axis=1)
+            return PiecewiseCubic(times, initial, np.zeros(h.size))
+        spline = CubicSpline(times, values, bc_type=((1, 0.0), (1, 0.0)))
+        c = spline.c  # (4, n - 1), highest power first, about each interval's start
+        initial = np.stack([c[3], c[2], 2.0 * c[1]], axis=1)
+        return PiecewiseCubic(times, initial, 6.0 * c[0])
+
+
+def divided_differences(times: np.ndarray, values: np.ndarray, order: int) -> tuple[np.ndarray, np.ndarray]:
+    """``order! * f[t_i, ..., t_{i+order}]`` for consecutive points, and the round-off weight of each.
+
+    By the mean-value theorem each is the ``order``-th derivative of any smooth
+    function through the points somewhere between them (a weighted mean of it
+    for a piecewise-smooth one), so it is bounded by that derivative's limit.
+
+    Parameters
+    ----------
+    times, values : ndarray, shape (n,)
+    order : int
+        1, 2 or 3.
+
+    Returns
+    -------
+    ndarray, shape (n - order,)
+        The scaled divided differences.
+    ndarray, shape (n - order,)
+        ``order! * sum_m 1 / prod_{l != m} |t_m - t_l|``: how much a round-off of
+        1 in every value can move each difference.
+    """
+    table = np.asarray(values, dtype=float)
+    for k in range(1, order + 1):
+        table = (table[1:] - table[:-1]) / (times[k:] - times[:-k])
+    weight = np.zeros(table.size)
+    n = times.size - order
+    for m in range(order + 1):
+        product = np.ones(n)
+        for other in range(order + 1):
+            if other != m:
+                product *= np.abs(times[m : m + n] - times[other : other + n])
+        weight += 1.0 / product
+    return math.factorial(order) * table, math.factorial(order) * weight
+
+
+def _at_rest_both_ends(table: ProfileTable, count: int) -> tuple[np.ndarray, np.ndarray]:
+    """The table's points with ``count`` points of rest added before the start and after the end."""
+    times, values = table.times, table.values
+    rest_value = 0.0 if table.interpolation is Interpolation.VELOCITY else None
+    first_step = times[1] - times[0] if times.size > 1 else 1.0
+    last_step = times[-1] - times[-2] if times.size > 1 else 1.0
+    before = times[0] - first_step * np.arange(count, 0, -1)
+    after = times[-1] + last_step * np.arange(1, count + 1)
+    head = np.full(count, values[0] if rest_value is None else rest_value)
+    tail = np.full(count, values[-1] if rest_value is None else rest_value)
+    return np.concatenate([before, times, after]), np.concatenate([head, values, tail])
+
+
+@dataclass(frozen=True, slots=True)
+class DifferenceCheck:
+    """A limit checked from divided differences: the worst ratio and where it is."""
+
+    quantity: str
+    ratio: float
+    time: float
+    value: float
+    limit: float
+    allowed: float
+
+
+def _difference_checks(table: ProfileTable, limits, *, jerk: bool) -> list[DifferenceCheck]:
+    """The limits a table's interpolation leaves undefined, from divided differences of its points."""
+    checks = []
+    smoothness = table.interpolation.smoothness
+    if table.times.size < 2 or smoothness >= 2:
+        return checks
+    velocity_table = table.interpolation is Interpolation.VELOCITY
+    wanted = [("acceleration", 2, limits.max_acceleration)] if smoothness == 0 else []
+    if jerk:
+        wanted.append(("jerk", 3, limits.max_jerk))
+    for quantity, derivative, limit in wanted:
+        order = derivative - (1 if velocity_table else 0)  # a velocity table's values are one derivative up
+        times, values = _at_rest_both_ends(table, order)
+        difference, weight = divided_differences(times, values, order)
+        allowed = limit * (1.0 + RELATIVE_TOLERANCE) + table.resolution * weight
+        excess = np.abs(difference) - allowed
+        k = int(np.argmax(excess))
+        middle = 0.5 * (times[k] + times[k + order])
+        checks.append(
+            DifferenceCheck(
+                quantity,
+                float(np.max(np.abs(difference)) / limit),
+                float(min(max(middle, 0.0), table.duration)),
+                float(abs(difference[k])),
+                float(limit),
+                float(allowed[k]),
+            )
+        )
+    return checks
+
+
+def limit_ratios(tables: tuple[ProfileTable, ProfileTable], limits: Limits, *, jerk: bool = True) -> dict:
+    """Largest |v|, |a|, |j| over each limit per vehicle as the controllers interpolate the tables.
+
+    Closed form within the interpolated pieces; divided differences where the
+    interpolation leaves a derivative undefined. Without round-off allowance:
+    used to find how much a table must be slowed down to fit the limits.
+
+    Returns
+    -------
+    dict
+        ``{"velocity": (r1, r2), "acceleration": (r1, r2), "jerk": (r1, r2) or None}``.
+    """
+    ratios: dict[str, list[float]] = {"velocity": [0.0, 0.0], "acceleration": [0.0, 0.0], "jerk": [0.0, 0.0]}
+    for vehicle, table in enumerate(tables):
+        vehicle_limits = limits.vehicles[vehicle]
+        motion = table.motion()
+        peaks = _piece_peaks(motion)
+        for name, order in (("velocity", 1), ("acceleration", 2), ("jerk", 3)):
+            if order <= table.interpolation.smoothness + 1:
+                limit = getattr(vehicle_limits, f"max_{name}")
+                ratios[name][vehicle] = peaks[order - 1] / limit
+        for check in _difference_checks(table, vehicle_limits, jerk=jerk):
+            ratios[check.quantity][vehicle] = check.ratio
+    return {
+        "velocity": tuple(ratios["velocity"]),
+        "acceleration": tuple(ratios["acceleration"]),
+        "jerk": tuple(ratios["jerk"]) if jerk else None,
+    }
+
+
+def _piece_peaks(motion: PiecewiseCubic) -> tuple[float, float, float]:
+    """Largest |v|, |a|, |j| of a piecewise cubic, in closed form."""
+    h = np.diff(motion.times)
+    v0, a0, j = motion.initial[:, 1], motion.initial[:, 2], motion.jerk
+    v1 = v0 + h * (a0 + 0.5 * h * j)
+    a1 = a0 + h * j
+    velocity = np.maximum(np.abs(v0), np.abs(v1))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        vertex = np.where(j != 0.0, -a0 / j, -1.0)
+    inside = (vertex > 0.0) & (vertex < h)
+    velocity = np.where(
+        inside, np.maximum(velocity, np.abs(v0 - 0.5 * a0 * a0 / np.where(j != 0, j, 1))), velocity
+    )
+    return (
+        float(velocity.max(initial=0.0)),
+        float(np.maximum(np.abs(a0), np.abs(a1)).max(initial=0.0)),
+        float(np.abs(j[h > 0.0]).max(initial=0.0)),
+    )
+
+
+def _phase_maps(path: VehiclePath, lengths: tuple[float, ...]) -> list[AxisMap]:
+    """One axis map per stretch between reversals of ``path``, extended along its end legs."""
+    if not path.legs:
+        leg, s = path.home
+        return [AxisMap.parked(path.axis_starts[0] if path.axis_starts else 0.0, leg, s)]
+    maps = []
+    bounds = [0.0, *path.stops, path.length]
+    for begin, end in itertools.pairwise(bounds):
+        segments = [k for k in range(len(path.legs)) if begin - 1e-12 <= path.starts[k] < end - 1e-12]
+        axis_start, axis_end, legs, s_start, outward = [], [], [], [], []
+        for k in segments:
+            length = abs(path.s_to[k] - path.s_from[k])
+            slope = (1 if path.s_to[k] > path.s_from[k] else -1) * path.headings[k]  # ds / d axis
+            axis_start.append(path.axis_starts[k])
+            axis_end.append(path.axis_starts[k] + path.headings[k] * length)
+            legs.append(path.legs[k])
+            s_start.append(path.s_from[k])
+            outward.append(slope)
+        # run on along the first and last legs, to the junction or the leg's end (a spline may overshoot)
+        first, last = segments[0], segments[-1]
+        back = path.s_from[first] if outward[0] * path.headings[first] > 0 else lengths[legs[0]] - s_start[0]
+        heading = path.headings[first]
+        axis_start[0] -= heading * back
+        s_start[0] -= outward[0] * heading * back  # ds/dp times the way back
+        s_end = path.s_to[last]
+        ahead = lengths[legs[-1]] - s_end if outward[-1] * path.headings[last] > 0 else s_end
+        axis_end[-1] += path.headings[last] * ahead
+        maps.append(
+            AxisMap(
+                np.array(axis_start), np.array(axis_end), np.array(legs), np.array(s_start), np.array(outward)
+            )
+        )
+    return maps
+
+
+def _phase_starts(path: VehiclePath, table: ProfileTable) -> list[float]:
+    """The table's time at which each stretch between reversals of ``path`` begins."""
+    starts = [0.0]
+    positions = table.positions()
+    index = 0
+    for stop in path.stops:
+        k = path.segment(stop - 1e-12)
+        target = path.axis(stop)
+        reached = np.nonzero(path.headings[k] * (positions[index:] - target) >= -REVERSAL_TOLERANCE)[0]
+        if not reached.size:
+            break  # never reaches the reversal: the rest is read along this stretch (and fails its goal)
+        index += int(reached[0])
+        starts.append(float(table.times[index]))
+    return starts
+
+
+def _slice(profile: PiecewiseCubic, begin: float, end: float) -> PiecewiseCubic:
+    """The part of ``profile`` from ``begin`` to ``end`` seconds, in local time (at rest past its end)."""
+    inner = profile.times[(profile.times > begin) & (profile.times < end)]
+    times = np.concatenate([[begin], inner, [end]])
+    last = profile.duration
+    k = np.clip(np.searchsorted(profile.times, times[:-1], side="right") - 1, 0, len(profile.jerk) - 1)
+    h = np.minimum(times[:-1], last) - profile.times[k]
+    p0, v0, a0, j = profile.initial[k, 0], profile.initial[k, 1], profile.initial[k, 2], profile.jerk[k]
+    initial = np.stack(
+        [p0 + h * (v0 + h * (a0 / 2.0 + h * j / 6.0)), v0 + h * (a0 + h * j / 2.0), a0 + h * j], axis=1
+    )
+    jerk = j.copy()
+    ended = times[:-1] >= last
+    if ended.any():
+        end_position = profile.end_state()[0]
+        initial[ended] = (end_position, 0.0, 0.0)
+        jerk[ended] = 0.0
+    return PiecewiseCubic(times - begin, initial, jerk)
+
+
+@dataclass(frozen=True, slots=True)
+class TableMotion(TimingMethod):
+    """The motion two controllers drive from two profile tables, as a schedule along a route.
+
+    Not a registered timing method: it times nothing, it reads what the tables
+    say, so the verifier can check them like any schedule.
+
+    Parameters
+    ----------
+    tables : tuple of 2 ProfileTable
+        Vehicle 1's and vehicle 2's tables, in the schedule's axis convention
+        (axis 0 at the start, growing in the direction of the first move).
+    jerk : bool
+        Whether the tables are held to the jerk limits (default True).
+    """
+
+    name: ClassVar[str] = "table"
+    summary: ClassVar[str] = "the motion of two interpolated profile tables"
+
+    tables: tuple[ProfileTable, ProfileTable]
+    jerk: bool = True
+
+    @property
+    def jerk_limited(self) -> bool:
+        """Whether the tables are held to the jerk limits."""
+        return self.jerk
+
+    def schedule(self, route: Route, limits: Limits) -> Schedule:
+        """The tables' motion along ``route``: sections between reversals of either vehicle."""
+        lengths = route.graph.lengths
+        motions, phase_maps, phase_starts = [], [], []
+        for vehicle, table in enumerate(self.tables):
+            path = VehiclePath.from_route(route, vehicle, axis_start=float(table.positions()[0]))
+            motions.append(table.motion())
+            phase_maps.append(_phase_maps(path, lengths))
+            phase_starts.append(_phase_starts(path, table) if path.legs else [0.0])
+        end = max(motion.duration for motion in motions)
+        cuts = sorted({0.0, end, *phase_starts[0], *phase_starts[1]})
+        cuts = [t for t in cuts if t <= end]
+        sections = []
+        for begin, finish in itertools.pairwise(cuts) if len(cuts) > 1 else [(0.0, 0.0)]:
+            maps = []
+            for vehicle in range(2):
+                phase = int(np.searchsorted(phase_starts[vehicle], begin, side="right") - 1)
+                maps.append(phase_maps[vehicle][min(phase, len(phase_maps[vehicle]) - 1)])
+            kinematics = CubicKinematics(tuple(_slice(m, begin, finish) for m in motions))
+            sections.append(Section(begin, kinematics, tuple(maps)))
+        smoothness = min(table.interpolation.smoothness for table in self.tables)
+        return Schedule(route, limits, self, tuple(sections), jerk_limited=self.jerk, continuity=smoothness)
+
+
+@dataclass(frozen=True, slots=True)
+class TableCheck:
+    """The verdict on two profile tables along a route.
+
+    Attributes
+    ----------
+    passed : bool
+    failures : tuple of str
+        Each names the time, the quantity, its value and its limit.
+    report : VerificationReport
+        The verifier's report on the tables' motion (separation, track, start
+        and goal, homotopy class, closed-form limits).
+    ratios : dict
+        Worst |v|, |a|, |j| over each limit per vehicle (:func:`limit_ratios`).
+    route : Route
+        The route the tables were read along.
+    """
+
+    passed: bool
+    failures: tuple[str, ...]
+    report: VerificationReport
+    ratios: dict
+    route: Route
+
+    def summary(self) -> dict:
+        """JSON-ready verdict."""
+        return {
+            "passed": self.passed,
+            "failures": list(self.failures),
+            "min_separation_m": self.report.min_separation,
+            "ratios": {k: (list(v) if v is not None else None) for k, v in self.ratios.items()},
+            "homotopy": self.route.homotopy.value,
+        }
+
+
+def check_tables(
+    tables: tuple[ProfileTable, ProfileTable], route: Route, limits: Limits, *, jerk: bool = True
+) -> TableCheck:
+    """Verify two profile tables as their controllers interpolate them, along ``route``.
+
+    Parameters
+    ----------
+    tables : tuple of 2 ProfileTable
+    route : Route
+        The route the tables follow (its homotopy class is checked).
+    limits : Limits
+    jerk : bool, optional
+        Hold the tables to the jerk limits (default True).
+
+    Returns
+    -------
+    TableCheck
+    """
+    if len(tables) != 2 or not all(isinstance(table, ProfileTable) for table in tables):
+        raise InputError(f"check_tables expects two ProfileTables, got {short_repr(tables)}")
+    failures: list[str] = []
+    for vehicle, table in enumerate(tables):
+        bad = table.decreasing_times()
+        if bad.size:
+            k = int(bad[0])
+            failures.append(
+                f"vehicle {vehicle + 1} time {table.times[k]:.9g} s at point {k + 1} does not increase "
+                f"(previous {table.times[k - 1]:.9g} s)"
+            )
+    if failures:
+        nan = float("nan")
+        report = VerificationReport(
+            passed=False,
+            failures=tuple(failures),
+            pieces=0,
+            min_separation=nan,
+            separation_margin=nan,
+            velocity_ratio=(nan, nan),
+            acceleration_ratio=(nan, nan),
+            jerk_ratio=None,
+            start_error=nan,
+            goal_error=nan,
+            regions_match=False,
+        )
+        return TableCheck(False, tuple(failures), report, {}, route)
+    schedule = TableMotion(tables, jerk=jerk).schedule(route, limits)
+    report = verify(schedule)
+    failures += report.failures
+    for vehicle, table in enumerate(tables):
+        for check in _difference_checks(table, limits.vehicles[vehicle], jerk=jerk):
+            if check.value > check.allowed:
+                unit = "m/s^2" if check.quantity == "acceleration" else "m/s^3"
+                failures.append(
+                    f"vehicle {vehicle + 1} {check.quantity} reaches {check.value:.9g} {unit} at "
+                    f"t={check.time:.6f} s exceeds its max_{check.quantity} {check.limit:g} {unit} "
+                    "(from the table's points)"
+                )
+    ratios = limit_ratios(tables, limits, jerk=jerk)
+    return TableCheck(not failures, tuple(failures), report, ratios, route)
