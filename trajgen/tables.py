@@ -43,10 +43,8 @@ __all__ = [
     "check_tables",
     "divided_differences",
     "limit_ratios",
+    "turning_points",
 ]
-
-#: How close (metres) a table must come to a reversal point of its path to count as having reached it.
-REVERSAL_TOLERANCE = 1e-6
 
 
 class Interpolation(Option):
@@ -102,6 +100,12 @@ class ProfileTable(ArrayValue):
             raise InputError("a profile table must hold finite numbers only")
         if times[0] != 0.0:
             raise InputError(f"a profile table starts at t = 0 s, got {times[0]!r} s")
+
+    @property
+    def round_off(self) -> float:
+        """How far each value may be from what it stands for: :attr:`resolution`, or float round-off."""
+        scale = float(np.max(np.abs(self.values))) + abs(self.start)
+        return max(self.resolution, 4.0 * float(np.finfo(float).eps) * scale)
 
     @property
     def duration(self) -> float:
@@ -225,14 +229,15 @@ def _difference_checks(table: ProfileTable, limits, *, jerk: bool) -> list[Diffe
         order = derivative - (1 if velocity_table else 0)  # a velocity table's values are one derivative up
         times, values = _at_rest_both_ends(table, order)
         difference, weight = divided_differences(times, values, order)
-        allowed = limit * (1.0 + RELATIVE_TOLERANCE) + table.resolution * weight
+        explained = table.round_off * weight  # what the values' round-off alone can make of it
+        allowed = limit * (1.0 + RELATIVE_TOLERANCE) + explained
         excess = np.abs(difference) - allowed
         k = int(np.argmax(excess))
         middle = 0.5 * (times[k] + times[k + order])
         checks.append(
             DifferenceCheck(
                 quantity,
-                float(np.max(np.abs(difference)) / limit),
+                float(np.max(np.maximum(np.abs(difference) - explained, 0.0)) / limit),
                 float(min(max(middle, 0.0), table.duration)),
                 float(abs(difference[k])),
                 float(limit),
@@ -292,55 +297,79 @@ def _piece_peaks(motion: PiecewiseCubic) -> tuple[float, float, float]:
     )
 
 
-def _phase_maps(path: VehiclePath, lengths: tuple[float, ...]) -> list[AxisMap]:
-    """One axis map per stretch between reversals of ``path``, extended along its end legs."""
+def turning_points(table: ProfileTable) -> np.ndarray:
+    """Indices of the points at which the table's axis turns back (moves under 1 nm ignored)."""
+    steps = np.diff(table.positions())
+    moving = np.nonzero(np.abs(steps) > 1e-9)[0]
+    signs = np.sign(steps[moving])
+    flips = np.nonzero(signs[1:] != signs[:-1])[0]
+    return moving[flips] + 1
+
+
+def _phase_segments(path: VehiclePath) -> list[list[int]]:
+    """The path's segments grouped into stretches between its reversals."""
+    bounds = [*path.stops, math.inf]
+    phases: list[list[int]] = [[] for _ in bounds]
+    for k, start in enumerate(path.starts):
+        phases[int(np.searchsorted(bounds, start + 1e-12, side="right"))].append(k)
+    return phases
+
+
+def _phase_map(
+    path: VehiclePath, segments: list[int], anchor: tuple[float, int, float], lengths: tuple[float, ...]
+) -> AxisMap:
+    """The axis map of one stretch between reversals, from ``anchor`` = (axis, leg, s) on.
+
+    The stretch follows the path's legs from where the table actually is at its
+    start; its first and last legs run on to the junction or the leg's end, so
+    a table that turns short of or beyond the route's reversal point, or
+    overshoots between points, is still read where it really is.
+    """
+    axis, _, s = anchor
+    heading = path.headings[segments[0]]
+    axis_start, axis_end, legs, s_start, outward = [], [], [], [], []
+    for n, k in enumerate(segments):
+        leg = path.legs[k]
+        along = 1 if path.s_to[k] > path.s_from[k] else -1  # ds / dp
+        begin = s if n == 0 else path.s_from[k]
+        if n == len(segments) - 1:
+            length = lengths[leg] - begin if along > 0 else begin
+        else:
+            length = abs(path.s_to[k] - begin)
+        if n == 0:  # run back along the first leg too
+            back = begin if along > 0 else lengths[leg] - begin
+            axis -= heading * back
+            begin -= along * back
+            length += back
+        axis_start.append(axis)
+        axis_end.append(axis + heading * length)
+        legs.append(leg)
+        s_start.append(begin)
+        outward.append(along * heading)
+        axis += heading * length
+    return AxisMap(
+        np.array(axis_start), np.array(axis_end), np.array(legs), np.array(s_start), np.array(outward)
+    )
+
+
+def _phases(path: VehiclePath, table: ProfileTable, lengths: tuple[float, ...]):
+    """Start times and axis maps of the stretches between reversals, anchored where the table turns."""
+    positions = table.positions()
     if not path.legs:
         leg, s = path.home
-        return [AxisMap.parked(path.axis_starts[0] if path.axis_starts else 0.0, leg, s)]
-    maps = []
-    bounds = [0.0, *path.stops, path.length]
-    for begin, end in itertools.pairwise(bounds):
-        segments = [k for k in range(len(path.legs)) if begin - 1e-12 <= path.starts[k] < end - 1e-12]
-        axis_start, axis_end, legs, s_start, outward = [], [], [], [], []
-        for k in segments:
-            length = abs(path.s_to[k] - path.s_from[k])
-            slope = (1 if path.s_to[k] > path.s_from[k] else -1) * path.headings[k]  # ds / d axis
-            axis_start.append(path.axis_starts[k])
-            axis_end.append(path.axis_starts[k] + path.headings[k] * length)
-            legs.append(path.legs[k])
-            s_start.append(path.s_from[k])
-            outward.append(slope)
-        # run on along the first and last legs, to the junction or the leg's end (a spline may overshoot)
-        first, last = segments[0], segments[-1]
-        back = path.s_from[first] if outward[0] * path.headings[first] > 0 else lengths[legs[0]] - s_start[0]
-        heading = path.headings[first]
-        axis_start[0] -= heading * back
-        s_start[0] -= outward[0] * heading * back  # ds/dp times the way back
-        s_end = path.s_to[last]
-        ahead = lengths[legs[-1]] - s_end if outward[-1] * path.headings[last] > 0 else s_end
-        axis_end[-1] += path.headings[last] * ahead
-        maps.append(
-            AxisMap(
-                np.array(axis_start), np.array(axis_end), np.array(legs), np.array(s_start), np.array(outward)
-            )
-        )
-    return maps
-
-
-def _phase_starts(path: VehiclePath, table: ProfileTable) -> list[float]:
-    """The table's time at which each stretch between reversals of ``path`` begins."""
-    starts = [0.0]
-    positions = table.positions()
-    index = 0
-    for stop in path.stops:
-        k = path.segment(stop - 1e-12)
-        target = path.axis(stop)
-        reached = np.nonzero(path.headings[k] * (positions[index:] - target) >= -REVERSAL_TOLERANCE)[0]
-        if not reached.size:
-            break  # never reaches the reversal: the rest is read along this stretch (and fails its goal)
-        index += int(reached[0])
-        starts.append(float(table.times[index]))
-    return starts
+        return [0.0], [AxisMap.parked(float(positions[0]), leg, s)]
+    turns = turning_points(table)[: len(path.stops)]
+    starts, maps = [0.0], []
+    anchor = (float(positions[0]), path.legs[0], path.s_from[0])
+    for phase, segments in enumerate(_phase_segments(path)):
+        maps.append(_phase_map(path, segments, anchor, lengths))
+        if phase >= turns.size:
+            break
+        turn = int(turns[phase])
+        leg, s = maps[-1].locate(np.array([positions[turn]]))
+        anchor = (float(positions[turn]), int(leg[0]), float(s[0]))
+        starts.append(float(table.times[turn]))
+    return starts, maps
 
 
 def _slice(profile: PiecewiseCubic, begin: float, end: float) -> PiecewiseCubic:
@@ -397,8 +426,9 @@ class TableMotion(TimingMethod):
         for vehicle, table in enumerate(self.tables):
             path = VehiclePath.from_route(route, vehicle, axis_start=float(table.positions()[0]))
             motions.append(table.motion())
-            phase_maps.append(_phase_maps(path, lengths))
-            phase_starts.append(_phase_starts(path, table) if path.legs else [0.0])
+            starts, maps = _phases(path, table, lengths)
+            phase_starts.append(starts)
+            phase_maps.append(maps)
         end = max(motion.duration for motion in motions)
         cuts = sorted({0.0, end, *phase_starts[0], *phase_starts[1]})
         cuts = [t for t in cuts if t <= end]
@@ -494,6 +524,13 @@ def check_tables(
             regions_match=False,
         )
         return TableCheck(False, tuple(failures), report, {}, route)
+    for vehicle, table in enumerate(tables):
+        wanted = len(VehiclePath.from_route(route, vehicle).stops)
+        turns = turning_points(table).size
+        if turns != wanted:
+            failures.append(
+                f"vehicle {vehicle + 1} turns back {turns} times: expected {wanted}, as its route does"
+            )
     schedule = TableMotion(tables, jerk=jerk).schedule(route, limits)
     report = verify(schedule)
     failures += report.failures

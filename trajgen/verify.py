@@ -254,7 +254,7 @@ def _check_ends(schedule: Schedule, state, failures: list[str]) -> tuple[float, 
             # at rest: v = 0; a jerk-limited method also starts and ends with a = 0 (a linearly
             # interpolated table has no velocity at its ends: the drive's own ramps are checked there)
             residue = abs(state.velocity[vehicle, index]) if schedule.smoothness >= 1 else 0.0
-            if schedule.smoothness >= 2:
+            if schedule.smoothness >= 2 and schedule.jerk_limited:
                 residue += abs(state.acceleration[vehicle, index])
             if not residue <= REST_TOLERANCE:
                 failures.append(
