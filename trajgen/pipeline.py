@@ -23,6 +23,8 @@ from trajgen.export import (
     profile_chunks,
     profile_paths,
 )
+from trajgen.export.dialects import DIALECTS, Dialect, TableDialect
+from trajgen.export.plc import PlcTables, check_dialect_method, plc_tables, table_paths
 from trajgen.methods import METHODS, make_schedule
 from trajgen.plots import render_coordination, render_separation, render_speed
 from trajgen.scenario import Scenario
@@ -57,23 +59,41 @@ class Outputs:
     plot_dir : path or None
         Folder for ``speed.png``, ``separation.png`` and ``coordination.png``; ``None``: no plots.
     csv : CsvOptions
-        Format of the CSV profiles.
+        Format of the ``generic`` CSV profiles.
+    dialect : Dialect or str
+        The PLC dialect of the profile files (default ``generic``;
+        :data:`~trajgen.export.dialects.DIALECTS`).
+    max_points : int or None
+        Points per table of a table dialect (default: the dialect's limit).
     """
 
     csv_dir: Path | None = None
     plot_dir: Path | None = None
     csv: CsvOptions = field(default_factory=CsvOptions)
+    dialect: Dialect | str = "generic"
+    max_points: int | None = None
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "csv_dir", _folder(self.csv_dir, "CSV output folder"))
         object.__setattr__(self, "plot_dir", _folder(self.plot_dir, "plot output folder"))
         if not isinstance(self.csv, CsvOptions):
             raise InputError(f"csv options must be CsvOptions, got {type(self.csv).__name__}")
+        dialect = DIALECTS.lookup(self.dialect)
+        object.__setattr__(self, "dialect", dialect)
+        if isinstance(dialect, TableDialect):
+            object.__setattr__(self, "max_points", dialect.check_points(self.max_points))
+        elif self.max_points is not None:
+            raise InputError(
+                f"max points {self.max_points!r} applies to table dialects: dialect 'generic' is "
+                "sampled every sample period (its limit is max_rows)"
+            )
 
     def paths(self, names: tuple[str, str]) -> tuple[Path, ...]:
         """Every file this request writes for vehicles named ``names``."""
         paths: list[Path] = []
-        if self.csv_dir is not None:
+        if self.csv_dir is not None and isinstance(self.dialect, TableDialect):
+            paths += table_paths(self.dialect, names, self.csv_dir)
+        elif self.csv_dir is not None:
             paths += profile_paths(names, self.csv_dir)
         if self.plot_dir is not None:
             paths += [self.plot_dir / name for name in PLOT_NAMES]
@@ -96,6 +116,8 @@ class RunResult:
         Every file written (all committed together).
     notes : tuple of str
         What the run did beyond the schedule's own notes (e.g. a method left out of a plot).
+    tables : PlcTables or None
+        The PLC tables written, for a table dialect.
     """
 
     scenario: Scenario
@@ -104,6 +126,7 @@ class RunResult:
     verified: VerifiedSchedule
     files: tuple[Path, ...]
     notes: tuple[str, ...] = ()
+    tables: PlcTables | None = None
 
     def summary(self) -> dict:
         """The JSON-ready summary printed by ``trajgen schedule --json``."""
@@ -120,6 +143,7 @@ class RunResult:
             "fallback_reason": None if schedule.fallback_reason is None else schedule.fallback_reason.value,
             "solver": None if schedule.info is None else schedule.info.summary(),
             "route": route_summary(self.route),
+            "export": None if self.tables is None else self.tables.summary(),
             "files": [str(path) for path in self.files],
         }
 
@@ -176,13 +200,23 @@ def run(
         raise InputError(f"run expects a Scenario, got {type(scenario).__name__}")
     chosen = METHODS.create(method)
     check_output_paths(outputs.paths(scenario.names))
+    tabled = outputs.csv_dir is not None and isinstance(outputs.dialect, TableDialect)
+    if tabled:
+        check_dialect_method(outputs.dialect, chosen.jerk_limited)
     route = scenario.plan()
-    if outputs.csv_dir is not None:  # refuse a profile too long for any schedule before computing one
+    if outputs.csv_dir is not None and not tabled:  # refuse a profile too long before computing one
         check_row_limit(lower_bound(route, scenario.limits), outputs.csv, lower_bound=True)
     verified = certify(make_schedule(route, scenario.limits, method=chosen))
     files: dict[Path, object] = {}
     notes: list[str] = []
-    if outputs.csv_dir is not None:  # streamed into the commit, a block of rows at a time
+    tables = None
+    if tabled:  # resampled to the dialect's points and verified as its controllers interpolate them
+        tables = plc_tables(verified, outputs.dialect, max_points=outputs.max_points)
+        for path, content in zip(
+            table_paths(outputs.dialect, scenario.names, outputs.csv_dir), tables.contents, strict=True
+        ):
+            files[path] = content
+    elif outputs.csv_dir is not None:  # streamed into the commit, a block of rows at a time
         for vehicle, path in enumerate(profile_paths(scenario.names, outputs.csv_dir)):
             files[path] = profile_chunks(verified, vehicle, outputs.csv)
     if outputs.plot_dir is not None:
@@ -193,4 +227,4 @@ def run(
         files[coordination] = render_coordination(compared)
     written = commit_files(files) if files else ()
     # the schedule's route: optimal may have taken the other homotopy class
-    return RunResult(scenario, chosen, verified.schedule.route, verified, written, tuple(notes))
+    return RunResult(scenario, chosen, verified.schedule.route, verified, written, tuple(notes), tables)

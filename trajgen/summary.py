@@ -77,6 +77,20 @@ def format_run(summary: dict) -> str:
             for c in summary["solver"].get("classes", ())
         ]
     lines += [f"note: {note}" for note in summary["notes"]]
+    export = summary.get("export")
+    if export is not None:
+        slower = (
+            f", {100.0 * (export['time_scale'] - 1.0):.4f} % slower to fit the limits as interpolated"
+            if export["time_scale"] > 1.0
+            else ""
+        )
+        lines.append(
+            f"{export['dialect']} tables: {export['points'][0]} and {export['points'][1]} points "
+            f"(limit {export['point_limit']:,}, {export['interpolation']}), worst error "
+            f"{1e3 * max(export['position_error_m']):.4f} mm and "
+            f"{1e3 * max(export['velocity_error_mps']):.4f} mm/s{slower}; verified as interpolated: "
+            f"separation {export['min_separation_m']:.4f} m"
+        )
     if summary["fallback_reason"]:
         lines.append(f"warning: fell back to the exact schedule ({summary['fallback_reason']})")
     lines += [f"wrote {path}" for path in summary["files"]]

@@ -23,7 +23,7 @@ from dataclasses import dataclass
 from typing import ClassVar
 
 import numpy as np
-from scipy.interpolate import CubicSpline
+from scipy.interpolate import CubicHermiteSpline, CubicSpline
 
 from limits import Limits
 from topology import Option, Route
@@ -53,11 +53,29 @@ class Interpolation(Option):
     LINEAR = "linear"  #: position linear in time (cam tables): velocity steps at the points
     CUBIC = "cubic"  #: position a C2 cubic spline through the points, at rest (v = 0) at both ends
     VELOCITY = "linear-velocity"  #: velocity linear in time, position its integral from the start
+    #: position cubic between points through each point's position and velocity: a sampled motion read
+    #: back, where the limits beyond velocity are those of the samples (divided differences)
+    HERMITE = "hermite"
 
     @property
     def smoothness(self) -> int:
         """Derivatives of position the interpolation keeps continuous: 0, 1 or 2."""
-        return {Interpolation.LINEAR: 0, Interpolation.VELOCITY: 1, Interpolation.CUBIC: 2}[self]
+        return {
+            Interpolation.LINEAR: 0,
+            Interpolation.VELOCITY: 1,
+            Interpolation.HERMITE: 0,
+            Interpolation.CUBIC: 2,
+        }[self]
+
+    @property
+    def closed_form(self) -> int:
+        """Derivatives (1 = velocity, ...) the interpolated pieces define: checked in closed form."""
+        return {
+            Interpolation.LINEAR: 1,
+            Interpolation.VELOCITY: 2,
+            Interpolation.HERMITE: 1,
+            Interpolation.CUBIC: 3,
+        }[self]
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -77,6 +95,8 @@ class ProfileTable(ArrayValue):
     resolution : float
         Half the step of the numbers as written (metres, or m/s), the round-off
         the limit checks allow for; 0 for exact values.
+    velocities : ndarray, shape (n,), or None
+        The axis velocity at every point, m/s (:attr:`Interpolation.HERMITE` tables only).
     """
 
     times: np.ndarray
@@ -84,6 +104,7 @@ class ProfileTable(ArrayValue):
     interpolation: Interpolation
     start: float = 0.0
     resolution: float = 0.0
+    velocities: np.ndarray | None = None
 
     def __post_init__(self) -> None:
         times = readonly(np.atleast_1d(np.asarray(self.times, dtype=float)))
@@ -100,6 +121,14 @@ class ProfileTable(ArrayValue):
             raise InputError("a profile table must hold finite numbers only")
         if times[0] != 0.0:
             raise InputError(f"a profile table starts at t = 0 s, got {times[0]!r} s")
+        hermite = self.interpolation is Interpolation.HERMITE
+        if hermite != (self.velocities is not None):
+            raise InputError("a profile table has velocities at its points if and only if it is hermite")
+        if hermite:
+            velocities = readonly(np.atleast_1d(np.asarray(self.velocities, dtype=float)))
+            if velocities.shape != times.shape or not np.all(np.isfinite(velocities)):
+                raise InputError(f"a hermite table needs a finite velocity per point, got {velocities.shape}")
+            object.__setattr__(self, "velocities", velocities)
 
     @property
     def round_off(self) -> float:
@@ -149,7 +178,10 @@ class ProfileTable(ArrayValue):
         if self.interpolation is Interpolation.VELOCITY:
             initial = np.stack([self.positions()[:-1], values[:-1], np.diff(values) / h], axis=1)
             return PiecewiseCubic(times, initial, np.zeros(h.size))
-        spline = CubicSpline(times, values, bc_type=((1, 0.0), (1, 0.0)))
+        if self.interpolation is Interpolation.HERMITE:
+            spline = CubicHermiteSpline(times, values, self.velocities)
+        else:
+            spline = CubicSpline(times, values, bc_type=((1, 0.0), (1, 0.0)))
         c = spline.c  # (4, n - 1), highest power first, about each interval's start
         initial = np.stack([c[3], c[2], 2.0 * c[1]], axis=1)
         return PiecewiseCubic(times, initial, 6.0 * c[0])
@@ -218,11 +250,11 @@ class DifferenceCheck:
 def _difference_checks(table: ProfileTable, limits, *, jerk: bool) -> list[DifferenceCheck]:
     """The limits a table's interpolation leaves undefined, from divided differences of its points."""
     checks = []
-    smoothness = table.interpolation.smoothness
-    if table.times.size < 2 or smoothness >= 2:
+    defined = table.interpolation.closed_form
+    if table.times.size < 2 or defined >= 3:
         return checks
     velocity_table = table.interpolation is Interpolation.VELOCITY
-    wanted = [("acceleration", 2, limits.max_acceleration)] if smoothness == 0 else []
+    wanted = [("acceleration", 2, limits.max_acceleration)] if defined < 2 else []
     if jerk:
         wanted.append(("jerk", 3, limits.max_jerk))
     for quantity, derivative, limit in wanted:
@@ -265,7 +297,7 @@ def limit_ratios(tables: tuple[ProfileTable, ProfileTable], limits: Limits, *, j
         motion = table.motion()
         peaks = _piece_peaks(motion)
         for name, order in (("velocity", 1), ("acceleration", 2), ("jerk", 3)):
-            if order <= table.interpolation.smoothness + 1:
+            if order <= table.interpolation.closed_form:
                 limit = getattr(vehicle_limits, f"max_{name}")
                 ratios[name][vehicle] = peaks[order - 1] / limit
         for check in _difference_checks(table, vehicle_limits, jerk=jerk):

@@ -220,7 +220,7 @@ def verify(schedule: Schedule) -> VerificationReport:
 
 def _failed(schedule: Schedule, failures: list[str], pieces: int = 0) -> VerificationReport:
     """A failed report for a schedule that cannot even be taken apart."""
-    logger.warning("schedule (%s) failed verification: %s", schedule.method, "; ".join(failures))
+    logger.info("schedule (%s) failed verification: %s", schedule.method, "; ".join(failures))
     nan = float("nan")
     return VerificationReport(
         passed=False,
@@ -346,7 +346,7 @@ def _verify(schedule: Schedule) -> VerificationReport:
             f"homotopy class differs: schedule visits [{show(sequence)}], route [{show(expected)}]"
         )
     if failures:
-        logger.warning("schedule (%s) failed verification: %s", schedule.method, "; ".join(failures))
+        logger.info("schedule (%s) failed verification: %s", schedule.method, "; ".join(failures))
     return VerificationReport(
         passed=not failures,
         failures=tuple(failures),
@@ -389,6 +389,9 @@ def _check_piece_limits(pieces: Pieces, schedule: Schedule, failures: list[str])
     names = [("velocity", "max_velocity", "m/s"), ("acceleration", "max_acceleration", "m/s^2")]
     if schedule.jerk_limited:
         names.append(("jerk", "max_jerk", "m/s^3"))
+    # a table read back defines only the derivatives its interpolation keeps (plus one piecewise):
+    # the others are checked from its points (trajgen.tables)
+    names = names[: schedule.smoothness + 1]
     ratios: dict[str, tuple[float, float] | None] = {
         "velocity": (0.0, 0.0),
         "acceleration": (0.0, 0.0),

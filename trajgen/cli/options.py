@@ -13,6 +13,7 @@ import dataclasses
 
 from trajgen.errors import InputError, OptionError
 from trajgen.export import DEFAULT_MAX_ROWS, CsvOptions, Units
+from trajgen.export.dialects import DIALECTS
 from trajgen.methods import METHODS, HomotopyChoice, Optimal
 from trajgen.scenario import Scenario, default_scenario, load_scenario
 from trajgen.schedule import TimingMethod
@@ -106,6 +107,17 @@ def add_csv_options(parser: argparse.ArgumentParser, *, sampling: bool = True) -
         "--units", default="m", choices=[u.value for u in Units], help="length unit of the CSV (m)"
     )
     if sampling:
+        parser.add_argument(
+            "--dialect",
+            default="generic",
+            metavar="|".join(DIALECTS.names),
+            help=f"PLC dialect of the --csv files, one of:\n{DIALECTS.help()}",
+        )
+        parser.add_argument(
+            "--max-points",
+            type=int,
+            help="points per table of a table dialect (default: the dialect's limit)",
+        )
         parser.add_argument(
             "--max-rows",
             type=int,

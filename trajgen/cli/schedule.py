@@ -28,7 +28,13 @@ def _command_plan(args: argparse.Namespace) -> int:
 
 def _command_schedule(args: argparse.Namespace) -> int:
     scenario = scenario_from(args.scenario)
-    outputs = Outputs(csv_dir=args.csv, plot_dir=args.plot, csv=csv_options(args))
+    outputs = Outputs(
+        csv_dir=args.csv,
+        plot_dir=args.plot,
+        csv=csv_options(args),
+        dialect=args.dialect,
+        max_points=args.max_points,
+    )
     summary = run(scenario, method=method_from(args), outputs=outputs).summary()
     print(json.dumps(summary, indent=2) if args.json else format_run(summary))
     return EXIT_OK
@@ -69,7 +75,9 @@ def register(commands) -> None:
     )
     schedule.add_argument("scenario", help="scenario TOML file")
     add_method(schedule)
-    schedule.add_argument("--csv", metavar="DIR", help="write DIR/<vehicle name>.csv per vehicle")
+    schedule.add_argument(
+        "--csv", metavar="DIR", help="write DIR/<vehicle name>.csv per vehicle (.txt for codesys-xy)"
+    )
     schedule.add_argument(
         "--plot", metavar="DIR", help="write DIR/speed.png, DIR/separation.png, DIR/coordination.png"
     )

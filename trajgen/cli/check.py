@@ -1,0 +1,58 @@
+"""``trajgen check``: verify profile files against a scenario (exit 0 pass, 1 violations, 2 unreadable)."""
+
+from __future__ import annotations
+
+import argparse
+import json
+
+from trajgen.cli.options import EXIT_FAILURE, EXIT_OK, scenario_from
+from trajgen.export.check import check_profiles
+from trajgen.export.dialects import DIALECTS
+
+__all__ = ["SHOWN_FAILURES", "register"]
+
+#: Violations printed without --json (the JSON lists all).
+SHOWN_FAILURES = 10
+
+
+def _command_check(args: argparse.Namespace) -> int:
+    scenario = scenario_from(args.scenario)
+    verdict = check_profiles(scenario, args.csv, dialect=args.dialect, jerk=not args.ignore_jerk)
+    summary = verdict.summary()
+    if args.json:
+        print(json.dumps(summary, indent=2))
+    else:
+        print(f"scenario: {scenario.source}")
+        print(f"files ({summary['dialect']}): {', '.join(summary['files'])}")
+        print(
+            f"points: {summary['points'][0]} and {summary['points'][1]}; closest approach "
+            f"{summary['min_separation_m']:.4f} m (minimum {scenario.limits.min_separation:g} m); "
+            f"homotopy class: {summary['homotopy']}"
+        )
+        failures = summary["failures"]
+        for failure in failures[:SHOWN_FAILURES]:
+            print(f"violation: {failure}")
+        if len(failures) > SHOWN_FAILURES:
+            print(f"... and {len(failures) - SHOWN_FAILURES} more (--json lists all)")
+        print("PASS: the files keep the separation and the limits" if verdict.passed else "FAIL")
+    return EXIT_OK if verdict.passed else EXIT_FAILURE
+
+
+def register(commands) -> None:
+    """Add ``check`` to the sub-commands."""
+    check = commands.add_parser(
+        "check",
+        help="verify profile files against a scenario (exit 1 on violations, 2 if unreadable)",
+        formatter_class=argparse.RawTextHelpFormatter,
+    )
+    check.add_argument("scenario", help="scenario TOML file")
+    check.add_argument("--csv", metavar="DIR", required=True, help="folder holding both vehicles' files")
+    check.add_argument(
+        "--dialect",
+        default="generic",
+        metavar="|".join(DIALECTS.names),
+        help=f"dialect of the files, one of:\n{DIALECTS.help()}",
+    )
+    check.add_argument("--ignore-jerk", action="store_true", help="do not hold the files to the jerk limits")
+    check.add_argument("--json", action="store_true", help="print a machine-readable verdict")
+    check.set_defaults(run=_command_check)

@@ -1,0 +1,451 @@
+"""PLC dialects of the profile files: one writer and one reader per controller's format.
+
+Every dialect is a peer behind :class:`Dialect`, found through :data:`DIALECTS`:
+
+- ``generic``: the CSV of :mod:`trajgen.export.csv`, one row per sample period (no resampling);
+- ``twincat-cam``: Beckhoff TwinCAT non-equidistant cam table (``MC_CAM_REF``), linear;
+- ``codesys-xy``: CODESYS SoftMotion non-equidistant XY cam table as text, linear;
+- ``logix-time-cam``: Rockwell Logix time cam rows ``Master,Slave,SegmentType`` (cubic);
+- ``siemens-xy``: x/y interpolation points for a SIMATIC ``TO_Cam`` / ``TO_Cam_10k``, linear;
+- ``velocity-profile``: (time, velocity) pairs for PLCopen ``MC_VelocityProfile``.
+
+The cam dialects write master = time in seconds and slave = the vehicle's axis
+in millimetres (the velocity profile: mm/s), nine decimals, one point per
+line; ``docs/formats/`` gives each format with its public source. Readers are
+strict: what a controller would reject or misread is reported.
+"""
+
+from __future__ import annotations
+
+import abc
+import math
+from collections.abc import Iterator
+from dataclasses import dataclass
+from typing import ClassVar
+
+import numpy as np
+
+from topology import Option
+from topology.validation import short_repr
+from trajgen.errors import OptionError, ProfileFileError
+from trajgen.export.csv import HEADER_NAMES, Units
+from trajgen.tables import Interpolation, ProfileTable
+
+__all__ = [
+    "DIALECTS",
+    "Dialect",
+    "DialectName",
+    "DialectRegistry",
+    "GenericDialect",
+    "ParsedProfile",
+    "TableDialect",
+]
+
+#: Decimal places of the times and values the table dialects write.
+DECIMALS = 9
+
+
+class DialectName(Option):
+    """Name of a profile file dialect (``--dialect``)."""
+
+    GENERIC = "generic"
+    TWINCAT_CAM = "twincat-cam"
+    CODESYS_XY = "codesys-xy"
+    LOGIX_TIME_CAM = "logix-time-cam"
+    SIEMENS_XY = "siemens-xy"
+    VELOCITY_PROFILE = "velocity-profile"
+
+
+@dataclass(frozen=True, slots=True)
+class ParsedProfile:
+    """A profile file as read: the table, and what in its format a controller would not take.
+
+    Attributes
+    ----------
+    table : ProfileTable
+    problems : tuple of str
+        Format deviations (line ends, header, point count), each naming the line.
+    """
+
+    table: ProfileTable
+    problems: tuple[str, ...]
+
+
+class Dialect(abc.ABC):
+    """Interface of the profile file dialects."""
+
+    __slots__ = ()
+
+    #: ``--dialect NAME``.
+    name: ClassVar[DialectName]
+    #: One line for the help texts.
+    summary: ClassVar[str]
+    #: The file name suffix.
+    suffix: ClassVar[str] = ".csv"
+
+    @property
+    @abc.abstractmethod
+    def point_limit(self) -> int | None:
+        """Most points a table of this dialect has by default (``None``: sampled, no limit)."""
+
+    @property
+    @abc.abstractmethod
+    def interpolation(self) -> Interpolation:
+        """How the controller interpolates the file's points."""
+
+    @abc.abstractmethod
+    def read(self, data: bytes, *, source: str) -> ParsedProfile:
+        """The table in ``data`` (a whole file) and its format problems.
+
+        Raises
+        ------
+        ProfileFileError
+            The file cannot be read as this dialect (``source`` names it in the message).
+        """
+
+
+def _decode(data: bytes, source: str) -> str:
+    if not data:
+        raise ProfileFileError(f"{source} is empty: expected a profile table")
+    try:
+        return data.decode("ascii")
+    except UnicodeDecodeError as error:
+        raise ProfileFileError(
+            f"{source} is not ASCII text (byte {data[error.start]:#04x} at offset {error.start})"
+        ) from None
+
+
+def _lines(text: str, source: str, *, crlf: bool) -> tuple[list[str], list[str]]:
+    """The lines of ``text`` and problems with their ends."""
+    problems = []
+    lines = text.split("\n")
+    if lines[-1] == "":
+        lines.pop()
+    elif crlf:
+        problems.append(f"{source} line {len(lines)}: no CRLF after the last line, expected one")
+    bare = [n + 1 for n, line in enumerate(lines) if not line.endswith("\r")]
+    if crlf and bare:
+        problems.append(f"{source} line {bare[0]}: ends with LF only, expected CRLF ({len(bare)} such lines)")
+    return [line.removesuffix("\r") for line in lines], problems
+
+
+def _number(field: str, source: str, line: int, what: str) -> tuple[float, int]:
+    """A decimal number and its number of decimal places."""
+    text = field.strip()
+    try:
+        value = float(text)
+    except ValueError:
+        raise ProfileFileError(
+            f"{source} line {line}: {what} {short_repr(text)} is not a number "
+            "(expected digits with '.' as the decimal mark)"
+        ) from None
+    if not math.isfinite(value) or not text.replace(".", "").replace("-", "").replace("+", "").isdigit():
+        raise ProfileFileError(
+            f"{source} line {line}: {what} {short_repr(text)} is not a finite decimal number"
+        )
+    return value, len(text.partition(".")[2])
+
+
+def _number_text(value: float, decimals: int) -> str:
+    return f"{round(float(value), decimals) + 0.0:.{decimals}f}"  # + 0.0: no "-0"
+
+
+@dataclass(frozen=True, slots=True)
+class TableDialect(Dialect):
+    """A table of points ``master<delimiter>slave[<delimiter>extra]``, one per line.
+
+    Parameters
+    ----------
+    name : DialectName
+    summary : str
+    default_points : int
+        Points per table unless ``--max-points`` says otherwise.
+    most_points : int or None
+        Most points any target of the dialect takes (``--max-points`` may not exceed it).
+    table_interpolation : Interpolation
+    delimiter : str
+    crlf : bool
+        CRLF after every line, the last included (else LF).
+    header : str or None
+        A first line naming the columns.
+    extra : str or None
+        A third column's value on every line (Logix: the segment type).
+    file_suffix : str
+    """
+
+    name: DialectName
+    summary: str
+    default_points: int
+    most_points: int | None
+    table_interpolation: Interpolation
+    delimiter: str
+    crlf: bool = True
+    header: str | None = None
+    extra: str | None = None
+    file_suffix: str = ".csv"
+
+    @property
+    def point_limit(self) -> int:
+        """Points per table by default."""
+        return self.default_points
+
+    @property
+    def interpolation(self) -> Interpolation:
+        """How the controller interpolates the points."""
+        return self.table_interpolation
+
+    @property
+    def suffix(self) -> str:
+        """The file name suffix."""
+        return self.file_suffix
+
+    @property
+    def unit(self) -> str:
+        """Unit of the slave column."""
+        return "mm/s" if self.table_interpolation is Interpolation.VELOCITY else "mm"
+
+    def check_points(self, max_points: int | None) -> int:
+        """``max_points`` (or the default) if this dialect's targets can take that many, else raise.
+
+        Raises
+        ------
+        OptionError
+        """
+        if max_points is None:
+            return self.default_points
+        if isinstance(max_points, bool) or not isinstance(max_points, int) or max_points < 2:
+            raise OptionError(f"max points must be an integer >= 2, got {short_repr(max_points)}")
+        if self.most_points is not None and max_points > self.most_points:
+            raise OptionError(
+                f"max points {max_points:,} is more than dialect {self.name.value!r} takes: "
+                f"expected at most {self.most_points:,}"
+            )
+        return max_points
+
+    def lines(self, table: ProfileTable) -> Iterator[str]:
+        """The file's lines, without line ends."""
+        if self.header is not None:
+            yield self.header
+        values = table.values * 1000.0  # metres to millimetres (m/s to mm/s)
+        for t, value in zip(table.times, values, strict=True):
+            fields = [_number_text(t, DECIMALS), _number_text(value, DECIMALS)]
+            if self.extra is not None:
+                fields.append(self.extra)
+            yield self.delimiter.join(fields)
+
+    def render(self, table: ProfileTable) -> bytes:
+        """The whole file as ASCII bytes."""
+        end = "\r\n" if self.crlf else "\n"
+        return "".join(line + end for line in self.lines(table)).encode("ascii")
+
+    def read(self, data: bytes, *, source: str) -> ParsedProfile:
+        """The table in ``data`` and its format problems (see :meth:`Dialect.read`)."""
+        lines, problems = _lines(_decode(data, source), source, crlf=self.crlf)
+        first = 1
+        if self.header is not None:
+            if not lines or lines[0].strip() != self.header:
+                raise ProfileFileError(
+                    f"{source} line 1: header {short_repr(lines[0] if lines else '')} is not {self.header!r}"
+                )
+            lines, first = lines[1:], 2
+        if not lines:
+            raise ProfileFileError(f"{source} has no points: expected at least one line of values")
+        columns = 2 if self.extra is None else 3
+        times, values, places = np.empty(len(lines)), np.empty(len(lines)), []
+        segment_types = set()
+        for n, line in enumerate(lines):
+            fields = line.split(self.delimiter)
+            if len(fields) != columns:
+                raise ProfileFileError(
+                    f"{source} line {n + first}: {len(fields)} field(s) separated by "
+                    f"{self.delimiter!r}, expected {columns} ({short_repr(line)})"
+                )
+            times[n], _ = _number(fields[0], source, n + first, "master value (time, s)")
+            values[n], decimals = _number(fields[1], source, n + first, f"slave value ({self.unit})")
+            places.append(decimals)
+            if self.extra is not None:
+                segment_types.add(fields[2].strip())
+        interpolation = self.table_interpolation
+        if self.extra is not None:
+            interpolation = _logix_interpolation(segment_types, source)
+        if times[0] != 0.0:
+            raise ProfileFileError(
+                f"{source} line {first}: the first master value is {times[0]!r} s, expected 0"
+            )
+        if self.most_points is not None and len(lines) > self.most_points:
+            problems.append(f"{source}: {len(lines):,} points, more than {self.most_points:,}")
+        resolution = 0.5 * 10.0 ** -min(places) / 1000.0
+        table = ProfileTable(times, values / 1000.0, interpolation, resolution=resolution)
+        return ParsedProfile(table, tuple(problems))
+
+
+def _logix_interpolation(segment_types: set[str], source: str) -> Interpolation:
+    """All cubic (1) or all linear (0) segments; a mix is beyond this checker."""
+    if segment_types == {"1"}:
+        return Interpolation.CUBIC
+    if segment_types == {"0"}:
+        return Interpolation.LINEAR
+    raise ProfileFileError(
+        f"{source}: segment types {sorted(segment_types)!r}: expected all 1 (cubic) or all 0 (linear)"
+    )
+
+
+@dataclass(frozen=True, slots=True)
+class GenericDialect(Dialect):
+    """The generic CSV (:mod:`trajgen.export.csv`): a row per sample period.
+
+    Read as a cubic Hermite table: between two rows the axis is the cubic that
+    matches both rows' position and velocity (``axis`` and ``v`` columns).
+    """
+
+    name: ClassVar[DialectName] = DialectName.GENERIC
+    summary: ClassVar[str] = "trajgen's CSV: t, axis, v, a, j, leg, s, x, y every sample period (default)"
+
+    @property
+    def point_limit(self) -> None:
+        """Sampled, not resampled: the row limit is ``--max-rows``."""
+        return None
+
+    @property
+    def interpolation(self) -> Interpolation:
+        """Rows are read as a cubic Hermite table (position and velocity per row)."""
+        return Interpolation.HERMITE
+
+    def read(self, data: bytes, *, source: str) -> ParsedProfile:
+        """The ``t``, ``axis`` and ``v`` columns; delimiter, decimal mark and unit from the header row."""
+        lines, problems = _lines(_decode(data, source), source, crlf=True)
+        if not lines:
+            raise ProfileFileError(f"{source} is empty: expected a header row")
+        header = lines[0]
+        delimiter = header[3:4] if header.startswith("t_s") else ""
+        names = header.split(delimiter) if delimiter else []
+        units = next((unit for unit, expected in HEADER_NAMES.items() if tuple(names) == expected), None)
+        if units is None:
+            raise ProfileFileError(
+                f"{source} line 1: header {short_repr(header)} is not trajgen's: expected "
+                f"{';'.join(HEADER_NAMES[Units.METRES])!r} (any delimiter, or the mm columns)"
+            )
+        rows = lines[1:]
+        if not rows:
+            raise ProfileFileError(f"{source} has no rows: expected at least one")
+        comma = delimiter != "," and any("," in row for row in rows[:1])
+        times, values, velocities = np.empty(len(rows)), np.empty(len(rows)), np.empty(len(rows))
+        places = []
+        for n, row in enumerate(rows):
+            fields = row.split(delimiter)
+            if len(fields) != len(names):
+                raise ProfileFileError(
+                    f"{source} line {n + 2}: {len(fields)} field(s) separated by {delimiter!r}, "
+                    f"expected {len(names)} ({short_repr(row)})"
+                )
+            if comma:
+                fields = [field.replace(",", ".") for field in fields[:3]]
+            times[n], _ = _number(fields[0], source, n + 2, f"{names[0]}")
+            values[n], decimals = _number(fields[1], source, n + 2, f"{names[1]}")
+            velocities[n], _ = _number(fields[2], source, n + 2, f"{names[2]}")
+            places.append(decimals)
+        if times[0] != 0.0:
+            raise ProfileFileError(f"{source} line 2: the first time is {times[0]!r} s, expected 0")
+        resolution = 0.5 * 10.0 ** -min(places) / units.scale
+        table = ProfileTable(
+            times,
+            values / units.scale,
+            Interpolation.HERMITE,
+            resolution=resolution,
+            velocities=velocities / units.scale,
+        )
+        return ParsedProfile(table, tuple(problems))
+
+
+class DialectRegistry:
+    """The dialects by name, in a fixed order; ``generic`` is the default.
+
+    Examples
+    --------
+    >>> DIALECTS.lookup("TwinCAT-Cam").point_limit
+    10000
+    """
+
+    __slots__ = ("_by_name",)
+
+    def __init__(self, dialects: tuple[Dialect, ...]) -> None:
+        self._by_name = {dialect.name: dialect for dialect in dialects}
+
+    @property
+    def names(self) -> tuple[str, ...]:
+        """Dialect names, in registration order."""
+        return tuple(name.value for name in self._by_name)
+
+    def __iter__(self) -> Iterator[Dialect]:
+        return iter(self._by_name.values())
+
+    def lookup(self, name: object) -> Dialect:
+        """The dialect named ``name`` (case-insensitive), or ``name`` itself if it is one.
+
+        Raises
+        ------
+        OptionError
+            Naming the value and the accepted names.
+        """
+        if isinstance(name, Dialect):
+            return name
+        return self._by_name[DialectName.lookup(name)]
+
+    def help(self) -> str:
+        """One line per dialect for help texts."""
+        lines = []
+        for dialect in self:
+            limit = "" if dialect.point_limit is None else f" [{dialect.point_limit:,} points]"
+            lines.append(f"{dialect.name.value}: {dialect.summary}{limit}")
+        return "\n".join(lines)
+
+
+#: Every dialect, ``generic`` first (the default).
+DIALECTS = DialectRegistry(
+    (
+        GenericDialect(),
+        TableDialect(
+            DialectName.TWINCAT_CAM,
+            "Beckhoff TwinCAT MC_CAM_REF non-equidistant cam table: s;mm, linear",
+            default_points=10_000,
+            most_points=None,
+            table_interpolation=Interpolation.LINEAR,
+            delimiter=";",
+        ),
+        TableDialect(
+            DialectName.CODESYS_XY,
+            "CODESYS SoftMotion non-equidistant XY cam table (text): s<TAB>mm, linear",
+            default_points=10_000,
+            most_points=None,
+            table_interpolation=Interpolation.LINEAR,
+            delimiter="\t",
+            file_suffix=".txt",
+        ),
+        TableDialect(
+            DialectName.LOGIX_TIME_CAM,
+            "Rockwell Logix time cam (MCCP/MATC) rows Master,Slave,SegmentType: s,mm,1 (cubic)",
+            default_points=1_000,
+            most_points=None,
+            table_interpolation=Interpolation.CUBIC,
+            delimiter=",",
+            header="Master,Slave,SegmentType",
+            extra="1",
+        ),
+        TableDialect(
+            DialectName.SIEMENS_XY,
+            "SIMATIC TO_Cam interpolation points x;y: s;mm, linear (TO_Cam_10k: --max-points 10000)",
+            default_points=1_000,
+            most_points=10_000,
+            table_interpolation=Interpolation.LINEAR,
+            delimiter=";",
+        ),
+        TableDialect(
+            DialectName.VELOCITY_PROFILE,
+            "PLCopen MC_VelocityProfile (time, velocity) pairs: s;mm/s, velocity linear",
+            default_points=100,
+            most_points=None,
+            table_interpolation=Interpolation.VELOCITY,
+            delimiter=";",
+        ),
+    )
+)

@@ -1,0 +1,132 @@
+"""PLC tables of a verified schedule: resampled, rendered, read back and verified as interpolated.
+
+What is verified is what is written: the rendered bytes are read back with the
+dialect's own reader and the two tables are checked along the schedule's route
+(:func:`trajgen.tables.check_tables`) as the controllers interpolate them.
+A table set that fails is never returned.
+"""
+
+from __future__ import annotations
+
+import logging
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+
+from trajgen.errors import OptionError, VerificationError
+from trajgen.export.dialects import DIALECTS, TableDialect
+from trajgen.export.resample import Resampled, resample
+from trajgen.naming import check_vehicle_names
+from trajgen.tables import Interpolation, TableCheck, check_tables
+from trajgen.verify import VerifiedSchedule, require_verified
+
+__all__ = ["PlcTables", "check_dialect_method", "plc_tables", "table_paths"]
+
+logger = logging.getLogger(__name__)
+
+
+@dataclass(frozen=True, slots=True)
+class PlcTables:
+    """Both vehicles' files in one dialect, verified as their controllers interpolate them.
+
+    Attributes
+    ----------
+    dialect : TableDialect
+    max_points : int
+        The point limit the tables were made for.
+    resampled : Resampled
+        The tables and their error against the schedule.
+    check : TableCheck
+        The verdict on the tables as read back from ``contents``.
+    contents : tuple of 2 bytes
+        The files of vehicle 1 and vehicle 2.
+    """
+
+    dialect: TableDialect
+    max_points: int
+    resampled: Resampled
+    check: TableCheck
+    contents: tuple[bytes, bytes]
+
+    def summary(self) -> dict:
+        """JSON-ready figures of the export (``export`` in ``trajgen schedule --json``)."""
+        return {
+            "dialect": self.dialect.name.value,
+            "point_limit": self.max_points,
+            **self.resampled.summary(),
+            "verified": self.check.passed,
+            "min_separation_m": self.check.report.min_separation,
+        }
+
+
+def check_dialect_method(dialect: TableDialect, jerk_limited: bool) -> None:
+    """Refuse a cubic-spline dialect for a schedule without jerk limits (its spline would overshoot).
+
+    Raises
+    ------
+    OptionError
+    """
+    if dialect.interpolation is Interpolation.CUBIC and not jerk_limited:
+        raise OptionError(
+            f"dialect {dialect.name.value!r} interpolates a cubic spline: it needs a jerk-limited "
+            "schedule (method optimal or exact), got a method without jerk limits"
+        )
+
+
+def table_paths(dialect: TableDialect, names: Sequence[str], directory: str | Path) -> tuple[Path, Path]:
+    """``directory/<name><suffix>`` for both vehicles."""
+    first, second = check_vehicle_names(names)
+    directory = Path(directory)
+    return (directory / f"{first}{dialect.suffix}", directory / f"{second}{dialect.suffix}")
+
+
+def plc_tables(
+    verified: VerifiedSchedule, dialect: TableDialect | str, *, max_points: int | None = None
+) -> PlcTables:
+    """Both vehicles' tables in ``dialect``, at most ``max_points`` points each, verified as written.
+
+    Parameters
+    ----------
+    verified : VerifiedSchedule
+    dialect : TableDialect or str
+        A dialect other than ``generic`` (:data:`~trajgen.export.dialects.DIALECTS`).
+    max_points : int, optional
+        Points per table (default: the dialect's limit).
+
+    Raises
+    ------
+    OptionError
+        ``generic`` (it is sampled, not resampled), too many points for the dialect, or a cubic
+        dialect for a schedule without jerk limits.
+    OutputLimitError
+        A vehicle starts, stops and reverses more often than ``max_points`` allows.
+    VerificationError
+        The tables, as their controllers interpolate them, fail the checks.
+    """
+    schedule = require_verified(verified, "plc_tables").schedule
+    dialect = DIALECTS.lookup(dialect)
+    if not isinstance(dialect, TableDialect):
+        raise OptionError(
+            f"dialect {dialect.name.value!r} is sampled, not resampled: expected a table dialect"
+        )
+    points = dialect.check_points(max_points)
+    check_dialect_method(dialect, schedule.jerk_limited)
+    resampled = resample(verified, interpolation=dialect.interpolation, max_points=points)
+    contents = tuple(dialect.render(table) for table in resampled.tables)
+    parsed = tuple(
+        dialect.read(data, source=f"vehicle {vehicle + 1}'s table").table
+        for vehicle, data in enumerate(contents)
+    )
+    check = check_tables(parsed, schedule.route, schedule.limits, jerk=schedule.jerk_limited)
+    if not check.passed:
+        raise VerificationError(
+            f"the {dialect.name.value} tables ({points} points) fail as their controllers interpolate "
+            f"them: {'; '.join(check.failures[:3])} (more points may help: --max-points)"
+        )
+    logger.info(
+        "%s tables: %s points, position error %.3g m, verified",
+        dialect.name.value,
+        [table.times.size for table in parsed],
+        max(resampled.position_error),
+    )
+    return PlcTables(dialect, points, resampled, check, contents)
