@@ -270,7 +270,7 @@ class TableDialect(Dialect):
             interpolation = _logix_interpolation(segment_types, source)
         if times[0] != 0.0:
             raise ProfileFileError(
-                f"{source} line {first}: the first master value is {times[0]!r} s, expected 0"
+                f"{source} line {first}: the first master value is {float(times[0])!r} s, expected 0"
             )
         if self.most_points is not None and len(lines) > self.most_points:
             problems.append(f"{source}: {len(lines):,} points, more than {self.most_points:,}")
@@ -345,7 +345,7 @@ class GenericDialect(Dialect):
             velocities[n], _ = _number(fields[2], source, n + 2, f"{names[2]}")
             places.append(decimals)
         if times[0] != 0.0:
-            raise ProfileFileError(f"{source} line 2: the first time is {times[0]!r} s, expected 0")
+            raise ProfileFileError(f"{source} line 2: the first time is {float(times[0])!r} s, expected 0")
         resolution = 0.5 * 10.0 ** -min(places) / units.scale
         table = ProfileTable(
             times,

@@ -19,10 +19,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from topology.indexed import track_distance
 from trajgen.errors import InputError, OutputLimitError
 from trajgen.pieces import schedule_pieces
 from trajgen.schedule import Schedule
-from trajgen.tables import Interpolation, ProfileTable, limit_ratios
+from trajgen.tables import Interpolation, ProfileTable, divided_differences, limit_ratios
 from trajgen.verify import VerifiedSchedule, require_verified
 
 __all__ = ["POSITION_SCALE", "VELOCITY_SCALE", "Resampled", "resample"]
@@ -30,10 +31,12 @@ __all__ = ["POSITION_SCALE", "VELOCITY_SCALE", "Resampled", "resample"]
 logger = logging.getLogger(__name__)
 
 #: Samples of the schedule per polynomial piece against which a table's error is measured.
-SAMPLES_PER_PIECE = 32
+SAMPLES_PER_PIECE = 16
 #: Errors are weighed as position / POSITION_SCALE and velocity / VELOCITY_SCALE (m, m/s).
 POSITION_SCALE = 1e-3
 VELOCITY_SCALE = 1e-2
+#: Shortest step between two points of a table, seconds (a spline over a shorter one has no use).
+MIN_STEP = 1e-6
 #: Below this speed (m/s) a vehicle counts as at rest.
 REST_SPEED = 1e-9
 
@@ -71,16 +74,35 @@ class Resampled:
         }
 
 
-def _reference_times(schedule: Schedule, decimals: int) -> tuple[np.ndarray, np.ndarray]:
-    """A grid of SAMPLES_PER_PIECE samples per piece, and the pieces' boundaries (both rounded)."""
+def _spread(times: np.ndarray) -> np.ndarray:
+    """Sorted unique times without any closer than MIN_STEP to the one before (the last kept)."""
+    keep = [0]
+    for k in range(1, times.size):
+        if times[k] - times[keep[-1]] >= MIN_STEP:
+            keep.append(k)
+    if times.size > 1 and keep[-1] != times.size - 1:
+        keep[-1] = times.size - 1
+    return times[keep]
+
+
+def _reference_times(schedule: Schedule, decimals: int, points: int) -> tuple[np.ndarray, np.ndarray]:
+    """Candidate times, and the pieces' boundaries (both rounded to ``decimals``).
+
+    The candidates: SAMPLES_PER_PIECE per piece, and ``4 * points`` evenly (finer than any table
+    of ``points`` points needs), so their number grows with the pieces and the points, not the duration.
+    """
     pieces = schedule_pieces(schedule)
     duration = schedule.duration
     boundaries = np.concatenate([[0.0, duration], pieces.start, pieces.start + pieces.length])
     fractions = np.linspace(0.0, 1.0, SAMPLES_PER_PIECE + 1)
     grid = (pieces.start[:, None] + pieces.length[:, None] * fractions[None, :]).ravel()
     boundaries = np.unique(np.clip(np.round(boundaries, decimals), 0.0, duration))
-    grid = np.unique(np.concatenate([np.clip(np.round(grid, decimals), 0.0, duration), boundaries]))
-    return grid, boundaries
+    boundaries = _spread(boundaries)
+    even = np.linspace(0.0, duration, 4 * points + 1)
+    grid = np.unique(
+        np.concatenate([np.clip(np.round(np.r_[grid, even], decimals), 0.0, duration), boundaries])
+    )
+    return _spread(grid), boundaries
 
 
 def _required(boundaries: np.ndarray, velocity: np.ndarray, middle: np.ndarray) -> np.ndarray:
@@ -97,20 +119,39 @@ def _required(boundaries: np.ndarray, velocity: np.ndarray, middle: np.ndarray) 
     return boundaries[keep]
 
 
-def _matched_velocities(times: np.ndarray, velocity: np.ndarray, axis: np.ndarray) -> np.ndarray:
-    """Velocities scaled per stretch between rests so the table's integral lands where the schedule does."""
+def _matched_velocities(
+    times: np.ndarray, velocity: np.ndarray, axis: np.ndarray, anchors: np.ndarray
+) -> np.ndarray:
+    """Velocities scaled between anchors so the table's integral lands where the schedule is at each.
+
+    ``anchors``: indices of the points where the position must be the schedule's (start, goal,
+    starts, stops, reversals, closest approaches). Every rest is one; an anchor with no point
+    between it and the previous one is passed over (nothing there to scale).
+    """
     velocity = velocity.copy()
     rests = np.nonzero(np.abs(velocity) <= REST_SPEED)[0]
-    rests = np.unique(np.concatenate([[0], rests, [times.size - 1]]))
     velocity[rests] = 0.0
-    for a, b in itertools.pairwise(rests):
+    wanted = set(anchors.tolist()) | {0, times.size - 1}
+    resting = set(rests.tolist()) | {0, times.size - 1}
+    kept = [0]
+    for k in range(1, times.size):
+        if k not in wanted:
+            continue
+        if k - kept[-1] < 2:
+            if k not in resting:
+                continue
+            if kept[-1] not in resting:
+                kept.pop()  # a rest is kept before a closer anchor: nothing lies between them
+        kept.append(k)
+    for a, b in itertools.pairwise(kept):
         if b - a < 2:
             continue
-        span = slice(a, b + 1)
-        travelled = float(np.sum(0.5 * (velocity[span][:-1] + velocity[span][1:]) * np.diff(times[span])))
-        wanted = float(axis[b] - axis[a])
-        if travelled != 0.0:
-            velocity[a + 1 : b] *= wanted / travelled
+        steps = np.diff(times[a : b + 1])
+        ends = 0.5 * (velocity[a] * steps[0] + velocity[b] * steps[-1])  # the anchors' own share
+        inner = float(np.sum(velocity[a + 1 : b] * 0.5 * (steps[:-1] + steps[1:])))
+        target = float(axis[b] - axis[a]) - ends
+        if inner * target > 0.0 and 0.5 < target / inner < 2.0:
+            velocity[a + 1 : b] *= target / inner
     return velocity
 
 
@@ -121,18 +162,18 @@ def _table(
     interpolation: Interpolation,
     scale: float,
     *,
-    matched: bool = True,
+    anchors: np.ndarray | None = None,
 ) -> ProfileTable:
     """The table with points at ``times`` (its own time) of a schedule slowed by ``scale``.
 
-    A velocity table's velocities are scaled per stretch between rests so it arrives where the
-    schedule does (``matched``), else they are the schedule's.
+    A velocity table's velocities are scaled between the points at ``anchors`` (indices) so it
+    is where the schedule is at each of them; without anchors they are the schedule's.
     """
     state = schedule.state(times / scale)
     if interpolation is Interpolation.VELOCITY:
         values = state.velocity[vehicle] / scale
-        if matched:
-            values = _matched_velocities(times, values, state.axis[vehicle])
+        if anchors is not None:
+            values = _matched_velocities(times, values, state.axis[vehicle], anchors)
         return ProfileTable(times, values, interpolation, start=float(state.axis[vehicle, 0]))
     return ProfileTable(times, state.axis[vehicle], interpolation)
 
@@ -143,6 +184,41 @@ def _errors(table: ProfileTable, grid: np.ndarray, axis: np.ndarray, velocity: n
     return np.abs(values[0] - axis), np.abs(values[1] * scale - velocity)
 
 
+def _closest_approaches(grid: np.ndarray, state, separation: float) -> np.ndarray:
+    """Times of the grid where the vehicles' track distance has a local minimum near ``separation``."""
+    distance = track_distance(state.leg[0], state.s[0], state.leg[1], state.s[1])
+    if distance.size < 3:
+        return np.zeros(0)
+    inner = (distance[1:-1] < distance[:-2]) & (distance[1:-1] <= distance[2:])
+    near = distance[1:-1] < 1.05 * separation + 0.01
+    return grid[1:-1][inner & near]
+
+
+def _equidistributed(grid: np.ndarray, density: np.ndarray, required: np.ndarray, count: int) -> np.ndarray:
+    """Indices of ``count`` grid points, the ``required`` ones among them, equal ``density`` between.
+
+    Linear interpolation's error on a step ``h`` grows as ``h**2`` times the second derivative,
+    so equal shares of ``sqrt(|second derivative|)`` per step make the steps' errors equal.
+    """
+    mass = np.concatenate([[0.0], np.cumsum(0.5 * (density[1:] + density[:-1]) * np.diff(grid))])
+    shares = np.diff(mass[required])
+    budget = count - required.size
+    if budget <= 0 or mass[-1] <= 0.0:
+        return required
+    quota = budget * shares / shares.sum()
+    extra = np.floor(quota).astype(int)
+    leftover = budget - int(extra.sum())
+    extra[np.argsort(-(quota - extra))[:leftover]] += 1
+    chosen = [required]
+    for k, n in enumerate(extra):
+        if n <= 0:
+            continue
+        targets = mass[required[k]] + shares[k] * np.arange(1, n + 1) / (n + 1)
+        inside = np.clip(np.searchsorted(mass, targets), required[k] + 1, required[k + 1] - 1)
+        chosen.append(inside[inside < required[k + 1]])
+    return np.unique(np.concatenate(chosen))
+
+
 def _points(
     schedule: Schedule,
     vehicle: int,
@@ -151,28 +227,47 @@ def _points(
     grid: np.ndarray,
     boundaries: np.ndarray,
     state,
-) -> np.ndarray:
-    """The times (of the schedule) of one vehicle's table points, at most ``max_points``."""
+    critical: np.ndarray,
+) -> tuple[np.ndarray, np.ndarray]:
+    """The times (of the schedule) of one vehicle's table points, at most ``max_points``.
+
+    Returns the times and the indices among them where the table must be where the schedule is.
+    """
     at_bounds = schedule.state(boundaries)
     middles = schedule.state(0.5 * (boundaries[:-1] + boundaries[1:]))
     required = _required(boundaries, at_bounds.velocity[vehicle], middles.velocity[vehicle])
     if boundaries.size <= 1:
-        return boundaries
+        return boundaries, np.arange(boundaries.size)
     if required.size > max_points:
         raise OutputLimitError(
             f"vehicle {vehicle + 1}'s table needs at least {required.size} points (start, goal and every "
             f"start, stop and reversal): expected at most max_points {max_points} (raise --max-points)"
         )
+    if required.size + critical.size <= max_points // 2:  # where the vehicles come closest
+        required = np.union1d(required, critical)
     if interpolation is Interpolation.CUBIC and boundaries.size <= max_points:
-        required = boundaries  # a spline with knots at every jerk switch is the schedule itself
-    chosen = np.searchsorted(grid, required)
+        # a spline with knots at every jerk switch is the schedule itself; more knots would only
+        # let the values' round-off through (it grows as the cube of a short step)
+        return boundaries, np.searchsorted(boundaries, required)
+    chosen = np.unique(np.searchsorted(grid, required))
+    anchors = chosen.copy()
     axis, velocity = state.axis[vehicle], state.velocity[vehicle]
+    if interpolation is not Interpolation.CUBIC:
+        # second differences on the grid: also where the schedule's own derivative jumps (toppra)
+        quantity = axis if interpolation is Interpolation.LINEAR else velocity
+        second, _ = divided_differences(grid, quantity, 2)
+        curvature = np.abs(np.concatenate([[second[0]], second, [second[-1]]]))
+        curvature = np.maximum(curvature, np.maximum(np.roll(curvature, 1), np.roll(curvature, -1)))
+        chosen = _equidistributed(grid, np.sqrt(curvature), chosen, max_points)
     while chosen.size < max_points:
-        table = _table(schedule, vehicle, grid[chosen], interpolation, 1.0, matched=False)
+        table = _table(schedule, vehicle, grid[chosen], interpolation, 1.0)
         position_error, velocity_error = _errors(table, grid, axis, velocity, 1.0)
         if interpolation is Interpolation.VELOCITY:  # its position error is the integral: not local
-            position_error = 0.0
-        error = np.maximum(position_error / POSITION_SCALE, velocity_error / VELOCITY_SCALE)
+            error = velocity_error
+        elif interpolation is Interpolation.LINEAR:  # its velocity steps at every point whatever we do
+            error = position_error
+        else:
+            error = np.maximum(position_error / POSITION_SCALE, velocity_error / VELOCITY_SCALE)
         error[chosen] = 0.0  # already points
         interval = np.searchsorted(chosen, np.arange(grid.size), side="right") - 1
         worst = np.full(chosen.size, -1.0)
@@ -187,7 +282,7 @@ def _points(
         room = max_points - chosen.size
         take = candidates[np.argsort(-worst[candidates])][: max(1, min(room, chosen.size // 2 + 1))]
         chosen = np.unique(np.concatenate([chosen, where[take]]))
-    return grid[chosen]
+    return grid[chosen], np.searchsorted(chosen, anchors)
 
 
 def resample(
@@ -219,12 +314,15 @@ def resample(
     interpolation = Interpolation.lookup(interpolation)
     if isinstance(max_points, bool) or not isinstance(max_points, int) or max_points < 2:
         raise InputError(f"max_points must be an integer >= 2, got {max_points!r}")
-    grid, boundaries = _reference_times(schedule, decimals)
+    grid, boundaries = _reference_times(schedule, decimals, max_points)
     state = schedule.state(grid)
-    times = [
-        _points(schedule, vehicle, interpolation, max_points, grid, boundaries, state) for vehicle in range(2)
+    critical = _closest_approaches(grid, state, schedule.limits.min_separation)
+    points = [
+        _points(schedule, vehicle, interpolation, max_points, grid, boundaries, state, critical)
+        for vehicle in range(2)
     ]
-    tables = tuple(_table(schedule, v, times[v], interpolation, 1.0) for v in range(2))
+    times = [p[0] for p in points]
+    tables = tuple(_table(schedule, v, times[v], interpolation, 1.0, anchors=points[v][1]) for v in range(2))
     ratios = limit_ratios(tables, schedule.limits, jerk=schedule.jerk_limited)
     scale = 1.0
     for order, name in enumerate(("velocity", "acceleration", "jerk"), start=1):
@@ -234,7 +332,10 @@ def resample(
         scale *= 1.0 + 1e-6  # clear of the limit, not on it
         logger.info("tables slowed down by %.6g to respect the limits as interpolated", scale)
         tables = tuple(
-            _table(schedule, v, np.round(times[v] * scale, decimals), interpolation, scale) for v in range(2)
+            _table(
+                schedule, v, np.round(times[v] * scale, decimals), interpolation, scale, anchors=points[v][1]
+            )
+            for v in range(2)
         )
     else:
         scale = 1.0

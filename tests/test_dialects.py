@@ -1,0 +1,316 @@
+"""PLC dialects: resampled tables, their files, and ``trajgen check`` on them and on edited files."""
+
+from __future__ import annotations
+
+import json
+import re
+
+import numpy as np
+import pytest
+from hypothesis import given
+from hypothesis import strategies as st
+
+from tests.conftest import REPO
+from tests.helpers import LIMITS, MIXED, route_of
+from trajgen import Exact, Optimal, Toppra, certify, default_scenario, make_schedule, run
+from trajgen.cli import EXIT_BAD_INPUT, EXIT_FAILURE, EXIT_OK, main
+from trajgen.errors import OptionError, OutputLimitError, ProfileFileError, VerificationError
+from trajgen.export.check import check_profiles
+from trajgen.export.dialects import DIALECTS, TableDialect
+from trajgen.export.plc import plc_tables
+from trajgen.export.resample import resample
+from trajgen.pipeline import Outputs
+from trajgen.tables import Interpolation, ProfileTable, check_tables, divided_differences
+
+SWAP = str(REPO / "examples" / "swap.toml")
+TABLE_DIALECTS = [d for d in DIALECTS if isinstance(d, TableDialect)]
+ALL = [d.name.value for d in DIALECTS]
+
+
+@pytest.fixture(scope="module")
+def swap():
+    """The demo swap, scheduled by optimal (the default), verified."""
+    return run(default_scenario()).verified
+
+
+@pytest.fixture(scope="module")
+def exported(tmp_path_factory):
+    """Every dialect's files of the demo swap, written by ``trajgen schedule --dialect``."""
+    root = tmp_path_factory.mktemp("dialects")
+    for name in ALL:
+        assert main(["schedule", SWAP, "--csv", str(root / name), "--dialect", name]) == EXIT_OK
+    return root
+
+
+def _files(folder, dialect):
+    suffix = ".csv" if dialect.point_limit is None else dialect.suffix
+    return [folder / f"agv1{suffix}", folder / f"agv2{suffix}"]
+
+
+@pytest.mark.parametrize("name", ALL, ids=ALL)
+def test_every_dialects_output_passes_the_checker(exported, name, capsys):
+    assert main(["check", SWAP, "--csv", str(exported / name), "--dialect", name, "--json"]) == EXIT_OK
+    verdict = json.loads(capsys.readouterr().out)
+    assert verdict["passed"]
+    assert verdict["failures"] == []
+    assert verdict["min_separation_m"] >= 1.5 - 1e-9
+
+
+@pytest.mark.parametrize("dialect", TABLE_DIALECTS, ids=[d.name.value for d in TABLE_DIALECTS])
+def test_table_files_have_the_dialects_format(exported, dialect, swap):
+    for vehicle, path in enumerate(_files(exported / dialect.name.value, dialect)):
+        data = path.read_bytes()
+        text = data.decode("ascii")
+        assert text.endswith("\r\n")
+        assert text.count("\r\n") == text.count("\n")
+        lines = text.split("\r\n")[:-1]
+        if dialect.header is not None:
+            assert lines.pop(0) == dialect.header
+        rows = [line.split(dialect.delimiter) for line in lines]
+        assert {len(row) for row in rows} == {2 if dialect.extra is None else 3}
+        master = np.array([float(row[0]) for row in rows])
+        slave = np.array([float(row[1]) for row in rows])
+        assert np.all(np.diff(master) > 0.0)  # master values strictly increase
+        assert 2 <= len(rows) <= dialect.point_limit
+        assert master[0] == 0.0
+        assert master[-1] == pytest.approx(swap.schedule.duration, rel=1e-3)  # slowed by < 0.1 %
+        if dialect.interpolation is Interpolation.VELOCITY:
+            assert slave[0] == slave[-1] == 0.0  # from rest to rest, mm/s
+        else:
+            goal = swap.schedule.state(swap.schedule.duration).axis[vehicle, 0]
+            assert slave[0] == 0.0
+            assert slave[-1] == pytest.approx(1000.0 * goal, abs=1e-6)  # millimetres
+
+
+@pytest.mark.parametrize("name", ALL, ids=ALL)
+def test_a_row_moved_by_a_centimetre_fails_the_check(exported, name, tmp_path, capsys):
+    dialect = DIALECTS.lookup(name)
+    edited = tmp_path / name
+    edited.mkdir()
+    for source in _files(exported / name, dialect):
+        (edited / source.name).write_bytes(source.read_bytes())
+    path = _files(edited, dialect)[0]
+    lines = path.read_bytes().decode("ascii").split("\r\n")
+    row = len(lines) // 3
+    separator = "\t" if "\t" in lines[row] else (";" if ";" in lines[row] else ",")
+    fields = lines[row].split(separator)
+    scale = 1.0 if name == "generic" else 1000.0  # generic: metres; the tables: millimetres (mm/s)
+    fields[1] = f"{float(fields[1]) + 0.01 * scale:.9f}"
+    lines[row] = separator.join(fields)
+    path.write_bytes("\r\n".join(lines).encode("ascii"))
+    assert main(["check", SWAP, "--csv", str(edited), "--dialect", name]) == EXIT_FAILURE
+    out = capsys.readouterr().out
+    assert "FAIL" in out
+    assert "violation: vehicle 1" in out or "violation: goal" in out or "violation: separation" in out
+
+
+def test_a_violation_names_the_time_the_quantity_the_value_and_the_limit(exported, tmp_path, capsys):
+    dialect = DIALECTS.lookup("siemens-xy")
+    edited = tmp_path / "siemens"
+    edited.mkdir()
+    for source in _files(exported / "siemens-xy", dialect):
+        (edited / source.name).write_bytes(source.read_bytes())
+    path = edited / "agv2.csv"
+    lines = path.read_bytes().decode("ascii").split("\r\n")
+    t, x = lines[400].split(";")
+    lines[400] = f"{t};{float(x) + 10.0:.9f}"
+    path.write_bytes("\r\n".join(lines).encode("ascii"))
+    verdict = check_profiles(default_scenario(), edited, dialect="siemens-xy")
+    assert not verdict.passed
+    assert any(
+        f.startswith("vehicle 2 velocity reaches") and "at t=" in f and "max_velocity 1 m/s" in f
+        for f in verdict.failures
+    )
+    assert any(
+        "vehicle 2 acceleration reaches" in f and "max_acceleration 0.5" in f for f in verdict.failures
+    )
+
+
+@pytest.mark.parametrize(
+    ("name", "mangle", "match"),
+    [
+        ("twincat-cam", lambda t: t.replace(";", ","), r"1 field\(s\) separated by ';', expected 2"),
+        ("codesys-xy", lambda t: t.replace("\t", ";"), r"separated by '\\t', expected 2"),
+        ("logix-time-cam", lambda t: t.replace("Master,Slave,SegmentType\r\n", ""), r"header .* is not"),
+        ("logix-time-cam", lambda t: t.replace(",1\r\n", ",0\r\n", 3), r"segment types \['0', '1'\]"),
+        ("siemens-xy", lambda t: t.replace("0.000000000;", "zero;", 1), r"'zero' is not a number"),
+        ("velocity-profile", lambda t: t.replace("0.000000000;", "0.5;", 1), r"first master value is 0.5 s"),
+        ("generic", lambda t: "x;y\r\n" + t, r"header 'x;y' is not trajgen's"),
+        ("twincat-cam", lambda t: t.replace("0.000000000;0.000000000", "nan;0", 1), r"'nan' is not a finite"),
+        ("twincat-cam", lambda t: "", r"is empty"),
+    ],
+    ids=[
+        "delimiter",
+        "codesys-delimiter",
+        "no-header",
+        "mixed-segments",
+        "text",
+        "start",
+        "generic-header",
+        "nan",
+        "empty",
+    ],
+)
+def test_a_file_that_cannot_be_read_exits_2(exported, tmp_path, capsys, name, mangle, match):
+    dialect = DIALECTS.lookup(name)
+    broken = tmp_path / name
+    broken.mkdir()
+    for source in _files(exported / name, dialect):
+        (broken / source.name).write_bytes(source.read_bytes())
+    path = _files(broken, dialect)[0]
+    path.write_bytes(mangle(path.read_bytes().decode("ascii")).encode("ascii"))
+    with pytest.raises(ProfileFileError, match=match):
+        check_profiles(default_scenario(), broken, dialect=name)
+    assert main(["check", SWAP, "--csv", str(broken), "--dialect", name]) == EXIT_BAD_INPUT
+    assert "trajgen: error:" in capsys.readouterr().err
+
+
+def test_missing_files_and_line_ends(exported, tmp_path, capsys):
+    assert main(["check", SWAP, "--csv", str(tmp_path), "--dialect", "twincat-cam"]) == EXIT_BAD_INPUT
+    assert "does not exist" in capsys.readouterr().err
+    lf = tmp_path / "lf"
+    lf.mkdir()
+    for source in _files(exported / "twincat-cam", DIALECTS.lookup("twincat-cam")):
+        (lf / source.name).write_bytes(source.read_bytes().replace(b"\r\n", b"\n"))
+    verdict = check_profiles(default_scenario(), lf, dialect="twincat-cam")
+    assert not verdict.passed
+    assert verdict.check.passed
+    assert any("ends with LF only, expected CRLF" in problem for problem in verdict.problems)
+
+
+def test_the_summary_reports_points_and_errors(tmp_path, capsys):
+    out = tmp_path / "plc"
+    assert main(["schedule", SWAP, "--csv", str(out), "--dialect", "velocity-profile", "--json"]) == EXIT_OK
+    export = json.loads(capsys.readouterr().out)["export"]
+    assert export["dialect"] == "velocity-profile"
+    assert export["point_limit"] == 100
+    assert max(export["points"]) <= 100
+    assert 0.0 < max(export["position_error_m"]) < 0.005
+    assert 0.0 < max(export["velocity_error_mps"]) < 0.01
+    assert export["verified"]
+    assert export["time_scale"] >= 1.0
+    assert main(["schedule", SWAP, "--csv", str(out), "--dialect", "siemens-xy"]) == EXIT_OK
+    assert (
+        "siemens-xy tables: 1000 and 1000 points (limit 1,000, linear), worst error"
+        in capsys.readouterr().out
+    )
+
+
+@pytest.mark.parametrize(
+    ("args", "match"),
+    [
+        (
+            ["--dialect", "siemens-xy", "--max-points", "20000"],
+            r"max points 20,000 is more than dialect 'siemens-xy'",
+        ),
+        (["--dialect", "fanuc"], r"dialectname 'fanuc' is unknown"),
+        (["--dialect", "twincat-cam", "--max-points", "1"], r"max points must be an integer >= 2, got 1"),
+        (["--max-points", "50"], r"max points 50 applies to table dialects"),
+        (["--dialect", "logix-time-cam", "--method", "toppra"], r"needs a jerk-limited schedule"),
+    ],
+    ids=["siemens-limit", "unknown", "one-point", "generic-points", "cubic-toppra"],
+)
+def test_bad_dialect_options_exit_2_and_write_nothing(tmp_path, capsys, args, match):
+    out = tmp_path / "out"
+    assert main(["schedule", SWAP, "--csv", str(out), *args]) == EXIT_BAD_INPUT
+    err = capsys.readouterr().err
+    assert re.search(match, err), err
+    assert not out.exists()
+
+
+def test_too_few_points_for_the_starts_and_stops_are_refused(swap):
+    with pytest.raises(OutputLimitError, match=r"needs at least 3 points .* expected at most max_points 2"):
+        plc_tables(swap, "twincat-cam", max_points=2)
+
+
+def test_tables_that_fail_as_interpolated_are_never_written(tmp_path, monkeypatch):
+    from trajgen.export import plc
+
+    def too_far(tables, route, limits, *, jerk):  # the tables read back, judged with 12 m separation
+        return check_tables(tables, route, type(limits)(limits.vehicles, min_separation=12.0), jerk=jerk)
+
+    monkeypatch.setattr(plc, "check_tables", too_far)
+    out = tmp_path / "out"
+    with pytest.raises(
+        VerificationError, match=r"twincat-cam tables .* fail as their controllers interpolate"
+    ):
+        run(
+            default_scenario(),
+            method=Exact(),
+            outputs=Outputs(csv_dir=out, plot_dir=out, dialect="twincat-cam"),
+        )
+    assert not out.exists()
+
+
+def test_placed_points_beat_evenly_spaced_points(swap):
+    resampled = resample(swap, interpolation="linear", max_points=300)
+    schedule = swap.schedule
+    grid = np.linspace(0.0, schedule.duration, 20_001)
+    truth = schedule.state(grid).axis
+    for vehicle, table in enumerate(resampled.tables):
+        assert table.times.size <= 300
+        even_times = np.linspace(0.0, schedule.duration, table.times.size)
+        even = ProfileTable(even_times, schedule.state(even_times).axis[vehicle], "linear")
+        even_error = np.abs(even.motion().evaluate(grid)[0] - truth[vehicle]).max()
+        assert resampled.position_error[vehicle] < 0.7 * even_error
+
+
+def test_a_spline_with_knots_at_every_jerk_switch_is_the_schedule(swap):
+    resampled = resample(swap, interpolation="cubic", max_points=1000)
+    assert resampled.time_scale == pytest.approx(1.0, abs=2e-6)
+    assert max(resampled.position_error) < 1e-9
+    assert max(resampled.velocity_error) < 1e-7
+
+
+@pytest.mark.parametrize(
+    ("method", "limits"),
+    [(Exact(), LIMITS), (Toppra(), LIMITS), (Optimal(), MIXED)],
+    ids=["exact", "toppra", "optimal-mixed"],
+)
+@pytest.mark.parametrize("interpolation", ["linear", "linear-velocity"], ids=["linear", "velocity"])
+def test_resampled_tables_verify_and_agree_with_the_schedule(method, limits, interpolation):
+    route = route_of((12.0, 8.0, 15.0), ("A:12", "B:8"), ("B:8", "A:12"))
+    verified = certify(make_schedule(route, limits, method=method))
+    resampled = resample(verified, interpolation=interpolation, max_points=400)
+    schedule = verified.schedule
+    verdict = check_tables(resampled.tables, schedule.route, limits, jerk=schedule.jerk_limited)
+    assert verdict.passed, verdict.failures
+    assert resampled.time_scale < 1.01
+    assert max(resampled.position_error) < 0.01
+    for vehicle, table in enumerate(resampled.tables):  # start and goal exact
+        positions = table.positions()
+        end = schedule.state(schedule.duration).axis[vehicle, 0]
+        assert positions[0] == pytest.approx(0.0, abs=1e-12)
+        assert positions[-1] == pytest.approx(end, abs=1e-9)
+
+
+@given(
+    coefficients=st.lists(st.floats(-5, 5), min_size=4, max_size=4),
+    gaps=st.lists(st.floats(0.01, 2.0), min_size=3, max_size=3),
+)
+def test_divided_differences_of_a_cubic_are_its_derivatives(coefficients, gaps):
+    times = np.concatenate([[0.0], np.cumsum(gaps)])
+    values = np.polyval(coefficients[::-1], times)
+    third, weight = divided_differences(times, values, 3)
+    assert third[0] == pytest.approx(6.0 * coefficients[3], abs=1e-6 * (1 + weight[0]))
+    second, _ = divided_differences(times, values, 2)
+    # 2 f[t0, t1, t2] is f'' somewhere in [t0, t2]: between f''(t0) and f''(t2) for a cubic
+    f2 = 2.0 * coefficients[2] + 6.0 * coefficients[3] * times
+    assert min(f2[0], f2[2]) - 1e-6 <= second[0] <= max(f2[0], f2[2]) + 1e-6
+
+
+def test_tables_along_the_wrong_class_fail(swap):
+    from topology import Homotopy, plan
+
+    scenario = default_scenario()
+    other = Homotopy.OTHER if swap.schedule.route.homotopy is Homotopy.PAPER else Homotopy.PAPER
+    wrong = plan(scenario.track, scenario.start, scenario.goal, min_separation=1.5, homotopy=other)
+    resampled = resample(swap, interpolation="linear", max_points=2000)
+    assert check_tables(resampled.tables, swap.schedule.route, scenario.limits).passed
+    verdict = check_tables(resampled.tables, wrong, scenario.limits)
+    assert not verdict.passed
+
+
+def test_option_errors():
+    with pytest.raises(OptionError, match=r"dialectname 'nope' is unknown"):
+        DIALECTS.lookup("nope")
