@@ -317,6 +317,9 @@ class Schedule:
         How many derivatives of position are continuous and zero at the start
         and goal (0: position only, as a linearly interpolated table; 1: also
         velocity; 2: also acceleration). ``None``: 2 if ``jerk_limited``, else 1.
+    end_tolerance : float or None
+        How far from the route's start and goal the motion may begin and end,
+        metres (``None``: the verifier's 1e-9 m; PLC tables: 1e-6 m).
     """
 
     route: Route
@@ -328,6 +331,7 @@ class Schedule:
     fallback_reason: FallbackReason | None = None
     info: MethodInfo | None = field(default=None, compare=False)
     continuity: int | None = None
+    end_tolerance: float | None = None
     _starts: np.ndarray = field(init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:

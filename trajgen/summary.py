@@ -87,8 +87,8 @@ def format_run(summary: dict) -> str:
         lines.append(
             f"{export['dialect']} tables: {export['points'][0]} and {export['points'][1]} points "
             f"(limit {export['point_limit']:,}, {export['interpolation']}), worst error "
-            f"{1e3 * max(export['position_error_m']):.4f} mm and "
-            f"{1e3 * max(export['velocity_error_mps']):.4f} mm/s{slower}; verified as interpolated: "
+            f"{1e3 * max(export['position_error_m']):.3g} mm and "
+            f"{1e3 * max(export['velocity_error_mps']):.3g} mm/s{slower}; verified as interpolated: "
             f"separation {export['min_separation_m']:.4f} m"
         )
     if summary["fallback_reason"]:

@@ -26,7 +26,7 @@ import numpy as np
 from scipy.interpolate import CubicHermiteSpline, CubicSpline
 
 from limits import Limits
-from topology import Option, Route
+from topology import JUNCTION_INDEX, Option, Route
 from topology.validation import short_repr
 from trajgen.errors import InputError
 from trajgen.paths import VehiclePath
@@ -42,9 +42,17 @@ __all__ = [
     "TableMotion",
     "check_tables",
     "divided_differences",
+    "junction_crossings",
+    "leg_visits",
     "limit_ratios",
-    "turning_points",
+    "slowdown",
 ]
+
+
+#: How far from the route's start and goal a table may begin and end, metres.
+END_TOLERANCE = 1e-6
+#: How far past the junction a table's axis must go to count as passing it, metres.
+CROSSING_TOLERANCE = 1e-9
 
 
 class Interpolation(Option):
@@ -309,6 +317,19 @@ def limit_ratios(tables: tuple[ProfileTable, ProfileTable], limits: Limits, *, j
     }
 
 
+def slowdown(ratios: dict) -> float:
+    """The uniform slow-down that brings every ratio of :func:`limit_ratios` to at most 1.
+
+    Running a motion ``s`` times slower divides velocity by ``s``, acceleration by ``s**2``
+    and jerk by ``s**3``.
+    """
+    scale = 1.0
+    for order, name in enumerate(("velocity", "acceleration", "jerk"), start=1):
+        if ratios[name] is not None:
+            scale = max(scale, max(ratios[name]) ** (1.0 / order))
+    return scale
+
+
 def _piece_peaks(motion: PiecewiseCubic) -> tuple[float, float, float]:
     """Largest |v|, |a|, |j| of a piecewise cubic, in closed form."""
     h = np.diff(motion.times)
@@ -329,79 +350,96 @@ def _piece_peaks(motion: PiecewiseCubic) -> tuple[float, float, float]:
     )
 
 
-def turning_points(table: ProfileTable) -> np.ndarray:
-    """Indices of the points at which the table's axis turns back (moves under 1 nm ignored)."""
-    steps = np.diff(table.positions())
-    moving = np.nonzero(np.abs(steps) > 1e-9)[0]
-    signs = np.sign(steps[moving])
-    flips = np.nonzero(signs[1:] != signs[:-1])[0]
-    return moving[flips] + 1
-
-
-def _phase_segments(path: VehiclePath) -> list[list[int]]:
-    """The path's segments grouped into stretches between its reversals."""
-    bounds = [*path.stops, math.inf]
-    phases: list[list[int]] = [[] for _ in bounds]
-    for k, start in enumerate(path.starts):
-        phases[int(np.searchsorted(bounds, start + 1e-12, side="right"))].append(k)
-    return phases
-
-
-def _phase_map(
-    path: VehiclePath, segments: list[int], anchor: tuple[float, int, float], lengths: tuple[float, ...]
-) -> AxisMap:
-    """The axis map of one stretch between reversals, from ``anchor`` = (axis, leg, s) on.
-
-    The stretch follows the path's legs from where the table actually is at its
-    start; its first and last legs run on to the junction or the leg's end, so
-    a table that turns short of or beyond the route's reversal point, or
-    overshoots between points, is still read where it really is.
-    """
-    axis, _, s = anchor
-    heading = path.headings[segments[0]]
-    axis_start, axis_end, legs, s_start, outward = [], [], [], [], []
-    for n, k in enumerate(segments):
-        leg = path.legs[k]
-        along = 1 if path.s_to[k] > path.s_from[k] else -1  # ds / dp
-        begin = s if n == 0 else path.s_from[k]
-        if n == len(segments) - 1:
-            length = lengths[leg] - begin if along > 0 else begin
-        else:
-            length = abs(path.s_to[k] - begin)
-        if n == 0:  # run back along the first leg too
-            back = begin if along > 0 else lengths[leg] - begin
-            axis -= heading * back
-            begin -= along * back
-            length += back
-        axis_start.append(axis)
-        axis_end.append(axis + heading * length)
-        legs.append(leg)
-        s_start.append(begin)
-        outward.append(along * heading)
-        axis += heading * length
-    return AxisMap(
-        np.array(axis_start), np.array(axis_end), np.array(legs), np.array(s_start), np.array(outward)
-    )
-
-
-def _phases(path: VehiclePath, table: ProfileTable, lengths: tuple[float, ...]):
-    """Start times and axis maps of the stretches between reversals, anchored where the table turns."""
-    positions = table.positions()
+def leg_visits(route: Route, vehicle: int) -> tuple[int, ...]:
+    """The legs ``vehicle`` drives on, in order, one entry per stay (it passes the junction between)."""
+    path = VehiclePath.from_route(route, vehicle)
     if not path.legs:
-        leg, s = path.home
-        return [0.0], [AxisMap.parked(float(positions[0]), leg, s)]
-    turns = turning_points(table)[: len(path.stops)]
-    starts, maps = [0.0], []
-    anchor = (float(positions[0]), path.legs[0], path.s_from[0])
-    for phase, segments in enumerate(_phase_segments(path)):
-        maps.append(_phase_map(path, segments, anchor, lengths))
-        if phase >= turns.size:
-            break
-        turn = int(turns[phase])
-        leg, s = maps[-1].locate(np.array([positions[turn]]))
-        anchor = (float(positions[turn]), int(leg[0]), float(s[0]))
-        starts.append(float(table.times[turn]))
-    return starts, maps
+        return (path.home[0],)
+    visits = [path.legs[0]]
+    for leg in path.legs[1:]:
+        if leg != visits[-1]:
+            visits.append(leg)
+    return tuple(visits)
+
+
+def _start(route: Route, vehicle: int) -> tuple[int, float]:
+    first = route.indexed_waypoints[0]
+    return int(first[2 * vehicle]), float(first[2 * vehicle + 1])
+
+
+def junction_crossings(motion: PiecewiseCubic, junction: float) -> list[float]:
+    """Times at which ``motion`` crosses the axis value ``junction`` (touching it is no crossing).
+
+    Between consecutive piece ends and velocity zeros the motion is monotone, so each sign
+    change of ``axis - junction`` there holds one crossing, found by bisection.
+    """
+    times = [float(motion.times[0])]
+    for k in range(len(motion.jerk)):
+        begin, end = float(motion.times[k]), float(motion.times[k + 1])
+        _, v0, a0 = motion.initial[k]
+        j = motion.jerk[k]
+        for root in np.roots([j / 2.0, a0, v0]) if (j or a0) else []:  # v(h) = v0 + a0 h + j h^2 / 2
+            if abs(root.imag) < 1e-12 and 0.0 < root.real < end - begin:
+                times.append(begin + float(root.real))
+        times.append(end)
+    times = np.unique(times)
+    gap = motion.evaluate(times)[0] - junction
+    tolerance = CROSSING_TOLERANCE
+    crossings, side = [], 0.0
+    for k, value in enumerate(gap):
+        sign = 0.0 if abs(value) <= tolerance else np.sign(value)
+        if sign and side and sign != side:
+            low, high = float(times[k - 1]), float(times[k])
+            for _ in range(80):
+                middle = 0.5 * (low + high)
+                if np.sign(motion.evaluate(np.array([middle]))[0, 0] - junction) == side:
+                    low = middle
+                else:
+                    high = middle
+            crossings.append(0.5 * (low + high))
+        if sign:
+            side = sign
+    return crossings
+
+
+def _stays(
+    route: Route, vehicle: int, table: ProfileTable, motion: PiecewiseCubic, orientation: int
+) -> tuple[list[float], list[AxisMap], int]:
+    """When each stay on a leg begins, its axis map, and the junction crossings beyond the route's.
+
+    The axis is a line through the legs: ``s = s0 + orientation * (axis - axis0)`` on the first
+    leg, and every time the axis passes the junction's value the vehicle goes on to the next leg
+    its route visits, where ``s`` grows the other way round.
+    """
+    leg, s0 = _start(route, vehicle)
+    axis0 = float(table.positions()[0])
+    if not VehiclePath.from_route(route, vehicle).legs:  # its route does not move it
+        return [0.0], [AxisMap.parked(axis0, leg, s0)], 0
+    visits = leg_visits(route, vehicle)
+    if leg == JUNCTION_INDEX:  # starts at the junction: the axis grows onto its first leg
+        leg = visits[0]
+    junction = axis0 - orientation * s0
+    crossings = junction_crossings(motion, junction)
+    starts = [0.0]
+    maps = [
+        AxisMap(
+            np.array([axis0]), np.array([axis0]), np.array([leg]), np.array([s0]), np.array([orientation])
+        )
+    ]
+    slope = orientation
+    for n, time in enumerate(crossings[: len(visits) - 1], start=1):
+        slope = -slope
+        maps.append(
+            AxisMap(
+                np.array([junction]),
+                np.array([junction]),
+                np.array([visits[n]]),
+                np.zeros(1),
+                np.array([slope]),
+            )
+        )
+        starts.append(time)
+    return starts, maps, max(0, len(crossings) - (len(visits) - 1))
 
 
 def _slice(profile: PiecewiseCubic, begin: float, end: float) -> PiecewiseCubic:
@@ -434,8 +472,10 @@ class TableMotion(TimingMethod):
     Parameters
     ----------
     tables : tuple of 2 ProfileTable
-        Vehicle 1's and vehicle 2's tables, in the schedule's axis convention
-        (axis 0 at the start, growing in the direction of the first move).
+        Vehicle 1's and vehicle 2's tables: each the signed axis of its vehicle.
+    orientations : tuple of 2 int
+        ``ds/d axis`` of each vehicle at its start: +1 if its axis grows away from
+        the junction (the first move of a schedule is its axis's positive direction).
     jerk : bool
         Whether the tables are held to the jerk limits (default True).
     """
@@ -444,6 +484,7 @@ class TableMotion(TimingMethod):
     summary: ClassVar[str] = "the motion of two interpolated profile tables"
 
     tables: tuple[ProfileTable, ProfileTable]
+    orientations: tuple[int, int] = (1, 1)
     jerk: bool = True
 
     @property
@@ -452,28 +493,35 @@ class TableMotion(TimingMethod):
         return self.jerk
 
     def schedule(self, route: Route, limits: Limits) -> Schedule:
-        """The tables' motion along ``route``: sections between reversals of either vehicle."""
-        lengths = route.graph.lengths
-        motions, phase_maps, phase_starts = [], [], []
+        """The tables' motion along ``route``: a section for each stay of either vehicle on a leg."""
+        motions, stay_maps, stay_starts = [], [], []
         for vehicle, table in enumerate(self.tables):
-            path = VehiclePath.from_route(route, vehicle, axis_start=float(table.positions()[0]))
-            motions.append(table.motion())
-            starts, maps = _phases(path, table, lengths)
-            phase_starts.append(starts)
-            phase_maps.append(maps)
+            motion = table.motion()
+            starts, maps, _ = _stays(route, vehicle, table, motion, self.orientations[vehicle])
+            motions.append(motion)
+            stay_starts.append(starts)
+            stay_maps.append(maps)
         end = max(motion.duration for motion in motions)
-        cuts = sorted({0.0, end, *phase_starts[0], *phase_starts[1]})
+        cuts = sorted({0.0, end, *stay_starts[0], *stay_starts[1]})
         cuts = [t for t in cuts if t <= end]
         sections = []
         for begin, finish in itertools.pairwise(cuts) if len(cuts) > 1 else [(0.0, 0.0)]:
             maps = []
             for vehicle in range(2):
-                phase = int(np.searchsorted(phase_starts[vehicle], begin, side="right") - 1)
-                maps.append(phase_maps[vehicle][min(phase, len(phase_maps[vehicle]) - 1)])
+                stay = int(np.searchsorted(stay_starts[vehicle], begin, side="right") - 1)
+                maps.append(stay_maps[vehicle][stay])
             kinematics = CubicKinematics(tuple(_slice(m, begin, finish) for m in motions))
             sections.append(Section(begin, kinematics, tuple(maps)))
         smoothness = min(table.interpolation.smoothness for table in self.tables)
-        return Schedule(route, limits, self, tuple(sections), jerk_limited=self.jerk, continuity=smoothness)
+        return Schedule(
+            route,
+            limits,
+            self,
+            tuple(sections),
+            jerk_limited=self.jerk,
+            continuity=smoothness,
+            end_tolerance=END_TOLERANCE,
+        )
 
 
 @dataclass(frozen=True, slots=True)
@@ -509,6 +557,15 @@ class TableCheck:
             "ratios": {k: (list(v) if v is not None else None) for k, v in self.ratios.items()},
             "homotopy": self.route.homotopy.value,
         }
+
+
+def _orientations(route: Route) -> list[tuple[int, int]]:
+    """Both vehicles' start orientations to try: the route's first moves first."""
+    first = []
+    for vehicle in range(2):
+        path = VehiclePath.from_route(route, vehicle)
+        first.append(1 if not path.legs or path.s_to[0] > path.s_from[0] else -1)
+    return [(first[0] * a, first[1] * b) for a, b in ((1, 1), (-1, 1), (1, -1), (-1, -1))]
 
 
 def check_tables(
@@ -556,24 +613,31 @@ def check_tables(
             regions_match=False,
         )
         return TableCheck(False, tuple(failures), report, {}, route)
-    for vehicle, table in enumerate(tables):
-        wanted = len(VehiclePath.from_route(route, vehicle).stops)
-        turns = turning_points(table).size
-        if turns != wanted:
-            failures.append(
-                f"vehicle {vehicle + 1} turns back {turns} times: expected {wanted}, as its route does"
-            )
-    schedule = TableMotion(tables, jerk=jerk).schedule(route, limits)
-    report = verify(schedule)
-    failures += report.failures
+    differences = []
     for vehicle, table in enumerate(tables):
         for check in _difference_checks(table, limits.vehicles[vehicle], jerk=jerk):
             if check.value > check.allowed:
                 unit = "m/s^2" if check.quantity == "acceleration" else "m/s^3"
-                failures.append(
+                differences.append(
                     f"vehicle {vehicle + 1} {check.quantity} reaches {check.value:.9g} {unit} at "
                     f"t={check.time:.6f} s exceeds its max_{check.quantity} {check.limit:g} {unit} "
                     "(from the table's points)"
                 )
+    # the files do not say which way along its leg each vehicle's axis grows: read both ways
+    verdicts = []
+    for orientations in _orientations(route):
+        found = []
+        for vehicle, table in enumerate(tables):
+            *_, extra = _stays(route, vehicle, table, table.motion(), orientations[vehicle])
+            if extra:
+                found.append(
+                    f"vehicle {vehicle + 1} passes the junction {extra} more time(s) than its route does"
+                )
+        report = verify(TableMotion(tables, orientations, jerk=jerk).schedule(route, limits))
+        verdicts.append((found + list(report.failures), report))
+        if not verdicts[-1][0]:
+            break
+    found, report = min(verdicts, key=lambda verdict: len(verdict[0]))
+    failures += found + differences
     ratios = limit_ratios(tables, limits, jerk=jerk)
     return TableCheck(not failures, tuple(failures), report, ratios, route)

@@ -260,8 +260,11 @@ def _check_ends(schedule: Schedule, state, failures: list[str]) -> tuple[float, 
                 failures.append(
                     f"vehicle {vehicle + 1} is not at rest at the {label} (|v| + |a| = {residue:.3g})"
                 )
-        if not error <= POSITION_TOLERANCE:
-            failures.append(f"{label} is off the route's {label} by {error:.3g} m (expected <= 1e-9 m)")
+        tolerance = POSITION_TOLERANCE if schedule.end_tolerance is None else schedule.end_tolerance
+        if not error <= tolerance:
+            failures.append(
+                f"{label} is off the route's {label} by {error:.3g} m (expected <= {tolerance:g} m)"
+            )
         errors.append(error)
     start_gap = float(track_distance(state.leg[0, 0], state.s[0, 0], state.leg[1, 0], state.s[1, 0]))
     return errors[0], errors[1], start_gap

@@ -17,7 +17,7 @@ from trajgen.errors import OptionError, VerificationError
 from trajgen.export.dialects import DIALECTS, TableDialect
 from trajgen.export.resample import Resampled, resample
 from trajgen.naming import check_vehicle_names
-from trajgen.tables import Interpolation, TableCheck, check_tables
+from trajgen.tables import Interpolation, TableCheck, check_tables, limit_ratios, slowdown
 from trajgen.verify import VerifiedSchedule, require_verified
 
 __all__ = ["PlcTables", "check_dialect_method", "plc_tables", "table_paths"]
@@ -57,6 +57,10 @@ class PlcTables:
             "verified": self.check.passed,
             "min_separation_m": self.check.report.min_separation,
         }
+
+
+#: How often the tables are made again, slower, when their written values exceed a limit.
+SCALE_ATTEMPTS = 3
 
 
 def check_dialect_method(dialect: TableDialect, jerk_limited: bool) -> None:
@@ -111,12 +115,20 @@ def plc_tables(
         )
     points = dialect.check_points(max_points)
     check_dialect_method(dialect, schedule.jerk_limited)
-    resampled = resample(verified, interpolation=dialect.interpolation, max_points=points)
-    contents = tuple(dialect.render(table) for table in resampled.tables)
-    parsed = tuple(
-        dialect.read(data, source=f"vehicle {vehicle + 1}'s table").table
-        for vehicle, data in enumerate(contents)
-    )
+    scale = 1.0
+    for _ in range(SCALE_ATTEMPTS):  # what is written (rounded) may need a little more time than computed
+        resampled = resample(
+            verified, interpolation=dialect.interpolation, max_points=points, min_scale=scale
+        )
+        contents = tuple(dialect.render(table) for table in resampled.tables)
+        parsed = tuple(
+            dialect.read(data, source=f"vehicle {vehicle + 1}'s table").table
+            for vehicle, data in enumerate(contents)
+        )
+        needed = slowdown(limit_ratios(parsed, schedule.limits, jerk=schedule.jerk_limited))
+        if needed <= 1.0 + 1e-9:
+            break
+        scale = resampled.time_scale * needed * (1.0 + 1e-6)
     check = check_tables(parsed, schedule.route, schedule.limits, jerk=schedule.jerk_limited)
     if not check.passed:
         raise VerificationError(

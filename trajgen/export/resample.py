@@ -23,7 +23,7 @@ from topology.indexed import track_distance
 from trajgen.errors import InputError, OutputLimitError
 from trajgen.pieces import schedule_pieces
 from trajgen.schedule import Schedule
-from trajgen.tables import Interpolation, ProfileTable, divided_differences, limit_ratios
+from trajgen.tables import Interpolation, ProfileTable, divided_differences, limit_ratios, slowdown
 from trajgen.verify import VerifiedSchedule, require_verified
 
 __all__ = ["POSITION_SCALE", "VELOCITY_SCALE", "Resampled", "resample"]
@@ -286,7 +286,12 @@ def _points(
 
 
 def resample(
-    verified: VerifiedSchedule, *, interpolation: Interpolation, max_points: int, decimals: int = 9
+    verified: VerifiedSchedule,
+    *,
+    interpolation: Interpolation,
+    max_points: int,
+    decimals: int = 9,
+    min_scale: float = 1.0,
 ) -> Resampled:
     """Tables of both vehicles with at most ``max_points`` points each, for ``interpolation``.
 
@@ -300,6 +305,9 @@ def resample(
     decimals : int, optional
         Decimal places of the times written (default 9: nanoseconds); the points' times are
         rounded to them before the values are taken, so what is written is what was verified.
+    min_scale : float, optional
+        Slow the tables down at least this much (default 1.0), e.g. when their written values'
+        round-off needs it.
 
     Returns
     -------
@@ -324,12 +332,11 @@ def resample(
     times = [p[0] for p in points]
     tables = tuple(_table(schedule, v, times[v], interpolation, 1.0, anchors=points[v][1]) for v in range(2))
     ratios = limit_ratios(tables, schedule.limits, jerk=schedule.jerk_limited)
-    scale = 1.0
-    for order, name in enumerate(("velocity", "acceleration", "jerk"), start=1):
-        if ratios[name] is not None:
-            scale = max(scale, max(ratios[name]) ** (1.0 / order))
+    scale = slowdown(ratios)
     if scale > 1.0 + 1e-9:
         scale *= 1.0 + 1e-6  # clear of the limit, not on it
+    scale = max(scale, min_scale)
+    if scale > 1.0 + 1e-9:
         logger.info("tables slowed down by %.6g to respect the limits as interpolated", scale)
         tables = tuple(
             _table(
