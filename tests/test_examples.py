@@ -21,6 +21,12 @@ FIGURES = {
     "03_optimal_swap": (r"optimal / exact = ([0-9.]+)", 0.4076, 0.0005),
     # the plan keeps 1.5 m + twice the 0.05 m margin; the stopped vehicle never gets closer
     "04_online_stop_in_the_junction": (r"closest approach ([0-9.]+) m", 1.600, 0.003),
+    # equal vehicles: the paper's class; both move at once, the waiting one parks only as deep as needed
+    "05_unequal_legs": (r"optimal / exact = ([0-9.]+)", 0.364, 0.005),
+    # the README's figures: 37.46 s in the paper's class, 33.84 s in the other
+    "06_two_different_vehicles": (r"time saved by the other class: ([0-9.]+) s", 3.62, 0.05),
+    # a point moved by 1 cm breaks the velocity (closed form), acceleration and jerk (divided differences)
+    "07_export_for_a_plc_and_check": (r"violations after moving one point by 1 cm: ([0-9]+)", 3, 0),
 }
 
 
