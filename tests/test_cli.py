@@ -78,6 +78,7 @@ def test_demo_runs_the_default_scenario_end_to_end(tmp_path, capsys):
     assert sorted(p.name for p in output.iterdir()) == [
         "agv1.csv",
         "agv2.csv",
+        "configuration.png",
         "coordination.png",
         "separation.png",
         "speed.png",

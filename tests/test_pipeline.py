@@ -125,6 +125,7 @@ def test_a_run_verifies_each_schedule_once_and_commits_every_file(tmp_path, capl
         "speed.png",
         "separation.png",
         "coordination.png",
+        "configuration.png",
     ]
     assert all(p.is_file() for p in result.files)
     summary = result.summary()

@@ -32,6 +32,7 @@ def test_readme_python_example_runs_and_its_comments_hold(tmp_path, monkeypatch)
     assert sorted(p.name for p in (tmp_path / "run").iterdir()) == [
         "agv1.csv",
         "agv2.csv",
+        "configuration.png",
         "coordination.png",
         "separation.png",
         "speed.png",

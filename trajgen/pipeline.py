@@ -26,7 +26,7 @@ from trajgen.export import (
 from trajgen.export.dialects import DIALECTS, Dialect, TableDialect
 from trajgen.export.plc import PlcTables, check_dialect_method, plc_tables, table_paths
 from trajgen.methods import METHODS, make_schedule
-from trajgen.plots import render_coordination, render_separation, render_speed
+from trajgen.plots import render_configuration, render_coordination, render_separation, render_speed
 from trajgen.scenario import Scenario
 from trajgen.schedule import TimingMethod
 from trajgen.summary import route_summary
@@ -37,7 +37,7 @@ __all__ = ["PLOT_NAMES", "Outputs", "RunResult", "run"]
 logger = logging.getLogger(__name__)
 
 #: The files written into the plot folder.
-PLOT_NAMES = ("speed.png", "separation.png", "coordination.png")
+PLOT_NAMES = ("speed.png", "separation.png", "coordination.png", "configuration.png")
 
 
 def _folder(value: object, option: str) -> Path | None:
@@ -57,7 +57,8 @@ class Outputs:
     csv_dir : path or None
         Folder for ``<vehicle name>.csv`` of both vehicles; ``None``: no CSV.
     plot_dir : path or None
-        Folder for ``speed.png``, ``separation.png`` and ``coordination.png``; ``None``: no plots.
+        Folder for ``speed.png``, ``separation.png``, ``coordination.png`` and
+        ``configuration.png``; ``None``: no plots.
     csv : CsvOptions
         Format of the ``generic`` CSV profiles.
     dialect : Dialect or str
@@ -221,10 +222,11 @@ def run(
             files[path] = profile_chunks(verified, vehicle, outputs.csv)
     if outputs.plot_dir is not None:
         compared, notes = _comparison(route, scenario, chosen, verified)
-        speed, separation, coordination = (outputs.plot_dir / name for name in PLOT_NAMES)
+        speed, separation, coordination, configuration = (outputs.plot_dir / name for name in PLOT_NAMES)
         files[speed] = render_speed(verified, names=scenario.names)
         files[separation] = render_separation(verified)
         files[coordination] = render_coordination(compared)
+        files[configuration] = render_configuration(verified, names=scenario.names)
     written = commit_files(files) if files else ()
     # the schedule's route: optimal may have taken the other homotopy class
     return RunResult(scenario, chosen, verified.schedule.route, verified, written, tuple(notes), tables)

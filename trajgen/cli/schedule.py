@@ -79,7 +79,10 @@ def register(commands) -> None:
         "--csv", metavar="DIR", help="write DIR/<vehicle name>.csv per vehicle (.txt for codesys-xy)"
     )
     schedule.add_argument(
-        "--plot", metavar="DIR", help="write DIR/speed.png, DIR/separation.png, DIR/coordination.png"
+        "--plot",
+        metavar="DIR",
+        help="write DIR/speed.png, DIR/separation.png, DIR/coordination.png,\n"
+        "DIR/configuration.png (the configuration space drawn flat: route and retraction)",
     )
     schedule.add_argument("--json", action="store_true", help="print a machine-readable summary")
     add_csv_options(schedule)

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import io
 
-__all__ = ["PNG_DPI", "new_figure", "png_bytes"]
+__all__ = ["PNG_DPI", "frame_painter", "new_figure", "png_bytes"]
 
 #: Resolution of the PNGs, dots per inch.
 PNG_DPI = 110
@@ -28,3 +28,35 @@ def png_bytes(figure) -> bytes:
     buffer = io.BytesIO()
     figure.savefig(buffer, format="png", dpi=PNG_DPI)
     return buffer.getvalue()
+
+
+def frame_painter(figure, animated):
+    """A function that draws the frames of an animation of ``figure`` as RGB arrays.
+
+    Everything but the ``animated`` artists is drawn once (Agg, at the figure's dpi)
+    and kept; each call of the returned function restores that background, draws the
+    ``animated`` artists over it in the order given (after their data were changed)
+    and returns the frame as a new array of shape (height, width, 3), uint8.
+
+    Parameters
+    ----------
+    figure : matplotlib Figure
+    animated : sequence of matplotlib Artist
+        The artists that change from frame to frame, in drawing order.
+    """
+    import numpy as np
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+
+    canvas = FigureCanvasAgg(figure)
+    for artist in animated:
+        artist.set_animated(True)
+    canvas.draw()
+    background = canvas.copy_from_bbox(figure.bbox)
+
+    def paint():
+        canvas.restore_region(background)
+        for artist in animated:
+            figure.draw_artist(artist)
+        return np.array(np.asarray(canvas.buffer_rgba())[:, :, :3])
+
+    return paint

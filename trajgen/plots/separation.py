@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import numpy as np
+
 from topology.indexed import track_distance
 from trajgen.plots.figure import new_figure, png_bytes
 from trajgen.plots.speed import plot_period
@@ -17,10 +19,18 @@ def render_separation(verified: VerifiedSchedule) -> bytes:
     state = schedule.sample(plot_period(schedule.duration))
     distance = track_distance(state.leg[0], state.s[0], state.leg[1], state.s[1])
     required = max(schedule.limits.min_separation, schedule.route.min_separation)
-    figure = new_figure(figsize=(9, 4))
+    figure = new_figure(figsize=(10.5, 4))
     axis = figure.subplots()
     axis.plot(state.t, distance, label="track distance")
     axis.axhline(required, color="tab:red", linestyle="--", label=f"minimum {required:g} m")
+    closest = int(np.argmin(distance))
+    axis.plot(
+        state.t[closest],
+        distance[closest],
+        "v",
+        color="black",
+        label=f"closest {distance[closest]:.3f} m at {state.t[closest]:.2f} s",
+    )
     axis.fill_between(state.t, 0, required, color="tab:red", alpha=0.1)
     axis.set_xlabel("t [s]")
     axis.set_ylabel("separation [m]")
@@ -29,7 +39,7 @@ def render_separation(verified: VerifiedSchedule) -> bytes:
         f"{schedule.method.name} schedule: separation along the track\nclass {class_label(schedule.route)}",
         fontsize=10,
     )
-    axis.legend(loc="upper right")
+    axis.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=9)
     axis.grid(True, alpha=0.3)
     figure.tight_layout()
     return png_bytes(figure)

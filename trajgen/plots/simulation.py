@@ -75,7 +75,7 @@ def render_simulation(result, *, names: tuple[str, str], min_separation: float) 
         raise InputError(f"min_separation (m) must be a finite number >= 0, got {short_repr(min_separation)}")
     t = np.asarray(result.plot["t"])
     planned = result.schedule.schedule.state(t).velocity
-    figure = new_figure(figsize=(9, 7))
+    figure = new_figure(figsize=(10.5, 7))
     speed_axis, separation_axis = figure.subplots(2, 1, sharex=True)
     for vehicle in range(2):
         colour = VEHICLE_COLOURS[vehicle]
@@ -89,7 +89,7 @@ def render_simulation(result, *, names: tuple[str, str], min_separation: float) 
         )
         speed_axis.plot(t, result.plot["speed"][vehicle], color=colour, label=f"{names[vehicle]} executed")
     speed_axis.set_ylabel("v [m/s]")
-    speed_axis.legend(loc="lower right", fontsize=8)
+    speed_axis.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=8)
     separation_axis.plot(t, result.plot["separation"], color="tab:green", label="true track distance")
     separation_axis.axhline(
         min_separation, color="tab:red", linestyle="--", label=f"minimum {min_separation:g} m"
@@ -98,7 +98,7 @@ def render_simulation(result, *, names: tuple[str, str], min_separation: float) 
     separation_axis.set_ylim(bottom=0)
     separation_axis.set_ylabel("separation [m]")
     separation_axis.set_xlabel("t [s]")
-    separation_axis.legend(loc="upper right", fontsize=8)
+    separation_axis.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=8)
     marks = [(f.time, f.value if f.kind is FaultKind.STOP else None, f.spec) for f in result.faults]
     for axis in (speed_axis, separation_axis):
         _mark_faults(axis, marks)

@@ -34,29 +34,37 @@ def render_speed(verified: VerifiedSchedule, *, names: tuple[str, str] = ("vehic
     """
     schedule = require_verified(verified, "render_speed").schedule
     state = schedule.sample(plot_period(schedule.duration))
-    figure = new_figure(figsize=(9, 7.5))
+    figure = new_figure(figsize=(10.5, 7.5))
     axes = figure.subplots(3, 1, sharex=True)
     rows = [
-        (state.velocity, "max_velocity", "v [m/s]"),
-        (state.acceleration, "max_acceleration", "a [m/s²]"),
-        (state.jerk, "max_jerk", "j [m/s³]"),
+        (state.velocity, "max_velocity", "v [m/s]", "m/s"),
+        (state.acceleration, "max_acceleration", "a [m/s²]", "m/s²"),
+        (state.jerk, "max_jerk", "j [m/s³]", "m/s³"),
     ]
-    for axis, (values, limit_name, label) in zip(axes, rows, strict=True):
+    for axis, (values, limit_name, label, unit) in zip(axes, rows, strict=True):
         for vehicle in range(2):
-            colour = VEHICLE_COLOURS[vehicle]
-            axis.plot(state.t, values[vehicle], color=colour, label=names[vehicle])
-            limit = getattr(schedule.limits.vehicles[vehicle], limit_name)
-            if limit_name != "max_jerk" or schedule.jerk_limited:
+            axis.plot(state.t, values[vehicle], color=VEHICLE_COLOURS[vehicle], label=names[vehicle])
+        limits = [getattr(schedule.limits.vehicles[vehicle], limit_name) for vehicle in range(2)]
+        if limit_name != "max_jerk" or schedule.jerk_limited:
+            shared = limits[0] == limits[1]  # one black line for both, else one per vehicle in its colour
+            for vehicle in (0,) if shared else (0, 1):
+                whose = "both" if shared else names[vehicle]
                 for sign in (1, -1):
-                    axis.axhline(sign * limit, color=colour, linestyle="--", linewidth=0.8)
+                    axis.axhline(
+                        sign * limits[vehicle],
+                        color="black" if shared else VEHICLE_COLOURS[vehicle],
+                        linestyle="--",
+                        linewidth=0.9,
+                        label=f"limit ±{limits[vehicle]:g} {unit} ({whose})" if sign == 1 else None,
+                    )
         axis.set_ylabel(label)
         axis.grid(True, alpha=0.3)
+        axis.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=8)
     if not schedule.jerk_limited:
         axes[2].set_title("jerk not limited by this method (steps in a)", fontsize=9)
-    axes[0].legend(loc="upper right")
     axes[0].set_title(
         f"{schedule.method.name} schedule, {schedule.duration:.2f} s, class {class_label(schedule.route)}"
-        "\n(dashed: limits)",
+        "\n(dashed: the limits)",
         fontsize=10,
     )
     axes[-1].set_xlabel("t [s]")

@@ -1,0 +1,516 @@
+"""The pictures people look at: the animation (GIF) and the configuration space drawn flat (PNG)."""
+
+from __future__ import annotations
+
+import io
+import itertools
+import math
+import re
+
+import numpy as np
+import pytest
+from matplotlib.colors import to_rgb
+from PIL import Image
+
+from tests.conftest import REPO
+from tests.helpers import LIMITS, conf, route_of
+from topology import JUNCTION_INDEX, YGraph, plan
+from topology.indexed import segment_region_key
+from trajgen import Exact, certify, default_scenario, make_schedule
+from trajgen.cli import EXIT_BAD_INPUT, EXIT_OK, main
+from trajgen.errors import OptionError, UnverifiedScheduleError
+from trajgen.pipeline import PLOT_NAMES
+from trajgen.plots import render_animation, render_configuration
+from trajgen.plots.animation import (
+    DEFAULT_MAX_FRAMES,
+    END_HOLD_MS,
+    FRAME_HEIGHT_PX,
+    FRAME_WIDTH_PX,
+    clock_text,
+    distance_text,
+    frame_geometry,
+    frame_layout,
+    playback,
+    speed_text,
+)
+from trajgen.plots.configuration import ConfigurationLayout, route_samples, schedule_samples
+from trajgen.plots.gif import gif_bytes
+from trajgen.plots.speed import VEHICLE_COLOURS
+
+SWAP = str(REPO / "examples" / "swap.toml")
+
+
+# -- helpers -----------------------------------------------------------------
+def _frames(gif: bytes) -> list[np.ndarray]:
+    image = Image.open(io.BytesIO(gif))
+    frames = []
+    for k in range(image.n_frames):
+        image.seek(k)
+        frames.append(np.asarray(image.convert("RGB")).astype(int))
+    return frames
+
+
+def _rgb(colour: str) -> np.ndarray:
+    return np.round(np.array(to_rgb(colour)) * 255).astype(int)
+
+
+def _pixel(frame: np.ndarray, column: float, row: float) -> np.ndarray:
+    return frame[round(float(row)), round(float(column))]
+
+
+def _near(pixel: np.ndarray, colour: str, tolerance: int = 12) -> bool:
+    return bool(np.abs(pixel - _rgb(colour)).max() <= tolerance)
+
+
+def _segment_distance(point: np.ndarray, a: np.ndarray, b: np.ndarray) -> float:
+    along = np.clip((point - a) @ (b - a) / ((b - a) @ (b - a)), 0.0, 1.0)
+    return float(np.hypot(*(point - a - along * (b - a))))
+
+
+def _distance_to_outline(point: np.ndarray, polygon: np.ndarray) -> float:
+    return min(
+        _segment_distance(point, a, b) for a, b in zip(polygon, np.roll(polygon, -1, axis=0), strict=True)
+    )
+
+
+def _inside(point: np.ndarray, polygon: np.ndarray) -> bool:
+    """Even-odd rule."""
+    inside = False
+    for a, b in zip(polygon, np.roll(polygon, -1, axis=0), strict=True):
+        if (a[1] > point[1]) != (b[1] > point[1]):
+            cross = a[0] + (point[1] - a[1]) * (b[0] - a[0]) / (b[1] - a[1])
+            inside ^= bool(point[0] < cross)
+    return inside
+
+
+def _in_region(point: np.ndarray, polygon: np.ndarray) -> bool:
+    return _inside(point, polygon) or _distance_to_outline(point, polygon) < 1e-9
+
+
+# -- the swap of examples/swap.toml, timed by exact (fast), rendered once -------------------------
+@pytest.fixture(scope="module")
+def swap():
+    scenario = default_scenario()
+    return scenario, certify(make_schedule(scenario.plan(), scenario.limits, method=Exact()))
+
+
+@pytest.fixture(scope="module")
+def swap_gif(swap):
+    scenario, verified = swap
+    return render_animation(verified, names=scenario.names, max_frames=80)
+
+
+# -- playback ----------------------------------------------------------------------------------------
+@pytest.mark.parametrize(
+    ("duration", "fps", "max_frames", "speedup", "frames"),
+    [
+        pytest.param(0.0, 10, 300, 1.0, 1, id="zero-duration"),
+        pytest.param(27.5, 10, 300, 1.0, 276, id="swap-real-time"),
+        pytest.param(100.0, 10, 300, 4.0, 251, id="100s-x4"),
+        pytest.param(67.5, 10, 80, 1.0 * 10, 69, id="exact-swap-x10"),
+        pytest.param(86_400.0, 10, 300, 3000.0, 289, id="a-day-x3000"),
+        pytest.param(10.0, 25, 2, 300.0, 2, id="two-frames"),
+    ],
+)
+def test_playback_caps_the_frames_with_a_round_speedup(duration, fps, max_frames, speedup, frames):
+    play = playback(duration, fps=fps, max_frames=max_frames)
+    assert play.speedup == speedup
+    assert play.frame_count == frames <= max_frames
+    times = play.times()
+    assert times.shape == (frames,)
+    assert times[0] == 0.0
+    assert times[-1] == duration
+    assert np.allclose(np.diff(times)[:-1], play.step)  # the last step ends at the goal
+    assert np.all(np.diff(times) > 0.0)
+    assert play.label == ("real time" if speedup == 1.0 else f"×{speedup:g} speed")
+
+
+@pytest.mark.parametrize(
+    ("options", "match"),
+    [
+        pytest.param({"fps": 0}, "fps .* from 1 to 50, got 0", id="fps-0"),
+        pytest.param({"fps": 51}, "fps .* got 51", id="fps-51"),
+        pytest.param({"fps": 2.5}, "fps .* got 2.5", id="fps-float"),
+        pytest.param({"fps": True}, "fps .* got True", id="fps-bool"),
+        pytest.param({"max_frames": 1}, "max_frames must be an integer from 2 to 3000, got 1", id="frames-1"),
+        pytest.param({"max_frames": 3001}, "max_frames .* got 3001", id="frames-3001"),
+    ],
+)
+def test_playback_refuses_bad_options(options, match):
+    with pytest.raises(OptionError, match=match):
+        playback(10.0, **options)
+
+
+# -- the animation's geometry and its pixels -----------------------------------------------------------
+def test_the_gif_decodes_with_its_frames_size_and_delays(swap, swap_gif):
+    _, verified = swap
+    play = playback(verified.schedule.duration, max_frames=80)
+    image = Image.open(io.BytesIO(swap_gif))
+    assert image.format == "GIF"
+    assert image.size == (FRAME_WIDTH_PX, FRAME_HEIGHT_PX)
+    assert image.n_frames == play.frame_count <= 80
+    assert play.label == "×10 speed"
+    delays = []
+    for k in range(image.n_frames):
+        image.seek(k)
+        delays.append(image.info["duration"])
+    assert delays[:-1] == [play.delay_ms] * (image.n_frames - 1)
+    assert delays[-1] == END_HOLD_MS
+
+
+@pytest.mark.parametrize("which", ["first", "last"])
+def test_the_first_frame_shows_the_start_and_the_last_the_goal(swap, swap_gif, which):
+    scenario, verified = swap
+    play = playback(verified.schedule.duration, max_frames=80)
+    geometry = frame_geometry(verified, play.times())
+    layout = frame_layout(scenario.track, geometry)
+    frames = _frames(swap_gif)
+    frame = frames[0] if which == "first" else frames[-1]
+    route = verified.schedule.route
+    here = route.start if which == "first" else route.goal
+    there = route.goal if which == "first" else route.start
+    graph = scenario.track
+    for vehicle in range(2):
+        column, row = layout.track_pixel(*graph.xy(here[vehicle]))
+        assert _near(_pixel(frame, column, row), VEHICLE_COLOURS[vehicle])
+        # in a swap, where this vehicle is at the other end the other vehicle is now
+        column, row = layout.track_pixel(*graph.xy(there[vehicle]))
+        assert _near(_pixel(frame, column, row), VEHICLE_COLOURS[1 - vehicle])
+
+
+@pytest.mark.parametrize("t", [0.0, 5.0, 21.7, 33.75, 50.0, 67.5], ids=lambda t: f"t={t}")
+def test_frame_positions_are_the_schedules_positions(swap, t):
+    scenario, verified = swap
+    geometry = frame_geometry(verified, [t])
+    configuration = verified.schedule.configuration_at(t)
+    for vehicle in range(2):
+        x, y = scenario.track.xy(configuration[vehicle])
+        assert geometry.x[vehicle, 0] == pytest.approx(x, abs=1e-9)
+        assert geometry.y[vehicle, 0] == pytest.approx(y, abs=1e-9)
+    assert geometry.distance[0] == pytest.approx(scenario.track.separation(configuration), abs=1e-9)
+
+
+def test_the_separation_bar_is_the_track_distance_long(swap, swap_gif):
+    scenario, verified = swap
+    play = playback(verified.schedule.duration, max_frames=80)
+    geometry = frame_geometry(verified, play.times())
+    layout = frame_layout(scenario.track, geometry)
+    frames = _frames(swap_gif)
+    for k in (0, len(frames) // 3, len(frames) // 2, len(frames) - 1):
+        end = layout.bar_pixel(geometry.distance[k])
+        assert _near(_pixel(frames[k], end - 4, layout.bar_row), "tab:green"), k
+        assert _near(_pixel(frames[k], end + 4, layout.bar_row), "white"), k
+        assert geometry.distance[k] == pytest.approx(
+            scenario.track.separation(verified.schedule.configuration_at(geometry.t[k])), abs=1e-9
+        )
+    assert geometry.distance[0] == pytest.approx(20.0)
+    assert not geometry.near.any()  # exact moves one vehicle at a time: never closer than 10 m
+
+
+def test_the_separation_bar_is_red_near_the_minimum():
+    # both on leg A, 1.6 m apart (under 1.25 x 1.5 m): the nearer one drives out first
+    route = route_of((10.0, 10.0, 10.0), ("A:3", "A:4.6"), ("B:5", "C:5"))
+    verified = certify(make_schedule(route, LIMITS, method=Exact()))
+    gif = render_animation(verified, max_frames=6)
+    play = playback(verified.schedule.duration, max_frames=6)
+    geometry = frame_geometry(verified, play.times())
+    layout = frame_layout(route.graph, geometry)
+    first = _frames(gif)[0]
+    end = layout.bar_pixel(geometry.distance[0])
+    assert geometry.distance[0] == pytest.approx(1.6)
+    assert geometry.near[0]
+    assert _near(_pixel(first, end - 4, layout.bar_row), "tab:red")
+    assert _near(_pixel(first, end + 4, layout.bar_row), "white")
+    assert _near(_pixel(first, layout.bar_pixel(0.5), layout.bar_row), "tab:red")
+
+
+def test_the_texts_of_a_frame(swap):
+    _, verified = swap
+    duration = verified.schedule.duration
+    geometry = frame_geometry(verified, [0.0, duration])
+    assert clock_text(geometry.t[0], duration) == "t = 0.0 s of 67.5 s"
+    assert clock_text(geometry.t[1], duration) == "t = 67.5 s of 67.5 s"
+    assert clock_text(12.34, 27.51) == "t = 12.3 s of 27.5 s"
+    assert speed_text("agv1", float(geometry.speed[0, 0])) == "agv1  0.00 m/s"
+    assert speed_text("agv2", 0.8449) == "agv2  0.84 m/s"
+    assert distance_text(12.345, 1.5) == "12.35 m (minimum 1.5 m)"
+
+
+def test_a_long_schedule_is_played_faster_within_the_frame_cap():
+    route = route_of((1000.0, 800.0, 1500.0), ("A:1000", "B:800"), ("B:800", "A:1000"))
+    verified = certify(make_schedule(route, LIMITS, method=Exact()))
+    play = playback(verified.schedule.duration, fps=10, max_frames=30)
+    assert verified.schedule.duration > 5000.0
+    assert play.speedup >= verified.schedule.duration / 2.9
+    gif = render_animation(verified, names=("a", "b"), fps=10, max_frames=30)
+    image = Image.open(io.BytesIO(gif))
+    assert image.n_frames == play.frame_count <= 30
+    assert image.size == (FRAME_WIDTH_PX, FRAME_HEIGHT_PX)
+
+
+def test_a_zero_duration_schedule_is_one_frame():
+    route = route_of((10.0, 10.0, 10.0), ("A:10", "B:10"), ("A:10", "B:10"))
+    verified = certify(make_schedule(route, LIMITS, method=Exact()))
+    assert verified.schedule.duration == 0.0
+    image = Image.open(io.BytesIO(render_animation(verified)))
+    assert image.n_frames == 1
+
+
+@pytest.mark.parametrize(
+    ("render", "what"),
+    [
+        pytest.param(render_animation, "render_animation", id="animation"),
+        pytest.param(render_configuration, "render_configuration", id="configuration"),
+        pytest.param(lambda s: frame_geometry(s, [0.0]), "frame_geometry", id="geometry"),
+    ],
+)
+def test_unverified_schedules_are_refused(swap, render, what):
+    _, verified = swap
+    with pytest.raises(UnverifiedScheduleError, match=f"{what} takes a VerifiedSchedule"):
+        render(verified.schedule)
+
+
+def test_the_gif_encoder_reproduces_its_frames_exactly():
+    rng = np.random.default_rng(7)
+    colours = rng.integers(0, 256, size=(40, 3), dtype=np.uint8)
+    frames = [colours[rng.integers(0, 40, size=(30, 50))] for _ in range(3)]
+    frames.append(frames[-1].copy())  # unchanged: kept as it is
+    moved = frames[-1].copy()
+    moved[10:12, 20:23] = colours[0]
+    frames.append(moved)
+    gif = gif_bytes(iter(frames), delays_ms=[100, 100, 50, 30, 2000], palette_samples=frames[:1])
+    decoded = _frames(gif)
+    assert len(decoded) == len(frames)
+    for got, want in zip(decoded, frames, strict=True):
+        assert np.array_equal(got, want)
+
+
+# -- the configuration space drawn flat ------------------------------------------------------------------
+TRACKS = {
+    "equal": YGraph({"A": 10.0, "B": 10.0, "C": 10.0}),
+    "unequal": YGraph({"A": 12.0, "B": 8.0, "C": 15.0}),
+}
+
+
+@pytest.mark.parametrize("track", TRACKS.values(), ids=TRACKS.keys())
+def test_each_region_is_drawn_as_its_polygon(track):
+    layout = ConfigurationLayout.of(track, min_separation=1.5)
+    vertices = {str(v): layout.vertices[k] for k, v in enumerate(track.boundary_vertices)}
+    names = track.names
+    assert len(layout.regions) == 12
+    for key in layout.regions:
+        polygon = layout.region_polygon(key)
+        if key.nearer:  # T(k, r): a triangle from the valley of its ray (vehicle r at O)
+            assert polygon.shape == (3, 2)
+            end = f"{names[key.first_leg]}:{track.lengths[key.first_leg]:g}"
+            valley = f"(O, {end})" if key.nearer == 1 else f"({end}, O)"
+            assert np.array_equal(polygon[0], vertices[valley])
+        else:  # Q(i, j): the kite origin, V2(i), P(i, j), V1(j)
+            i, j = (f"{names[n]}:{track.lengths[n]:g}" for n in (key.first_leg, key.second_leg))
+            assert polygon.shape == (4, 2)
+            assert np.array_equal(polygon[0], [0.0, 0.0])
+            assert np.array_equal(polygon[1], vertices[f"({i}, O)"])
+            assert np.array_equal(polygon[2], vertices[f"({i}, {j})"])
+            assert np.array_equal(polygon[3], vertices[f"(O, {j})"])
+        # no two regions overlap: a point well inside one is inside no other
+        centre = polygon.mean(axis=0) if key.nearer else 0.5 * polygon[2]
+        assert [other for other in layout.regions if _inside(centre, layout.region_polygon(other))] == [key]
+
+
+ROUTES = {
+    "swap": route_of((10.0, 10.0, 10.0), ("A:10", "B:10"), ("B:10", "A:10")),
+    "swap-other-way": plan(
+        YGraph({"A": 12.0, "B": 8.0, "C": 15.0}),
+        conf("A:12", "B:8"),
+        conf("B:8", "A:12"),
+        min_separation=1.5,
+        homotopy="other",
+    ),
+    "from-a-triangle": route_of((10.0, 8.0, 15.0), ("A:3", "A:7"), ("B:6", "C:4")),
+    "to-a-triangle": route_of((10.0, 8.0, 15.0), ("B:2", "C:9"), ("C:12", "C:4")),
+    "from-a-ray": route_of((10.0, 8.0, 15.0), ("O", "B:5"), ("C:3", "A:9")),
+    "quadrangle-to-quadrangle": route_of((12.0, 8.0, 15.0), ("A:6", "B:2"), ("C:7", "A:3")),
+}
+
+
+@pytest.mark.parametrize("route", ROUTES.values(), ids=ROUTES.keys())
+def test_the_route_is_drawn_in_the_regions_it_visits(route):
+    layout = ConfigurationLayout.of(route.graph, min_separation=route.min_separation)
+    visited = set(route.region_keys)
+    checked = 0
+    for a, b in itertools.pairwise(route.indexed_waypoints):
+        key = segment_region_key(a, b)
+        if key is None:
+            continue
+        assert key in visited
+        configurations = _segment(a, b)
+        for c in configurations[1:-1]:  # the segment's interior
+            assert _in_region(layout.point(c, key), layout.region_polygon(key)), (c, key)
+            checked += 1
+    assert checked > 0
+    # and the polylines drawn pass through every sample, start to goal
+    configurations, regions = route_samples(route)
+    lines = layout.paths(configurations, regions)
+    assert np.allclose(lines[0][0], layout.point(route.indexed_waypoints[0], regions[0]))
+    assert np.allclose(lines[-1][-1], layout.point(route.indexed_waypoints[-1], regions[-1]))
+
+
+def _segment(a, b, count: int = 9):
+    leg1 = a[0] if a[0] != JUNCTION_INDEX else b[0]
+    leg2 = a[2] if a[2] != JUNCTION_INDEX else b[2]
+    configurations = []
+    for f in np.linspace(0.0, 1.0, count):
+        s1, s2 = a[1] + f * (b[1] - a[1]), a[3] + f * (b[3] - a[3])
+        configurations.append(
+            (leg1 if s1 > 0 else JUNCTION_INDEX, s1, leg2 if s2 > 0 else JUNCTION_INDEX, s2)
+        )
+    return configurations
+
+
+def _random_configurations(graph: YGraph, count: int, seed: int):
+    rng = np.random.default_rng(seed)
+    found = []
+    while len(found) < count:
+        legs = rng.integers(-1, 3, size=2)
+        s = [
+            0.0 if leg == JUNCTION_INDEX else float(rng.uniform(0.01, 1.0) * graph.lengths[leg])
+            for leg in legs
+        ]
+        c = (int(legs[0]), s[0], int(legs[1]), s[1])
+        if (c[0] == c[2] == JUNCTION_INDEX) or (c[0] == c[2] and c[1] == c[3]):
+            continue
+        found.append(c)
+    return found
+
+
+@pytest.mark.parametrize("track", TRACKS.values(), ids=TRACKS.keys())
+def test_the_retraction_lies_on_the_boundary_circle(track):
+    layout = ConfigurationLayout.of(track)
+    star = layout.vertices
+    on_circle = 0
+    for c in _random_configurations(track, 300, seed=11):
+        image = layout.boundary_image(c)
+        assert _distance_to_outline(image, star) < 1e-9
+        trace = layout.retraction(c)
+        assert np.allclose(trace[-1], image)
+        assert np.allclose(trace[0], layout.point(c))
+        if c[0] != c[2] and JUNCTION_INDEX not in (c[0], c[2]):  # a quadrangle: straight out from the centre
+            point = layout.base_point(c)
+            m = max(c[1] / track.lengths[c[0]], c[3] / track.lengths[c[2]])
+            assert np.allclose(point, m * image)
+            on_circle += m == 1.0
+    assert on_circle == 0  # the random points were inside
+
+
+@pytest.mark.parametrize("track", TRACKS.values(), ids=TRACKS.keys())
+def test_antipodal_boundary_points_are_drawn_opposite(track):
+    layout = ConfigurationLayout.of(track)
+    half = 0.5 * track.perimeter
+    for theta in np.linspace(0.0, track.perimeter, 61):
+        assert np.allclose(layout.boundary_point(theta + half), -layout.boundary_point(theta), atol=1e-12)
+    # r(c) and r(swap(c)) are half a perimeter apart, so drawn opposite
+    for c in _random_configurations(track, 200, seed=5):
+        swapped = (c[2], c[3], c[0], c[1])
+        assert np.allclose(layout.boundary_image(swapped), -layout.boundary_image(c), atol=1e-12)
+    # the swap: start and goal (peaks, vehicles exchanged) opposite, the route half way round
+    route = ROUTES["swap-other-way"]
+    swap_layout = ConfigurationLayout.of(route.graph)
+    start, goal = (swap_layout.point(c) for c in (route.indexed_waypoints[0], route.indexed_waypoints[-1]))
+    assert np.allclose(goal, -start)
+    assert abs(route.arc_length) == pytest.approx(0.5 * route.graph.perimeter)
+
+
+@pytest.mark.parametrize(("separation", "count"), [(0.0, 0), (1.5, 12)])
+def test_the_too_close_parts(separation, count):
+    track = TRACKS["unequal"]
+    layout = ConfigurationLayout.of(track, min_separation=separation)
+    polygons = layout.too_close_polygons()
+    assert len(polygons) == count
+    if count:
+        near = [(0, 0.5, 1, 0.4), (2, 3.0, 2, 3.8), (JUNCTION_INDEX, 0.0, 1, 1.0)]
+        far = [(0, 6.0, 1, 4.0), (2, 3.0, 2, 9.0)]
+        for c in near:
+            assert any(_inside(layout.point(c), p) for p in polygons), c
+        for c in far:
+            assert not any(_inside(layout.point(c), p) for p in polygons), c
+
+
+def test_the_schedules_path_stays_in_its_class(swap):
+    _, verified = swap
+    layout = ConfigurationLayout.of(verified.schedule.route.graph, min_separation=1.5)
+    configurations, regions = schedule_samples(verified, count=400)
+    assert len(configurations) == 400
+    keys = set(verified.schedule.route.region_keys)
+    for c, region in zip(configurations, regions, strict=True):
+        if region is not None and region.nearer == 0 and JUNCTION_INDEX not in (c[0], c[2]):
+            assert region in keys
+            assert _in_region(layout.point(c), layout.region_polygon(region))
+
+
+def test_render_configuration_of_a_route_and_of_a_schedule(swap):
+    _, verified = swap
+    for subject in (ROUTES["from-a-triangle"], verified):
+        png = render_configuration(subject)
+        image = Image.open(io.BytesIO(png))
+        assert image.format == "PNG"
+        assert image.size[0] > 800
+        assert image.size[1] > 900
+    with pytest.raises(UnverifiedScheduleError, match="render_configuration takes a VerifiedSchedule"):
+        render_configuration("a route")
+
+
+# -- the pipeline and the command line -------------------------------------------------------------------
+def test_plot_writes_configuration_png(tmp_path, capsys):
+    assert "configuration.png" in PLOT_NAMES
+    assert main(["schedule", SWAP, "--method", "exact", "--plot", str(tmp_path)]) == EXIT_OK
+    capsys.readouterr()
+    data = (tmp_path / "configuration.png").read_bytes()
+    assert data.startswith(b"\x89PNG\r\n\x1a\n")
+    image = Image.open(io.BytesIO(data))
+    image.verify()
+    assert sorted(p.name for p in tmp_path.iterdir()) == sorted(PLOT_NAMES)
+
+
+def test_animate_writes_the_gif(tmp_path, capsys):
+    out = tmp_path / "movie" / "swap.gif"
+    argv = ["animate", SWAP, "--out", str(out), "--method", "exact", "--max-frames", "40", "--fps", "5"]
+    assert main(argv) == EXIT_OK
+    stdout = capsys.readouterr().out
+    image = Image.open(out)
+    play = playback(67.5, fps=5, max_frames=40)
+    assert image.n_frames == play.frame_count <= 40
+    assert f"{play.frame_count} frames" in stdout
+    assert play.label in stdout
+    assert sorted(p.name for p in out.parent.iterdir()) == ["swap.gif"]  # no temporary files left
+
+
+@pytest.mark.parametrize(
+    ("out", "extra", "match"),
+    [
+        pytest.param("movie.png", [], "does not end in .gif", id="not-gif"),
+        pytest.param("folder.gif", [], "exists as a folder", id="a-folder"),
+        pytest.param("sub/", [], "names no file", id="trailing-slash"),
+        pytest.param("file/x.gif", [], "exists and is not a folder", id="below-a-file"),
+        pytest.param("ok.gif", ["--fps", "0"], "fps .* from 1 to 50", id="bad-fps"),
+        pytest.param("ok.gif", ["--max-frames", "1"], "max_frames .* from 2", id="bad-max-frames"),
+        pytest.param(
+            "ok.gif", ["--method", "toppra", "--homotopy", "paper"], "--homotopy", id="bad-homotopy"
+        ),
+    ],
+)
+def test_animate_bad_input_exits_2_and_writes_nothing(tmp_path, capsys, monkeypatch, out, extra, match):
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "folder.gif").mkdir()
+    (tmp_path / "file").write_text("a file")
+    before = sorted(p.name for p in tmp_path.rglob("*"))
+    assert main(["animate", SWAP, "--out", out, *extra]) == EXIT_BAD_INPUT
+    err = capsys.readouterr().err
+    assert err.startswith("trajgen: error:")
+    assert re.search(match, err), err
+    assert sorted(p.name for p in tmp_path.rglob("*")) == before
+
+
+def test_the_default_frame_cap_is_documented():
+    assert DEFAULT_MAX_FRAMES == 300
+    assert math.isclose(playback(29.9).speedup, 1.0)
+    assert playback(30.0).speedup == 2.0
