@@ -19,6 +19,10 @@ Example (``examples/swap.toml``)::
 
     [[vehicle]]
     ...
+
+A vehicle may take ``max_velocity`` and ``max_acceleration`` from a VDA 5050
+factsheet instead (``factsheet = "agv.json"``, relative to the scenario file's
+folder; see :mod:`trajgen.factsheet`); it still gives ``max_jerk``.
 """
 
 from __future__ import annotations
@@ -34,6 +38,7 @@ from limits import Limits, VehicleLimits
 from topology import Configuration, Position, Route, YGraph, plan
 from topology.validation import short_repr
 from trajgen.errors import InputError, ScenarioError
+from trajgen.factsheet import read_factsheet
 from trajgen.naming import check_vehicle_name, check_vehicle_names
 
 __all__ = [
@@ -62,10 +67,11 @@ _TRACK_KEYS = {"legs": True, "angles_deg": False}
 _SAFETY_KEYS = {"min_separation": True}
 _VEHICLE_KEYS = {
     "name": True,
-    "max_velocity": True,
-    "max_acceleration": True,
+    "max_velocity": False,  # required unless a factsheet gives it
+    "max_acceleration": False,  # required unless a factsheet gives it
     "max_jerk": True,
     "emergency_deceleration": False,
+    "factsheet": False,
     "start": True,
     "goal": True,
 }
@@ -175,11 +181,46 @@ def _parse_track(data: dict, source: str) -> YGraph:
         raise ScenarioError(f"{source}: [track]: {error}") from None
 
 
-def _parse_vehicle(vehicle: object, k: int, track: YGraph, taken: list[str], source: str):
+def _factsheet_limits(vehicle: dict, where: str, source: str, folder: Path | None) -> dict[str, float]:
+    """``max_velocity`` and ``max_acceleration`` of a vehicle from its factsheet, or ``{}`` without one."""
+    if "factsheet" not in vehicle:
+        missing = [key for key in ("max_velocity", "max_acceleration") if key not in vehicle]
+        if missing:
+            raise ScenarioError(
+                f"{source}: {where} is missing required key(s) {short_repr(missing)} "
+                "(or a VDA 5050 'factsheet' that gives them)"
+            )
+        return {}
+    given = [key for key in ("max_velocity", "max_acceleration") if key in vehicle]
+    if given:
+        raise ScenarioError(
+            f"{source}: {where} gives both 'factsheet' and {short_repr(given)}: "
+            "expected the limits from one of them (remove one)"
+        )
+    name = vehicle["factsheet"]
+    if not isinstance(name, str) or not name:
+        raise ScenarioError(
+            f"{source}: {where} factsheet must be a file path string, "
+            f"got {type(name).__name__} {short_repr(name)}"
+        )
+    path = Path(name) if folder is None else folder / name
+    try:
+        sheet = read_factsheet(
+            path, velocity_range=PLAUSIBLE["max_velocity"], acceleration_range=PLAUSIBLE["max_acceleration"]
+        )
+    except InputError as error:
+        raise ScenarioError(f"{source}: {where}: {error}") from None
+    return {"max_velocity": sheet.speed_max, "max_acceleration": sheet.max_acceleration}
+
+
+def _parse_vehicle(
+    vehicle: object, k: int, track: YGraph, taken: list[str], source: str, folder: Path | None = None
+):
     """Name, limits, start and goal of ``[[vehicle]]`` number ``k``."""
     where = f"[[vehicle]] {k}"
     vehicle = _table(vehicle, where, source)
     _check_keys(vehicle, _VEHICLE_KEYS, where, source)
+    from_factsheet = _factsheet_limits(vehicle, where, source, folder)
     name = vehicle["name"]
     try:
         check_vehicle_name(name)
@@ -195,6 +236,7 @@ def _parse_vehicle(vehicle: object, k: int, track: YGraph, taken: list[str], sou
         for key in ("max_velocity", "max_acceleration", "max_jerk", "emergency_deceleration")
         if key in vehicle
     }
+    numbers.update(from_factsheet)
     try:
         limits = VehicleLimits(**numbers)
         _check_plausible_vehicle(limits, "vehicle")
@@ -215,8 +257,11 @@ def _parse_vehicle(vehicle: object, k: int, track: YGraph, taken: list[str], sou
     return name, limits, ends[0], ends[1]
 
 
-def parse_scenario(data: dict, *, source: str = "<scenario>") -> Scenario:
+def parse_scenario(data: dict, *, source: str = "<scenario>", folder: str | Path | None = None) -> Scenario:
     """Build a Scenario from parsed TOML data, naming ``source`` and the key in every error.
+
+    ``folder`` is where relative ``factsheet`` paths are found (``None``: the
+    current working directory).
 
     Raises
     ------
@@ -236,7 +281,9 @@ def parse_scenario(data: dict, *, source: str = "<scenario>") -> Scenario:
     names: list[str] = []
     parsed = []
     for k, vehicle in enumerate(vehicles, start=1):
-        parsed.append(_parse_vehicle(vehicle, k, track, names, source))
+        parsed.append(
+            _parse_vehicle(vehicle, k, track, names, source, None if folder is None else Path(folder))
+        )
         names.append(parsed[-1][0])
     try:
         limits = Limits(vehicles=(parsed[0][1], parsed[1][1]), min_separation=separation)
@@ -301,17 +348,17 @@ def load_scenario(path: str | Path) -> Scenario:
         raise ScenarioError(f"scenario path must name a file, got {short_repr(path)}")
     path = Path(path)
     label = str(path) if len(str(path)) <= 120 else str(path)[:117] + "..."
-    return _parse_text(_read_scenario_file(path, label), label)
+    return _parse_text(_read_scenario_file(path, label), label, path.parent)
 
 
-def _parse_text(text: str, source: str) -> Scenario:
+def _parse_text(text: str, source: str, folder: Path | None = None) -> Scenario:
     try:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as error:
         raise ScenarioError(f"{source}: not valid TOML: {error}") from None
     except RecursionError:
         raise ScenarioError(f"{source}: not a scenario: arrays or tables nested too deeply") from None
-    return parse_scenario(data, source=source)
+    return parse_scenario(data, source=source, folder=folder)
 
 
 def default_scenario() -> Scenario:

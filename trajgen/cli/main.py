@@ -13,7 +13,7 @@ import logging
 import sys
 from collections.abc import Sequence
 
-from trajgen.cli import check, schedule, simulate
+from trajgen.cli import animate, check, schedule, simulate, vda5050
 from trajgen.cli.options import EXIT_BAD_INPUT, EXIT_FAILURE, CommandParser
 from trajgen.errors import InputError
 
@@ -22,7 +22,7 @@ __all__ = ["COMMAND_MODULES", "build_parser", "main"]
 logger = logging.getLogger(__name__)
 
 #: The modules whose ``register(commands)`` adds the sub-commands, in help order.
-COMMAND_MODULES = (schedule, check, simulate)
+COMMAND_MODULES = (schedule, check, simulate, vda5050, animate)
 
 
 def build_parser() -> argparse.ArgumentParser:

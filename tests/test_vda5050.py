@@ -1,0 +1,857 @@
+"""VDA 5050 orders: schema-valid messages, paths on the route, safe releases, factsheet limits, CLI."""
+
+from __future__ import annotations
+
+import functools
+import itertools
+import json
+import math
+import re
+from datetime import UTC, datetime, timedelta, timezone
+from pathlib import Path
+
+import numpy as np
+import pytest
+from jsonschema import Draft202012Validator
+
+from tests.conftest import REPO
+from topology import JUNCTION_INDEX, Homotopy
+from trajgen import Exact, Optimal, Toppra, certify, make_schedule, parse_scenario, run
+from trajgen.cli import EXIT_BAD_INPUT, EXIT_FAILURE, EXIT_OK, main
+from trajgen.errors import InputError, OptionError, OutputError, UnverifiedScheduleError
+from trajgen.export.vda5050 import (
+    MANIFEST_NAME,
+    NodeKind,
+    Vda5050Options,
+    node_id,
+    plan_orders,
+    render_manifest,
+    render_orders,
+    write_orders,
+)
+from trajgen.factsheet import MAX_FACTSHEET_BYTES, read_factsheet
+from trajgen.scenario import PLAUSIBLE, load_scenario
+
+SCHEMAS = REPO.parent / "shared" / "vda5050"
+SWAP = REPO / "examples" / "swap.toml"
+START = datetime(2025, 5, 1, 8, 0, tzinfo=UTC)
+OPTIONS = Vda5050Options(start_time=START, map_id="hall-1", manufacturers=("Acme", "Acme"))
+
+
+@functools.cache
+def validator(name: str) -> Draft202012Validator:
+    schema = json.loads((SCHEMAS / name).read_text(encoding="utf-8"))
+    Draft202012Validator.check_schema(schema)
+    return Draft202012Validator(schema, format_checker=Draft202012Validator.FORMAT_CHECKER)
+
+
+def scenario_data(legs, first, second, *, separation=1.5, angles=None) -> dict:
+    """A scenario as parsed TOML: ``first``/``second`` are (start, goal, v, a, j)."""
+    track = {"legs": dict(zip("ABC", legs, strict=True))}
+    if angles is not None:
+        track["angles_deg"] = dict(zip("ABC", angles, strict=True))
+    vehicles = [
+        {"name": name, "start": start, "goal": goal, "max_velocity": v, "max_acceleration": a, "max_jerk": j}
+        for name, (start, goal, v, a, j) in zip(("agv1", "agv2"), (first, second), strict=True)
+    ]
+    return {"track": track, "safety": {"min_separation": separation}, "vehicle": vehicles}
+
+
+UNEQUAL = scenario_data((12.0, 8.0, 15.0), ("A:12", "B:8", 1.0, 0.5, 1.0), ("B:8", "A:12", 0.7, 0.35, 0.6))
+PARKED = scenario_data((10.0, 10.0, 10.0), ("A:10", "B:10", 1.0, 0.5, 1.0), ("C:10", "C:10", 1.0, 0.5, 1.0))
+#: case -> (scenario data or None for the demo swap, method)
+CASES = {
+    "swap-optimal": (None, Optimal()),
+    "swap-exact": (None, Exact()),
+    "swap-toppra": (None, Toppra()),
+    "unequal-other-class": (UNEQUAL, Optimal()),
+    "unequal-paper-class": (UNEQUAL, Optimal(homotopy="paper")),
+    "angled-shared-leg": (
+        scenario_data(
+            (9.0, 6.0, 11.0),
+            ("A:3", "C:7", 1.2, 0.6, 1.5),
+            ("A:8", "B:5", 0.8, 0.4, 0.8),
+            separation=2.0,
+            angles=(0.0, 100.0, 250.0),
+        ),
+        Optimal(),
+    ),
+    "one-vehicle-parked": (PARKED, Exact()),
+    # (a vehicle parked inside a leg is moved by the planner's retraction: there its order drives it)
+    "one-vehicle-parked-optimal": (PARKED, Optimal()),
+    "start-is-goal": (
+        scenario_data((10.0, 10.0, 10.0), ("A:10", "A:10", 1.0, 0.5, 1.0), ("B:10", "B:10", 1.0, 0.5, 1.0)),
+        Optimal(),
+    ),
+    # inside the legs the planner's route retracts to the boundary and back: its orders drive it
+    "start-is-goal-inside": (
+        scenario_data((10.0, 10.0, 10.0), ("A:4", "A:4", 1.0, 0.5, 1.0), ("B:6", "B:6", 1.0, 0.5, 1.0)),
+        Exact(),
+    ),
+}
+
+
+@functools.cache
+def case(name: str):
+    """(scenario, verified schedule, plan, messages as dicts, manifest) of a case, computed once."""
+    data, method = CASES[name]
+    scenario = load_scenario(SWAP) if data is None else parse_scenario(data, source=name)
+    verified = run(scenario, method=method).verified
+    plan = plan_orders(verified)
+    messages = render_orders(verified, scenario.names, options=OPTIONS, plan=plan)
+    manifest = json.loads(render_manifest(verified, scenario.names, messages, options=OPTIONS, plan=plan))
+    return scenario, verified, plan, messages, manifest
+
+
+def documents(name: str) -> list[dict]:
+    return [json.loads(message.data) for message in case(name)[3]]
+
+
+def by_vehicle(name: str) -> dict[str, list[dict]]:
+    out: dict[str, list[dict]] = {}
+    for document in documents(name):
+        out.setdefault(document["serialNumber"], []).append(document)
+    return out
+
+
+# ---- geometry read back from the messages, independently of the exporter --------------------------------
+
+
+def track_position(graph, x: float, y: float) -> tuple[int, float]:
+    """(leg, s) of a point of the drawn track, from the leg angles."""
+    s = math.hypot(x, y)
+    if s < 1e-9:
+        return JUNCTION_INDEX, 0.0
+    angle = math.degrees(math.atan2(y, x)) % 360.0
+    leg = min(range(3), key=lambda k: abs((graph.angles_deg[k] % 360.0 - angle + 180.0) % 360.0 - 180.0))
+    return leg, s
+
+
+def gap(a: tuple[int, float, float], b: tuple[int, float, float]) -> float:
+    """Track distance between stretches (leg, low, high); JUNCTION_INDEX is the point O."""
+    if a[0] == b[0] and a[0] != JUNCTION_INDEX:
+        return max(0.0, b[1] - a[2], a[1] - b[2])
+    return a[1] + b[1]
+
+
+def stretch(p: tuple[int, float], q: tuple[int, float]) -> tuple[int, float, float]:
+    leg = p[0] if p[0] != JUNCTION_INDEX else q[0]
+    if p[0] != JUNCTION_INDEX and q[0] != JUNCTION_INDEX:
+        assert p[0] == q[0], "an edge passes the junction without a node O"
+    return (leg, min(p[1], q[1]), max(p[1], q[1]))
+
+
+def vehicle_paths(name: str):
+    """Per vehicle: node positions (leg, s) by sequence id, and its messages' (first, decision point) seqs."""
+    scenario = case(name)[0]
+    graph = scenario.track
+    paths = []
+    for vehicle in scenario.names:
+        messages = by_vehicle(name)[vehicle]
+        positions = {}
+        for document in messages:
+            for node in document["nodes"]:
+                place = track_position(graph, node["nodePosition"]["x"], node["nodePosition"]["y"])
+                positions.setdefault(node["sequenceId"], place)
+                assert positions[node["sequenceId"]] == pytest.approx(place)
+        nodes = [positions[seq] for seq in sorted(positions)]
+        paths.append(nodes)
+    return paths
+
+
+# ---- the messages ------------------------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("name", CASES, ids=list(CASES))
+def test_every_message_validates_against_the_order_schema(name):
+    for document in documents(name):
+        errors = [error.message for error in validator("order.schema").iter_errors(document)]
+        assert errors == [], errors
+        assert document["version"] == "2.1.0"
+        stamp = document["timestamp"]
+        assert re.fullmatch(r"\d{4}-\d\d-\d\dT\d\d:\d\d:\d\d\.\d{3}Z", stamp), stamp
+        assert datetime.fromisoformat(stamp) >= START
+
+
+def test_the_schema_check_is_not_vacuous():
+    document = documents("swap-optimal")[0]
+    broken = {**document, "nodes": [{**document["nodes"][0], "sequenceId": -1}]}
+    assert list(validator("order.schema").iter_errors(broken))
+    assert list(validator("order.schema").iter_errors({k: v for k, v in document.items() if k != "edges"}))
+
+
+@pytest.mark.parametrize("name", CASES, ids=list(CASES))
+def test_sequence_ids_and_the_base_horizon_split(name):
+    for messages in by_vehicle(name).values():
+        for document in messages:
+            nodes, edges = document["nodes"], document["edges"]
+            assert len(edges) == len(nodes) - 1
+            first = nodes[0]["sequenceId"]
+            assert [n["sequenceId"] for n in nodes] == list(range(first, first + 2 * len(nodes), 2))
+            assert [e["sequenceId"] for e in edges] == [n["sequenceId"] + 1 for n in nodes[:-1]]
+            for edge, start, end in zip(edges, nodes, nodes[1:], strict=False):
+                assert (edge["startNodeId"], edge["endNodeId"]) == (start["nodeId"], end["nodeId"])
+                assert edge["edgeId"] == f"{start['nodeId']}->{end['nodeId']}"
+                # an edge is released exactly when both its nodes are
+                assert edge["released"] == (start["released"] and end["released"])
+            released = [n["released"] for n in nodes]
+            assert released[0] is True
+            assert released == sorted(released, reverse=True)  # the base, then the horizon
+
+
+@pytest.mark.parametrize("name", CASES, ids=list(CASES))
+def test_updates_continue_from_the_last_base_node(name):
+    scenario = case(name)[0]
+    for vehicle, messages in by_vehicle(name).items():
+        assert [m["orderUpdateId"] for m in messages] == list(range(len(messages)))
+        assert [m["headerId"] for m in messages] == list(range(len(messages)))
+        assert {m["orderId"] for m in messages} == {f"trajgen-{vehicle}"}
+        assert {m["manufacturer"] for m in messages} == {"Acme"}
+        assert [m["timestamp"] for m in messages] == sorted(m["timestamp"] for m in messages)
+        assert messages[0]["nodes"][0]["sequenceId"] == 0
+        for previous, update in itertools.pairwise(messages):
+            last_base = [n for n in previous["nodes"] if n["released"]][-1]
+            assert update["nodes"][0] == last_base  # the stitching node, unchanged
+            horizon = previous["nodes"][previous["nodes"].index(last_base) :]
+            assert [n["nodeId"] for n in update["nodes"]] == [n["nodeId"] for n in horizon]
+            assert len([n for n in update["nodes"] if n["released"]]) > 1  # it releases something
+        assert all(n["released"] for n in messages[-1]["nodes"])  # the last message releases the rest
+    assert set(by_vehicle(name)) == set(scenario.names)
+
+
+@pytest.mark.parametrize("name", CASES, ids=list(CASES))
+def test_start_and_goal_nodes_are_the_scenarios(name):
+    scenario = case(name)[0]
+    for vehicle, nodes in enumerate(vehicle_paths(name)):
+        graph = scenario.track
+        for position, node in ((scenario.start[vehicle], nodes[0]), (scenario.goal[vehicle], nodes[-1])):
+            leg = JUNCTION_INDEX if position.leg is None else graph.index(position.leg)
+            assert node == pytest.approx((leg, position.s), abs=1e-9)
+
+
+def collapsed_route(route, vehicle: int) -> list[tuple[int, float]]:
+    """The vehicle's own waypoints of the route, consecutive equal ones collapsed."""
+    out = []
+    for waypoint in route.indexed_waypoints:
+        place = (waypoint[2 * vehicle], waypoint[2 * vehicle + 1])
+        place = (JUNCTION_INDEX, 0.0) if place[1] == 0.0 else place
+        if not out or out[-1] != place:
+            out.append(place)
+    # a waypoint the vehicle passes without stopping or turning is no node
+    return [p for k, p in enumerate(out) if k in (0, len(out) - 1) or p[0] == JUNCTION_INDEX or turns(out, k)]
+
+
+def legs_visited(places) -> list[int]:
+    """The legs a path drives on, in order, each stay once."""
+    legs = [leg for leg, _ in places if leg != JUNCTION_INDEX]
+    return [leg for k, leg in enumerate(legs) if k == 0 or legs[k - 1] != leg]
+
+
+def turns(places, k) -> bool:
+    """Whether the vehicle reverses at ``places[k]`` (each segment stays on one leg)."""
+    (_, sa), (_, sb), (_, sc) = places[k - 1], places[k], places[k + 1]
+    return (sb - sa) * (sc - sb) < 0
+
+
+@pytest.mark.parametrize("name", CASES, ids=list(CASES))
+def test_node_positions_follow_the_schedules_route(name):
+    _, verified, plan, _, _ = case(name)
+    schedule = verified.schedule
+    radius = schedule.limits.min_separation
+    for vehicle, nodes in enumerate(vehicle_paths(name)):
+        path = plan.paths[vehicle]
+        # the nodes read back from the messages are the plan's, where the schedule is at the node's time
+        assert [leg for leg, _ in nodes] == [n.leg for n in path.nodes]
+        assert [s for _, s in nodes] == pytest.approx([n.s for n in path.nodes], abs=1e-9)
+        for node in path.nodes:
+            state = schedule.state([node.arrival, node.departure])
+            for k in range(2):
+                on_leg = int(state.leg[vehicle, k]) in (node.leg, JUNCTION_INDEX) or node.s == 0.0
+                assert on_leg
+                assert float(state.s[vehicle, k]) == pytest.approx(node.s, abs=2e-6)
+        route_places = collapsed_route(schedule.route, vehicle)
+        kept = [
+            (n.leg, n.s) for n in path.nodes if n.kinds != (NodeKind.HOLD,) and n.kinds != (NodeKind.STOP,)
+        ]
+        if isinstance(schedule.method, Exact):  # exact follows the waypoints
+            assert [p[0] for p in kept] == [p[0] for p in route_places]
+            for ours, theirs in zip(kept, route_places, strict=True):
+                assert ours == pytest.approx(theirs, abs=1e-9)
+        else:  # the same legs in the same order; optimal may reverse shallower, or not at all
+            assert legs_visited(kept) == legs_visited(route_places)
+        for node in path.nodes:
+            if NodeKind.HOLD in node.kinds:
+                assert node.s == radius
+
+
+@pytest.mark.parametrize("name", CASES, ids=list(CASES))
+def test_max_speed_covers_the_schedule_and_keeps_the_limit(name):
+    _, verified, plan, _, _ = case(name)
+    schedule = verified.schedule
+    for vehicle, path in enumerate(plan.paths):
+        limit = schedule.limits.vehicles[vehicle].max_velocity
+        messages = by_vehicle(name)[case(name)[0].names[vehicle]]
+        speeds = {e["sequenceId"]: e["maxSpeed"] for m in messages for e in m["edges"]}
+        lengths = {e["sequenceId"]: e["length"] for m in messages for e in m["edges"]}
+        assert sorted(speeds) == [2 * k + 1 for k in range(len(path.edges))]
+        for k, (a, b) in enumerate(zip(path.nodes, path.nodes[1:], strict=False)):
+            times = np.linspace(a.departure, b.arrival, 4001)
+            sampled = float(np.max(np.abs(schedule.state(times).velocity[vehicle])))
+            # the verifier lets a schedule exceed a limit by 1e-6 of it; maxSpeed never does
+            assert sampled <= speeds[2 * k + 1] + 1e-6 * limit
+            assert speeds[2 * k + 1] <= limit
+            assert speeds[2 * k + 1] <= sampled + 2e-3  # the edge's own peak, not just the limit
+            travelled = abs(
+                schedule.state(b.arrival).axis[vehicle, 0] - schedule.state(a.departure).axis[vehicle, 0]
+            )
+            assert lengths[2 * k + 1] == pytest.approx(travelled, abs=2e-6)
+
+
+# ---- the releases ------------------------------------------------------------------------------------------
+
+
+def interleavings(name: str):
+    """Every state of both vehicles driving their bases in any order and timing, messages on their triggers.
+
+    Yields (reached node index, delivered message count) per vehicle. A message is delivered once the
+    vehicle its manifest entry names has reached the trigger node; a vehicle moves on to its next node
+    only if that node is released.
+    """
+    scenario, _, _, messages, manifest = case(name)
+    names = scenario.names
+    entries = [[e for e in manifest["messages"] if e["vehicle"] == vehicle] for vehicle in names]
+    docs = [[json.loads(m.data) for m in messages if m.vehicle == v] for v in (0, 1)]
+    released = [
+        [max(n["sequenceId"] for n in d["nodes"] if n["released"]) // 2 for d in docs[v]] for v in (0, 1)
+    ]
+    last = [len(p) - 1 for p in vehicle_paths(name)]
+    start = ((0, 0), (1, 1))
+    seen = {start}
+    stack = [start]
+    while stack:
+        state = stack.pop()
+        (reached, delivered) = state
+        successors = []
+        for v in (0, 1):
+            base = released[v][delivered[v] - 1]
+            if reached[v] < min(base, last[v]):
+                successors.append(((*reached[:v], reached[v] + 1, *reached[v + 1 :]), delivered))
+            if delivered[v] < len(entries[v]):
+                trigger = entries[v][delivered[v]]["trigger"]
+                other = names.index(trigger["vehicle"])
+                if reached[other] * 2 >= trigger["sequence_id"]:
+                    successors.append((reached, (*delivered[:v], delivered[v] + 1, *delivered[v + 1 :])))
+        yield state, released, last, bool(successors)
+        for successor in successors:
+            if successor not in seen:
+                seen.add(successor)
+                stack.append(successor)
+
+
+def claims(paths, released, state):
+    (reached, delivered) = state
+    out = []
+    for v in (0, 1):
+        nodes = paths[v]
+        base = released[v][delivered[v] - 1]
+        claim = [(nodes[reached[v]][0], nodes[reached[v]][1], nodes[reached[v]][1])]
+        claim += [stretch(nodes[j], nodes[j + 1]) for j in range(reached[v], base)]
+        out.append(claim)
+    return out
+
+
+@pytest.mark.parametrize("name", CASES, ids=list(CASES))
+def test_released_track_stays_apart_in_every_interleaving(name):
+    scenario = case(name)[0]
+    separation = scenario.limits.min_separation
+    paths = vehicle_paths(name)
+    finished = False
+    count = 0
+    for state, released, last, can_move in interleavings(name):
+        count += 1
+        first, second = claims(paths, released, state)
+        closest = min(gap(a, b) for a in first for b in second)
+        assert closest >= separation - 1e-9, f"claims {closest} m apart in {state}"
+        # the junction in particular: released, not yet passed, while the other is near it
+        for v, claim in enumerate((first, second)):
+            other = (second, first)[v]
+            if any(c[1] == 0.0 for c in claim[1:]):
+                assert min(c[1] for c in other) >= separation - 1e-9
+        done = list(state[0]) == last and list(state[1]) == [len(r) for r in released]
+        finished |= done
+        assert can_move or done, f"deadlock in {state}"
+    assert finished
+    assert count > 1 or all(len(path) == 1 for path in paths)
+
+
+def junction_passages(verified, period: float = 1e-3) -> list[int]:
+    """The vehicles in the order they pass through the junction (from one leg to another) in the schedule."""
+    schedule = verified.schedule
+    state = schedule.state(np.arange(0.0, schedule.duration + period, period))
+    events = []
+    for v in (0, 1):
+        on_leg = state.leg[v] != JUNCTION_INDEX
+        legs, times = state.leg[v][on_leg], state.t[on_leg]
+        events += [(float(times[k]), v) for k in np.nonzero(legs[1:] != legs[:-1])[0]]
+    return [v for _, v in sorted(events)]
+
+
+def passages(path: list[tuple[int, float]]) -> list[int]:
+    """Indices of the nodes at which a path passes through the junction from one leg to another."""
+    return [
+        j
+        for j in range(1, len(path) - 1)
+        if path[j][0] == JUNCTION_INDEX and path[j - 1][0] != path[j + 1][0]
+    ]
+
+
+@pytest.mark.parametrize("name", CASES, ids=list(CASES))
+def test_the_junction_is_released_in_the_order_the_schedule_passes_it(name):
+    _, verified, _, _, manifest = case(name)
+    order = junction_passages(verified)
+    o_nodes = [passages(path) for path in vehicle_paths(name)]
+    assert [len(o_nodes[v]) for v in (0, 1)] == [order.count(v) for v in (0, 1)]
+    # in every interleaving, each passage of the junction comes after the other's earlier passages
+    for (reached, _), _, _, _ in interleavings(name):
+        passed = [sum(1 for j in o_nodes[v] if j <= reached[v]) for v in (0, 1)]
+        for v in (0, 1):
+            if passed[v]:
+                kth = [k for k, who in enumerate(order) if who == v][passed[v] - 1]
+                assert passed[1 - v] >= order[:kth].count(1 - v), (reached, order)
+    # the updates that release a passage of the junction are sent in the schedule's order
+    assert [e["send_at_s"] for e in manifest["messages"]] == sorted(
+        e["send_at_s"] for e in manifest["messages"]
+    )
+
+
+def test_the_demo_swap_in_detail():
+    manifest = case("swap-optimal")[4]
+    agv1, agv2 = by_vehicle("swap-optimal")["agv1"], by_vehicle("swap-optimal")["agv2"]
+    assert [n["nodeId"] for n in agv1[0]["nodes"]] == ["A:10", "A:1.5", "O", "B:1.5", "B:10"]
+    assert [n["released"] for n in agv1[0]["nodes"]] == [True, True, False, False, False]
+    assert [n["nodePosition"]["y"] for n in agv1[0]["nodes"]] == [10.0, 1.5, 0.0, -0.75, -5.0]
+    assert agv1[0]["edges"][2]["direction"] == "B"
+    # agv2 passes the junction first, parks just past the separation on C, and turns back
+    ids = [n["nodeId"] for n in agv2[0]["nodes"]]
+    assert ids[:3] == ["B:10", "B:1.5", "O"]
+    assert ids[3].startswith("C:1.5")
+    assert ids[4:] == ["O", "A:1.5", "A:10"]
+    assert agv2[0]["edges"][3]["orientation"] == math.pi  # it backs out of C
+    first_update = manifest["messages"][2]
+    assert first_update["vehicle"] == "agv1"
+    assert first_update["trigger"] == {"vehicle": "agv2", "node_id": ids[3], "sequence_id": 6}
+    assert first_update["send_at_s"] == pytest.approx(13.756, abs=0.01)
+    assert agv1[1]["timestamp"] == "2025-05-01T08:00:13.757Z"
+    assert manifest["planned_duration_s"] >= manifest["schedule_duration_s"]
+    assert agv1[0]["edges"][0]["maxSpeed"] < 1.0  # optimal's peak on that edge, below the limit
+
+
+def test_exact_needs_no_waits_and_optimal_says_how_long_it_waits():
+    exact = case("swap-exact")[4]
+    assert all(e["wait_s"] == 0.0 for e in exact["messages"])
+    assert exact["planned_duration_s"] == exact["schedule_duration_s"]
+    _, _, plan, _, optimal = case("swap-optimal")
+    ends = [
+        path.nodes[-1].arrival + sum(e["wait_s"] for e in optimal["messages"] if e["vehicle"] == name)
+        for path, name in zip(plan.paths, ("agv1", "agv2"), strict=True)
+    ]
+    assert min(e["wait_s"] for e in optimal["messages"][2:]) > 0.5
+    assert optimal["planned_duration_s"] == pytest.approx(max(ends), abs=1e-5)
+
+
+def test_the_other_class_is_exported_on_its_own_route():
+    _, verified, plan, _, _ = case("unequal-other-class")
+    assert verified.schedule.route.homotopy is Homotopy.OTHER
+    paper = case("unequal-paper-class")[1]
+    assert paper.schedule.route.homotopy is Homotopy.PAPER
+    other_nodes = [n.leg for n in plan.paths[1].nodes]
+    paper_nodes = [n.leg for n in case("unequal-paper-class")[2].paths[1].nodes]
+    assert other_nodes != paper_nodes
+
+
+def test_a_parked_vehicle_gets_one_node_and_no_edges():
+    assert by_vehicle("one-vehicle-parked-optimal")["agv2"] == by_vehicle("one-vehicle-parked")["agv2"]
+    agv2 = by_vehicle("one-vehicle-parked")["agv2"]
+    assert len(agv2) == 1
+    assert [n["nodeId"] for n in agv2[0]["nodes"]] == ["C:10"]
+    assert agv2[0]["edges"] == []
+    start_is_goal = by_vehicle("start-is-goal")
+    assert {v: [n["nodeId"] for n in d[0]["nodes"]] for v, d in start_is_goal.items()} == {
+        "agv1": ["A:10"],
+        "agv2": ["B:10"],
+    }
+
+
+def test_node_ids_are_stable_and_readable():
+    graph = case("swap-optimal")[0].track
+    assert node_id(graph, JUNCTION_INDEX, 0.0) == "O"
+    assert node_id(graph, 0, 10.0) == "A:10"
+    assert node_id(graph, 2, 1.5000009912) == "C:1.500001"
+    first = render_orders(case("swap-optimal")[1], ("agv1", "agv2"), options=OPTIONS)
+    assert [m.data for m in first] == [m.data for m in case("swap-optimal")[3]]  # same input, same bytes
+
+
+# ---- options, files, atomic writing -----------------------------------------------------------------------
+
+
+@pytest.mark.parametrize(
+    ("options", "match"),
+    [
+        ({"start_time": datetime(2025, 5, 1, 8, 0)}, "time zone aware"),
+        ({"start_time": "2025-05-01T08:00:00Z"}, "time zone aware"),
+        ({"start_time": START, "map_id": ""}, "map_id must be a non-empty"),
+        ({"start_time": START, "order_id": "a\nb"}, "order_id must be a non-empty printable"),
+        ({"start_time": START, "manufacturers": "Acme"}, "manufacturers must be a pair"),
+        ({"start_time": START, "serial_numbers": ("SN1", 2)}, r"serial_numbers\[1\]"),
+        ({"start_time": START, "first_header_id": -1}, "first_header_id must be an integer"),
+        ({"start_time": START, "first_header_id": True}, "first_header_id must be an integer"),
+    ],
+    ids=["naive", "text", "empty-map", "newline", "one-manufacturer", "serial-type", "negative", "bool"],
+)
+def test_bad_options_are_refused(options, match):
+    with pytest.raises(OptionError, match=match):
+        Vda5050Options(**options)
+
+
+def test_options_shape_the_header():
+    options = Vda5050Options(
+        start_time=datetime(2025, 5, 1, 10, 0, tzinfo=timezone(timedelta(hours=2))),
+        order_id="job7",
+        serial_numbers=("SN-1", "SN-2"),
+        first_header_id=41,
+    )
+    _, verified, plan, _, _ = case("swap-exact")
+    messages = render_orders(verified, ("agv1", "agv2"), options=options, plan=plan)
+    first = json.loads(messages[0].data)
+    assert first["timestamp"] == "2025-05-01T08:00:00.000Z"  # in UTC
+    assert (first["serialNumber"], first["orderId"], first["headerId"]) == ("SN-1", "job7-agv1", 41)
+    assert str(messages[-1].path) == "agv2/order-001.json"
+
+
+def test_renderers_take_only_verified_schedules():
+    schedule = case("swap-exact")[1].schedule
+    with pytest.raises(UnverifiedScheduleError):
+        plan_orders(schedule)
+    with pytest.raises(UnverifiedScheduleError):
+        render_orders(schedule, ("agv1", "agv2"), options=OPTIONS)
+
+
+def test_write_orders_writes_every_file_and_the_manifest(tmp_path):
+    _, verified, _, messages, manifest = case("swap-optimal")
+    paths = write_orders(verified, ("agv1", "agv2"), tmp_path / "out", options=OPTIONS)
+    names = sorted(str(p.relative_to(tmp_path / "out")) for p in paths)
+    assert names == sorted([MANIFEST_NAME, *(str(m.path) for m in messages)])
+    written = json.loads((tmp_path / "out" / MANIFEST_NAME).read_text(encoding="utf-8"))
+    assert written == manifest
+    assert [e["file"] for e in written["messages"]] == [str(m.path) for m in messages]
+
+
+def test_a_failed_write_writes_nothing(tmp_path):
+    verified = case("swap-optimal")[1]
+    out = tmp_path / "out"
+    (out / "agv2" / "order-001.json").mkdir(parents=True)  # a folder where an update goes
+    (out / "agv1").mkdir()
+    (out / "agv1" / "order-000.json").write_text("old", encoding="utf-8")
+    with pytest.raises(OutputError, match=r"order-001\.json"):
+        write_orders(verified, ("agv1", "agv2"), out, options=OPTIONS)
+    assert (out / "agv1" / "order-000.json").read_text(encoding="utf-8") == "old"
+    assert sorted(p.name for p in out.rglob("*")) == ["agv1", "agv2", "order-000.json", "order-001.json"]
+
+
+def test_a_failure_while_committing_writes_nothing(tmp_path, monkeypatch):
+    import os
+
+    verified = case("swap-optimal")[1]
+    calls = []
+    real_replace = os.replace
+
+    def failing_replace(source, target):
+        if Path(target).suffix == ".json":  # an order or the manifest, not a journal
+            calls.append(target)
+        if len(calls) == 3:  # the third file: two are already in place
+            raise OSError(28, "No space left on device")
+        return real_replace(source, target)
+
+    monkeypatch.setattr(os, "replace", failing_replace)
+    with pytest.raises(OutputError, match="No space left on device"):
+        write_orders(verified, ("agv1", "agv2"), tmp_path / "out", options=OPTIONS)
+    monkeypatch.undo()
+    assert len(calls) >= 3
+    assert list(tmp_path.rglob("*")) == []  # no file, no hidden leftover, no folder
+
+
+# ---- factsheets ------------------------------------------------------------------------------------------
+
+
+def factsheet(speed=1.2, acceleration=0.8, deceleration=0.6) -> dict:
+    """A complete VDA 5050 2.1.0 factsheet (valid against factsheet.schema)."""
+    return {
+        "headerId": 1,
+        "timestamp": "2025-05-01T08:00:00.00Z",
+        "version": "2.1.0",
+        "manufacturer": "Acme",
+        "serialNumber": "SN-1",
+        "typeSpecification": {
+            "seriesName": "Y-100",
+            "agvKinematic": "DIFF",
+            "agvClass": "CARRIER",
+            "maxLoadMass": 500,
+            "localizationTypes": ["NATURAL"],
+            "navigationTypes": ["VIRTUAL_LINE_GUIDED"],
+        },
+        "physicalParameters": {
+            "speedMin": 0.01,
+            "speedMax": speed,
+            "accelerationMax": acceleration,
+            "decelerationMax": deceleration,
+            "heightMax": 0.4,
+            "width": 0.8,
+            "length": 1.2,
+        },
+        "protocolLimits": {
+            "maxStringLens": {},
+            "maxArrayLens": {},
+            "timing": {"minOrderInterval": 0.5, "minStateInterval": 0.5},
+        },
+        "protocolFeatures": {"optionalParameters": [], "agvActions": []},
+        "agvGeometry": {},
+        "loadSpecification": {},
+    }
+
+
+def write_factsheet_scenario(folder: Path, sheet: str | None = "agv.json", extra: str = "") -> Path:
+    folder.mkdir(parents=True, exist_ok=True)
+    text = SWAP.read_text(encoding="utf-8")
+    first = text.index("max_velocity")
+    end = text.index("max_jerk", first)
+    line = f'factsheet = "{sheet}"\n{extra}' if sheet is not None else extra
+    path = folder / "scenario.toml"
+    path.write_text(text[:first] + line + text[end:], encoding="utf-8")
+    return path
+
+
+def test_the_test_factsheet_is_valid_against_the_factsheet_schema():
+    errors = [e.message for e in validator("factsheet.schema").iter_errors(factsheet())]
+    assert errors == []
+    broken = factsheet()
+    del broken["physicalParameters"]["speedMax"]
+    assert list(validator("factsheet.schema").iter_errors(broken))
+
+
+def test_limits_are_read_from_a_factsheet(tmp_path):
+    (tmp_path / "sheets").mkdir()
+    (tmp_path / "sheets" / "agv.json").write_text(json.dumps(factsheet(1.2, 0.8, 0.6)), encoding="utf-8")
+    scenario = load_scenario(write_factsheet_scenario(tmp_path, "sheets/agv.json"))
+    first, second = scenario.limits.vehicles
+    assert (first.max_velocity, first.max_acceleration, first.max_jerk) == (1.2, 0.6, 1.0)  # min(acc, dec)
+    assert (second.max_velocity, second.max_acceleration) == (1.0, 0.5)  # the scenario's own
+    sheet = read_factsheet(
+        tmp_path / "sheets" / "agv.json",
+        velocity_range=PLAUSIBLE["max_velocity"],
+        acceleration_range=PLAUSIBLE["max_acceleration"],
+    )
+    assert (sheet.speed_max, sheet.acceleration_max, sheet.deceleration_max) == (1.2, 0.8, 0.6)
+    assert sheet.max_acceleration == 0.6
+
+
+def bad_sheet(document) -> bytes:
+    return document if isinstance(document, bytes) else json.dumps(document).encode("utf-8")
+
+
+def without(key: str) -> dict:
+    sheet = factsheet()
+    del sheet["physicalParameters"][key]
+    return sheet
+
+
+def with_value(key: str, value) -> dict:
+    sheet = factsheet()
+    sheet["physicalParameters"][key] = value
+    return sheet
+
+
+BAD_FACTSHEETS = {
+    "not-json": (b"{speedMax: 1}", r"agv\.json: not valid JSON"),
+    "not-utf8": (b'{"a": "\xff"}', r"agv\.json: is not UTF-8 text: byte 0xff"),
+    "array": (b"[1, 2]", r"agv\.json: the document is list \[1, 2\]: expected a JSON object"),
+    "no-physical": ({"version": "2.1.0"}, r"has no 'physicalParameters'"),
+    "physical-not-object": ({"physicalParameters": [1]}, r"'physicalParameters' is list \[1\]"),
+    "missing-speed": (without("speedMax"), r"physicalParameters has no 'speedMax': expected a number of m/s"),
+    "missing-deceleration": (without("decelerationMax"), r"has no 'decelerationMax'"),
+    "text-speed": (
+        with_value("speedMax", "fast"),
+        r"physicalParameters\.speedMax is str 'fast': expected a number",
+    ),
+    "bool-acceleration": (with_value("accelerationMax", True), r"accelerationMax is bool True"),
+    "zero-speed": (
+        with_value("speedMax", 0),
+        r"physicalParameters\.speedMax is 0: expected 0\.0001 to 100 m/s",
+    ),
+    "huge-deceleration": (with_value("decelerationMax", 1e6), r"decelerationMax is 1000000\.0: expected"),
+    "overflowing-int": (with_value("speedMax", 10**400), r"speedMax is 1000.*: expected 0\.0001 to 100"),
+    "infinite": (b'{"physicalParameters": {"speedMax": 1e999}}', r"speedMax is inf: expected"),
+    "nan": (b'{"physicalParameters": {"speedMax": NaN}}', r"not valid JSON: NaN is not a JSON number"),
+    "duplicate": (
+        b'{"physicalParameters": {}, "physicalParameters": {}}',
+        r"key 'physicalParameters' is given",
+    ),
+    "nested": (b"[" * 100_000 + b"]" * 100_000, r"nested too deeply|not valid JSON"),
+}
+
+
+@pytest.mark.parametrize(("content", "match"), BAD_FACTSHEETS.values(), ids=list(BAD_FACTSHEETS))
+def test_bad_factsheets_are_input_errors_naming_file_key_and_value(tmp_path, content, match):
+    (tmp_path / "agv.json").write_bytes(bad_sheet(content))
+    with pytest.raises(InputError, match=match) as error:
+        load_scenario(write_factsheet_scenario(tmp_path))
+    assert "[[vehicle]] 1" in str(error.value)
+    assert "agv.json" in str(error.value)
+
+
+@pytest.mark.parametrize(
+    ("setup", "match"),
+    [
+        ("missing", r"factsheet .*agv\.json: cannot read the file: No such file"),
+        ("folder", r"agv\.json: is not a regular file"),
+        ("large", rf"agv\.json: is {MAX_FACTSHEET_BYTES + 1:,} bytes: expected a factsheet of at most"),
+    ],
+    ids=["missing", "folder", "too-large"],
+)
+def test_unreadable_factsheets_are_refused_unread(tmp_path, setup, match):
+    if setup == "folder":
+        (tmp_path / "agv.json").mkdir()
+    elif setup == "large":
+        (tmp_path / "agv.json").write_bytes(b" " * (MAX_FACTSHEET_BYTES + 1))
+    with pytest.raises(InputError, match=match):
+        load_scenario(write_factsheet_scenario(tmp_path))
+
+
+@pytest.mark.parametrize(
+    ("sheet", "extra", "match"),
+    [
+        ("agv.json", "max_velocity = 1.0\n", r"gives both 'factsheet' and \['max_velocity'\]"),
+        (None, "", r"missing required key\(s\) \['max_velocity', 'max_acceleration'\] \(or a VDA 5050"),
+        (None, "max_velocity = 1.0\n", r"missing required key\(s\) \['max_acceleration'\]"),
+    ],
+    ids=["both", "neither", "no-acceleration"],
+)
+def test_a_vehicle_takes_its_limits_from_one_place(tmp_path, sheet, extra, match):
+    (tmp_path / "agv.json").write_text(json.dumps(factsheet()), encoding="utf-8")
+    with pytest.raises(InputError, match=match):
+        load_scenario(write_factsheet_scenario(tmp_path, sheet, extra))
+
+
+def test_a_factsheet_does_not_replace_the_jerk(tmp_path):
+    (tmp_path / "agv.json").write_text(json.dumps(factsheet()), encoding="utf-8")
+    path = write_factsheet_scenario(tmp_path)
+    text = path.read_text(encoding="utf-8").replace("max_jerk = 1.0\n", "", 1)
+    path.write_text(text, encoding="utf-8")
+    with pytest.raises(InputError, match=r"\[\[vehicle\]\] 1 is missing required key\(s\) \['max_jerk'\]"):
+        load_scenario(path)
+
+
+# ---- the command line --------------------------------------------------------------------------------------
+
+
+def test_the_command_writes_the_orders(tmp_path, capsys):
+    out = tmp_path / "orders"
+    argv = ["export-vda5050", str(SWAP), "--out", str(out), "--start-time", "2025-05-01T08:00:00Z", "--json"]
+    argv += ["--manufacturer", "Acme", "--serial-number", "agv2=SN-2", "--map-id", "hall-1"]
+    argv += ["--method", "exact", "--first-header-id", "7", "--order-id", "job"]
+    assert main(argv) == EXIT_OK
+    summary = json.loads(capsys.readouterr().out)
+    assert summary["computed_by"] == "exact"
+    assert len(summary["files"]) == 5
+    assert sorted(str(p.relative_to(out)) for p in out.rglob("*.json")) == [
+        "agv1/order-000.json",
+        "agv1/order-001.json",
+        "agv2/order-000.json",
+        "agv2/order-001.json",
+        "manifest.json",
+    ]
+    update = json.loads((out / "agv2" / "order-001.json").read_text(encoding="utf-8"))
+    assert (update["serialNumber"], update["manufacturer"]) == ("SN-2", "Acme")
+    assert (update["headerId"], update["orderId"], update["orderUpdateId"]) == (8, "job-agv2", 1)
+    assert summary["start_time"] == "2025-05-01T08:00:00.000Z"
+    assert update["nodes"][0]["nodePosition"]["mapId"] == "hall-1"
+    assert summary["messages"][3]["trigger"]["vehicle"] == "agv1"
+    assert main(["export-vda5050", str(SWAP), "--out", str(out), "--method", "exact"]) == EXIT_OK
+    assert "at the start, base to A:1.5" in capsys.readouterr().out
+
+
+def test_the_command_with_a_factsheet(tmp_path, capsys):
+    (tmp_path / "agv.json").write_text(json.dumps(factsheet(0.8, 0.4, 0.5)), encoding="utf-8")
+    scenario = write_factsheet_scenario(tmp_path)
+    argv = [
+        "export-vda5050",
+        str(scenario),
+        "--out",
+        str(tmp_path / "o"),
+        "--start-time",
+        "2025-05-01T08:00Z",
+    ]
+    assert main([*argv, "--method", "exact", "--json"]) == EXIT_OK
+    summary = json.loads(capsys.readouterr().out)
+    speeds = [
+        e["maxSpeed"]
+        for path in (tmp_path / "o" / "agv1").iterdir()
+        for e in json.loads(path.read_text(encoding="utf-8"))["edges"]
+    ]
+    assert max(speeds) == 0.8  # the factsheet's speedMax
+    assert summary["duration_s"] > 67.5  # slower than the demo's 1.0 m/s
+
+
+@pytest.mark.parametrize(
+    ("extra", "match"),
+    [
+        (["--start-time", "2025-05-01T08:00:00"], "has no time zone"),
+        (["--start-time", "tomorrow"], "is not an ISO 8601 time"),
+        (["--serial-number", "agv9=X"], "names no vehicle of the scenario"),
+        (["--map-id", ""], "map_id must be a non-empty"),
+        (["--homotopy", "paper", "--method", "exact"], "applies to the method 'optimal' only"),
+    ],
+    ids=["naive-time", "bad-time", "unknown-vehicle", "empty-map", "homotopy-exact"],
+)
+def test_bad_options_exit_2_and_write_nothing(tmp_path, capsys, extra, match):
+    out = tmp_path / "orders"
+    assert main(["export-vda5050", str(SWAP), "--out", str(out), *extra]) == EXIT_BAD_INPUT
+    assert re.search(match, capsys.readouterr().err)
+    assert not out.exists()
+
+
+def test_a_bad_factsheet_exits_2_and_writes_nothing(tmp_path, capsys):
+    (tmp_path / "agv.json").write_text(json.dumps(with_value("speedMax", -1)), encoding="utf-8")
+    scenario = write_factsheet_scenario(tmp_path)
+    out = tmp_path / "orders"
+    assert main(["export-vda5050", str(scenario), "--out", str(out)]) == EXIT_BAD_INPUT
+    err = capsys.readouterr().err
+    assert "agv.json: physicalParameters.speedMax is -1: expected 0.0001 to 100 m/s" in err
+    assert not out.exists()
+
+
+def test_an_output_path_that_is_a_file_exits_2_before_computing(tmp_path, capsys):
+    (tmp_path / "orders").write_text("a file", encoding="utf-8")
+    assert main(["export-vda5050", str(SWAP), "--out", str(tmp_path / "orders")]) == EXIT_BAD_INPUT
+    assert "exists and is not a folder" in capsys.readouterr().err
+
+
+def test_an_internal_failure_exits_1_and_writes_nothing(tmp_path, capsys, monkeypatch):
+    import trajgen.cli.vda5050
+
+    def broken(*args, **kwargs):
+        raise RuntimeError("renderer broke")
+
+    monkeypatch.setattr(trajgen.cli.vda5050, "order_files", broken)
+    out = tmp_path / "orders"
+    assert main(["export-vda5050", str(SWAP), "--out", str(out), "--method", "exact"]) == EXIT_FAILURE
+    assert "internal failure: RuntimeError: renderer broke" in capsys.readouterr().err
+    assert not out.exists()
+
+
+def test_schedules_of_every_method_can_be_certified_and_exported():
+    scenario = load_scenario(SWAP)
+    for method in (Exact(jerk=False), Toppra(grid_points=60)):
+        verified = certify(make_schedule(scenario.plan(), scenario.limits, method=method))
+        messages = render_orders(verified, scenario.names, options=OPTIONS)
+        for message in messages:
+            assert not list(validator("order.schema").iter_errors(json.loads(message.data)))
