@@ -50,6 +50,17 @@ def test_a_failed_rename_puts_every_earlier_file_back(tmp_path, monkeypatch):
     assert _hidden(tmp_path) == []
 
 
+def test_a_journal_that_cannot_be_put_in_place_leaves_nothing(tmp_path, monkeypatch):
+    (tmp_path / "old").mkdir()
+    (tmp_path / "old" / "agv1.csv").write_bytes(b"old 1")
+    _fail_renames_onto(monkeypatch, ".trajgen-journal")
+    with pytest.raises(OutputError, match=r"Permission denied"):
+        commit_files({tmp_path / "old" / "agv1.csv": b"new 1", tmp_path / "new" / "agv2.csv": b"new 2"})
+    assert (tmp_path / "old" / "agv1.csv").read_bytes() == b"old 1"
+    assert _hidden(tmp_path / "old") == []
+    assert not (tmp_path / "new").exists()
+
+
 def test_a_failed_write_removes_the_folders_it_made(tmp_path, monkeypatch):
     real = atomic.tempfile.mkstemp
     calls = []

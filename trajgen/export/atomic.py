@@ -159,11 +159,15 @@ def _write_journal(
     }
     journal = Path(folder) / JOURNAL_NAME
     temporary = journal.with_name(f"{JOURNAL_NAME}.{key}{_TMP_SUFFIX}")
-    with open(temporary, "w", encoding="utf-8") as stream:
-        json.dump(record, stream)
-        stream.flush()
-        os.fsync(stream.fileno())
-    os.replace(temporary, journal)
+    try:
+        with open(temporary, "w", encoding="utf-8") as stream:
+            json.dump(record, stream)
+            stream.flush()
+            os.fsync(stream.fileno())
+        os.replace(temporary, journal)
+    except BaseException:
+        temporary.unlink(missing_ok=True)  # a journal that was never in place leaves nothing behind
+        raise
     _sync_folder(Path(folder))
 
 
