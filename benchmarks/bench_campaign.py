@@ -17,7 +17,10 @@ import resource
 import statistics
 import time
 
+from tqdm import tqdm
+
 from trajgen import METHODS, Optimal, SolverCache, make_schedule, verify
+from trajgen.progress import progress
 from trajgen.sampling import campaign_scenarios
 
 
@@ -31,7 +34,8 @@ def main() -> None:
     times = {m.name: [] for m in methods}
     verify_times = []
     longest = (0.0, "")
-    for scenario in campaign_scenarios(args.scenarios, seed=args.seed):
+    scenarios = campaign_scenarios(args.scenarios, seed=args.seed)
+    for scenario in progress(scenarios, description="scenarios"):
         route = scenario.plan()
         for method in methods:
             began = time.perf_counter()
@@ -44,7 +48,7 @@ def main() -> None:
             longest = max(longest, (schedule.duration, f"{scenario.source} {method.name}"))
             if not report.passed:
                 failures += 1
-                print(f"FAILED {scenario.source} {method.name}: {report.failures[:2]}")
+                tqdm.write(f"FAILED {scenario.source} {method.name}: {report.failures[:2]}")  # above the bar
     print(f"{args.scenarios} scenarios x {len(methods)} methods (seed {args.seed})")
     print(f"verification failures: {failures} (target 0)")
     print("fallbacks: " + ", ".join(f"{name} {count}" for name, count in fallbacks.items()))

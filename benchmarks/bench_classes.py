@@ -21,18 +21,27 @@ from __future__ import annotations
 
 import argparse
 import statistics
+import sys
 import time
 
 from baselines import prioritized, zone_locking
+from tqdm import tqdm
 
 from limits import Limits, VehicleLimits
 from topology import Configuration, Homotopy, YGraph, plan
 from trajgen import Exact, Optimal, SolverCache, Toppra, lower_bound, verify
 from trajgen.methods.optimal import DEFAULT_NODES
+from trajgen.progress import progress
 from trajgen.sampling import random_scenarios, reference_sets
 
 AGV = VehicleLimits(1.0, 0.5, 1.0)
 SLOW = VehicleLimits(0.7, 0.35, 0.6)
+
+
+def emit(line: str) -> None:
+    """Print a result row above the progress bar, at once (also into a pipe)."""
+    tqdm.write(line)
+    sys.stdout.flush()
 
 
 def _swaps(track: YGraph) -> list[tuple[str, Configuration, Configuration]]:
@@ -94,53 +103,55 @@ def main() -> None:
         f"{'opt/prio':>8} {'ms':>6}"
     )
     rows = []
-    for label, track, limits, scenarios in benchmark_sets(args.random):
-        if not label.startswith(args.only):
-            continue
-        for name, start, goal in scenarios:
-            route = plan(track, start, goal, min_separation=limits.min_separation)
-            exact = Exact().schedule(route, limits)
-            timed = Toppra().schedule(route, limits)
-            began = time.perf_counter()
-            best = fastest.schedule(route, limits)
-            wall = time.perf_counter() - began
-            in_paper = paper.schedule(route, limits)
-            # the converged optimum of the chosen class
-            chosen_route = best.route
-            converged = reference.schedule(chosen_route, limits)
-            zone = zone_locking(route, limits)
-            priority = prioritized(route, limits)
-            bound = lower_bound(route, limits)
-            schedules = (exact, timed, best, in_paper, converged)
-            passed = all(verify(s).passed for s in schedules)
-            row = {
-                "set": label,
-                "name": name,
-                "exact": exact.duration,
-                "toppra": timed.duration,
-                "paper": in_paper.duration,
-                "optimal": best.duration,
-                "other_class": best.route.homotopy is Homotopy.OTHER,
-                "converged": converged.duration,
-                "zone": zone.makespan if zone.safe else float("inf"),
-                "prio": priority.makespan if priority.safe else float("inf"),
-                "lower": bound,
-                "wall": wall,
-                "built": best.info is not None and best.info.built,
-                "fallback": best.fallback_reason is not None or in_paper.fallback_reason is not None,
-                "verified": passed,
-                "short": label in "abcd",
-            }
-            rows.append(row)
-            print(
-                f"{label:>22} {name:>10} {row['exact']:8.2f} {row['toppra']:8.2f} {row['paper']:9.3f} "
-                f"{row['optimal']:9.3f} {'other' if row['other_class'] else 'paper':>5} "
-                f"{row['converged']:9.3f} "
-                f"{row['zone']:8.2f} {row['prio']:8.2f} {bound:8.2f} "
-                f"{row['optimal'] / row['converged']:8.5f} {row['optimal'] / row['zone']:8.4f} "
-                f"{row['optimal'] / row['prio']:8.4f} {1e3 * wall:5.0f}{'*' if row['built'] else ' '}",
-                flush=True,
-            )
+    cases = [
+        (label, track, limits, scenario)
+        for label, track, limits, scenarios in benchmark_sets(args.random)
+        if label.startswith(args.only)
+        for scenario in scenarios
+    ]
+    for label, track, limits, (name, start, goal) in progress(cases, description="scenarios"):
+        route = plan(track, start, goal, min_separation=limits.min_separation)
+        exact = Exact().schedule(route, limits)
+        timed = Toppra().schedule(route, limits)
+        began = time.perf_counter()
+        best = fastest.schedule(route, limits)
+        wall = time.perf_counter() - began
+        in_paper = paper.schedule(route, limits)
+        # the converged optimum of the chosen class
+        chosen_route = best.route
+        converged = reference.schedule(chosen_route, limits)
+        zone = zone_locking(route, limits)
+        priority = prioritized(route, limits)
+        bound = lower_bound(route, limits)
+        schedules = (exact, timed, best, in_paper, converged)
+        passed = all(verify(s).passed for s in schedules)
+        row = {
+            "set": label,
+            "name": name,
+            "exact": exact.duration,
+            "toppra": timed.duration,
+            "paper": in_paper.duration,
+            "optimal": best.duration,
+            "other_class": best.route.homotopy is Homotopy.OTHER,
+            "converged": converged.duration,
+            "zone": zone.makespan if zone.safe else float("inf"),
+            "prio": priority.makespan if priority.safe else float("inf"),
+            "lower": bound,
+            "wall": wall,
+            "built": best.info is not None and best.info.built,
+            "fallback": best.fallback_reason is not None or in_paper.fallback_reason is not None,
+            "verified": passed,
+            "short": label in "abcd",
+        }
+        rows.append(row)
+        emit(
+            f"{label:>22} {name:>10} {row['exact']:8.2f} {row['toppra']:8.2f} {row['paper']:9.3f} "
+            f"{row['optimal']:9.3f} {'other' if row['other_class'] else 'paper':>5} "
+            f"{row['converged']:9.3f} "
+            f"{row['zone']:8.2f} {row['prio']:8.2f} {bound:8.2f} "
+            f"{row['optimal'] / row['converged']:8.5f} {row['optimal'] / row['zone']:8.4f} "
+            f"{row['optimal'] / row['prio']:8.4f} {1e3 * wall:5.0f}{'*' if row['built'] else ' '}"
+        )
     _summary(rows)
 
 

@@ -13,6 +13,7 @@ import sys
 from pathlib import Path
 
 import numpy as np
+from tqdm import tqdm
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))  # the tests' helpers
 
@@ -22,6 +23,7 @@ from tests.mutants import between_samples, free_window, with_bump, with_coeffici
 from tests.sampled_verifier import sampled_verify
 from topology.indexed import track_distance
 from trajgen import Exact, Optimal, Schedule, verify
+from trajgen.progress import progress
 
 SWAP = ((10.0, 10.0, 10.0), ("A:10", "B:10"), ("B:10", "A:10"))
 
@@ -82,13 +84,16 @@ def main() -> None:
     print("| mutant | closed-form verifier | sampled every 1 ms | right? |")
     print("| --- | --- | --- | --- |")
     wrong = 0
-    for name, schedule, defective in mutants():
+    cases = list(mutants())
+    for name, schedule, defective in progress(cases, description="mutants"):
         closed, sampled = verify(schedule).passed, sampled_verify(schedule).passed
         right = closed is not defective
         wrong += not right
         closed_text = "caught" if not closed else "passed"
         sampled_text = "caught" if not sampled else ("missed" if defective else "passed")
-        print(f"| {name} | {closed_text} | {sampled_text} | {'yes' if right else 'NO'} |")
+        tqdm.write(
+            f"| {name} | {closed_text} | {sampled_text} | {'yes' if right else 'NO'} |"
+        )  # above the bar
     print(f"\nverifier verdicts wrong: {wrong} (target 0)")
 
 

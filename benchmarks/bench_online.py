@@ -24,6 +24,7 @@ import time
 from trajgen.online import Executor
 from trajgen.online.executor import execution_margin, plan_for_execution
 from trajgen.online.simulation import parse_faults, simulate
+from trajgen.progress import progress
 from trajgen.sampling import campaign_faults, online_campaign
 
 
@@ -58,7 +59,7 @@ def timed_cycles(count: int, seed: int) -> tuple[list[float], list[float]]:
 
     Executor.step = step
     try:
-        for k in range(count):
+        for k in progress(range(count), description="timed scenarios"):
             run_case((k, seed))
     finally:
         Executor.step = original
@@ -92,7 +93,9 @@ def main() -> None:
 
     started = time.perf_counter()
     with multiprocessing.Pool(args.workers) as pool:
-        rows = sorted(pool.map(run_case, [(k, args.seed) for k in range(args.count)]), key=lambda r: r["k"])
+        cases = [(k, args.seed) for k in range(args.count)]
+        done = progress(pool.imap_unordered(run_case, cases), total=len(cases), description="campaign")
+        rows = sorted(done, key=lambda r: r["k"])
     wall = time.perf_counter() - started
     failed = [r for r in rows if not r["reached_goal"] or r["violations"]]
     lost = [r["time_lost_s"] for r in rows if r["reached_goal"]]

@@ -19,12 +19,22 @@ from __future__ import annotations
 
 import argparse
 import statistics
+import sys
 import time
+
+from tqdm import tqdm
 
 from topology import plan
 from trajgen import Exact, Optimal, SolverCache, Toppra, lower_bound, verify
 from trajgen.methods.optimal import DEFAULT_NODES, Source
+from trajgen.progress import progress
 from trajgen.sampling import reference_sets
+
+
+def emit(line: str) -> None:
+    """Print a result row above the progress bar, at once (also into a pipe)."""
+    tqdm.write(line)
+    sys.stdout.flush()
 
 
 def main() -> None:
@@ -42,45 +52,46 @@ def main() -> None:
     # one cache per grid, large enough for every shape of the sets: each shape is built once
     optimal = Optimal(nodes=args.nodes, cache=SolverCache(maxsize=128))
     refined = Optimal(nodes=2 * args.nodes, cache=SolverCache(maxsize=128))
-    for reference in reference_sets(args.random):
+    cases = [
+        (reference, scenario) for reference in reference_sets(args.random) for scenario in reference.scenarios
+    ]
+    for reference, (name, start, goal) in progress(cases, description="scenarios"):
         label, limits = reference.label, reference.limits
-        for name, start, goal in reference.scenarios:
-            route = plan(reference.track, start, goal, min_separation=limits.min_separation)
-            exact = Exact().schedule(route, limits)
-            timed = Toppra().schedule(route, limits)
-            best = optimal.schedule(route, limits)
-            bound = lower_bound(route, limits)
-            info = best.info
-            change = float("nan")
-            if not args.skip_refinement and best.fallback_reason is None:
-                fine = refined.schedule(route, limits)
-                if fine.fallback_reason is None:
-                    change = abs(fine.duration - best.duration) / best.duration
-            passed = all(verify(s).passed for s in (exact, timed, best))
-            rows.append(
-                (
-                    label,
-                    name,
-                    exact.duration,
-                    timed.duration,
-                    best.duration,
-                    bound,
-                    info.solve_time,
-                    info.built,
-                    best.fallback_reason,
-                    change,
-                    passed,
-                    info.solver.value if info.solver else "none",
-                    info.source,
-                )
+        route = plan(reference.track, start, goal, min_separation=limits.min_separation)
+        exact = Exact().schedule(route, limits)
+        timed = Toppra().schedule(route, limits)
+        best = optimal.schedule(route, limits)
+        bound = lower_bound(route, limits)
+        info = best.info
+        change = float("nan")
+        if not args.skip_refinement and best.fallback_reason is None:
+            fine = refined.schedule(route, limits)
+            if fine.fallback_reason is None:
+                change = abs(fine.duration - best.duration) / best.duration
+        passed = all(verify(s).passed for s in (exact, timed, best))
+        rows.append(
+            (
+                label,
+                name,
+                exact.duration,
+                timed.duration,
+                best.duration,
+                bound,
+                info.solve_time,
+                info.built,
+                best.fallback_reason,
+                change,
+                passed,
+                info.solver.value if info.solver else "none",
+                info.source,
             )
-            print(
-                f"{label:>3} {name:>11} {exact.duration:7.2f} {timed.duration:7.2f} {best.duration:8.3f} "
-                f"{bound:7.2f} {best.duration / exact.duration:6.3f} {best.duration / bound:6.3f} "
-                f"{1e3 * info.solve_time:8.0f}{'*' if info.built else ' '} "
-                f"{'yes' if best.fallback_reason else 'no':>8} {100 * change:8.3f}%",
-                flush=True,
-            )
+        )
+        emit(
+            f"{label:>3} {name:>11} {exact.duration:7.2f} {timed.duration:7.2f} {best.duration:8.3f} "
+            f"{bound:7.2f} {best.duration / exact.duration:6.3f} {best.duration / bound:6.3f} "
+            f"{1e3 * info.solve_time:8.0f}{'*' if info.built else ' '} "
+            f"{'yes' if best.fallback_reason else 'no':>8} {100 * change:8.3f}%"
+        )
     swaps_rows = [r for r in rows if r[0] in "ab"]
     solve = [r[6] for r in rows]
     solve_cached = [r[6] for r in rows if not r[7]]

@@ -16,6 +16,7 @@ import time
 from limits import ILLUSTRATIVE_LIMITS
 from topology import YGraph
 from trajgen import METHODS, TimingMethod, default_scenario, make_schedule, verify
+from trajgen.progress import progress
 from trajgen.sampling import random_scenarios
 
 
@@ -54,7 +55,7 @@ def main() -> None:
         method = method_class()
         timed(swap, method)  # warm-up
         for label, batch in (("swap", [swap] * 5), (f"{len(randoms)} random", randoms)):
-            results = [timed(s, method) for s in batch]
+            results = [timed(s, method) for s in progress(batch, description=f"{method.name}, {label}")]
             failures += sum(not report.passed for _, report, _, _ in results)
             produce = [1e3 * r[2] for r in results]
             check = [1e3 * r[3] for r in results]

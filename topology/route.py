@@ -291,17 +291,17 @@ def plan(
         Minimum track distance between the vehicles, metres,
         ``0 <= min_separation <= shortest leg``. ``0`` means only "not the
         same point".
+    homotopy : Homotopy or str, optional
+        ``"paper"`` (default): the class the paper's instruction takes.
+        ``"other"``: the same retractions, but the other way round the
+        boundary circle (the second of the two shortest classes).
+        ``Route.instruction`` names the paper's instruction either way.
 
     Returns
     -------
     Route
         The route; the track distance along it never drops below
         ``min(dist(start), dist(goal), shortest leg) >= min_separation``.
-    homotopy : Homotopy or str, optional
-        ``"paper"`` (default): the class the paper's instruction takes.
-        ``"other"``: the same retractions, but the other way round the
-        boundary circle (the second of the two shortest classes).
-        ``Route.instruction`` names the paper's instruction either way.
 
     Raises
     ------

@@ -1,0 +1,147 @@
+"""The documentation site builds without a warning, reaches every page, and its examples run.
+
+The build is the one CI needs: ``python -m sphinx -W --keep-going -n -b html docs OUT``: nitpicky,
+so a reference to a page, heading or Python object that does not exist fails it. A tiny copy of
+the site with one planted defect shows that each kind of defect does fail it. The ``python`` code
+blocks of every page run (``>>>`` examples must print what they show); fence a fragment that cannot
+run as ``text``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import doctest
+import pickle
+import re
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from tests.conftest import REPO
+
+DOCS = REPO / "docs"
+PAGES = sorted([*DOCS.glob("*.md"), *(DOCS / "formats").glob("*.md")])
+
+
+def _sphinx(source: Path, out: Path) -> subprocess.CompletedProcess:
+    command = [
+        sys.executable,
+        "-m",
+        "sphinx",
+        "-W",
+        "--keep-going",
+        "-n",
+        "-b",
+        "html",
+        str(source),
+        str(out),
+    ]
+    return subprocess.run(command, capture_output=True, text=True, timeout=300, check=False)
+
+
+@pytest.fixture(scope="module")
+def built(tmp_path_factory) -> tuple[subprocess.CompletedProcess, Path]:
+    out = tmp_path_factory.mktemp("docs") / "html"
+    return _sphinx(DOCS, out), out
+
+
+def test_the_docs_build_with_no_warning_and_no_broken_reference(built):
+    result, out = built
+    assert result.returncode == 0, result.stdout + result.stderr
+    assert (out / "index.html").is_file()
+
+
+def test_every_page_is_reachable_from_the_root_toctree(built):
+    result, out = built
+    with (out / ".doctrees" / "environment.pickle").open("rb") as stream:
+        env = pickle.load(stream)  # written by the build above, in this test's temporary folder
+    reachable, todo = set(), [env.config.root_doc]
+    while todo:
+        page = todo.pop()
+        if page not in reachable:
+            reachable.add(page)
+            todo += env.toctree_includes.get(page, [])
+    pages = {page.relative_to(DOCS).with_suffix("").as_posix() for page in PAGES}
+    assert {"index", "planner", "timing", "verifier", "scenario", "cli", "online", "api"} <= pages
+    assert {"formats/index", "formats/generic-csv"} <= pages
+    assert pages - reachable == set(), result.stdout + result.stderr
+    for page in pages:
+        assert (out / f"{page}.html").is_file(), page
+
+
+def test_the_command_line_page_has_the_help_of_every_command(built):
+    from trajgen.cli import build_parser
+
+    _, out = built
+    text = (out / "cli.html").read_text(encoding="utf-8")
+    commands = next(a for a in build_parser()._actions if isinstance(a, argparse._SubParsersAction))
+    assert len(commands.choices) >= 5
+    for name in commands.choices:
+        assert f'id="command-{name}"' in text
+        assert f"usage: trajgen {name}" in text
+
+
+_TINY_INDEX = """# Tiny
+
+```{toctree}
+page
+```
+"""
+
+
+@pytest.mark.parametrize(
+    ("page", "defect"),
+    [
+        pytest.param("See [the other page](page.md).\n", None, id="no-defect-passes"),
+        pytest.param("See [a page](missing.md).\n", "missing.md", id="link-to-a-missing-page"),
+        pytest.param("See [a heading](page.md#no-such-heading).\n", "no-such-heading", id="missing-heading"),
+        pytest.param("See {py:func}`trajgen.no_such_function`.\n", "no_such_function", id="missing-object"),
+        pytest.param("See {py:class}`topology.Routes`.\n", "topology.Routes", id="misspelt-class"),
+    ],
+)
+def test_a_broken_reference_fails_the_build(tmp_path, page, defect):
+    source = tmp_path / "docs"
+    source.mkdir()
+    shutil.copy(DOCS / "conf.py", source / "conf.py")
+    (source / "index.md").write_text(_TINY_INDEX, encoding="utf-8")
+    (source / "page.md").write_text(f"# Page\n\n## A heading\n\n{page}", encoding="utf-8")
+    result = _sphinx(source, tmp_path / "html")
+    output = result.stdout + result.stderr
+    if defect is None:
+        assert result.returncode == 0, output
+    else:
+        assert result.returncode != 0, output
+        assert defect in output
+
+
+def test_a_page_outside_every_toctree_fails_the_build(tmp_path):
+    source = tmp_path / "docs"
+    source.mkdir()
+    shutil.copy(DOCS / "conf.py", source / "conf.py")
+    (source / "index.md").write_text(_TINY_INDEX, encoding="utf-8")
+    (source / "page.md").write_text("# Page\n", encoding="utf-8")
+    (source / "orphan.md").write_text("# Orphan\n", encoding="utf-8")
+    result = _sphinx(source, tmp_path / "html")
+    assert result.returncode != 0
+    assert "orphan" in result.stdout + result.stderr
+
+
+def _python_blocks(page: Path) -> list[str]:
+    """The ``python`` code blocks of a page."""
+    return re.findall(r"^```python\n(.*?)^```", page.read_text(encoding="utf-8"), flags=re.S | re.M)
+
+
+@pytest.mark.parametrize("page", [p for p in PAGES if _python_blocks(p)], ids=lambda p: p.name)
+def test_the_python_of_a_page_runs_and_prints_what_it_says(page, tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)  # in case an example writes files
+    parser, runner = doctest.DocTestParser(), doctest.DocTestRunner(optionflags=doctest.ELLIPSIS)
+    for number, block in enumerate(_python_blocks(page)):
+        name = f"{page.name}[{number}]"
+        if ">>>" in block:  # an interactive example: its output is checked
+            runner.run(parser.get_doctest(block, {}, name, str(page), 0))
+        else:  # a script: it runs
+            exec(compile(block, name, "exec"), {})  # our own documentation's example
+    assert runner.summarize(verbose=False).failed == 0
