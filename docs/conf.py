@@ -14,7 +14,6 @@ trajgen) is shown as code without a link. A name that does not exist still fails
 
 from __future__ import annotations
 
-import argparse
 import importlib
 import os
 import re
@@ -183,16 +182,13 @@ class CommandHelp(SphinxDirective):
 
     def run(self) -> list[nodes.Node]:
         """One section per sub-command: its summary line and its help text."""
-        from trajgen.cli import build_parser
+        from trajgen.cli import command_parsers
 
         with mock.patch.dict(os.environ, {"COLUMNS": "100"}):
-            parser = build_parser()
-            commands = next(a for a in parser._actions if isinstance(a, argparse._SubParsersAction))
             sections: list[nodes.Node] = []
-            for name, subparser in commands.choices.items():
+            for name, (summary, subparser) in command_parsers().items():
                 section = nodes.section(ids=[f"command-{name}"], names=[f"trajgen {name}"])
                 section += nodes.title(text=f"trajgen {name}")
-                summary = next((c.help for c in commands._choices_actions if c.dest == name), None)
                 if summary:
                     section += nodes.paragraph(text=summary[0].upper() + summary[1:] + ".")
                 help_text = subparser.format_help()

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import bisect
 import itertools
+import sys
 from dataclasses import dataclass, field
 
 from topology.cycle import ANTIPODAL_TOLERANCE, as_indexed, retract_indexed
@@ -340,7 +341,9 @@ def plan(
     else:
         instruction, counterclockwise = Instruction.SHORTEST, delta < half
     if homotopy is Homotopy.OTHER:
-        if delta == 0.0 or delta == perimeter:  # the same point (delta == perimeter after round-off)
+        # the same point: delta is 0, or the perimeter less a round-off (from retractions of
+        # positions such as 1e-311 m, a float's step away from the junction)
+        if min(delta, perimeter - delta) <= SAME_POINT_TOLERANCE * perimeter:
             raise OptionError(
                 f"homotopy 'other' from {start} to {goal}: both retract to the same boundary point, so "
                 "the other way round is a full turn; expected a query whose retractions differ"
@@ -371,6 +374,10 @@ def plan(
         cumulative_travel=tuple(cumulative),
         homotopy=homotopy,
     )
+
+
+#: Boundary points closer than this fraction of the perimeter are one point (float round-off).
+SAME_POINT_TOLERANCE = 64 * sys.float_info.epsilon
 
 
 def _check_min_separation(graph: YGraph, min_separation: float) -> float:

@@ -320,6 +320,11 @@ class Schedule:
     end_tolerance : float or None
         How far from the route's start and goal the motion may begin and end,
         metres (``None``: the verifier's 1e-9 m; PLC tables: 1e-6 m).
+    checked_limits : int or None
+        How many derivatives (1: velocity, 2: acceleration, 3: jerk) the
+        verifier checks against the limits in closed form. ``None``: velocity
+        and acceleration, and jerk if ``jerk_limited``; a table read back
+        defines fewer (:mod:`trajgen.tables` checks the rest from its points).
     """
 
     route: Route
@@ -332,6 +337,7 @@ class Schedule:
     info: MethodInfo | None = field(default=None, compare=False)
     continuity: int | None = None
     end_tolerance: float | None = None
+    checked_limits: int | None = None
     _starts: np.ndarray = field(init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:

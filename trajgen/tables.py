@@ -19,7 +19,7 @@ from __future__ import annotations
 
 import itertools
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import ClassVar
 
 import numpy as np
@@ -77,11 +77,16 @@ class Interpolation(Option):
 
     @property
     def closed_form(self) -> int:
-        """Derivatives (1 = velocity, ...) the interpolated pieces define: checked in closed form."""
+        """Derivatives (1 = velocity, ...) checked in closed form on the interpolated pieces.
+
+        The others are checked from divided differences of the points. A Hermite
+        table (a sampled motion read back) is judged by its points only: the
+        cubic through two samples is the reader's, not the drive's.
+        """
         return {
             Interpolation.LINEAR: 1,
             Interpolation.VELOCITY: 2,
-            Interpolation.HERMITE: 1,
+            Interpolation.HERMITE: 0,
             Interpolation.CUBIC: 3,
         }[self]
 
@@ -262,9 +267,11 @@ def _difference_checks(table: ProfileTable, limits, *, jerk: bool) -> list[Diffe
     if table.times.size < 2 or defined >= 3:
         return checks
     velocity_table = table.interpolation is Interpolation.VELOCITY
-    wanted = [("acceleration", 2, limits.max_acceleration)] if defined < 2 else []
-    if jerk:
-        wanted.append(("jerk", 3, limits.max_jerk))
+    wanted = [
+        (quantity, derivative, getattr(limits, f"max_{quantity}"))
+        for derivative, quantity in ((1, "velocity"), (2, "acceleration"), (3, "jerk"))
+        if derivative > defined and (jerk or derivative < 3)
+    ]
     for quantity, derivative, limit in wanted:
         order = derivative - (1 if velocity_table else 0)  # a velocity table's values are one derivative up
         times, values = _at_rest_both_ends(table, order)
@@ -373,32 +380,33 @@ def junction_crossings(motion: PiecewiseCubic, junction: float) -> list[float]:
     Between consecutive piece ends and velocity zeros the motion is monotone, so each sign
     change of ``axis - junction`` there holds one crossing, found by bisection.
     """
-    times = [float(motion.times[0])]
-    for k in range(len(motion.jerk)):
-        begin, end = float(motion.times[k]), float(motion.times[k + 1])
-        _, v0, a0 = motion.initial[k]
-        j = motion.jerk[k]
-        for root in np.roots([j / 2.0, a0, v0]) if (j or a0) else []:  # v(h) = v0 + a0 h + j h^2 / 2
-            if abs(root.imag) < 1e-12 and 0.0 < root.real < end - begin:
-                times.append(begin + float(root.real))
-        times.append(end)
-    times = np.unique(times)
+    begin = motion.times[:-1]
+    length = np.diff(motion.times)
+    v0, a0, j = motion.initial[:, 1], motion.initial[:, 2], motion.jerk
+    roots = []
+    with np.errstate(divide="ignore", invalid="ignore"):  # v(h) = v0 + a0 h + j h^2 / 2 = 0
+        root = np.sqrt(a0 * a0 - 2.0 * j * v0)
+        roots += [(-a0 + root) / j, (-a0 - root) / j, -v0 / a0]
+    candidates = [motion.times]
+    for h in roots:
+        inside = np.isfinite(h) & (h > 0.0) & (h < length)
+        candidates.append(begin[inside] + h[inside])
+    times = np.unique(np.concatenate(candidates))
     gap = motion.evaluate(times)[0] - junction
-    tolerance = CROSSING_TOLERANCE
-    crossings, side = [], 0.0
-    for k, value in enumerate(gap):
-        sign = 0.0 if abs(value) <= tolerance else np.sign(value)
-        if sign and side and sign != side:
-            low, high = float(times[k - 1]), float(times[k])
-            for _ in range(80):
-                middle = 0.5 * (low + high)
-                if np.sign(motion.evaluate(np.array([middle]))[0, 0] - junction) == side:
-                    low = middle
-                else:
-                    high = middle
-            crossings.append(0.5 * (low + high))
-        if sign:
-            side = sign
+    sign = np.where(np.abs(gap) <= CROSSING_TOLERANCE, 0.0, np.sign(gap))
+    nonzero = np.nonzero(sign)[0]
+    flips = nonzero[1:][sign[nonzero[1:]] != sign[nonzero[:-1]]]
+    crossings = []
+    for k in flips:
+        side = sign[nonzero[np.searchsorted(nonzero, k) - 1]]
+        low, high = float(times[k - 1]), float(times[k])
+        for _ in range(80):
+            middle = 0.5 * (low + high)
+            if np.sign(motion.evaluate(np.array([middle]))[0, 0] - junction) == side:
+                low = middle
+            else:
+                high = middle
+        crossings.append(0.5 * (low + high))
     return crossings
 
 
@@ -478,6 +486,8 @@ class TableMotion(TimingMethod):
         the junction (the first move of a schedule is its axis's positive direction).
     jerk : bool
         Whether the tables are held to the jerk limits (default True).
+    motions : tuple of 2 PiecewiseCubic, optional
+        The tables' :meth:`ProfileTable.motion`, if already computed.
     """
 
     name: ClassVar[str] = "table"
@@ -486,6 +496,7 @@ class TableMotion(TimingMethod):
     tables: tuple[ProfileTable, ProfileTable]
     orientations: tuple[int, int] = (1, 1)
     jerk: bool = True
+    motions: tuple[PiecewiseCubic, PiecewiseCubic] | None = field(default=None, compare=False, repr=False)
 
     @property
     def jerk_limited(self) -> bool:
@@ -495,8 +506,9 @@ class TableMotion(TimingMethod):
     def schedule(self, route: Route, limits: Limits) -> Schedule:
         """The tables' motion along ``route``: a section for each stay of either vehicle on a leg."""
         motions, stay_maps, stay_starts = [], [], []
+        given = self.motions or tuple(table.motion() for table in self.tables)
         for vehicle, table in enumerate(self.tables):
-            motion = table.motion()
+            motion = given[vehicle]
             starts, maps, _ = _stays(route, vehicle, table, motion, self.orientations[vehicle])
             motions.append(motion)
             stay_starts.append(starts)
@@ -521,6 +533,7 @@ class TableMotion(TimingMethod):
             jerk_limited=self.jerk,
             continuity=smoothness,
             end_tolerance=END_TOLERANCE,
+            checked_limits=min(table.interpolation.closed_form for table in self.tables),
         )
 
 
@@ -540,6 +553,8 @@ class TableCheck:
         Worst |v|, |a|, |j| over each limit per vehicle (:func:`limit_ratios`).
     route : Route
         The route the tables were read along.
+    schedule : Schedule or None
+        The tables' motion along it, as verified (None if they could not be read along it).
     """
 
     passed: bool
@@ -547,6 +562,7 @@ class TableCheck:
     report: VerificationReport
     ratios: dict
     route: Route
+    schedule: Schedule | None = None
 
     def summary(self) -> dict:
         """JSON-ready verdict."""
@@ -557,6 +573,46 @@ class TableCheck:
             "ratios": {k: (list(v) if v is not None else None) for k, v in self.ratios.items()},
             "homotopy": self.route.homotopy.value,
         }
+
+
+#: A drive that ramps through a linear table's velocity step at its acceleration limit leaves the
+#: table by ``step**2 / (8 * max_acceleration)`` at most; this is the most allowed, metres.
+TRACKING_TOLERANCE = 1e-3
+
+
+def _velocity_steps(table: ProfileTable, vehicle: int, max_acceleration: float) -> list[str]:
+    """A linear table's velocity steps at its points (rest before and after), if a drive cannot follow.
+
+    The controller's velocity jumps at each point of a linear table; a drive
+    ramping through the step at ``max_acceleration``, centred on the point,
+    departs from the table by ``step**2 / (8 * max_acceleration)``.
+    """
+    if table.interpolation is not Interpolation.LINEAR or table.times.size < 2:
+        return []
+    velocity = np.diff(table.values) / np.diff(table.times)
+    steps = np.abs(np.diff(np.concatenate([[0.0], velocity, [0.0]])))
+    departure = steps**2 / (8.0 * max_acceleration)
+    k = int(np.argmax(departure))
+    if departure[k] <= TRACKING_TOLERANCE:
+        return []
+    return [
+        f"vehicle {vehicle + 1} velocity steps by {steps[k]:.6g} m/s at t={table.times[k]:.6f} s: a drive "
+        f"ramping at its max_acceleration {max_acceleration:g} m/s^2 would leave the table by "
+        f"{1e3 * departure[k]:.3g} mm, expected at most {1e3 * TRACKING_TOLERANCE:g} mm (more points)"
+    ]
+
+
+def _first_move(table: ProfileTable, vehicle: int) -> list[str]:
+    """The axis must grow in the direction of the first move (the convention of the files)."""
+    steps = np.diff(table.positions())
+    moving = np.nonzero(np.abs(steps) > CROSSING_TOLERANCE)[0]
+    if moving.size and steps[moving[0]] < 0.0:
+        k = int(moving[0])
+        return [
+            f"vehicle {vehicle + 1}'s axis first moves backwards (at t={table.times[k]:.6f} s): expected "
+            "it to grow in the direction of the first move"
+        ]
+    return []
 
 
 def _orientations(route: Route) -> list[tuple[int, int]]:
@@ -613,31 +669,35 @@ def check_tables(
             regions_match=False,
         )
         return TableCheck(False, tuple(failures), report, {}, route)
-    differences = []
+    units = {"velocity": "m/s", "acceleration": "m/s^2", "jerk": "m/s^3"}
     for vehicle, table in enumerate(tables):
+        failures += _first_move(table, vehicle)
         for check in _difference_checks(table, limits.vehicles[vehicle], jerk=jerk):
             if check.value > check.allowed:
-                unit = "m/s^2" if check.quantity == "acceleration" else "m/s^3"
-                differences.append(
+                unit = units[check.quantity]
+                failures.append(
                     f"vehicle {vehicle + 1} {check.quantity} reaches {check.value:.9g} {unit} at "
                     f"t={check.time:.6f} s exceeds its max_{check.quantity} {check.limit:g} {unit} "
                     "(from the table's points)"
                 )
+        failures += _velocity_steps(table, vehicle, limits.vehicles[vehicle].max_acceleration)
+    motions = tuple(table.motion() for table in tables)
     # the files do not say which way along its leg each vehicle's axis grows: read both ways
     verdicts = []
     for orientations in _orientations(route):
         found = []
         for vehicle, table in enumerate(tables):
-            *_, extra = _stays(route, vehicle, table, table.motion(), orientations[vehicle])
+            *_, extra = _stays(route, vehicle, table, motions[vehicle], orientations[vehicle])
             if extra:
                 found.append(
                     f"vehicle {vehicle + 1} passes the junction {extra} more time(s) than its route does"
                 )
-        report = verify(TableMotion(tables, orientations, jerk=jerk).schedule(route, limits))
-        verdicts.append((found + list(report.failures), report))
+        schedule = TableMotion(tables, orientations, jerk=jerk, motions=motions).schedule(route, limits)
+        report = verify(schedule)
+        verdicts.append((found + list(report.failures), report, schedule))
         if not verdicts[-1][0]:
             break
-    found, report = min(verdicts, key=lambda verdict: len(verdict[0]))
-    failures += found + differences
+    found, report, schedule = min(verdicts, key=lambda verdict: len(verdict[0]))
+    failures += found
     ratios = limit_ratios(tables, limits, jerk=jerk)
-    return TableCheck(not failures, tuple(failures), report, ratios, route)
+    return TableCheck(not failures, tuple(failures), report, ratios, route, schedule)

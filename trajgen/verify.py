@@ -392,9 +392,8 @@ def _check_piece_limits(pieces: Pieces, schedule: Schedule, failures: list[str])
     names = [("velocity", "max_velocity", "m/s"), ("acceleration", "max_acceleration", "m/s^2")]
     if schedule.jerk_limited:
         names.append(("jerk", "max_jerk", "m/s^3"))
-    # a table read back defines only the derivatives its interpolation keeps (plus one piecewise):
-    # the others are checked from its points (trajgen.tables)
-    names = names[: schedule.smoothness + 1]
+    if schedule.checked_limits is not None:  # a table read back: the rest is checked from its points
+        names = names[: schedule.checked_limits]
     ratios: dict[str, tuple[float, float] | None] = {
         "velocity": (0.0, 0.0),
         "acceleration": (0.0, 0.0),

@@ -17,7 +17,9 @@ SHOWN_FAILURES = 10
 
 def _command_check(args: argparse.Namespace) -> int:
     scenario = scenario_from(args.scenario)
-    verdict = check_profiles(scenario, args.csv, dialect=args.dialect, jerk=not args.ignore_jerk)
+    verdict = check_profiles(
+        scenario, args.csv, dialect=args.dialect, jerk=not args.ignore_jerk, max_points=args.max_points
+    )
     summary = verdict.summary()
     if args.json:
         print(json.dumps(summary, indent=2))
@@ -52,6 +54,11 @@ def register(commands) -> None:
         default="generic",
         metavar="|".join(DIALECTS.names),
         help=f"dialect of the files, one of:\n{DIALECTS.help()}",
+    )
+    check.add_argument(
+        "--max-points",
+        type=int,
+        help="most points per table the target takes (default: the dialect's limit)",
     )
     check.add_argument("--ignore-jerk", action="store_true", help="do not hold the files to the jerk limits")
     check.add_argument("--json", action="store_true", help="print a machine-readable verdict")

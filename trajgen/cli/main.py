@@ -17,7 +17,7 @@ from trajgen.cli import animate, check, schedule, simulate, vda5050
 from trajgen.cli.options import EXIT_BAD_INPUT, EXIT_FAILURE, CommandParser
 from trajgen.errors import InputError
 
-__all__ = ["COMMAND_MODULES", "build_parser", "main"]
+__all__ = ["COMMAND_MODULES", "Commands", "build_parser", "command_parsers", "main"]
 
 logger = logging.getLogger(__name__)
 
@@ -25,14 +25,48 @@ logger = logging.getLogger(__name__)
 COMMAND_MODULES = (schedule, check, simulate, vda5050, animate)
 
 
-def build_parser() -> argparse.ArgumentParser:
-    """The argument parser of the ``trajgen`` command."""
+class Commands:
+    """The sub-commands as they are registered: each one's parser and one-line help.
+
+    Parameters
+    ----------
+    action
+        What ``ArgumentParser.add_subparsers`` returned.
+    """
+
+    __slots__ = ("_action", "parsers")
+
+    def __init__(self, action) -> None:
+        self._action = action
+        #: name -> (one-line help, its parser), in registration order
+        self.parsers: dict[str, tuple[str, argparse.ArgumentParser]] = {}
+
+    def add_parser(
+        self, name: str, *, help: str, formatter_class: type = argparse.HelpFormatter
+    ) -> argparse.ArgumentParser:
+        """Add the sub-command ``name`` and return its parser."""
+        parser = self._action.add_parser(name, help=help, formatter_class=formatter_class)
+        self.parsers[name] = (help, parser)
+        return parser
+
+
+def _build() -> tuple[argparse.ArgumentParser, Commands]:
     parser = CommandParser(prog="trajgen", description="Collision-free schedules for two AGVs on a Y-track.")
     parser.add_argument("-v", "--verbose", action="store_true", help="log progress to stderr")
-    commands = parser.add_subparsers(dest="command", required=True, parser_class=CommandParser)
+    commands = Commands(parser.add_subparsers(dest="command", required=True, parser_class=CommandParser))
     for module in COMMAND_MODULES:
         module.register(commands)
-    return parser
+    return parser, commands
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """The argument parser of the ``trajgen`` command."""
+    return _build()[0]
+
+
+def command_parsers() -> dict[str, tuple[str, argparse.ArgumentParser]]:
+    """Every sub-command's one-line help and parser, by name, in help order."""
+    return _build()[1].parsers
 
 
 def main(argv: Sequence[str] | None = None) -> int:

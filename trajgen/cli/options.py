@@ -49,15 +49,51 @@ def scenario_from(path: str | None) -> Scenario:
     return default_scenario() if path is None else load_scenario(path)
 
 
+#: The generic CSV's options and their defaults (``None`` in the parser, so a given one is known).
+GENERIC_DEFAULTS = {
+    "sample_period": 0.01,
+    "delimiter": ";",
+    "decimal": ".",
+    "units": "m",
+    "max_rows": DEFAULT_MAX_ROWS,
+}
+
+
+def _given(args: argparse.Namespace, name: str):
+    value = getattr(args, name, None)
+    return GENERIC_DEFAULTS[name] if value is None else value
+
+
 def csv_dialect(args: argparse.Namespace) -> dict:
     """``--delimiter``, ``--decimal``, ``--units`` as keyword arguments of CsvOptions."""
-    delimiter = "\t" if args.delimiter in ("tab", "\\t") else args.delimiter
-    return {"delimiter": delimiter, "decimal": args.decimal, "units": Units.lookup(args.units)}
+    delimiter = _given(args, "delimiter")
+    delimiter = "\t" if delimiter in ("tab", "\\t") else delimiter
+    return {
+        "delimiter": delimiter,
+        "decimal": _given(args, "decimal"),
+        "units": Units.lookup(_given(args, "units")),
+    }
 
 
 def csv_options(args: argparse.Namespace) -> CsvOptions:
-    """The CsvOptions of ``--sample-period``, ``--max-rows`` and the dialect options."""
-    return CsvOptions(sample_period=args.sample_period, max_rows=args.max_rows, **csv_dialect(args))
+    """The CsvOptions of ``--sample-period``, ``--max-rows`` and the dialect options.
+
+    Raises
+    ------
+    OptionError
+        One of them is given with a table ``--dialect`` (its format is the dialect's).
+    """
+    dialect = getattr(args, "dialect", "generic")
+    given = [name for name in GENERIC_DEFAULTS if getattr(args, name, None) is not None]
+    if given and DIALECTS.lookup(dialect).point_limit is not None:
+        options = ", ".join("--" + name.replace("_", "-") for name in given)
+        raise OptionError(
+            f"{options} set the generic CSV: dialect {dialect!r} writes its own fixed format "
+            "(see docs/formats/); expected them only with --dialect generic"
+        )
+    return CsvOptions(
+        sample_period=_given(args, "sample_period"), max_rows=_given(args, "max_rows"), **csv_dialect(args)
+    )
 
 
 def add_method(
@@ -99,13 +135,11 @@ def add_csv_options(parser: argparse.ArgumentParser, *, sampling: bool = True) -
     """The CSV dialect options; with ``sampling``, also ``--sample-period`` and ``--max-rows``."""
     if sampling:
         parser.add_argument(
-            "--sample-period", type=float, default=0.01, help="seconds between CSV rows (0.01)"
+            "--sample-period", type=float, help="seconds between CSV rows (0.01; generic only)"
         )
-    parser.add_argument("--delimiter", default=";", help="CSV field separator (';'); 'tab' for a tab")
-    parser.add_argument("--decimal", default=".", choices=[".", ","], help="decimal mark ('.')")
-    parser.add_argument(
-        "--units", default="m", choices=[u.value for u in Units], help="length unit of the CSV (m)"
-    )
+    parser.add_argument("--delimiter", help="CSV field separator (';'); 'tab' for a tab")
+    parser.add_argument("--decimal", choices=[".", ","], help="decimal mark ('.')")
+    parser.add_argument("--units", choices=[u.value for u in Units], help="length unit of the CSV (m)")
     if sampling:
         parser.add_argument(
             "--dialect",
@@ -121,6 +155,5 @@ def add_csv_options(parser: argparse.ArgumentParser, *, sampling: bool = True) -
         parser.add_argument(
             "--max-rows",
             type=int,
-            default=DEFAULT_MAX_ROWS,
-            help=f"refuse a CSV profile of more rows than this ({DEFAULT_MAX_ROWS:,})",
+            help=f"refuse a CSV profile of more rows than this ({DEFAULT_MAX_ROWS:,}; generic only)",
         )

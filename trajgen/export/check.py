@@ -11,11 +11,14 @@ planner's classes are tried; the files pass if they pass along one.
 
 from __future__ import annotations
 
+import contextlib
 from dataclasses import dataclass
 from pathlib import Path
 
+import numpy as np
+
 from topology import Homotopy, Route, plan
-from trajgen.errors import ProfileFileError
+from trajgen.errors import OptionError, ProfileFileError
 from trajgen.export.csv import profile_paths
 from trajgen.export.dialects import DIALECTS, Dialect, TableDialect
 from trajgen.export.plc import table_paths
@@ -24,8 +27,10 @@ from trajgen.tables import ProfileTable, TableCheck, check_tables
 
 __all__ = ["MAX_FILE_BYTES", "ProfileCheck", "check_profiles", "profile_files"]
 
-#: Largest profile file read (a day of 10 ms rows of the generic CSV is about 900 MB), bytes.
-MAX_FILE_BYTES = 1 << 30
+#: Largest profile file read, bytes (a generic CSV of 1,000,000 rows is about 100 MB).
+MAX_FILE_BYTES = 256 << 20
+#: Most points (rows) per file the checker reads.
+MAX_POINTS = 1_000_000
 
 
 @dataclass(frozen=True, slots=True)
@@ -93,16 +98,89 @@ def _read(path: Path) -> bytes:
 
 
 def _routes(scenario: Scenario) -> tuple[Route, ...]:
-    """The planner's route in the paper's class, then the other class's."""
+    """The planner's route in the paper's class, then the other class's (if there is another way round)."""
     separation = scenario.limits.min_separation
-    return tuple(
-        plan(scenario.track, scenario.start, scenario.goal, min_separation=separation, homotopy=homotopy)
-        for homotopy in (Homotopy.PAPER, Homotopy.OTHER)
+    routes = [plan(scenario.track, scenario.start, scenario.goal, min_separation=separation)]
+    # where start and goal retract to one boundary point, the other way round is a full turn: none
+    with contextlib.suppress(OptionError):
+        routes.append(
+            plan(
+                scenario.track,
+                scenario.start,
+                scenario.goal,
+                min_separation=separation,
+                homotopy=Homotopy.OTHER,
+            )
+        )
+    return tuple(routes)
+
+
+def _generic_columns(parsed, vehicle: int, check: TableCheck, scenario: Scenario, jerk: bool) -> list[str]:
+    """A generic CSV's other columns agree with its motion and keep the limits they state."""
+    columns, table = parsed.columns, parsed.table
+    limits = scenario.limits.vehicles[vehicle]
+    name = f"vehicle {vehicle + 1}"
+    failures = []
+    if check.schedule is not None:
+        state = check.schedule.state(table.times)
+        legs = columns["leg"].astype(int) - 1  # 1-based in the file, JUNCTION_INDEX (-1) at the junction
+        where = np.nonzero((legs != state.leg[vehicle]) | (np.abs(columns["s"] - state.s[vehicle]) > 1e-6))[0]
+        if where.size:
+            k = int(where[0])
+            failures.append(
+                f"{name} row at t={table.times[k]:.6f} s says leg {int(columns['leg'][k])}, s "
+                f"{columns['s'][k]:.9g} m, but its axis puts it on leg {int(state.leg[vehicle, k]) + 1}, s "
+                f"{state.s[vehicle, k]:.9g} m"
+            )
+    angles = np.radians(np.array(scenario.track.angles_deg))
+    legs = columns["leg"].astype(int)
+    known = (legs >= 0) & (legs <= len(angles))
+    angle = angles[np.where(legs > 0, legs - 1, 0)[known]]
+    off = np.hypot(
+        columns["x"][known] - columns["s"][known] * np.cos(angle),
+        columns["y"][known] - columns["s"][known] * np.sin(angle),
     )
+    if np.any(~known) or np.any(off > 1e-6):
+        k = int(np.argmax(~known)) if np.any(~known) else int(np.nonzero(known)[0][np.argmax(off)])
+        failures.append(
+            f"{name} row at t={table.times[k]:.6f} s: x, y do not lie at leg {legs[k]}, "
+            f"s {columns['s'][k]:.9g} m"
+        )
+    # the v column against the positions: for any motion within max_acceleration the central
+    # difference is within max_acceleration (h0^2 + h1^2) / (2 (h0 + h1)) of the velocity
+    if table.times.size >= 3:
+        h = np.diff(table.times)
+        central = (table.values[2:] - table.values[:-2]) / (h[1:] + h[:-1])
+        bound = limits.max_acceleration * (h[:-1] ** 2 + h[1:] ** 2) / (2.0 * (h[:-1] + h[1:]))
+        bound = bound * (1.0 + 1e-6) + 2.0 * table.round_off / (h[1:] + h[:-1]) + 1e-9
+        gap = np.abs(columns["v"][1:-1] - central) - bound
+        if np.any(gap > 0.0):
+            k = int(np.argmax(gap)) + 1
+            failures.append(
+                f"{name} velocity column {columns['v'][k]:.9g} m/s at t={table.times[k]:.6f} s disagrees "
+                f"with its positions ({central[k - 1]:.9g} m/s between its neighbours)"
+            )
+    stated = [("velocity", "v", limits.max_velocity), ("acceleration", "a", limits.max_acceleration)]
+    if jerk:
+        stated.append(("jerk", "j", limits.max_jerk))
+    for quantity, column, limit in stated:
+        peak = np.abs(columns[column])
+        k = int(np.argmax(peak))
+        if peak[k] > limit * (1.0 + 1e-6) + 1e-9:
+            failures.append(
+                f"{name} {quantity} column reaches {peak[k]:.9g} at t={table.times[k]:.6f} s, exceeds its "
+                f"max_{quantity} {limit:g}"
+            )
+    return failures
 
 
 def check_profiles(
-    scenario: Scenario, directory: str | Path, *, dialect: Dialect | str = "generic", jerk: bool = True
+    scenario: Scenario,
+    directory: str | Path,
+    *,
+    dialect: Dialect | str = "generic",
+    jerk: bool = True,
+    max_points: int | None = None,
 ) -> ProfileCheck:
     """Read both vehicles' files of ``dialect`` in ``directory`` and verify them against ``scenario``.
 
@@ -115,6 +193,8 @@ def check_profiles(
         Default ``generic``.
     jerk : bool, optional
         Hold the tables to the jerk limits (default True).
+    max_points : int, optional
+        Most points the target takes per table (default: the dialect's limit; ``generic``: none).
 
     Returns
     -------
@@ -126,12 +206,26 @@ def check_profiles(
         A file is missing, too large, or not readable as the dialect.
     """
     dialect = DIALECTS.lookup(dialect)
+    limit = dialect.check_points(max_points) if isinstance(dialect, TableDialect) else None
     files = profile_files(scenario, directory, dialect)
     parsed = [dialect.read(_read(path), source=str(path)) for path in files]
     tables = (parsed[0].table, parsed[1].table)
-    problems = parsed[0].problems + parsed[1].problems
-    verdicts = [check_tables(tables, route, scenario.limits, jerk=jerk) for route in _routes(scenario)]
-    best = next((verdict for verdict in verdicts if verdict.passed), None)
-    if best is None:
-        best = min(verdicts, key=lambda verdict: len(verdict.failures))
-    return ProfileCheck(dialect, files, problems, tables, best)
+    problems = list(parsed[0].problems + parsed[1].problems)
+    for path, table in zip(files, tables, strict=True):
+        if table.times.size > MAX_POINTS:
+            raise ProfileFileError(
+                f"{path} has {table.times.size:,} points: expected at most {MAX_POINTS:,} "
+                "(the checker's limit)"
+            )
+        if limit is not None and table.times.size > limit:
+            problems.append(f"{path}: {table.times.size:,} points, more than the target takes ({limit:,})")
+    verdicts = []
+    for route in _routes(scenario):
+        verdicts.append(check_tables(tables, route, scenario.limits, jerk=jerk))
+        if verdicts[-1].passed:
+            break
+    best = verdicts[-1] if verdicts[-1].passed else min(verdicts, key=lambda verdict: len(verdict.failures))
+    if parsed[0].columns is not None:
+        for vehicle in range(2):
+            problems += _generic_columns(parsed[vehicle], vehicle, best, scenario, jerk)
+    return ProfileCheck(dialect, files, tuple(problems), tables, best)

@@ -43,6 +43,8 @@ __all__ = [
 
 #: Decimal places of the times and values the table dialects write.
 DECIMALS = 9
+#: The columns of the generic CSV, in order (:data:`~trajgen.export.csv.HEADER_NAMES`).
+GENERIC_COLUMNS = ("t", "axis", "v", "a", "j", "leg", "s", "x", "y")
 
 
 class DialectName(Option):
@@ -65,10 +67,14 @@ class ParsedProfile:
     table : ProfileTable
     problems : tuple of str
         Format deviations (line ends, header, point count), each naming the line.
+    columns : dict of str to ndarray, or None
+        Every column of a ``generic`` file in SI units (``t``, ``axis``, ``v``, ``a``, ``j``,
+        ``leg`` (1-based, 0 at the junction), ``s``, ``x``, ``y``), shape (n,) each.
     """
 
     table: ProfileTable
     problems: tuple[str, ...]
+    columns: dict | None = None
 
 
 class Dialect(abc.ABC):
@@ -131,7 +137,7 @@ def _lines(text: str, source: str, *, crlf: bool) -> tuple[list[str], list[str]]
 
 def _number(field: str, source: str, line: int, what: str) -> tuple[float, int]:
     """A decimal number and its number of decimal places."""
-    text = field.strip()
+    text = field
     try:
         value = float(text)
     except ValueError:
@@ -139,7 +145,8 @@ def _number(field: str, source: str, line: int, what: str) -> tuple[float, int]:
             f"{source} line {line}: {what} {short_repr(text)} is not a number "
             "(expected digits with '.' as the decimal mark)"
         ) from None
-    if not math.isfinite(value) or not text.replace(".", "").replace("-", "").replace("+", "").isdigit():
+    digits = text.removeprefix("-")
+    if not math.isfinite(value) or not digits.replace(".", "", 1).isdigit() or not digits[:1].isdigit():
         raise ProfileFileError(
             f"{source} line {line}: {what} {short_repr(text)} is not a finite decimal number"
         )
@@ -264,7 +271,7 @@ class TableDialect(Dialect):
             values[n], decimals = _number(fields[1], source, n + first, f"slave value ({self.unit})")
             places.append(decimals)
             if self.extra is not None:
-                segment_types.add(fields[2].strip())
+                segment_types.add(fields[2])
         interpolation = self.table_interpolation
         if self.extra is not None:
             interpolation = _logix_interpolation(segment_types, source)
@@ -274,7 +281,8 @@ class TableDialect(Dialect):
             )
         if self.most_points is not None and len(lines) > self.most_points:
             problems.append(f"{source}: {len(lines):,} points, more than {self.most_points:,}")
-        resolution = 0.5 * 10.0 ** -min(places) / 1000.0
+        # the file's precision: a value written with fewer places (a "0" from a spreadsheet) is exact
+        resolution = 0.5 * 10.0 ** -max(places) / 1000.0
         table = ProfileTable(times, values / 1000.0, interpolation, resolution=resolution)
         return ParsedProfile(table, tuple(problems))
 
@@ -329,7 +337,7 @@ class GenericDialect(Dialect):
         if not rows:
             raise ProfileFileError(f"{source} has no rows: expected at least one")
         comma = delimiter != "," and any("," in row for row in rows[:1])
-        times, values, velocities = np.empty(len(rows)), np.empty(len(rows)), np.empty(len(rows))
+        columns = np.empty((len(names), len(rows)))
         places = []
         for n, row in enumerate(rows):
             fields = row.split(delimiter)
@@ -338,23 +346,32 @@ class GenericDialect(Dialect):
                     f"{source} line {n + 2}: {len(fields)} field(s) separated by {delimiter!r}, "
                     f"expected {len(names)} ({short_repr(row)})"
                 )
-            if comma:
-                fields = [field.replace(",", ".") for field in fields[:3]]
-            times[n], _ = _number(fields[0], source, n + 2, f"{names[0]}")
-            values[n], decimals = _number(fields[1], source, n + 2, f"{names[1]}")
-            velocities[n], _ = _number(fields[2], source, n + 2, f"{names[2]}")
-            places.append(decimals)
-        if times[0] != 0.0:
-            raise ProfileFileError(f"{source} line 2: the first time is {float(times[0])!r} s, expected 0")
-        resolution = 0.5 * 10.0 ** -min(places) / units.scale
+            for k, field in enumerate(fields):
+                columns[k, n], decimals = _number(
+                    field.replace(",", ".") if comma else field, source, n + 2, names[k]
+                )
+                if k == 1:
+                    places.append(decimals)
+        if columns[0, 0] != 0.0:
+            raise ProfileFileError(
+                f"{source} line 2: the first time is {float(columns[0, 0])!r} s, expected 0"
+            )
+        legs = columns[5]
+        if not np.all(legs == np.round(legs)):
+            bad = int(np.argmax(legs != np.round(legs)))
+            raise ProfileFileError(f"{source} line {bad + 2}: leg {legs[bad]!r} is not a whole number")
+        resolution = 0.5 * 10.0 ** -max(places) / units.scale
+        scaled = {
+            name: columns[k] / (1.0 if k in (0, 5) else units.scale) for k, name in enumerate(GENERIC_COLUMNS)
+        }
         table = ProfileTable(
-            times,
-            values / units.scale,
+            columns[0],
+            scaled["axis"],
             Interpolation.HERMITE,
             resolution=resolution,
-            velocities=velocities / units.scale,
+            velocities=scaled["v"],
         )
-        return ParsedProfile(table, tuple(problems))
+        return ParsedProfile(table, tuple(problems), scaled)
 
 
 class DialectRegistry:
