@@ -207,8 +207,10 @@ def test_the_summary_reports_points_and_errors(tmp_path, capsys):
         (["--dialect", "twincat-cam", "--max-points", "1"], r"max points must be an integer >= 2, got 1"),
         (["--max-points", "50"], r"max points 50 applies to table dialects"),
         (["--dialect", "logix-time-cam", "--method", "toppra"], r"needs a jerk-limited schedule"),
+        (["--dialect", "twincat-cam", "--units", "m"], r"--units set the generic CSV: dialect 'twincat-cam'"),
+        (["--dialect", "siemens-xy", "--delimiter", ","], r"--delimiter set the generic CSV"),
     ],
-    ids=["siemens-limit", "unknown", "one-point", "generic-points", "cubic-toppra"],
+    ids=["siemens-limit", "unknown", "one-point", "generic-points", "cubic-toppra", "units", "delimiter"],
 )
 def test_bad_dialect_options_exit_2_and_write_nothing(tmp_path, capsys, args, match):
     out = tmp_path / "out"
@@ -314,3 +316,134 @@ def test_tables_along_the_wrong_class_fail(swap):
 def test_option_errors():
     with pytest.raises(OptionError, match=r"dialectname 'nope' is unknown"):
         DIALECTS.lookup("nope")
+
+
+def _write(folder, dialect, tables):
+    """Write two tables' files of ``dialect`` (ProfileTables in metres) into ``folder``."""
+    folder.mkdir(parents=True, exist_ok=True)
+    for name, table in zip(("agv1", "agv2"), tables, strict=True):
+        (folder / f"{name}{dialect.suffix}").write_bytes(dialect.render(table))
+
+
+def test_a_sparse_linear_table_with_velocity_steps_fails(tmp_path, swap):
+    # 0 -> 1 m/s -> 0 at once: three points whose divided differences look harmless
+    twincat = DIALECTS.lookup("twincat-cam")
+    jumpy = ProfileTable([0.0, 10.0, 30.0], [0.0, 0.0, 20.0], "linear")
+    other = resample(swap, interpolation="linear", max_points=10_000).tables[1]
+    _write(tmp_path, twincat, (jumpy, other))
+    verdict = check_profiles(default_scenario(), tmp_path, dialect=twincat)
+    assert any(
+        "vehicle 1 velocity steps by 1 m/s at t=10.000000 s" in f and "would leave the table by 250 mm" in f
+        for f in verdict.failures
+    )
+
+
+def test_too_few_points_to_follow_are_refused_not_written(tmp_path, capsys):
+    out = tmp_path / "out"
+    args = ["schedule", SWAP, "--csv", str(out), "--dialect", "twincat-cam", "--max-points", "12"]
+    assert main(args) == EXIT_FAILURE
+    assert "velocity steps by" in capsys.readouterr().err
+    assert not out.exists()
+
+
+def test_a_value_written_without_decimals_does_not_widen_the_allowance(exported, tmp_path):
+    dialect = DIALECTS.lookup("twincat-cam")
+    for source in _files(exported / "twincat-cam", dialect):
+        (tmp_path / source.name).write_bytes(source.read_bytes())
+    path = tmp_path / "agv1.csv"
+    lines = path.read_bytes().decode("ascii").split("\r\n")
+    lines[0] = "0;0"  # as a spreadsheet saves it
+    t, x = lines[40].split(";")
+    lines[40] = f"{t};{float(x) + 0.05:.9f}"  # 50 um: a small step, far beyond any limit over 3 ms
+    path.write_bytes("\r\n".join(lines).encode("ascii"))
+    verdict = check_profiles(default_scenario(), tmp_path, dialect=dialect)
+    assert any("vehicle 1 jerk reaches" in f for f in verdict.failures)
+
+
+@pytest.mark.parametrize(
+    ("column", "change", "match"),
+    [
+        (5, lambda v, row: "3" if v == "2" else v, r"says leg 3, .* but its axis puts it on leg 2"),
+        (
+            2,
+            lambda v, row: (
+                f"{float(v) + (0.3 if row % 2 else -0.3):.9f}" if 0.2 < abs(float(v)) < 0.65 else v
+            ),
+            r"velocity column .* disagrees with its positions",
+        ),
+        (7, lambda v, row: f"{float(v) + 1.0:.9f}", r"x, y do not lie at leg"),
+        (3, lambda v, row: "9.0" if row == 50 else v, r"acceleration column reaches 9 at"),
+    ],
+    ids=["leg", "velocity", "x", "acceleration"],
+)
+def test_every_column_of_a_generic_file_is_checked(exported, tmp_path, column, change, match):
+    for source in _files(exported / "generic", DIALECTS.lookup("generic")):
+        (tmp_path / source.name).write_bytes(source.read_bytes())
+    path = tmp_path / "agv1.csv"
+    lines = path.read_bytes().decode("ascii").split("\r\n")
+    for row in range(1, len(lines) - 1):
+        fields = lines[row].split(";")
+        fields[column] = change(fields[column], row)
+        lines[row] = ";".join(fields)
+    path.write_bytes("\r\n".join(lines).encode("ascii"))
+    verdict = check_profiles(default_scenario(), tmp_path)
+    assert not verdict.passed
+    assert any(re.search(match, f) for f in verdict.failures), verdict.failures
+
+
+def test_a_table_whose_axis_runs_backwards_fails(exported, tmp_path):
+    dialect = DIALECTS.lookup("siemens-xy")
+    parsed = [
+        dialect.read(p.read_bytes(), source=p.name).table for p in _files(exported / "siemens-xy", dialect)
+    ]
+    flipped = ProfileTable(parsed[0].times, -parsed[0].values, "linear")
+    _write(tmp_path, dialect, (flipped, parsed[1]))
+    verdict = check_profiles(default_scenario(), tmp_path, dialect=dialect)
+    assert any("vehicle 1's axis first moves backwards" in f for f in verdict.failures)
+
+
+STILL = """
+[track]
+legs = { A = 10.0, B = 10.0, C = 10.0 }
+[safety]
+min_separation = 1.5
+[[vehicle]]
+name = "agv1"
+max_velocity = 1.0
+max_acceleration = 0.5
+max_jerk = 1.0
+start = "A:10.0"
+goal = "A:10.0"
+[[vehicle]]
+name = "agv2"
+max_velocity = 1.0
+max_acceleration = 0.5
+max_jerk = 1.0
+start = "B:10.0"
+goal = "B:10.0"
+"""
+
+
+def test_the_checker_takes_scenarios_where_nothing_moves(tmp_path):
+    scenario_path = tmp_path / "still.toml"
+    scenario_path.write_text(STILL)
+    out = tmp_path / "out"
+    assert main(["schedule", str(scenario_path), "--csv", str(out), "--dialect", "siemens-xy"]) == EXIT_OK
+    assert main(["check", str(scenario_path), "--csv", str(out), "--dialect", "siemens-xy"]) == EXIT_OK
+
+
+def test_more_points_than_the_target_takes_fail_the_check(tmp_path, swap):
+    dialect = DIALECTS.lookup("velocity-profile")
+    _write(tmp_path, dialect, resample(swap, interpolation="linear-velocity", max_points=400).tables)
+    verdict = check_profiles(default_scenario(), tmp_path, dialect=dialect)
+    assert verdict.check.passed  # the motion is fine
+    assert any("points, more than the target takes (100)" in p for p in verdict.problems)
+    assert check_profiles(default_scenario(), tmp_path, dialect=dialect, max_points=400).passed
+
+
+@pytest.mark.parametrize("method", ["toppra", "exact"], ids=["toppra", "exact"])
+def test_the_generic_files_of_every_method_pass_the_checker(tmp_path, method):
+    out = tmp_path / method
+    assert main(["schedule", SWAP, "--csv", str(out), "--method", method]) == EXIT_OK
+    jerk = [] if method == "exact" else ["--ignore-jerk"]
+    assert main(["check", SWAP, "--csv", str(out), *jerk]) == EXIT_OK

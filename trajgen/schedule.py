@@ -319,7 +319,8 @@ class Schedule:
         velocity; 2: also acceleration). ``None``: 2 if ``jerk_limited``, else 1.
     end_tolerance : float or None
         How far from the route's start and goal the motion may begin and end,
-        metres (``None``: the verifier's 1e-9 m; PLC tables: 1e-6 m).
+        and past a leg's end it may reach, metres (``None``: the verifier's
+        1e-9 m and 1e-6 m; PLC tables: 1e-6 m; a generic CSV read back: 1e-5 m).
     checked_limits : int or None
         How many derivatives (1: velocity, 2: acceleration, 3: jerk) the
         verifier checks against the limits in closed form. ``None``: velocity

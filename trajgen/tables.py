@@ -49,8 +49,10 @@ __all__ = [
 ]
 
 
-#: How far from the route's start and goal a table may begin and end, metres.
-END_TOLERANCE = 1e-6
+#: How far from the route's start and goal a table may begin and end, and past a leg's end it may
+#: reach, metres. The cubic through two rows of a generic CSV is the reader's, not the drive's: where
+#: a motion stops hard at a leg's end (toppra) it overshoots the rows by a few micrometres.
+END_TOLERANCES = {"linear": 1e-6, "cubic": 1e-6, "linear-velocity": 1e-6, "hermite": 1e-5}
 #: How far past the junction a table's axis must go to count as passing it, metres.
 CROSSING_TOLERANCE = 1e-9
 
@@ -532,7 +534,7 @@ class TableMotion(TimingMethod):
             tuple(sections),
             jerk_limited=self.jerk,
             continuity=smoothness,
-            end_tolerance=END_TOLERANCE,
+            end_tolerance=max(END_TOLERANCES[table.interpolation] for table in self.tables),
             checked_limits=min(table.interpolation.closed_form for table in self.tables),
         )
 

@@ -335,7 +335,8 @@ def _verify(schedule: Schedule) -> VerificationReport:
     _check_tiling(pieces, duration, failures)
     _check_parked(pieces, schedule, failures)
     ratios = _check_piece_limits(pieces, schedule, failures)
-    _check_piece_track(pieces, track, route.graph, failures)
+    past_end = max(TRACK_END_TOLERANCE, schedule.end_tolerance or 0.0)
+    _check_piece_track(pieces, track, route.graph, failures, past_end)
     closest, regions = _check_piece_separation(pieces, track, required, failures)
     closest = min(closest, start_gap)
     if not pieces.count and start_gap < required - POSITION_TOLERANCE:
@@ -421,14 +422,16 @@ def _check_piece_limits(pieces: Pieces, schedule: Schedule, failures: list[str])
     return ratios
 
 
-def _check_piece_track(pieces: Pieces, track: np.ndarray, graph, failures: list[str]) -> None:
+def _check_piece_track(
+    pieces: Pieces, track: np.ndarray, graph, failures: list[str], past_end: float = TRACK_END_TOLERANCE
+) -> None:
     """Each vehicle stays on its leg and in its map's range; ``track``: s polynomials, shape (2, n, 5)."""
     lengths = np.array(graph.lengths)
     for vehicle in range(2):
         low, t_low, high, t_high = polynomials.extrema(track[vehicle], pieces.length)
         on_leg = pieces.leg[vehicle] != JUNCTION_INDEX
         length = np.where(on_leg, lengths[np.where(on_leg, pieces.leg[vehicle], 0)], 0.0)
-        over = np.nonzero(on_leg & (high > length + TRACK_END_TOLERANCE))[0]
+        over = np.nonzero(on_leg & (high > length + past_end))[0]
         if over.size:
             k = int(over[0])
             failures.append(

@@ -18,6 +18,7 @@ from pathlib import Path
 import numpy as np
 
 from topology import Homotopy, Route, plan
+from topology.indexed import track_distance
 from trajgen.errors import OptionError, ProfileFileError
 from trajgen.export.csv import profile_paths
 from trajgen.export.dialects import DIALECTS, Dialect, TableDialect
@@ -124,7 +125,8 @@ def _generic_columns(parsed, vehicle: int, check: TableCheck, scenario: Scenario
     if check.schedule is not None:
         state = check.schedule.state(table.times)
         legs = columns["leg"].astype(int) - 1  # 1-based in the file, JUNCTION_INDEX (-1) at the junction
-        where = np.nonzero((legs != state.leg[vehicle]) | (np.abs(columns["s"] - state.s[vehicle]) > 1e-6))[0]
+        apart = track_distance(legs, columns["s"], state.leg[vehicle], state.s[vehicle])
+        where = np.nonzero(apart > 1e-6)[0]
         if where.size:
             k = int(where[0])
             failures.append(
