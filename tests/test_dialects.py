@@ -167,7 +167,7 @@ def test_a_file_that_cannot_be_read_exits_2(exported, tmp_path, capsys, name, ma
 
 def test_missing_files_and_line_ends(exported, tmp_path, capsys):
     assert main(["check", SWAP, "--csv", str(tmp_path), "--dialect", "twincat-cam"]) == EXIT_BAD_INPUT
-    assert "does not exist" in capsys.readouterr().err
+    assert "agv1.csv: cannot read the profile file: No such file" in capsys.readouterr().err
     lf = tmp_path / "lf"
     lf.mkdir()
     for source in _files(exported / "twincat-cam", DIALECTS.lookup("twincat-cam")):

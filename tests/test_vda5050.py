@@ -711,7 +711,7 @@ def test_bad_factsheets_are_input_errors_naming_file_key_and_value(tmp_path, con
 @pytest.mark.parametrize(
     ("setup", "match"),
     [
-        ("missing", r"factsheet .*agv\.json: cannot read the file: No such file"),
+        ("missing", r"factsheet .*agv\.json: cannot read the factsheet: No such file"),
         ("folder", r"agv\.json: is not a regular file"),
         ("large", rf"agv\.json: is {MAX_FACTSHEET_BYTES + 1:,} bytes: expected a factsheet of at most"),
     ],

@@ -16,18 +16,19 @@ from __future__ import annotations
 
 import json
 import math
-import os
-import stat
 from dataclasses import dataclass
 from pathlib import Path
 
 from topology.validation import short_repr
 from trajgen.errors import InputError
+from trajgen.reading import FileKind, file_label, read_bounded
 
 __all__ = ["FACTSHEET_KEYS", "MAX_FACTSHEET_BYTES", "FactsheetLimits", "read_factsheet"]
 
 #: Largest factsheet file read, bytes; a larger one is refused unread.
 MAX_FACTSHEET_BYTES = 1 << 20
+#: How factsheets are read (:func:`~trajgen.reading.read_bounded`).
+FACTSHEET_FILE = FileKind("a factsheet", "a VDA 5050 factsheet JSON file", MAX_FACTSHEET_BYTES)
 #: The keys of ``physicalParameters`` that are read.
 FACTSHEET_KEYS = ("speedMax", "accelerationMax", "decelerationMax")
 
@@ -57,34 +58,6 @@ class FactsheetLimits:
     def max_acceleration(self) -> float:
         """The symmetric acceleration limit, m/s²: the smaller of acceleration and deceleration."""
         return min(self.acceleration_max, self.deceleration_max)
-
-
-def _label(path: Path) -> str:
-    text = str(path)
-    return text if len(text) <= 120 else text[:117] + "..."
-
-
-def _read_bytes(path: Path, label: str) -> bytes:
-    try:
-        info = os.stat(path)
-        if not stat.S_ISREG(info.st_mode):
-            raise InputError(
-                f"factsheet {label}: is not a regular file: expected a VDA 5050 factsheet JSON file"
-            )
-        if info.st_size > MAX_FACTSHEET_BYTES:
-            raise InputError(
-                f"factsheet {label}: is {info.st_size:,} bytes: "
-                f"expected a factsheet of at most {MAX_FACTSHEET_BYTES:,} bytes"
-            )
-        with open(path, "rb") as stream:
-            data = stream.read(MAX_FACTSHEET_BYTES + 1)
-    except OSError as error:
-        raise InputError(f"factsheet {label}: cannot read the file: {error.strerror or error}") from None
-    if len(data) > MAX_FACTSHEET_BYTES:
-        raise InputError(
-            f"factsheet {label}: is longer than {MAX_FACTSHEET_BYTES:,} bytes: expected a factsheet"
-        )
-    return data
 
 
 def _refuse_constant(name: str) -> float:
@@ -152,8 +125,8 @@ def read_factsheet(
     if not isinstance(path, (str, Path)) or str(path) == "":
         raise InputError(f"factsheet path must name a file, got {short_repr(path)}")
     path = Path(path)
-    label = _label(path)
-    document = _parse(_read_bytes(path, label), label)
+    label = file_label(path)
+    document = _parse(read_bounded(path, f"factsheet {label}", FACTSHEET_FILE), label)
     parameters = document.get("physicalParameters")
     if parameters is None:
         raise InputError(

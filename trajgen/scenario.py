@@ -27,8 +27,6 @@ folder; see :mod:`trajgen.factsheet`); it still gives ``max_jerk``.
 
 from __future__ import annotations
 
-import os
-import stat
 import tomllib
 from dataclasses import dataclass
 from importlib import resources
@@ -40,6 +38,7 @@ from topology.validation import short_repr
 from trajgen.errors import InputError, ScenarioError
 from trajgen.factsheet import read_factsheet
 from trajgen.naming import check_vehicle_name, check_vehicle_names
+from trajgen.reading import FileKind, file_label, read_bounded
 
 __all__ = [
     "DEFAULT_SCENARIO_NAME",
@@ -54,6 +53,8 @@ __all__ = [
 DEFAULT_SCENARIO_NAME = "swap.toml"
 #: Largest scenario file read, bytes; a larger one is refused unread.
 MAX_SCENARIO_BYTES = 1 << 20
+#: How scenario files are read (:func:`~trajgen.reading.read_bounded`).
+SCENARIO_FILE = FileKind("a scenario file", "a scenario TOML file", MAX_SCENARIO_BYTES, ScenarioError)
 #: Plausible range of each quantity of a scenario (SI units): outside it a scenario is refused.
 PLAUSIBLE = {
     "leg length": (1e-3, 1e5),
@@ -312,21 +313,7 @@ def parse_scenario(data: dict, *, source: str = "<scenario>", folder: str | Path
 
 def _read_scenario_file(path: Path, label: str) -> str:
     """The text of a scenario file: a regular file of at most :data:`MAX_SCENARIO_BYTES`, UTF-8."""
-    try:
-        info = os.stat(path)
-        if not stat.S_ISREG(info.st_mode):
-            raise ScenarioError(f"{label}: is not a regular file: expected a scenario TOML file")
-        if info.st_size > MAX_SCENARIO_BYTES:
-            raise ScenarioError(
-                f"{label}: is {info.st_size:,} bytes: "
-                f"expected a scenario file of at most {MAX_SCENARIO_BYTES:,} bytes"
-            )
-        with open(path, "rb") as stream:
-            data = stream.read(MAX_SCENARIO_BYTES + 1)
-    except OSError as error:
-        raise ScenarioError(f"{label}: cannot read the scenario file: {error.strerror or error}") from None
-    if len(data) > MAX_SCENARIO_BYTES:
-        raise ScenarioError(f"{label}: is longer than {MAX_SCENARIO_BYTES:,} bytes: expected a scenario file")
+    data = read_bounded(path, label, SCENARIO_FILE)
     try:
         return data.decode("utf-8")
     except UnicodeDecodeError as error:
@@ -347,7 +334,7 @@ def load_scenario(path: str | Path) -> Scenario:
     if not isinstance(path, (str, Path)) or str(path) == "":
         raise ScenarioError(f"scenario path must name a file, got {short_repr(path)}")
     path = Path(path)
-    label = str(path) if len(str(path)) <= 120 else str(path)[:117] + "..."
+    label = file_label(path)
     return _parse_text(_read_scenario_file(path, label), label, path.parent)
 
 

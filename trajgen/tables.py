@@ -656,20 +656,7 @@ def check_tables(
                 f"(previous {table.times[k - 1]:.9g} s)"
             )
     if failures:
-        nan = float("nan")
-        report = VerificationReport(
-            passed=False,
-            failures=tuple(failures),
-            pieces=0,
-            min_separation=nan,
-            separation_margin=nan,
-            velocity_ratio=(nan, nan),
-            acceleration_ratio=(nan, nan),
-            jerk_ratio=None,
-            start_error=nan,
-            goal_error=nan,
-            regions_match=False,
-        )
+        report = VerificationReport.failed(tuple(failures))
         return TableCheck(False, tuple(failures), report, {}, route)
     units = {"velocity": "m/s", "acceleration": "m/s^2", "jerk": "m/s^3"}
     for vehicle, table in enumerate(tables):

@@ -113,6 +113,24 @@ class VerificationReport:
     goal_error: float
     regions_match: bool
 
+    @classmethod
+    def failed(cls, failures: tuple[str, ...], *, pieces: int = 0) -> VerificationReport:
+        """The report of a motion that could not be checked further (its figures are NaN)."""
+        nan = float("nan")
+        return cls(
+            passed=False,
+            failures=tuple(failures),
+            pieces=pieces,
+            min_separation=nan,
+            separation_margin=nan,
+            velocity_ratio=(nan, nan),
+            acceleration_ratio=(nan, nan),
+            jerk_ratio=None,
+            start_error=nan,
+            goal_error=nan,
+            regions_match=False,
+        )
+
     def raise_if_failed(self) -> None:
         """Raise VerificationError listing the failures, if any."""
         if not self.passed:
@@ -221,20 +239,7 @@ def verify(schedule: Schedule) -> VerificationReport:
 def _failed(schedule: Schedule, failures: list[str], pieces: int = 0) -> VerificationReport:
     """A failed report for a schedule that cannot even be taken apart."""
     logger.info("schedule (%s) failed verification: %s", schedule.method, "; ".join(failures))
-    nan = float("nan")
-    return VerificationReport(
-        passed=False,
-        failures=tuple(failures),
-        pieces=pieces,
-        min_separation=nan,
-        separation_margin=nan,
-        velocity_ratio=(nan, nan),
-        acceleration_ratio=(nan, nan),
-        jerk_ratio=None,
-        start_error=nan,
-        goal_error=nan,
-        regions_match=False,
-    )
+    return VerificationReport.failed(tuple(failures), pieces=pieces)
 
 
 def _check_ends(schedule: Schedule, state, failures: list[str]) -> tuple[float, float, float]:

@@ -23,6 +23,7 @@ from trajgen.errors import OptionError, ProfileFileError
 from trajgen.export.csv import profile_paths
 from trajgen.export.dialects import DIALECTS, Dialect, TableDialect
 from trajgen.export.plc import table_paths
+from trajgen.reading import FileKind, file_label, read_bounded
 from trajgen.scenario import Scenario
 from trajgen.tables import ProfileTable, TableCheck, check_tables
 
@@ -32,6 +33,8 @@ __all__ = ["MAX_FILE_BYTES", "ProfileCheck", "check_profiles", "profile_files"]
 MAX_FILE_BYTES = 256 << 20
 #: Most points (rows) per file the checker reads.
 MAX_POINTS = 1_000_000
+#: How profile files are read (:func:`~trajgen.reading.read_bounded`).
+PROFILE_FILE = FileKind("a profile file", "a profile file", MAX_FILE_BYTES, ProfileFileError)
 
 
 @dataclass(frozen=True, slots=True)
@@ -85,17 +88,6 @@ def profile_files(scenario: Scenario, directory: str | Path, dialect: Dialect) -
     if isinstance(dialect, TableDialect):
         return table_paths(dialect, scenario.names, directory)
     return profile_paths(scenario.names, directory)
-
-
-def _read(path: Path) -> bytes:
-    if not path.exists():
-        raise ProfileFileError(f"profile file {path} does not exist")
-    if not path.is_file():
-        raise ProfileFileError(f"profile file {path} is not a regular file")
-    size = path.stat().st_size
-    if size > MAX_FILE_BYTES:
-        raise ProfileFileError(f"profile file {path} has {size:,} bytes: expected at most {MAX_FILE_BYTES:,}")
-    return path.read_bytes()
 
 
 def _routes(scenario: Scenario) -> tuple[Route, ...]:
@@ -210,7 +202,10 @@ def check_profiles(
     dialect = DIALECTS.lookup(dialect)
     limit = dialect.check_points(max_points) if isinstance(dialect, TableDialect) else None
     files = profile_files(scenario, directory, dialect)
-    parsed = [dialect.read(_read(path), source=str(path)) for path in files]
+    parsed = [
+        dialect.read(read_bounded(path, f"profile file {file_label(path)}", PROFILE_FILE), source=str(path))
+        for path in files
+    ]
     tables = (parsed[0].table, parsed[1].table)
     problems = list(parsed[0].problems + parsed[1].problems)
     for path, table in zip(files, tables, strict=True):
