@@ -10,12 +10,12 @@ import re
 
 import pytest
 
-import trajgen.online.run
+import trajgen.closed_loop
 from tests.conftest import REPO
 from trajgen.cli import EXIT_BAD_INPUT, EXIT_FAILURE, EXIT_OK, main
+from trajgen.closed_loop import format_simulation, run_simulation
 from trajgen.errors import InputError
 from trajgen.online.faults import FaultError
-from trajgen.online.run import format_simulation, run_simulation
 from trajgen.online.simulation import simulate
 from trajgen.plots import render_simulation
 from trajgen.scenario import load_scenario
@@ -84,7 +84,7 @@ def stopped_run(tmp_path_factory):
         contextlib.redirect_stdout(out),
         contextlib.redirect_stderr(err),
     ):
-        patch.setattr(trajgen.online.run, "simulate", recording)
+        patch.setattr(trajgen.closed_loop, "simulate", recording)
         status = main(argv)
     assert len(results) == 1
     return Run(status, out.getvalue(), err.getvalue(), results[0], trace, plot)
@@ -149,7 +149,7 @@ def test_a_failed_run_exits_1_and_still_writes_its_evidence(
     stopped_run, tmp_path, capsys, monkeypatch, change, message
 ):
     failed = dataclasses.replace(stopped_run.result, **change)
-    monkeypatch.setattr(trajgen.online.run, "simulate", lambda *args, **kwargs: (failed, None))
+    monkeypatch.setattr(trajgen.closed_loop, "simulate", lambda *args, **kwargs: (failed, None))
     plot = tmp_path / "plot"
     assert main(["simulate", SWAP, "--plot", str(plot)]) == EXIT_FAILURE
     captured = capsys.readouterr()
@@ -194,7 +194,7 @@ def nothing_computed(monkeypatch):
     def refuse(*args, **kwargs):
         raise AssertionError("simulate ran although the input was bad")
 
-    monkeypatch.setattr(trajgen.online.run, "simulate", refuse)
+    monkeypatch.setattr(trajgen.closed_loop, "simulate", refuse)
 
 
 @pytest.mark.usefixtures("nothing_computed")

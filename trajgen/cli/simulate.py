@@ -14,8 +14,8 @@ from trajgen.cli.options import (
     csv_dialect,
     scenario_from,
 )
+from trajgen.closed_loop import format_simulation, run_simulation
 from trajgen.export import CsvOptions
-from trajgen.online.run import format_simulation, run_simulation
 
 __all__ = ["register"]
 
