@@ -63,4 +63,4 @@ __all__ = [
     "verify",
     "write_profiles",
 ]
-__version__ = "0.4.0"
+__version__ = "0.5.0"
