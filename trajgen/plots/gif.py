@@ -14,11 +14,14 @@ from __future__ import annotations
 import io
 import struct
 from collections.abc import Iterable, Sequence
+from typing import TYPE_CHECKING
 
 import numpy as np
-from PIL import Image
 
 from trajgen.errors import InputError
+
+if TYPE_CHECKING:  # Pillow is imported when a GIF is made, not with the package
+    from PIL import Image
 
 __all__ = ["GIF_DELAY_UNIT_MS", "gif_bytes"]
 
@@ -157,6 +160,8 @@ def gif_bytes(
                 top, bottom, left, right = 0, 1, 0, 1
             window = (slice(top, bottom), slice(left, right))
             part = np.where(changed[window], palette.indices(packed[window]), _TRANSPARENT).astype(np.uint8)
+        from PIL import Image
+
         image = Image.frombytes("P", (part.shape[1], part.shape[0]), np.ascontiguousarray(part).tobytes())
         image.putpalette(palette.table)
         interlace, data = _image_data(image)
