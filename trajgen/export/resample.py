@@ -37,6 +37,8 @@ POSITION_SCALE = 1e-3
 VELOCITY_SCALE = 1e-2
 #: Shortest step between two points of a table, seconds (a spline over a shorter one has no use).
 MIN_STEP = 1e-6
+#: Points are also placed this long before and after each closest approach, seconds.
+APPROACH_SPAN = 0.1
 #: Below this speed (m/s) a vehicle counts as at rest.
 REST_SPEED = 1e-9
 
@@ -191,7 +193,11 @@ def _closest_approaches(grid: np.ndarray, state, separation: float) -> np.ndarra
         return np.zeros(0)
     inner = (distance[1:-1] < distance[:-2]) & (distance[1:-1] <= distance[2:])
     near = distance[1:-1] < 1.05 * separation + 0.01
-    return grid[1:-1][inner & near]
+    minima = grid[1:-1][inner & near]
+    # and a little before and after: where the vehicles run close together, a table is held to
+    # the schedule on both sides of the closest instant, not only at it
+    around = (minima[:, None] + np.array([-APPROACH_SPAN, 0.0, APPROACH_SPAN])[None, :]).ravel()
+    return np.unique(grid[np.clip(np.searchsorted(grid, around), 0, grid.size - 1)])
 
 
 def _equidistributed(grid: np.ndarray, density: np.ndarray, required: np.ndarray, count: int) -> np.ndarray:
