@@ -24,6 +24,7 @@ from trajgen.export.vda5050 import (
     NodeKind,
     Vda5050Options,
     node_id,
+    order_paths,
     plan_orders,
     render_manifest,
     render_orders,
@@ -505,12 +506,39 @@ def test_node_ids_are_stable_and_readable():
         ({"start_time": START, "serial_numbers": ("SN1", 2)}, r"serial_numbers\[1\]"),
         ({"start_time": START, "first_header_id": -1}, "first_header_id must be an integer"),
         ({"start_time": START, "first_header_id": True}, "first_header_id must be an integer"),
+        ({"start_time": datetime(9999, 12, 31, tzinfo=UTC)}, "start_time .* is out of range"),
+        (
+            {"start_time": datetime(1, 1, 1, tzinfo=timezone(timedelta(hours=14)))},
+            "start_time .* is out of range: expected a time from the years 1970 to 9000",
+        ),
+        ({"start_time": START, "serial_numbers": ("SN1", "SN1")}, "serial numbers are both 'SN1'"),
+        ({"start_time": START, "serial_numbers": ("a/b", "SN2")}, "serial number 'a/b' is not allowed"),
+        ({"start_time": START, "manufacturers": ("x/y", "Acme")}, r"manufacturer 'x/y' has '/', '#' or '\+'"),
     ],
-    ids=["naive", "text", "empty-map", "newline", "one-manufacturer", "serial-type", "negative", "bool"],
+    ids=[
+        "naive",
+        "text",
+        "empty-map",
+        "newline",
+        "one-manufacturer",
+        "serial-type",
+        "negative",
+        "bool",
+        "year-9999",
+        "year-1",
+        "same-serial",
+        "serial-slash",
+        "manufacturer-slash",
+    ],
 )
 def test_bad_options_are_refused(options, match):
     with pytest.raises(OptionError, match=match):
         Vda5050Options(**options)
+
+
+def test_a_vehicle_named_like_the_manifest_is_refused_before_anything_is_computed(tmp_path):
+    with pytest.raises(OptionError, match=r"vehicle name 'Manifest.json' is the manifest's file name"):
+        order_paths(("Manifest.json", "agv2"), tmp_path)
 
 
 def test_options_shape_the_header():
@@ -809,8 +837,10 @@ def test_the_command_with_a_factsheet(tmp_path, capsys):
         (["--serial-number", "agv9=X"], "names no vehicle of the scenario"),
         (["--map-id", ""], "map_id must be a non-empty"),
         (["--homotopy", "paper", "--method", "exact"], "applies to the method 'optimal' only"),
+        (["--serial-number", "SN1"], "names no vehicle: expected NAME=SERIAL"),
+        (["--start-time", "9999-12-31T23:59:59Z"], "is out of range"),
     ],
-    ids=["naive-time", "bad-time", "unknown-vehicle", "empty-map", "homotopy-exact"],
+    ids=["naive-time", "bad-time", "unknown-vehicle", "empty-map", "homotopy-exact", "bare-serial", "far-future"],
 )
 def test_bad_options_exit_2_and_write_nothing(tmp_path, capsys, extra, match):
     out = tmp_path / "orders"

@@ -47,6 +47,11 @@ def _per_vehicle(values: list[str], names: tuple[str, str], option: str, default
     for value in values:
         name, equals, text = value.partition("=")
         if not equals:
+            if option == "--serial-number":
+                raise OptionError(
+                    f"{option} {short_repr(value)} names no vehicle: expected NAME=SERIAL (two vehicles "
+                    "cannot share a serial number)"
+                )
             result = [value, value]
             continue
         if name not in names:

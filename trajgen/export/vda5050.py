@@ -47,6 +47,7 @@ from __future__ import annotations
 import itertools
 import json
 import math
+import re
 from collections.abc import Sequence
 from dataclasses import dataclass
 from datetime import UTC, datetime, timedelta
@@ -92,6 +93,10 @@ __all__ = [
 VDA5050_VERSION = "2.1.0"
 #: Name of the index file written beside the vehicles' folders.
 MANIFEST_NAME = "manifest.json"
+#: The characters VDA 5050 allows in a serial number (it is part of the MQTT topic).
+SERIAL_NUMBER = re.compile(r"[A-Za-z0-9_.:-]+")
+#: The years a start time may fall in (its timestamps must stay representable).
+FIRST_YEAR, LAST_YEAR = 1970, 9000
 #: Reversals shorter than this are round-off; nodes this close to each other, to a route waypoint,
 #: a leg's end or the junction are one, metres.
 NODE_TOLERANCE = 1e-6
@@ -264,12 +269,40 @@ class Vda5050Options:
             raise OptionError(
                 f"VDA 5050 start_time must be a time zone aware datetime, got {short_repr(self.start_time)}"
             )
-        object.__setattr__(self, "start_time", self.start_time.astimezone(UTC))
+        try:
+            start = self.start_time.astimezone(UTC)
+        except OverflowError:
+            start = None
+        if start is None or not FIRST_YEAR <= start.year <= LAST_YEAR:
+            raise OptionError(
+                f"VDA 5050 start_time {short_repr(str(self.start_time))} is out of range: expected a time "
+                f"from the years {FIRST_YEAR} to {LAST_YEAR} (UTC)"
+            )
+        object.__setattr__(self, "start_time", start)
         for name in ("map_id", "order_id"):
             _check_text(getattr(self, name), f"VDA 5050 {name}")
-        object.__setattr__(self, "manufacturers", _text_pair(self.manufacturers, "manufacturers"))
+        manufacturers = _text_pair(self.manufacturers, "manufacturers")
+        for value in manufacturers:
+            if any(character in value for character in "/#+"):
+                raise OptionError(
+                    f"VDA 5050 manufacturer {short_repr(value)} has '/', '#' or '+': it is part of the "
+                    "MQTT topic; expected none of them"
+                )
+        object.__setattr__(self, "manufacturers", manufacturers)
         if self.serial_numbers is not None:
-            object.__setattr__(self, "serial_numbers", _text_pair(self.serial_numbers, "serial_numbers"))
+            serials = _text_pair(self.serial_numbers, "serial_numbers")
+            for value in serials:
+                if not SERIAL_NUMBER.fullmatch(value):
+                    raise OptionError(
+                        f"VDA 5050 serial number {short_repr(value)} is not allowed: expected the characters "
+                        "A-Z a-z 0-9 _ . : - only"
+                    )
+            if serials[0] == serials[1] and manufacturers[0] == manufacturers[1]:
+                raise OptionError(
+                    f"VDA 5050 serial numbers are both {serials[0]!r} with one manufacturer: expected "
+                    "two vehicles (one MQTT topic each)"
+                )
+            object.__setattr__(self, "serial_numbers", serials)
         value = self.first_header_id
         if isinstance(value, bool) or not isinstance(value, int) or not 0 <= value <= MAX_FIRST_HEADER_ID:
             raise OptionError(
@@ -998,9 +1031,15 @@ def order_paths(names: Sequence[str], directory: str | Path) -> tuple[Path, Path
     Raises
     ------
     InputError
-        Bad names, or ``directory`` names no folder.
+        Bad names (also a vehicle named like the manifest), or ``directory`` names no folder.
     """
     first, second = check_vehicle_names(names)
+    for name in (first, second):
+        if name.lower() == MANIFEST_NAME.lower():
+            raise OptionError(
+                f"vehicle name {name!r} is the manifest's file name: expected another name (its orders "
+                f"go into a folder of that name beside {MANIFEST_NAME})"
+            )
     if not isinstance(directory, (str, Path)) or str(directory) == "":
         raise OptionError(f"VDA 5050 output folder must name a folder, got {short_repr(directory)}")
     directory = Path(directory)
