@@ -840,7 +840,15 @@ def test_the_command_with_a_factsheet(tmp_path, capsys):
         (["--serial-number", "SN1"], "names no vehicle: expected NAME=SERIAL"),
         (["--start-time", "9999-12-31T23:59:59Z"], "is out of range"),
     ],
-    ids=["naive-time", "bad-time", "unknown-vehicle", "empty-map", "homotopy-exact", "bare-serial", "far-future"],
+    ids=[
+        "naive-time",
+        "bad-time",
+        "unknown-vehicle",
+        "empty-map",
+        "homotopy-exact",
+        "bare-serial",
+        "far-future",
+    ],
 )
 def test_bad_options_exit_2_and_write_nothing(tmp_path, capsys, extra, match):
     out = tmp_path / "orders"
