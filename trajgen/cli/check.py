@@ -5,9 +5,8 @@ from __future__ import annotations
 import argparse
 import json
 
-from trajgen.cli.options import EXIT_FAILURE, EXIT_OK, scenario_from
+from trajgen.cli.options import EXIT_FAILURE, EXIT_OK, add_dialect_options, scenario_from
 from trajgen.export.check import check_profiles
-from trajgen.export.dialects import DIALECTS
 
 __all__ = ["SHOWN_FAILURES", "register"]
 
@@ -49,16 +48,10 @@ def register(commands) -> None:
     )
     check.add_argument("scenario", help="scenario TOML file")
     check.add_argument("--csv", metavar="DIR", required=True, help="folder holding both vehicles' files")
-    check.add_argument(
-        "--dialect",
-        default="generic",
-        metavar="|".join(DIALECTS.names),
-        help=f"dialect of the files, one of:\n{DIALECTS.help()}",
-    )
-    check.add_argument(
-        "--max-points",
-        type=int,
-        help="most points per table the target takes (default: the dialect's limit)",
+    add_dialect_options(
+        check,
+        dialect="dialect of the files",
+        points="most points per table the target takes (default: the dialect's limit)",
     )
     check.add_argument("--ignore-jerk", action="store_true", help="do not hold the files to the jerk limits")
     check.add_argument("--json", action="store_true", help="print a machine-readable verdict")

@@ -24,6 +24,7 @@ __all__ = [
     "EXIT_OK",
     "CommandParser",
     "add_csv_options",
+    "add_dialect_options",
     "add_method",
     "csv_dialect",
     "csv_options",
@@ -131,6 +132,17 @@ def method_from(args: argparse.Namespace) -> TimingMethod:
     return dataclasses.replace(method, homotopy=choice)
 
 
+def add_dialect_options(parser: argparse.ArgumentParser, *, dialect: str, points: str) -> None:
+    """``--dialect`` (help ``dialect``, then the list of dialects) and ``--max-points`` (help ``points``)."""
+    parser.add_argument(
+        "--dialect",
+        default="generic",
+        metavar="|".join(DIALECTS.names),
+        help=f"{dialect}, one of:\n{DIALECTS.help()}",
+    )
+    parser.add_argument("--max-points", type=int, help=points)
+
+
 def add_csv_options(parser: argparse.ArgumentParser, *, sampling: bool = True) -> None:
     """The CSV dialect options; with ``sampling``, also ``--sample-period`` and ``--max-rows``."""
     if sampling:
@@ -141,16 +153,10 @@ def add_csv_options(parser: argparse.ArgumentParser, *, sampling: bool = True) -
     parser.add_argument("--decimal", choices=[".", ","], help="decimal mark ('.')")
     parser.add_argument("--units", choices=[u.value for u in Units], help="length unit of the CSV (m)")
     if sampling:
-        parser.add_argument(
-            "--dialect",
-            default="generic",
-            metavar="|".join(DIALECTS.names),
-            help=f"PLC dialect of the --csv files, one of:\n{DIALECTS.help()}",
-        )
-        parser.add_argument(
-            "--max-points",
-            type=int,
-            help="points per table of a table dialect (default: the dialect's limit)",
+        add_dialect_options(
+            parser,
+            dialect="PLC dialect of the --csv files",
+            points="points per table of a table dialect (default: the dialect's limit)",
         )
         parser.add_argument(
             "--max-rows",
