@@ -47,6 +47,13 @@ def _files(folder, dialect):
     return [folder / f"agv1{suffix}", folder / f"agv2{suffix}"]
 
 
+def _copy(exported, dialect, target):
+    """The demo swap's files of ``dialect`` copied into ``target`` (to edit them there)."""
+    target.mkdir(parents=True, exist_ok=True)
+    for source in _files(exported / dialect.name.value, dialect):
+        (target / source.name).write_bytes(source.read_bytes())
+
+
 @pytest.mark.parametrize("name", ALL, ids=ALL)
 def test_every_dialects_output_passes_the_checker(exported, name, capsys):
     assert main(["check", SWAP, "--csv", str(exported / name), "--dialect", name, "--json"]) == EXIT_OK
@@ -86,9 +93,7 @@ def test_table_files_have_the_dialects_format(exported, dialect, swap):
 def test_a_row_moved_by_a_centimetre_fails_the_check(exported, name, tmp_path, capsys):
     dialect = DIALECTS.lookup(name)
     edited = tmp_path / name
-    edited.mkdir()
-    for source in _files(exported / name, dialect):
-        (edited / source.name).write_bytes(source.read_bytes())
+    _copy(exported, dialect, edited)
     path = _files(edited, dialect)[0]
     lines = path.read_bytes().decode("ascii").split("\r\n")
     row = len(lines) // 3
@@ -107,9 +112,7 @@ def test_a_row_moved_by_a_centimetre_fails_the_check(exported, name, tmp_path, c
 def test_a_violation_names_the_time_the_quantity_the_value_and_the_limit(exported, tmp_path, capsys):
     dialect = DIALECTS.lookup("siemens-xy")
     edited = tmp_path / "siemens"
-    edited.mkdir()
-    for source in _files(exported / "siemens-xy", dialect):
-        (edited / source.name).write_bytes(source.read_bytes())
+    _copy(exported, dialect, edited)
     path = edited / "agv2.csv"
     lines = path.read_bytes().decode("ascii").split("\r\n")
     t, x = lines[400].split(";")
@@ -154,9 +157,7 @@ def test_a_violation_names_the_time_the_quantity_the_value_and_the_limit(exporte
 def test_a_file_that_cannot_be_read_exits_2(exported, tmp_path, capsys, name, mangle, match):
     dialect = DIALECTS.lookup(name)
     broken = tmp_path / name
-    broken.mkdir()
-    for source in _files(exported / name, dialect):
-        (broken / source.name).write_bytes(source.read_bytes())
+    _copy(exported, dialect, broken)
     path = _files(broken, dialect)[0]
     path.write_bytes(mangle(path.read_bytes().decode("ascii")).encode("ascii"))
     with pytest.raises(ProfileFileError, match=match):
@@ -348,8 +349,7 @@ def test_too_few_points_to_follow_are_refused_not_written(tmp_path, capsys):
 
 def test_a_value_written_without_decimals_does_not_widen_the_allowance(exported, tmp_path):
     dialect = DIALECTS.lookup("twincat-cam")
-    for source in _files(exported / "twincat-cam", dialect):
-        (tmp_path / source.name).write_bytes(source.read_bytes())
+    _copy(exported, dialect, tmp_path)
     path = tmp_path / "agv1.csv"
     lines = path.read_bytes().decode("ascii").split("\r\n")
     lines[0] = "0;0"  # as a spreadsheet saves it
@@ -377,8 +377,7 @@ def test_a_value_written_without_decimals_does_not_widen_the_allowance(exported,
     ids=["leg", "velocity", "x", "acceleration"],
 )
 def test_every_column_of_a_generic_file_is_checked(exported, tmp_path, column, change, match):
-    for source in _files(exported / "generic", DIALECTS.lookup("generic")):
-        (tmp_path / source.name).write_bytes(source.read_bytes())
+    _copy(exported, DIALECTS.lookup("generic"), tmp_path)
     path = tmp_path / "agv1.csv"
     lines = path.read_bytes().decode("ascii").split("\r\n")
     for row in range(1, len(lines) - 1):
