@@ -312,7 +312,8 @@ def test_the_other_class_goes_the_other_way_round_the_circle(query):
     # the two shortest classes: together once round the circle, the paper's the shorter (or equal)
     tolerance = 1e-9 * graph.perimeter
     assert abs(paper.arc_length) + abs(other.arc_length) == pytest.approx(graph.perimeter, abs=tolerance)
-    assert abs(paper.arc_length) <= abs(other.arc_length) + tolerance
+    # (counterclockwise within the antipodal tolerance either side of half a turn: up to 2 x longer)
+    assert abs(paper.arc_length) <= abs(other.arc_length) + 2 * tolerance
     assert other.regions != paper.regions
 
 

@@ -117,9 +117,9 @@ def _write(tmp_path, text):
         pytest.param("C = 10.0 }", "C = 0.0 }", r"\[track\]: length of leg 'C' must be > 0 m", id="zero-leg"),
         pytest.param(
             "C = 10.0 }",
-            "C = 10.0, D = 3.0 }",
-            r"\[track\]: a Y-track has exactly 3 legs, got 4",
-            id="four-legs",
+            "C = 10.0, D = 3.0, E = 3.0, F = 3.0, G = 3.0, H = 3.0, I = 3.0 }",
+            r"\[track\]: a track has 3 to 8 legs, got 9",
+            id="nine-legs",
         ),
         pytest.param(
             "min_separation = 1.5",

@@ -1,8 +1,10 @@
-"""Exact collision-free motion planner for two vehicles on a Y-shaped track.
+"""Exact collision-free motion planner for two vehicles on a junction of 3 to 8 legs.
 
 Implements Baldi, *Collision-Free Motion Planning Algorithm in a Y-Graph*,
-with the conventions of ``ALGORITHM.md``: the configuration space deforms onto
-a circle, so two continuous instructions suffice (topological complexity 2).
+with the conventions of ``ALGORITHM.md``: on a Y the configuration space
+deforms onto a circle, so two continuous instructions suffice (topological
+complexity 2). With four to eight legs it deforms onto the graph ``G_k`` and
+the planner takes one of three instructions (``STAR-JUNCTIONS.md``).
 
 Examples
 --------
@@ -34,10 +36,11 @@ from topology.errors import (
     TrackError,
     TrajgenError,
 )
-from topology.graph import YGraph
+from topology.graph import MAX_LEGS, MIN_LEGS, StarGraph, YGraph
 from topology.indexed import JUNCTION_INDEX, RegionKey, reduce_regions
 from topology.options import Option
 from topology.positions import JUNCTION, JUNCTION_NAME, Configuration, Position
+from topology.retract_graph import Geodesic, GraphPoint, RetractGraph
 from topology.route import Homotopy, Instruction, Region, Route, WayRound, plan, region_sequence
 
 __all__ = [
@@ -45,9 +48,13 @@ __all__ = [
     "JUNCTION",
     "JUNCTION_INDEX",
     "JUNCTION_NAME",
+    "MAX_LEGS",
+    "MIN_LEGS",
     "BoundaryCycle",
     "Cell",
     "Configuration",
+    "Geodesic",
+    "GraphPoint",
     "Homotopy",
     "InputError",
     "Instruction",
@@ -57,8 +64,10 @@ __all__ = [
     "PositionError",
     "Region",
     "RegionKey",
+    "RetractGraph",
     "Route",
     "SeparationError",
+    "StarGraph",
     "TrackError",
     "TrajgenError",
     "WayRound",

@@ -8,7 +8,8 @@ one whole leg. Built once per track, from the leg names and lengths.
 from __future__ import annotations
 
 from topology.indexed import JUNCTION_INDEX, IndexedConfiguration, step
-from topology.positions import JUNCTION, Configuration, Position
+from topology.legs import LegTable
+from topology.positions import Configuration, Position
 
 __all__ = ["BoundaryCycle", "CycleLocation"]
 
@@ -45,6 +46,7 @@ class BoundaryCycle:
         "_valley_first_at_junction",
         "_valley_second_at_junction",
         "endpoints",
+        "legs",
         "lengths",
         "names",
         "perimeter",
@@ -55,9 +57,10 @@ class BoundaryCycle:
     )
 
     def __init__(self, names: tuple[str, ...], lengths: tuple[float, ...]) -> None:
+        self.legs = LegTable(names, lengths)
         self.names = names
         self.lengths = lengths
-        self.endpoints = tuple(Position(name, length) for name, length in zip(names, lengths, strict=True))
+        self.endpoints = self.legs.endpoints
         # Counterclockwise successors (ALGORITHM.md section 4), starting at P(0, 1):
         # P(i, i+1) -> V2(i) -> P(i, i-1) -> V1(i-1) -> P(i+1, i-1).
         tuples: list[IndexedConfiguration] = []
@@ -95,15 +98,11 @@ class BoundaryCycle:
     # -- conversions -----------------------------------------------------
     def position(self, leg: int, s: float) -> Position:
         """The position at leg index ``leg``, ``s`` metres from the junction (no checks)."""
-        if leg == JUNCTION_INDEX:
-            return JUNCTION
-        if s == self.lengths[leg]:
-            return self.endpoints[leg]
-        return Position.unchecked(self.names[leg], s)
+        return self.legs.position(leg, s)
 
     def configuration(self, c: IndexedConfiguration) -> Configuration:
         """The configuration of an indexed configuration (no checks)."""
-        return Configuration.unchecked(self.position(c[0], c[1]), self.position(c[2], c[3]))
+        return self.legs.configuration(c)
 
     # -- location on the cycle --------------------------------------------
     def locate(self, c: IndexedConfiguration) -> CycleLocation:

@@ -1,7 +1,7 @@
-"""The Y-shaped track: three legs of given lengths meeting at one junction.
+"""Tracks: k legs of given lengths meeting at one junction (a star); the Y is k = 3.
 
-Conventions follow ``ALGORITHM.md`` section 1: three legs listed in
-counterclockwise order around the junction ``O``.
+Conventions follow ``ALGORITHM.md`` section 1 and ``STAR-JUNCTIONS.md``: the
+legs are listed in counterclockwise order around the junction ``O``.
 """
 
 from __future__ import annotations
@@ -13,12 +13,18 @@ from types import MappingProxyType
 
 from topology.boundary import BoundaryCycle
 from topology.errors import PositionError, TrackError
+from topology.indexed import IndexedConfiguration
+from topology.legs import LegTable
 from topology.positions import JUNCTION, JUNCTION_NAME, Configuration, Position
+from topology.retract_graph import RetractGraph
 from topology.validation import finite_real, short_repr
 
-__all__ = ["YGraph"]
+__all__ = ["MAX_LEGS", "MIN_LEGS", "StarGraph", "YGraph"]
 
-_DEFAULT_ANGLES_DEG = (90.0, 210.0, 330.0)
+#: Fewest legs of a track.
+MIN_LEGS = 3
+#: Most legs of a track.
+MAX_LEGS = 8
 
 
 def _leg_pairs(legs: object) -> list[tuple[object, object]]:
@@ -36,87 +42,124 @@ def _leg_pairs(legs: object) -> list[tuple[object, object]]:
     return pairs
 
 
+def _checked_legs(pairs: list[tuple[object, object]]) -> tuple[tuple[str, ...], tuple[float, ...]]:
+    names: list[str] = []
+    lengths: list[float] = []
+    for name, length in pairs:
+        if not isinstance(name, str) or not name.strip():
+            raise TrackError(f"leg name must be a non-empty string, got {short_repr(name)}")
+        if name != name.strip() or name == JUNCTION_NAME or ":" in name:
+            raise TrackError(
+                f"leg name {short_repr(name)} is not allowed: expected no surrounding spaces, "
+                f"no ':' and not {JUNCTION_NAME!r} (the junction)"
+            )
+        if name in names:
+            raise TrackError(f"leg names must be distinct, got {short_repr(name)} twice")
+        value = finite_real(length, f"length of leg {short_repr(name)} (metres)", TrackError)
+        if value <= 0.0:
+            raise TrackError(f"length of leg {short_repr(name)} must be > 0 m, got {value!r}")
+        names.append(name)
+        lengths.append(value)
+    return tuple(names), tuple(lengths)
+
+
+def _checked_angles(names: tuple[str, ...], angles_deg: object) -> tuple[float, ...]:
+    count = len(names)
+    if angles_deg is None:
+        return tuple(math.fmod(90.0 + 360.0 * j / count, 360.0) for j in range(count))
+    if not isinstance(angles_deg, Mapping):
+        raise TrackError(f"angles_deg must map leg name -> degrees, got {short_repr(angles_deg)}")
+    if set(angles_deg) != set(names):
+        raise TrackError(
+            f"angles_deg must give exactly the legs {list(names)!r}, got {sorted(map(str, angles_deg))!r}"
+        )
+    angles = tuple(finite_real(angles_deg[n], f"angle of leg {n!r} (degrees)", TrackError) for n in names)
+    turn = [(a - angles[0]) % 360.0 for a in angles]
+    if not turn[1] > 0.0 or not all(a < b for a, b in zip(turn[1:], [*turn[2:], 360.0], strict=True)):
+        raise TrackError(
+            f"leg angles {dict(zip(names, angles, strict=True))!r} degrees are not distinct and "
+            f"counterclockwise in the order of the legs {list(names)!r}"
+        )
+    return angles
+
+
 @dataclass(frozen=True, slots=True, init=False)
-class YGraph:
-    """A Y-shaped track: three legs of given lengths meeting at one junction.
+class StarGraph:
+    """A junction of k legs (3 <= k <= 8) of given lengths: a star-shaped track.
 
     Parameters
     ----------
     legs : Mapping[str, float] or iterable of (str, float)
         Leg name -> length in metres, in counterclockwise order around the
-        junction as seen from above. Exactly three legs, distinct non-empty
-        names (not ``"O"``, no ``":"``), finite positive lengths.
+        junction as seen from above. 3 to 8 legs, distinct non-empty names
+        (not ``"O"``, no ``":"``), finite positive lengths.
     angles_deg : Mapping[str, float], optional
         Planar direction of each leg in degrees, for drawing and x/y export.
-        Default 90, 210, 330 in the order of ``legs``. The angles must be
-        distinct and in counterclockwise order, like the legs.
+        Default: spread evenly, ``90 + 360 j / k`` for the ``j``-th leg (90,
+        210, 330 for three legs). The angles must be distinct and in
+        counterclockwise order, like the legs.
 
     Attributes
     ----------
-    names : tuple of 3 str
+    names : tuple of str, shape (k,)
         Leg names in counterclockwise order.
-    lengths : tuple of 3 float
+    lengths : tuple of float, shape (k,)
         Leg lengths, metres.
-    angles_deg : tuple of 3 float
+    angles_deg : tuple of float, shape (k,)
         Leg directions, degrees.
-    cycle : BoundaryCycle
-        The oriented boundary cycle of the configuration space (ALGORITHM.md section 4).
+    cycle : BoundaryCycle or None
+        For three legs, the oriented boundary cycle of the configuration space
+        (ALGORITHM.md section 4); ``None`` for four or more.
+
+    Notes
+    -----
+    With three legs the configuration space deforms onto a circle and
+    :func:`~topology.plan` is the paper's planner (two instructions); with
+    four or more it deforms onto the graph ``G_k`` (:attr:`retract_graph`)
+    and the planner takes one of three instructions (``STAR-JUNCTIONS.md``).
+
+    Examples
+    --------
+    >>> crossing = StarGraph({"N": 10.0, "W": 10.0, "S": 10.0, "E": 10.0})
+    >>> crossing.angles_deg
+    (90.0, 180.0, 270.0, 0.0)
+    >>> len(crossing.retract_graph.vertices), len(crossing.retract_graph.edges)
+    (20, 24)
     """
 
-    names: tuple[str, str, str]
-    lengths: tuple[float, float, float]
-    angles_deg: tuple[float, float, float]
-    cycle: BoundaryCycle = field(repr=False, compare=False, hash=False)
+    names: tuple[str, ...]
+    lengths: tuple[float, ...]
+    angles_deg: tuple[float, ...]
+    cycle: BoundaryCycle | None = field(repr=False, compare=False, hash=False)
     _index: Mapping[str, int] = field(repr=False, compare=False, hash=False)
+    _legs: LegTable = field(repr=False, compare=False, hash=False)
+    _retract_graph: list = field(repr=False, compare=False, hash=False)
 
     def __init__(self, legs, *, angles_deg: Mapping[str, float] | None = None) -> None:
         pairs = _leg_pairs(legs)
-        if len(pairs) != 3:
-            raise TrackError(f"a Y-track has exactly 3 legs, got {len(pairs)}: {[p[0] for p in pairs]!r}")
-        names: list[str] = []
-        lengths: list[float] = []
-        for name, length in pairs:
-            if not isinstance(name, str) or not name.strip():
-                raise TrackError(f"leg name must be a non-empty string, got {short_repr(name)}")
-            if name != name.strip() or name == JUNCTION_NAME or ":" in name:
-                raise TrackError(
-                    f"leg name {short_repr(name)} is not allowed: expected no surrounding spaces, "
-                    f"no ':' and not {JUNCTION_NAME!r} (the junction)"
-                )
-            if name in names:
-                raise TrackError(f"leg names must be distinct, got {short_repr(name)} twice")
-            value = finite_real(length, f"length of leg {short_repr(name)} (metres)", TrackError)
-            if value <= 0.0:
-                raise TrackError(f"length of leg {short_repr(name)} must be > 0 m, got {value!r}")
-            names.append(name)
-            lengths.append(value)
-        angles = self._check_angles(names, angles_deg)
-        object.__setattr__(self, "names", tuple(names))
-        object.__setattr__(self, "lengths", tuple(lengths))
-        object.__setattr__(self, "angles_deg", angles)
-        object.__setattr__(self, "_index", MappingProxyType({n: k for k, n in enumerate(names)}))
-        object.__setattr__(self, "cycle", BoundaryCycle(self.names, self.lengths))
+        if not MIN_LEGS <= len(pairs) <= MAX_LEGS:
+            raise TrackError(
+                f"a track has {MIN_LEGS} to {MAX_LEGS} legs, got {len(pairs)}: "
+                f"{short_repr([p[0] for p in pairs], 200)}"
+            )
+        self._initialize(pairs, angles_deg)
 
-    @staticmethod
-    def _check_angles(names: list[str], angles_deg) -> tuple[float, float, float]:
-        if angles_deg is None:
-            return _DEFAULT_ANGLES_DEG
-        if not isinstance(angles_deg, Mapping):
-            raise TrackError(f"angles_deg must map leg name -> degrees, got {short_repr(angles_deg)}")
-        if set(angles_deg) != set(names):
-            raise TrackError(
-                f"angles_deg must give exactly the legs {names!r}, got {sorted(map(str, angles_deg))!r}"
-            )
-        angles = tuple(finite_real(angles_deg[n], f"angle of leg {n!r} (degrees)", TrackError) for n in names)
-        turn = [(a - angles[0]) % 360.0 for a in angles]
-        if not 0.0 < turn[1] < turn[2] < 360.0:
-            raise TrackError(
-                f"leg angles {dict(zip(names, angles, strict=True))!r} degrees are not distinct and "
-                f"counterclockwise in the order of the legs {names!r}"
-            )
-        return angles  # type: ignore[return-value]
+    def _initialize(self, pairs: list[tuple[object, object]], angles_deg: object) -> None:
+        names, lengths = _checked_legs(pairs)
+        object.__setattr__(self, "names", names)
+        object.__setattr__(self, "lengths", lengths)
+        object.__setattr__(self, "angles_deg", _checked_angles(names, angles_deg))
+        object.__setattr__(self, "_index", MappingProxyType({n: k for k, n in enumerate(names)}))
+        object.__setattr__(self, "_legs", LegTable(names, lengths))
+        object.__setattr__(self, "cycle", BoundaryCycle(names, lengths) if len(names) == 3 else None)
+        object.__setattr__(self, "_retract_graph", [])  # filled on first use
 
     # -- lookups ---------------------------------------------------------
+    @property
+    def leg_count(self) -> int:
+        """The number k of legs."""
+        return len(self.names)
+
     @property
     def legs(self) -> Mapping[str, float]:
         """Leg name -> length in metres, counterclockwise order (read-only)."""
@@ -128,7 +171,7 @@ class YGraph:
         return min(self.lengths)
 
     def index(self, leg: str) -> int:
-        """Counterclockwise index 0, 1 or 2 of a leg.
+        """Counterclockwise index ``0 .. k-1`` of a leg.
 
         Raises
         ------
@@ -148,7 +191,7 @@ class YGraph:
 
     def endpoint(self, leg: str) -> Position:
         """The far endpoint ``E_leg`` of a leg."""
-        return self.cycle.endpoints[self.index(leg)]
+        return self._legs.endpoints[self.index(leg)]
 
     @property
     def junction(self) -> Position:
@@ -199,18 +242,82 @@ class YGraph:
         angle = math.radians(self.angles_deg[self.index(position.leg)])
         return (position.s * math.cos(angle), position.s * math.sin(angle))
 
-    # -- boundary cycle (ALGORITHM.md section 4) --------------------------
+    def configuration(self, c: IndexedConfiguration) -> Configuration:
+        """The configuration of an indexed configuration ``(leg1, s1, leg2, s2)``, unchecked (hot paths)."""
+        return self._legs.configuration(c)
+
+    # -- the graph the configuration space deforms onto -------------------
+    @property
+    def retract_graph(self) -> RetractGraph:
+        """The retract graph ``G_k`` with its per-track tables, built on first use (STAR-JUNCTIONS.md)."""
+        built = self._retract_graph
+        if not built:
+            built.append(RetractGraph(self.names, self.lengths))
+        return built[0]
+
+    @property
+    def boundary_length(self) -> float:
+        """Total length of ``G_k``, ``2 (k - 1) (L_0 + ... + L_{k-1})`` metres (the perimeter for k = 3)."""
+        return 2.0 * (len(self.lengths) - 1) * math.fsum(self.lengths)
+
+    def _boundary_cycle(self) -> BoundaryCycle:
+        if self.cycle is None:
+            raise TrackError(
+                f"a track with {len(self.names)} legs has no boundary circle (only a Y has one): "
+                "expected three legs; use retract_graph for four or more"
+            )
+        return self.cycle
+
     @property
     def perimeter(self) -> float:
-        """Length of the boundary cycle, ``4 (L_0 + L_1 + L_2)`` metres."""
-        return self.cycle.perimeter
+        """Length of the boundary circle of a Y, ``4 (L_0 + L_1 + L_2)`` metres.
+
+        Raises
+        ------
+        TrackError
+            For four or more legs (no circle; see :attr:`boundary_length`).
+        """
+        return self._boundary_cycle().perimeter
 
     @property
     def boundary_vertices(self) -> tuple[Configuration, ...]:
-        """The 12 cycle vertices, counterclockwise from ``P(first leg, second leg)``, shape (12,)."""
-        return self.cycle.vertices
+        """The vertices of the boundary (12 for a Y, counterclockwise from ``P(first leg, second leg)``).
+
+        For four or more legs, the ``k (k + 1)`` vertices of ``G_k``: peaks, then valleys.
+        """
+        if self.cycle is not None:
+            return self.cycle.vertices
+        return self.retract_graph.vertex_configurations
 
     @property
     def boundary_vertex_angles(self) -> tuple[float, ...]:
-        """Arc length ``theta`` of each cycle vertex from ``P(A, B)``, metres, shape (12,)."""
-        return self.cycle.vertex_theta
+        """Arc length ``theta`` of each cycle vertex from ``P(A, B)``, metres, shape (12,); three legs."""
+        return self._boundary_cycle().vertex_theta
+
+
+@dataclass(frozen=True, slots=True, init=False)
+class YGraph(StarGraph):
+    """A Y-shaped track: three legs of given lengths meeting at one junction.
+
+    Parameters
+    ----------
+    legs : Mapping[str, float] or iterable of (str, float)
+        Leg name -> length in metres, in counterclockwise order around the
+        junction as seen from above. Exactly three legs, distinct non-empty
+        names (not ``"O"``, no ``":"``), finite positive lengths.
+    angles_deg : Mapping[str, float], optional
+        Planar direction of each leg in degrees, for drawing and x/y export.
+        Default 90, 210, 330 in the order of ``legs``. The angles must be
+        distinct and in counterclockwise order, like the legs.
+
+    Notes
+    -----
+    A :class:`StarGraph` of three legs; :attr:`cycle` is the oriented boundary
+    cycle of the configuration space (ALGORITHM.md section 4).
+    """
+
+    def __init__(self, legs, *, angles_deg: Mapping[str, float] | None = None) -> None:
+        pairs = _leg_pairs(legs)
+        if len(pairs) != 3:
+            raise TrackError(f"a Y-track has exactly 3 legs, got {len(pairs)}: {[p[0] for p in pairs]!r}")
+        self._initialize(pairs, angles_deg)

@@ -1,8 +1,11 @@
-"""The two-instruction motion planner and its result, the :class:`Route`.
+"""The motion planner and its result, the :class:`Route`.
 
-ALGORITHM.md sections 5 and 6: retract the start onto the boundary circle, go
-round the circle (shortest way, or counterclockwise half a turn when the goal
-is the start with the vehicles swapped), then undo the goal's retraction.
+ALGORITHM.md sections 5 and 6 (three legs): retract the start onto the
+boundary circle, go round the circle (shortest way, or counterclockwise half a
+turn when the goal is the start with the vehicles swapped), then undo the
+goal's retraction. STAR-JUNCTIONS.md (four to eight legs): the same
+retractions, and between them a route on the retract graph ``G_k`` chosen by
+three rules (:mod:`topology.retract_graph`).
 """
 
 from __future__ import annotations
@@ -14,7 +17,7 @@ from dataclasses import dataclass, field
 
 from topology.cycle import ANTIPODAL_TOLERANCE, as_indexed, retract_indexed
 from topology.errors import OptionError, PositionError, SeparationError
-from topology.graph import YGraph
+from topology.graph import StarGraph
 from topology.indexed import (
     JUNCTION_INDEX,
     IndexedConfiguration,
@@ -29,23 +32,48 @@ from topology.indexed import (
 )
 from topology.options import Option
 from topology.positions import Configuration
+from topology.retract_graph import Geodesic, GraphPoint, RetractGraph
 from topology.validation import finite_real
 
 __all__ = ["Homotopy", "Instruction", "Region", "Route", "WayRound", "plan", "region_sequence"]
 
 
 class Instruction(Option):
-    """The two continuous instructions of the planner (topological complexity 2)."""
+    """The continuous instructions of the planner.
 
-    SHORTEST = "shortest"  #: paper Instruction 2: the shorter way round the boundary
-    COUNTERCLOCKWISE = "counterclockwise"  #: paper Instruction 1: half a turn, for swaps
+    Three legs (topological complexity 2): ``SHORTEST`` and ``COUNTERCLOCKWISE``.
+    Four to eight legs (topological complexity 3): ``SHORTEST``, ``TWO_TIED``
+    and ``MANY_TIED`` (STAR-JUNCTIONS.md section 3).
+    """
+
+    #: the unique shortest route (three legs: paper Instruction 2, the shorter way round)
+    SHORTEST = "shortest"
+    #: three legs, paper Instruction 1: half a turn counterclockwise, for swaps
+    COUNTERCLOCKWISE = "counterclockwise"
+    #: four or more legs, rule 2: two shortest routes tie; the larger integral of ``w`` wins
+    TWO_TIED = "two-tied"
+    #: four or more legs, rule 3: three or more tie; a fixed deterministic choice
+    MANY_TIED = "many-tied"
+
+    @classmethod
+    def of_track(cls, graph: StarGraph) -> tuple[Instruction, ...]:
+        """The instructions of the planner on ``graph``: two for three legs, three for more."""
+        if graph.leg_count == 3:
+            return (cls.SHORTEST, cls.COUNTERCLOCKWISE)
+        return (cls.SHORTEST, cls.TWO_TIED, cls.MANY_TIED)
+
+
+#: The instruction of each rule of the geodesic planner on G_k (k >= 4), by the number of tied routes.
+_RULE_INSTRUCTION = {1: Instruction.SHORTEST, 2: Instruction.TWO_TIED, 3: Instruction.MANY_TIED}
 
 
 class Homotopy(Option):
     """Which of the two shortest homotopy classes :func:`plan` takes."""
 
-    PAPER = "paper"  #: the class of the paper's instruction (ALGORITHM.md section 5)
-    OTHER = "other"  #: the other way round the boundary circle
+    PAPER = "paper"  #: the class of the planner's instruction (ALGORITHM.md section 5)
+    #: three legs: the other way round the boundary circle; four or more: the shortest
+    #: route on ``G_k`` in another class (the second-shortest simple route)
+    OTHER = "other"
 
 
 class WayRound(Option):
@@ -54,6 +82,7 @@ class WayRound(Option):
     COUNTERCLOCKWISE = "counterclockwise"
     CLOCKWISE = "clockwise"
     NONE = "none"  #: start and goal retract to the same boundary point
+    GRAPH = "graph"  #: four or more legs: along the retract graph ``G_k``, which is no circle
 
 
 @dataclass(frozen=True, slots=True)
@@ -92,12 +121,12 @@ class Region:
         return self.first_leg == self.second_leg
 
     @classmethod
-    def from_key(cls, graph: YGraph, key: RegionKey) -> Region:
+    def from_key(cls, graph: StarGraph, key: RegionKey) -> Region:
         """The named region of a :class:`~topology.indexed.RegionKey` on ``graph``."""
         names = graph.names
         return cls(names[key.first_leg], names[key.second_leg], key.nearer or None)
 
-    def key(self, graph: YGraph) -> RegionKey:
+    def key(self, graph: StarGraph) -> RegionKey:
         """The region by leg indices of ``graph``."""
         return RegionKey(graph.index(self.first_leg), graph.index(self.second_leg), self.nearer or 0)
 
@@ -107,12 +136,12 @@ class Region:
         return f"Q({self.first_leg},{self.second_leg})"
 
 
-def region_sequence(graph: YGraph, configurations) -> tuple[Region, ...]:
+def region_sequence(graph: StarGraph, configurations) -> tuple[Region, ...]:
     """Reduced region sequence of densely sampled configurations.
 
     Parameters
     ----------
-    graph : YGraph
+    graph : StarGraph
     configurations : iterable of Configuration
         Samples along a motion, in time order, dense enough that no region is
         entered and left between two samples except through the same ray.
@@ -127,10 +156,11 @@ class Route:
 
     Attributes
     ----------
-    graph : YGraph
+    graph : StarGraph
         The track.
     instruction : Instruction
-        Which of the two instructions produced the route.
+        Which of the planner's instructions produced the route (two for three legs, three
+        for more: :meth:`Instruction.of_track`).
     waypoints : tuple of Configuration
         Start first, goal last; shape (n,), ``n >= 1``. Between consecutive
         waypoints each vehicle moves linearly within one leg (it crosses the
@@ -138,18 +168,18 @@ class Route:
     min_separation : float
         The separation the route was planned for, metres.
     arc_length : float
-        Signed length of the trip round the boundary circle, metres,
-        positive counterclockwise.
+        Three legs: signed length of the trip round the boundary circle, metres,
+        positive counterclockwise. Four or more: length of the route on ``G_k``, metres.
     indexed_waypoints : tuple of IndexedConfiguration
         The waypoints in the indexed form ``(leg1, s1, leg2, s2)``, shape (n,).
     cumulative_travel : tuple of float
         Travel ``|ds1| + |ds2|`` from the start to each waypoint, metres, shape (n,).
     homotopy : Homotopy
-        ``PAPER`` if the route takes the class of the paper's instruction, ``OTHER`` if it goes the
-        other way round the boundary circle (``plan(..., homotopy=Homotopy.OTHER)``).
+        ``PAPER`` if the route takes the class of the planner's instruction, ``OTHER`` for the
+        second class (``plan(..., homotopy=Homotopy.OTHER)``).
     """
 
-    graph: YGraph
+    graph: StarGraph
     instruction: Instruction
     waypoints: tuple[Configuration, ...]
     min_separation: float
@@ -169,7 +199,12 @@ class Route:
 
     @property
     def way_round(self) -> WayRound:
-        """The direction the route goes round the boundary circle (from the sign of ``arc_length``)."""
+        """The direction the route goes round the boundary circle (from the sign of ``arc_length``).
+
+        ``GRAPH`` for four or more legs, unless the route stays at one point of ``G_k``.
+        """
+        if self.graph.cycle is None:
+            return WayRound.GRAPH if self.arc_length > 0.0 else WayRound.NONE
         if self.arc_length > 0.0:
             return WayRound.COUNTERCLOCKWISE
         if self.arc_length < 0.0:
@@ -260,8 +295,7 @@ class Route:
         # s is 0 at the junction, so linear interpolation holds through it too.
         s1 = _between(a[1], b[1], fraction)
         s2 = _between(a[3], b[3], fraction)
-        cycle = self.graph.cycle
-        return cycle.configuration(
+        return self.graph.configuration(
             (leg1 if s1 > 0.0 else JUNCTION_INDEX, s1, leg2 if s2 > 0.0 else JUNCTION_INDEX, s2)
         )
 
@@ -273,19 +307,22 @@ def _between(s_a: float, s_b: float, fraction: float) -> float:
 
 
 def plan(
-    graph: YGraph,
+    graph: StarGraph,
     start: Configuration,
     goal: Configuration,
     *,
     min_separation: float = 0.0,
     homotopy: Homotopy | str = Homotopy.PAPER,
 ) -> Route:
-    """Plan a collision-free route from ``start`` to ``goal`` (ALGORITHM.md section 5).
+    """Plan a collision-free route from ``start`` to ``goal``.
+
+    Three legs: the paper's planner (ALGORITHM.md section 5). Four to eight
+    legs: the three-rule geodesic planner on ``G_k`` (STAR-JUNCTIONS.md).
 
     Parameters
     ----------
-    graph : YGraph
-        The track.
+    graph : StarGraph
+        The track (a :class:`~topology.YGraph` or any :class:`~topology.StarGraph`).
     start, goal : Configuration
         Vehicle 1 and vehicle 2 positions at the start and at the goal.
     min_separation : float, optional
@@ -293,10 +330,11 @@ def plan(
         ``0 <= min_separation <= shortest leg``. ``0`` means only "not the
         same point".
     homotopy : Homotopy or str, optional
-        ``"paper"`` (default): the class the paper's instruction takes.
+        ``"paper"`` (default): the class the planner's instruction takes.
         ``"other"``: the same retractions, but the other way round the
-        boundary circle (the second of the two shortest classes).
-        ``Route.instruction`` names the paper's instruction either way.
+        boundary circle (three legs), or the shortest route on ``G_k`` in
+        another class (four or more legs). ``Route.instruction`` names the
+        planner's instruction either way.
 
     Returns
     -------
@@ -312,11 +350,20 @@ def plan(
         An unknown ``homotopy``, or ``"other"`` where start and goal retract to
         the same boundary point (the other way would be a full turn).
     SeparationError
-        ``min_separation`` out of range, or the vehicles closer than it at
-        the start or at the goal.
+        ``min_separation`` out of range (naming the legs it would not fit as
+        sidings), or the vehicles closer than it at the start or at the goal.
+
+    Examples
+    --------
+    >>> from topology import StarGraph, Position, Configuration, plan
+    >>> crossing = StarGraph({"N": 10.0, "W": 10.0, "S": 10.0, "E": 10.0})
+    >>> start = Configuration(Position("N", 10.0), Position("S", 10.0))
+    >>> route = plan(crossing, start, Configuration(Position("S", 10.0), Position("N", 10.0)))
+    >>> route.instruction, len(route.waypoints), route.length
+    (<Instruction.SHORTEST: 'shortest'>, 7, 60.0)
     """
-    if not isinstance(graph, YGraph):
-        raise TypeError(f"graph must be a YGraph, got {graph!r} ({type(graph).__name__})")
+    if not isinstance(graph, StarGraph):
+        raise TypeError(f"graph must be a StarGraph or YGraph, got {graph!r} ({type(graph).__name__})")
     required = _check_min_separation(graph, min_separation)
     homotopy = Homotopy.lookup(homotopy)
     a = as_indexed(graph, start)
@@ -328,29 +375,19 @@ def plan(
                 f"expected at least the min_separation {required!r} m"
             )
     lengths = graph.lengths
-    cycle = graph.cycle
     to_boundary = retract_indexed(a, lengths)
     from_boundary = retract_indexed(b, lengths)
-    origin = cycle.locate(to_boundary[-1])
-    target = cycle.locate(from_boundary[-1])
-    perimeter = cycle.perimeter
-    half = 0.5 * perimeter
-    delta = cycle.counterclockwise_distance(origin, target)
-    if abs(delta - half) <= ANTIPODAL_TOLERANCE * perimeter:
-        instruction, counterclockwise = Instruction.COUNTERCLOCKWISE, True
+    if graph.cycle is None:
+        instruction, arc_length, boundary = _route_on_graph(
+            graph.retract_graph, to_boundary[-1], from_boundary[-1], homotopy, start, goal
+        )
+        vertex = graph.retract_graph.vertex_configuration
     else:
-        instruction, counterclockwise = Instruction.SHORTEST, delta < half
-    if homotopy is Homotopy.OTHER:
-        # the same point: delta is 0, or the perimeter less a round-off (from retractions of
-        # positions such as 1e-311 m, a float's step away from the junction)
-        if min(delta, perimeter - delta) <= SAME_POINT_TOLERANCE * perimeter:
-            raise OptionError(
-                f"homotopy 'other' from {start} to {goal}: both retract to the same boundary point, so "
-                "the other way round is a full turn; expected a query whose retractions differ"
-            )
-        counterclockwise = not counterclockwise
-    arc_length = delta if counterclockwise else -(perimeter - delta)
-    candidates = to_boundary + cycle.arc(origin, target, counterclockwise) + from_boundary[::-1]
+        instruction, arc_length, boundary = _route_round_circle(
+            graph, to_boundary[-1], from_boundary[-1], homotopy, start, goal
+        )
+        vertex = graph.cycle.vertex_configuration
+    candidates = to_boundary + boundary + from_boundary[::-1]
 
     # Drop zero-length segments only: a tiny step (even 1e-300 m) may carry a vehicle
     # to the junction, and dropping it would make that vehicle change legs mid-segment.
@@ -361,8 +398,7 @@ def plan(
         if travel > 0.0:
             kept.append(c)
             cumulative.append(cumulative[-1] + travel)
-    vertex = cycle.vertex_configuration
-    inner = tuple(vertex.get(c) or cycle.configuration(c) for c in kept[1:-1])
+    inner = tuple(vertex.get(c) or graph.configuration(c) for c in kept[1:-1])
     waypoints = (start, *inner, goal) if len(kept) > 1 else (start,)
     return Route(
         graph=graph,
@@ -376,15 +412,79 @@ def plan(
     )
 
 
+def _same_point_refused(start: Configuration, goal: Configuration) -> OptionError:
+    return OptionError(
+        f"homotopy 'other' from {start} to {goal}: both retract to the same boundary point, so "
+        "the other way round is a full turn; expected a query whose retractions differ"
+    )
+
+
+def _route_round_circle(
+    graph: StarGraph,
+    origin_point: IndexedConfiguration,
+    target_point: IndexedConfiguration,
+    homotopy: Homotopy,
+    start: Configuration,
+    goal: Configuration,
+) -> tuple[Instruction, float, list[IndexedConfiguration]]:
+    """Instruction, signed arc length and cycle vertices passed, three legs (ALGORITHM.md section 5)."""
+    cycle = graph.cycle
+    origin = cycle.locate(origin_point)
+    target = cycle.locate(target_point)
+    perimeter = cycle.perimeter
+    half = 0.5 * perimeter
+    delta = cycle.counterclockwise_distance(origin, target)
+    if abs(delta - half) <= ANTIPODAL_TOLERANCE * perimeter:
+        instruction, counterclockwise = Instruction.COUNTERCLOCKWISE, True
+    else:
+        instruction, counterclockwise = Instruction.SHORTEST, delta < half
+    if homotopy is Homotopy.OTHER:
+        # the same point: delta is 0, or the perimeter less a round-off (from retractions of
+        # positions such as 1e-311 m, a float's step away from the junction)
+        if min(delta, perimeter - delta) <= SAME_POINT_TOLERANCE * perimeter:
+            raise _same_point_refused(start, goal)
+        counterclockwise = not counterclockwise
+    arc_length = delta if counterclockwise else -(perimeter - delta)
+    return instruction, arc_length, cycle.arc(origin, target, counterclockwise)
+
+
+def _route_on_graph(
+    retract_graph: RetractGraph,
+    origin_point: IndexedConfiguration,
+    target_point: IndexedConfiguration,
+    homotopy: Homotopy,
+    start: Configuration,
+    goal: Configuration,
+) -> tuple[Instruction, float, list[IndexedConfiguration]]:
+    """Instruction, length and ``G_k`` vertices passed, four or more legs (STAR-JUNCTIONS.md section 3)."""
+    origin: GraphPoint = retract_graph.locate(origin_point)
+    target: GraphPoint = retract_graph.locate(target_point)
+    chosen: Geodesic = retract_graph.shortest(origin, target)
+    instruction = _RULE_INSTRUCTION[chosen.tied]
+    if homotopy is Homotopy.OTHER:
+        if retract_graph.same_point(origin, target, SAME_POINT_TOLERANCE * retract_graph.total_length):
+            raise _same_point_refused(start, goal)
+        chosen = retract_graph.second_shortest(origin, target, chosen)
+    vertices = retract_graph.vertices
+    return instruction, chosen.length, [vertices[v] for v in chosen.vertices]
+
+
 #: Boundary points closer than this fraction of the perimeter are one point (float round-off).
 SAME_POINT_TOLERANCE = 64 * sys.float_info.epsilon
 
 
-def _check_min_separation(graph: YGraph, min_separation: float) -> float:
+def _check_min_separation(graph: StarGraph, min_separation: float) -> float:
     separation = finite_real(min_separation, "min_separation (metres)", SeparationError)
     shortest = graph.shortest_leg
     if separation < 0.0 or separation > shortest:
+        short = [
+            f"{name!r} ({length!r} m)"
+            for name, length in zip(graph.names, graph.lengths, strict=True)
+            if length < separation
+        ]
+        why = f": legs {', '.join(short)} would be too short to serve as sidings" if short else ""
         raise SeparationError(
-            f"min_separation must be between 0 m and the shortest leg {shortest!r} m, got {separation!r} m"
+            f"min_separation must be between 0 m and the shortest leg {shortest!r} m, "
+            f"got {separation!r} m{why}"
         )
     return separation

@@ -15,7 +15,7 @@ Examples
 """
 
 from limits import Limits, VehicleLimits
-from topology import Configuration, Instruction, Position, Route, YGraph, plan
+from topology import Configuration, Instruction, Position, Route, StarGraph, YGraph, plan
 from trajgen.analysis import lower_bound
 from trajgen.errors import InputError, TrajgenError, VerificationError
 from trajgen.export import CsvOptions, Units, write_profiles
@@ -43,6 +43,7 @@ __all__ = [
     "Scenario",
     "Schedule",
     "SolverCache",
+    "StarGraph",
     "TimingMethod",
     "Toppra",
     "TrajgenError",
@@ -63,4 +64,4 @@ __all__ = [
     "verify",
     "write_profiles",
 ]
-__version__ = "0.5.0"
+__version__ = "0.6.0"

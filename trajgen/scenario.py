@@ -33,7 +33,7 @@ from importlib import resources
 from pathlib import Path
 
 from limits import Limits, VehicleLimits
-from topology import Configuration, Position, Route, YGraph, plan
+from topology import Configuration, Position, Route, StarGraph, YGraph, plan
 from topology.validation import short_repr
 from trajgen.errors import InputError, ScenarioError
 from trajgen.factsheet import read_factsheet
@@ -84,7 +84,9 @@ class Scenario:
 
     Attributes
     ----------
-    track : YGraph
+    track : StarGraph
+        The track: a :class:`~topology.YGraph` for three legs, a
+        :class:`~topology.StarGraph` for four to eight.
     limits : Limits
         Both vehicles' limits and the minimum separation.
     names : tuple of 2 str
@@ -94,7 +96,7 @@ class Scenario:
         Where it came from (file path or ``<built-in swap.toml>``).
     """
 
-    track: YGraph
+    track: StarGraph
     limits: Limits
     names: tuple[str, str]
     start: Configuration
@@ -102,8 +104,8 @@ class Scenario:
     source: str
 
     def __post_init__(self) -> None:
-        if not isinstance(self.track, YGraph):
-            raise InputError(f"scenario track must be a YGraph, got {type(self.track).__name__}")
+        if not isinstance(self.track, StarGraph):
+            raise InputError(f"scenario track must be a StarGraph or YGraph, got {type(self.track).__name__}")
         if not isinstance(self.limits, Limits):
             raise InputError(f"scenario limits must be Limits, got {type(self.limits).__name__}")
         object.__setattr__(self, "names", check_vehicle_names(self.names))
@@ -116,7 +118,7 @@ class Scenario:
         return plan(self.track, self.start, self.goal, min_separation=self.limits.min_separation)
 
 
-def _check_plausible_track(track: YGraph) -> None:
+def _check_plausible_track(track: StarGraph) -> None:
     low, high = PLAUSIBLE["leg length"]
     for name, length in zip(track.names, track.lengths, strict=True):
         if not low <= length <= high:
@@ -160,7 +162,7 @@ def _number(value: object, where: str, source: str) -> float:
     return float(value)
 
 
-def _parse_track(data: dict, source: str) -> YGraph:
+def _parse_track(data: dict, source: str) -> StarGraph:
     track_table = _table(data["track"], "[track]", source)
     _check_keys(track_table, _TRACK_KEYS, "[track]", source)
     legs = _table(track_table["legs"], "[track] legs", source)
@@ -175,7 +177,8 @@ def _parse_track(data: dict, source: str) -> YGraph:
             for name, a in angle_table.items()
         }
     try:
-        track = YGraph(lengths, angles_deg=angles)
+        kind = YGraph if len(lengths) == 3 else StarGraph
+        track = kind(lengths, angles_deg=angles)
         _check_plausible_track(track)
         return track
     except InputError as error:
@@ -215,7 +218,7 @@ def _factsheet_limits(vehicle: dict, where: str, source: str, folder: Path | Non
 
 
 def _parse_vehicle(
-    vehicle: object, k: int, track: YGraph, taken: list[str], source: str, folder: Path | None = None
+    vehicle: object, k: int, track: StarGraph, taken: list[str], source: str, folder: Path | None = None
 ):
     """Name, limits, start and goal of ``[[vehicle]]`` number ``k``."""
     where = f"[[vehicle]] {k}"
@@ -294,9 +297,12 @@ def parse_scenario(data: dict, *, source: str = "<scenario>", folder: str | Path
     goal = Configuration(parsed[0][3], parsed[1][3])
     shortest = track.shortest_leg
     if separation > shortest:
+        too_short = [
+            name for name, length in zip(track.names, track.lengths, strict=True) if length < separation
+        ]
         raise ScenarioError(
             f"{source}: [safety] min_separation {separation!r} m exceeds the shortest leg {shortest!r} m: "
-            "some swaps would be impossible"
+            f"legs {short_repr(too_short, 200)} could not serve as sidings, so some swaps would be impossible"
         )
     for label, configuration in (("start", start), ("goal", goal)):
         distance = track.separation(configuration)
