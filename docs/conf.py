@@ -53,7 +53,7 @@ html_theme_options = {"nosidebar": False, "fixed_sidebar": False}
 #: Words of numpydoc type descriptions that are no Python names ("float, optional", "array_like,
 #: shape (n,)", "iterable of Configuration", "path"): napoleon passes them on as class references.
 NUMPYDOC_WORDS = frozenset(
-    {"optional", "default", "array_like", "shape", "n", "iterable", "sequence", "path", "callable"}
+    {"optional", "default", "array_like", "shape", "n", "k", "iterable", "sequence", "path", "callable"}
 )
 _DOTTED_NAME = re.compile(r"[A-Za-z_][A-Za-z0-9_]*(\.[A-Za-z_][A-Za-z0-9_]*)*")
 

@@ -5,7 +5,7 @@ from __future__ import annotations
 from hypothesis import assume
 from hypothesis import strategies as st
 
-from topology import Configuration, Position, YGraph, retract
+from topology import Configuration, Position, StarGraph, YGraph, retract
 
 LEG_NAMES = (("A", "B", "C"), ("north", "west", "east"), ("1", "2", "3"))
 
@@ -57,6 +57,59 @@ def queries(draw):
         boundary = retract(graph, start)[-1].swapped()
         goal = scaled(graph, boundary, draw(st.floats(0.05, 1.0)))
         assume(graph.separation(goal) > 0.0)
+    ceiling = min(graph.shortest_leg, graph.separation(start), graph.separation(goal))
+    separation = draw(st.one_of(st.just(0.0), st.just(ceiling), st.floats(0.0, ceiling)))
+    return graph, start, goal, separation
+
+
+# -- junctions of 3 to 8 legs (STAR-JUNCTIONS.md) ------------------------------------------------------
+
+#: Leg names of star tracks, counterclockwise; a track of k legs takes the first k.
+STAR_LEG_NAMES = (
+    ("N", "W", "S", "E", "U", "V", "X", "Y"),
+    ("leg1", "leg2", "leg3", "leg4", "leg5", "leg6", "leg7", "leg8"),
+)
+
+
+@st.composite
+def star_tracks(
+    draw, min_legs: int = 4, max_legs: int = 8, min_length: float = 0.5, max_length: float = 50.0
+) -> StarGraph:
+    """A junction of ``min_legs`` to ``max_legs`` legs of random length in [min_length, max_length] metres."""
+    count = draw(st.integers(min_legs, max_legs))
+    names = draw(st.sampled_from(STAR_LEG_NAMES))[:count]
+    lengths = [draw(st.floats(min_length, max_length)) for _ in names]
+    return StarGraph(dict(zip(names, lengths, strict=True)))
+
+
+@st.composite
+def star_configurations(draw, graph: StarGraph, kind: str = "random") -> Configuration:
+    """A configuration of ``graph``: ``random``, ``endpoints`` (a peak of G_k) or ``junction`` (one at O)."""
+    if kind == "random":
+        return draw(configurations(graph))
+    first, second = draw(st.lists(st.sampled_from(graph.names), min_size=2, max_size=2, unique=True))
+    if kind == "endpoints":
+        return Configuration(graph.endpoint(first), graph.endpoint(second))
+    other = draw(st.one_of(st.just(graph.endpoint(second)), positions(graph).filter(lambda p: p.s > 0)))
+    pair = (graph.junction, other)
+    return Configuration(*(pair if draw(st.booleans()) else pair[::-1]))
+
+
+@st.composite
+def star_queries(draw, min_legs: int = 4, max_legs: int = 8):
+    """(graph, start, goal, min_separation) on a star; swaps, leg ends and the junction well represented."""
+    graph = draw(star_tracks(min_legs, max_legs))
+    how = draw(st.sampled_from(["random", "random", "swap", "endpoints", "junction", "mixed"]))
+    if how in ("random", "swap"):
+        start = draw(star_configurations(graph))
+        goal = start.swapped() if how == "swap" else draw(star_configurations(graph))
+    elif how == "mixed":
+        kinds = st.sampled_from(["random", "endpoints", "junction"])
+        start = draw(star_configurations(graph, draw(kinds)))
+        goal = draw(star_configurations(graph, draw(kinds)))
+    else:
+        start = draw(star_configurations(graph, how))
+        goal = draw(star_configurations(graph, how))
     ceiling = min(graph.shortest_leg, graph.separation(start), graph.separation(goal))
     separation = draw(st.one_of(st.just(0.0), st.just(ceiling), st.floats(0.0, ceiling)))
     return graph, start, goal, separation

@@ -7,8 +7,8 @@ the ``*_indexed`` variants work on the planner's indexed form
 
 from __future__ import annotations
 
-from topology.errors import PositionError, SeparationError
-from topology.graph import YGraph
+from topology.errors import PositionError, SeparationError, TrackError
+from topology.graph import StarGraph
 from topology.indexed import JUNCTION_INDEX, IndexedConfiguration, separation
 from topology.options import Option
 from topology.positions import Configuration
@@ -92,7 +92,7 @@ def retract_indexed(c: IndexedConfiguration, lengths: tuple[float, ...]) -> list
     return out
 
 
-def as_indexed(graph: YGraph, configuration: Configuration) -> IndexedConfiguration:
+def as_indexed(graph: StarGraph, configuration: Configuration) -> IndexedConfiguration:
     """Validate a configuration against the track and return its indexed form.
 
     Raises
@@ -117,7 +117,7 @@ def as_indexed(graph: YGraph, configuration: Configuration) -> IndexedConfigurat
     return c
 
 
-def classify(graph: YGraph, configuration: Configuration) -> Cell:
+def classify(graph: StarGraph, configuration: Configuration) -> Cell:
     """The cell of the configuration space that holds ``configuration``.
 
     Raises
@@ -130,7 +130,7 @@ def classify(graph: YGraph, configuration: Configuration) -> Cell:
     return classify_indexed(as_indexed(graph, configuration), graph.lengths)
 
 
-def retract(graph: YGraph, configuration: Configuration) -> tuple[Configuration, ...]:
+def retract(graph: StarGraph, configuration: Configuration) -> tuple[Configuration, ...]:
     """Waypoints of the retraction of ``configuration`` onto the boundary.
 
     Paper Instructions 3 and 4: first waypoint is ``configuration``, last is
@@ -142,13 +142,12 @@ def retract(graph: YGraph, configuration: Configuration) -> tuple[Configuration,
     tuple of Configuration
         Between 1 and 3 waypoints; every segment increases the separation.
     """
-    cycle = graph.cycle
     return tuple(
-        cycle.configuration(c) for c in retract_indexed(as_indexed(graph, configuration), graph.lengths)
+        graph.configuration(c) for c in retract_indexed(as_indexed(graph, configuration), graph.lengths)
     )
 
 
-def boundary_angle(graph: YGraph, configuration: Configuration) -> float:
+def boundary_angle(graph: StarGraph, configuration: Configuration) -> float:
     """Arc length ``theta`` of a boundary configuration, metres in ``[0, perimeter)``.
 
     Measured counterclockwise along the boundary cycle from ``P(first leg,
@@ -158,7 +157,15 @@ def boundary_angle(graph: YGraph, configuration: Configuration) -> float:
     ------
     PositionError
         If ``configuration`` is not on the boundary (retract it first).
+    TrackError
+        For a track of four or more legs, which has no boundary circle.
     """
+    cycle = graph.cycle
+    if cycle is None:
+        raise TrackError(
+            f"a track with {graph.leg_count} legs has no boundary circle (only a Y has one): "
+            "expected three legs; locate boundary points on retract_graph for four or more"
+        )
     c = as_indexed(graph, configuration)
     cell = classify_indexed(c, graph.lengths)
     if not cell.on_boundary:
@@ -166,11 +173,10 @@ def boundary_angle(graph: YGraph, configuration: Configuration) -> float:
             f"configuration {configuration} is in a {cell.value}, expected a boundary configuration "
             "(one vehicle at a leg's endpoint, the other on another leg or at the junction)"
         )
-    cycle = graph.cycle
     return cycle.theta(cycle.locate(c))
 
 
-def is_antipodal(graph: YGraph, first: Configuration, second: Configuration) -> bool:
+def is_antipodal(graph: StarGraph, first: Configuration, second: Configuration) -> bool:
     """Whether two boundary configurations are half a perimeter apart on the cycle.
 
     Uses the tolerance ``1e-9 * perimeter`` of ALGORITHM.md section 5.

@@ -129,14 +129,15 @@ class RetractGraph:
         The same vertices as configurations.
     edges : tuple of (int, int), shape (2 k (k - 1),)
         ``(peak, valley)`` vertex indices of each edge (its orientation).
-    edge_lengths : ndarray, shape (2 k (k - 1),)
+    edge_lengths : numpy.ndarray, shape (2 k (k - 1),)
         Lengths, metres (read-only).
-    perturbed_lengths : ndarray, shape (2 k (k - 1),)
+    perturbed_lengths : numpy.ndarray, shape (2 k (k - 1),)
         Lengths times ``1 + eta u``, metres (read-only; exact for k = 3).
-    weights : ndarray, shape (2 k (k - 1),)
+    weights : numpy.ndarray, shape (2 k (k - 1),)
         The 1-form ``w``, per edge from peak to valley (read-only).
-    distances : ndarray, shape (k (k + 1), k (k + 1))
-        Shortest perturbed distance between vertices, metres (read-only).
+    distances : numpy.ndarray, shape (k (k + 1), k (k + 1))
+        Shortest perturbed distance between vertices, metres (read-only); the shortest
+        vertex paths themselves are tabulated too, so that a query only looks them up.
     total_length : float
         Sum of the perturbed edge lengths, metres: the scale of the tie tolerance.
     """
@@ -144,12 +145,15 @@ class RetractGraph:
     __slots__ = (
         "_adjacent",
         "_distance_rows",
+        "_edge_length",
         "_legs",
         "_paths",
         "_peak",
+        "_perturbed_length",
         "_tolerance",
         "_valley_first_at_junction",
         "_valley_second_at_junction",
+        "_weight",
         "distances",
         "edge_lengths",
         "edges",
@@ -203,6 +207,10 @@ class RetractGraph:
             weights = np.array([rng.uniform(-1.0, 1.0) for _ in edges])
         self.perturbed_lengths = _read_only(self.edge_lengths * factors)
         self.weights = _read_only(weights)
+        # plain floats for the queries (faster than numpy scalars, and results are Python floats)
+        self._edge_length = tuple(self.edge_lengths.tolist())
+        self._perturbed_length = tuple(self.perturbed_lengths.tolist())
+        self._weight = tuple(self.weights.tolist())
         self.total_length = float(math.fsum(self.perturbed_lengths))
         self._tolerance = TIE_TOLERANCE * self.total_length
 
@@ -220,6 +228,9 @@ class RetractGraph:
         self.distances = _read_only(distances)
         self._distance_rows = distances.tolist()
         self._paths: dict[tuple[int, int], tuple[_Path, ...]] = {}
+        for a in range(size):
+            for b in range(size):
+                self._shortest_paths(a, b)
 
     # -- points of G_k -----------------------------------------------------
     def locate(self, c: IndexedConfiguration) -> GraphPoint:
@@ -268,7 +279,7 @@ class RetractGraph:
         if vertex.vertex == peak:
             return point.offset
         if vertex.vertex == valley:
-            return self.edge_lengths[point.edge] - point.offset
+            return self._edge_length[point.edge] - point.offset
         return math.inf
 
     # -- routes ------------------------------------------------------------
@@ -278,10 +289,10 @@ class RetractGraph:
             return [(point.vertex, 0.0, 0.0, 0.0, -1)]
         e = point.edge
         peak, valley = self.edges[e]
-        length = self.edge_lengths[e]
-        factor = self.perturbed_lengths[e] / length
+        length = self._edge_length[e]
+        factor = self._perturbed_length[e] / length
         fraction = point.offset / length
-        w = self.weights[e]
+        w = self._weight[e]
         sign = -1.0 if leaving else 1.0  # leaving towards the peak runs against the orientation
         rest = length - point.offset
         return [
@@ -301,14 +312,14 @@ class RetractGraph:
             found = []
             target = self._distance_rows[a][b]
             for neighbour, e in self._adjacent[a]:
-                if self.perturbed_lengths[e] + self._distance_rows[neighbour][b] <= target + self._tolerance:
+                if self._perturbed_length[e] + self._distance_rows[neighbour][b] <= target + self._tolerance:
                     forward = 1.0 if self.edges[e][0] == a else -1.0
                     for rest in self._shortest_paths(neighbour, b):
                         found.append(
                             _Path(
                                 (a, *rest.vertices),
-                                forward * self.weights[e] + rest.weight,
-                                self.edge_lengths[e] + rest.length,
+                                forward * self._weight[e] + rest.weight,
+                                self._edge_length[e] + rest.length,
                                 e,
                                 e if rest.last_edge < 0 else rest.last_edge,
                             )
@@ -338,10 +349,10 @@ class RetractGraph:
                         )
                     )
         if x.vertex < 0 and x.edge == y.edge:
-            length = self.edge_lengths[x.edge]
-            factor = self.perturbed_lengths[x.edge] / length
+            length = self._edge_length[x.edge]
+            factor = self._perturbed_length[x.edge] / length
             along = abs(y.offset - x.offset)
-            weight = (y.offset - x.offset) / length * self.weights[x.edge]
+            weight = (y.offset - x.offset) / length * self._weight[x.edge]
             found.append(Geodesic((), along, along * factor, weight, 0))
         found.sort(key=lambda g: g.perturbed_length)
         return found
@@ -385,10 +396,10 @@ class RetractGraph:
         adjacency: list[dict[int, tuple[float, int, float, float]]] = [{} for _ in range(size + 2)]
 
         def connect(u: int, v: int, e: int, start: float, end: float) -> None:
-            length = self.edge_lengths[e]
+            length = self._edge_length[e]
             metres = end - start
-            factor = self.perturbed_lengths[e] / length
-            w = self.weights[e] * metres / length
+            factor = self._perturbed_length[e] / length
+            w = self._weight[e] * metres / length
             adjacency[u][v] = (metres * factor, e, w, metres)
             adjacency[v][u] = (metres * factor, e, -w, metres)
 
@@ -401,7 +412,7 @@ class RetractGraph:
                 nodes.append(size + k)
                 cuts.setdefault(point.edge, []).append((point.offset, size + k))
         for e, (peak, valley) in enumerate(self.edges):
-            chain = [(0.0, peak), *sorted(cuts.get(e, [])), (self.edge_lengths[e], valley)]
+            chain = [(0.0, peak), *sorted(cuts.get(e, [])), (self._edge_length[e], valley)]
             for (s0, u), (s1, v) in itertools.pairwise(chain):
                 if u != v:
                     connect(u, v, e, s0, s1)

@@ -1,4 +1,4 @@
-"""trajgen: collision-free, time-optimal schedules for two AGVs on a Y-shaped track junction.
+"""trajgen: collision-free, time-optimal schedules for two AGVs on a track junction of 3 to 8 legs.
 
 The package face: scenarios, the planner's types, the timing methods, the
 verifier and the pipeline. The planner lives in :mod:`topology`, the vehicle
@@ -21,12 +21,20 @@ from trajgen.errors import InputError, TrajgenError, VerificationError
 from trajgen.export import CsvOptions, Units, write_profiles
 from trajgen.methods import METHODS, Exact, HomotopyChoice, Optimal, SolverCache, Toppra, make_schedule
 from trajgen.pipeline import Outputs, RunResult, run
-from trajgen.scenario import Scenario, default_scenario, load_scenario, parse_scenario
+from trajgen.scenario import (
+    BuiltinScenario,
+    Scenario,
+    builtin_scenario,
+    default_scenario,
+    load_scenario,
+    parse_scenario,
+)
 from trajgen.schedule import FallbackReason, Schedule, TimingMethod
 from trajgen.verify import VerificationReport, VerifiedSchedule, certify, verify
 
 __all__ = [
     "METHODS",
+    "BuiltinScenario",
     "Configuration",
     "CsvOptions",
     "Exact",
@@ -53,6 +61,7 @@ __all__ = [
     "VerificationReport",
     "VerifiedSchedule",
     "YGraph",
+    "builtin_scenario",
     "certify",
     "default_scenario",
     "load_scenario",

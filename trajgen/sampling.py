@@ -1,4 +1,4 @@
-"""Seeded random scenarios, for property tests and benchmarks."""
+"""Seeded random scenarios, for property tests and benchmarks, on junctions of 3 to 8 legs."""
 
 from __future__ import annotations
 
@@ -7,7 +7,8 @@ import random
 from dataclasses import dataclass
 
 from limits import Limits, VehicleLimits
-from topology import Configuration, Position, YGraph
+from topology import MAX_LEGS, MIN_LEGS, Configuration, Position, StarGraph, YGraph
+from trajgen.errors import InputError
 from trajgen.scenario import Scenario
 
 __all__ = [
@@ -18,11 +19,15 @@ __all__ = [
     "random_configuration",
     "random_position",
     "random_scenarios",
+    "random_track",
     "reference_sets",
 ]
 
+#: Leg names of random tracks, in counterclockwise order (the first ``k`` of them).
+LEG_NAMES = "ABCDEFGH"
 
-def random_position(rng: random.Random, track: YGraph) -> Position:
+
+def random_position(rng: random.Random, track: StarGraph) -> Position:
     """A position on ``track``; the junction and the leg ends are drawn often on purpose."""
     roll = rng.random()
     if roll < 0.08:
@@ -33,7 +38,7 @@ def random_position(rng: random.Random, track: YGraph) -> Position:
     return Position(leg, rng.uniform(0.0, track.length(leg)))
 
 
-def random_configuration(rng: random.Random, track: YGraph, min_separation: float) -> Configuration:
+def random_configuration(rng: random.Random, track: StarGraph, min_separation: float) -> Configuration:
     """A configuration whose vehicles are at least ``min_separation`` apart (and not at one point)."""
     while True:
         configuration = Configuration(random_position(rng, track), random_position(rng, track))
@@ -42,7 +47,39 @@ def random_configuration(rng: random.Random, track: YGraph, min_separation: floa
             return configuration
 
 
-def random_scenarios(count: int, *, seed: int, track: YGraph, limits: Limits) -> list[Scenario]:
+def random_track(
+    rng: random.Random, *, leg_count: int = 3, lengths: tuple[float, float] = (0.5, 30.0)
+) -> StarGraph:
+    """A track of ``leg_count`` legs named A, B, ... with log-uniform random lengths.
+
+    Parameters
+    ----------
+    rng : random.Random
+    leg_count : int, optional
+        Number of legs, 3 to 8 (default 3: a :class:`~topology.YGraph`).
+    lengths : tuple of 2 float, optional
+        Shortest and longest leg drawn, metres (default 0.5 to 30 m).
+
+    Raises
+    ------
+    InputError
+        ``leg_count`` not an integer from 3 to 8.
+
+    Examples
+    --------
+    >>> random_track(random.Random(1), leg_count=5).names
+    ('A', 'B', 'C', 'D', 'E')
+    """
+    if isinstance(leg_count, bool) or not isinstance(leg_count, int) or not MIN_LEGS <= leg_count <= MAX_LEGS:
+        raise InputError(
+            f"leg_count (number of legs) must be an integer from {MIN_LEGS} to {MAX_LEGS}, got {leg_count!r}"
+        )
+    low, high = (math.log(length) for length in lengths)
+    legs = {name: math.exp(rng.uniform(low, high)) for name in LEG_NAMES[:leg_count]}
+    return YGraph(legs) if leg_count == 3 else StarGraph(legs)
+
+
+def random_scenarios(count: int, *, seed: int, track: StarGraph, limits: Limits) -> list[Scenario]:
     """``count`` seeded random start/goal pairs on one track with the given limits.
 
     Parameters
@@ -50,7 +87,8 @@ def random_scenarios(count: int, *, seed: int, track: YGraph, limits: Limits) ->
     count : int
     seed : int
         Same seed, same scenarios.
-    track : YGraph
+    track : StarGraph
+        A track of 3 to 8 legs.
     limits : Limits
     """
     rng = random.Random(seed)
@@ -69,21 +107,23 @@ class ReferenceSet:
     Attributes
     ----------
     label : str
-    track : YGraph
+    track : StarGraph
     limits : Limits
     scenarios : tuple of (str, Configuration, Configuration)
         Name, start and goal of each scenario.
     """
 
     label: str
-    track: YGraph
+    track: StarGraph
     limits: Limits
     scenarios: tuple[tuple[str, Configuration, Configuration], ...]
 
 
-def _swaps(track: YGraph) -> tuple[tuple[str, Configuration, Configuration], ...]:
+def _swaps(track: StarGraph) -> tuple[tuple[str, Configuration, Configuration], ...]:
+    """The swaps of the ends of neighbouring legs (AB, BC, CA on a Y)."""
     out = []
-    for i, j in ((0, 1), (1, 2), (2, 0)):
+    count = track.leg_count
+    for i, j in ((k, (k + 1) % count) for k in range(count)):
         start = Configuration(track.endpoint(track.names[i]), track.endpoint(track.names[j]))
         out.append((f"swap {track.names[i]}{track.names[j]}", start, start.swapped()))
     return tuple(out)
@@ -123,8 +163,9 @@ def _drawn_scenarios(
     acceleration: tuple[float, float],
     jerk: tuple[float, float],
     label: str,
+    leg_count: int,
 ) -> list[Scenario]:
-    """Seeded scenarios: log-uniform legs and per-vehicle limits in the given ranges (SI units).
+    """Seeded scenarios: ``leg_count`` log-uniform legs and per-vehicle limits in the given ranges (SI units).
 
     The separation is drawn from 0 up to the shortest leg (every fifth scenario exactly the shortest
     leg); every fourth scenario is a swap, the others have a random start and goal.
@@ -136,7 +177,7 @@ def _drawn_scenarios(
 
     scenarios = []
     for k in range(count):
-        track = YGraph({name: log_uniform(*legs) for name in "ABC"})
+        track = random_track(rng, leg_count=leg_count, lengths=legs)
         vehicles = tuple(
             VehicleLimits(log_uniform(*velocity), log_uniform(*acceleration), log_uniform(*jerk))
             for _ in range(2)
@@ -150,7 +191,7 @@ def _drawn_scenarios(
     return scenarios
 
 
-def campaign_scenarios(count: int, *, seed: int) -> list[Scenario]:
+def campaign_scenarios(count: int, *, seed: int, leg_count: int = 3) -> list[Scenario]:
     """Seeded random scenarios over a wide range of tracks and vehicles, for robustness campaigns.
 
     Not the whole :data:`trajgen.scenario.PLAUSIBLE` range (which allows even more
@@ -160,7 +201,8 @@ def campaign_scenarios(count: int, *, seed: int) -> list[Scenario]:
     vehicle's limits drawn independently (0.05-5 m/s, 0.05-5 m/s², 0.05-20 m/s³,
     log-uniform), the separation from 0 up to the shortest leg (a fifth of
     the scenarios exactly the shortest leg), and a swap for every fourth
-    scenario, random start and goal otherwise.
+    scenario, random start and goal otherwise. Tracks of ``leg_count`` legs
+    (3 to 8, default 3) named A, B, ...
     """
     return _drawn_scenarios(
         count,
@@ -169,17 +211,19 @@ def campaign_scenarios(count: int, *, seed: int) -> list[Scenario]:
         velocity=(0.05, 5.0),
         acceleration=(0.05, 5.0),
         jerk=(0.05, 20.0),
-        label="campaign",
+        label="campaign" if leg_count == 3 else f"campaign k={leg_count}",
+        leg_count=leg_count,
     )
 
 
-def online_campaign(count: int, *, seed: int) -> list[Scenario]:
+def online_campaign(count: int, *, seed: int, leg_count: int = 3) -> list[Scenario]:
     """Seeded random scenarios for the closed-loop fault campaign (``trajgen simulate``).
 
     The range of the random planner tests (legs 0.5 to 30 m, log-uniform), each vehicle's limits
     drawn independently (0.2-3 m/s, 0.2-3 m/s², 0.5-10 m/s³, log-uniform), the separation from 0
     up to the shortest leg (a fifth of the scenarios exactly the shortest leg), a swap for every
-    fourth scenario, random start and goal otherwise. Pair with :func:`campaign_faults`.
+    fourth scenario, random start and goal otherwise; tracks of ``leg_count`` legs (3 to 8, default
+    3) named A, B, ... Pair with :func:`campaign_faults`.
     """
     return _drawn_scenarios(
         count,
@@ -188,7 +232,8 @@ def online_campaign(count: int, *, seed: int) -> list[Scenario]:
         velocity=(0.2, 3.0),
         acceleration=(0.2, 3.0),
         jerk=(0.5, 10.0),
-        label="online",
+        label="online" if leg_count == 3 else f"online k={leg_count}",
+        leg_count=leg_count,
     )
 
 

@@ -20,6 +20,11 @@ Example (``examples/swap.toml``)::
     [[vehicle]]
     ...
 
+The track has 3 to 8 legs (a Y, a 4-way crossing as in
+``examples/crossing.toml``, ...); without ``angles_deg`` they are spread
+evenly, ``90 + 360 j / k`` degrees. A minimum separation longer than a leg is
+refused, naming the legs that could not serve as sidings.
+
 A vehicle may take ``max_velocity`` and ``max_acceleration`` from a VDA 5050
 factsheet instead (``factsheet = "agv.json"``, relative to the scenario file's
 folder; see :mod:`trajgen.factsheet`); it still gives ``max_jerk``.
@@ -33,9 +38,9 @@ from importlib import resources
 from pathlib import Path
 
 from limits import Limits, VehicleLimits
-from topology import Configuration, Position, Route, StarGraph, YGraph, plan
+from topology import Configuration, Option, Position, Route, StarGraph, YGraph, plan
 from topology.validation import short_repr
-from trajgen.errors import InputError, ScenarioError
+from trajgen.errors import InputError, OptionError, ScenarioError
 from trajgen.factsheet import read_factsheet
 from trajgen.naming import check_vehicle_name, check_vehicle_names
 from trajgen.reading import FileKind, file_label, read_bounded
@@ -44,13 +49,55 @@ __all__ = [
     "DEFAULT_SCENARIO_NAME",
     "MAX_SCENARIO_BYTES",
     "PLAUSIBLE",
+    "BuiltinScenario",
     "Scenario",
+    "builtin_scenario",
     "default_scenario",
     "load_scenario",
     "parse_scenario",
 ]
 
 DEFAULT_SCENARIO_NAME = "swap.toml"
+
+
+class BuiltinScenario(Option):
+    """The scenarios shipped with trajgen (``trajgen/data/<name>.toml``; ``trajgen demo --scenario``)."""
+
+    #: two AGVs at the far ends of legs A and B of a Y swap places (``examples/swap.toml``); the default
+    SWAP = "swap"
+    #: a 4-way crossing N/W/S/E of 10 m legs: two AGVs at the ends of N and S cross straight over,
+    #: so one waits in a side leg while the other passes (``examples/crossing.toml``)
+    CROSSING = "crossing"
+
+    @classmethod
+    def lookup(cls, name: object) -> BuiltinScenario:
+        """The scenario named ``name`` (case-insensitive).
+
+        Raises
+        ------
+        OptionError
+            Naming the value and the known scenarios.
+        """
+        try:
+            return super().lookup(name)
+        except OptionError:
+            raise OptionError(
+                f"built-in scenario {name!r} is unknown: expected one of {[m.value for m in cls]!r}"
+            ) from None
+
+    @property
+    def file_name(self) -> str:
+        """The packaged file, e.g. ``swap.toml``."""
+        return f"{self.value}.toml"
+
+    @property
+    def description(self) -> str:
+        """What happens in it, for people."""
+        if self is BuiltinScenario.SWAP:
+            return "two AGVs swap ends of legs A and B"
+        return "a 4-way crossing: two AGVs cross from N to S and S to N, one waits in a side leg"
+
+
 #: Largest scenario file read, bytes; a larger one is refused unread.
 MAX_SCENARIO_BYTES = 1 << 20
 #: How scenario files are read (:func:`~trajgen.reading.read_bounded`).
@@ -354,7 +401,30 @@ def _parse_text(text: str, source: str, folder: Path | None = None) -> Scenario:
     return parse_scenario(data, source=source, folder=folder)
 
 
+def builtin_scenario(name: BuiltinScenario | str = BuiltinScenario.SWAP) -> Scenario:
+    """A scenario shipped with trajgen, by name (:class:`BuiltinScenario`).
+
+    Parameters
+    ----------
+    name : BuiltinScenario or str, optional
+        ``"swap"`` (default, :func:`default_scenario`) or ``"crossing"``.
+
+    Raises
+    ------
+    OptionError
+        An unknown name, naming the known ones.
+
+    Examples
+    --------
+    >>> crossing = builtin_scenario("crossing")
+    >>> crossing.track.names, crossing.source
+    (('N', 'W', 'S', 'E'), '<built-in crossing.toml>')
+    """
+    file_name = BuiltinScenario.lookup(name).file_name
+    text = resources.files("trajgen").joinpath("data", file_name).read_text(encoding="utf-8")
+    return _parse_text(text, f"<built-in {file_name}>")
+
+
 def default_scenario() -> Scenario:
     """The built-in default scenario: the swap of ``examples/swap.toml``."""
-    text = resources.files("trajgen").joinpath("data", DEFAULT_SCENARIO_NAME).read_text(encoding="utf-8")
-    return _parse_text(text, f"<built-in {DEFAULT_SCENARIO_NAME}>")
+    return builtin_scenario(BuiltinScenario.SWAP)

@@ -1,15 +1,55 @@
-"""Machine-readable (JSON-ready) and human-readable summaries of routes and runs."""
+"""Machine-readable (JSON-ready) and human-readable summaries of routes and runs.
+
+A route's homotopy class is named for people by :func:`class_name`: on a Y
+(three legs) the way round the boundary circle of the configuration space;
+on a junction of four to eight legs, which route on the retract graph
+``G_k`` it is (STAR-JUNCTIONS.md): the planner's shortest route (its
+instruction), or the second-shortest, in another class.
+"""
 
 from __future__ import annotations
 
-from topology import Homotopy, Route
+from topology import Homotopy, Instruction, Route, WayRound
 
-__all__ = ["class_label", "format_route", "format_run", "route_summary"]
+__all__ = ["class_label", "class_name", "format_route", "format_run", "route_summary"]
+
+#: Four or more legs: the class of the planner's route by its instruction (``{graph}``: ``G_k``).
+_PLANNER_CLASS = {
+    Instruction.SHORTEST: "shortest route on {graph}",
+    Instruction.TWO_TIED: "shortest route on {graph} (two tied)",
+    Instruction.MANY_TIED: "shortest route on {graph} (three or more tied)",
+}
+
+
+def class_name(route: Route) -> str:
+    """The route's homotopy class for people, without whose it is.
+
+    Three legs: its way round the boundary circle (``counterclockwise``,
+    ``clockwise`` or ``none``). Four to eight legs: which route on ``G_k`` it
+    is, e.g. ``shortest route on G_4`` (the planner's, by its instruction) or
+    ``second-shortest route on G_4`` (``plan(..., homotopy="other")``).
+
+    Examples
+    --------
+    >>> from topology import Configuration, Position, StarGraph, plan
+    >>> crossing = StarGraph({"N": 10.0, "W": 10.0, "S": 10.0, "E": 10.0})
+    >>> start = Configuration(Position("N", 10.0), Position("S", 10.0))
+    >>> class_name(plan(crossing, start, start.swapped(), homotopy="other"))
+    'second-shortest route on G_4'
+    """
+    if route.graph.cycle is not None:
+        return route.way_round.value
+    graph = f"G_{route.graph.leg_count}"
+    if route.way_round is WayRound.NONE:
+        return f"none (start and goal retract to one point of {graph})"
+    if route.homotopy is Homotopy.OTHER:
+        return f"second-shortest route on {graph}"
+    return _PLANNER_CLASS[route.instruction].format(graph=graph)
 
 
 def class_label(route: Route) -> str:
-    """The route's homotopy class for people: its way round and whether it is the paper's."""
-    return _class_text(route.way_round.value, route.homotopy is Homotopy.PAPER)
+    """The route's homotopy class for people: :func:`class_name` and whether it is the planner's."""
+    return _class_text(class_name(route), route.homotopy is Homotopy.PAPER, route.graph.cycle is not None)
 
 
 def _class_makespan(comparison: dict) -> str:
@@ -20,14 +60,19 @@ def _class_makespan(comparison: dict) -> str:
     return "not solved (its lower bound cannot beat exact)"
 
 
-def _class_text(way_round: str, paper: bool) -> str:
-    whose = "the paper's instruction" if paper else "not the paper's: faster"
-    return f"{way_round} ({whose})"
+def _class_text(name: str, paper: bool, circle: bool = True) -> str:
+    """``name (whose)``: the paper's instruction on a Y (``circle``), the planner's on more legs."""
+    whose = "the paper's" if circle else "the planner's"
+    return f"{name} ({whose} instruction)" if paper else f"{name} (not {whose}: faster)"
 
 
 def route_summary(route: Route) -> dict:
-    """A JSON-ready summary of a route."""
-    return {
+    """A JSON-ready summary of a route.
+
+    Four or more legs add ``legs`` (k) and ``class`` (:func:`class_name`); ``way_round`` is
+    ``graph`` there and ``arc_length_m`` the route's length on ``G_k``.
+    """
+    summary = {
         "instruction": route.instruction.value,
         "waypoints": [[{"leg": p.leg, "s_m": p.s} for p in (w.first, w.second)] for w in route.waypoints],
         "regions": [str(r) for r in route.regions],
@@ -38,10 +83,19 @@ def route_summary(route: Route) -> dict:
         "travel_m": list(route.travel),
         "min_separation_m": route.min_separation,
     }
+    if route.graph.cycle is None:
+        summary["legs"] = route.graph.leg_count
+        summary["class"] = class_name(route)
+    return summary
 
 
 def format_route(route: Route) -> str:
-    """Human-readable multi-line description of a route."""
+    """Human-readable multi-line description of a route.
+
+    Four or more legs also name the planner's three instructions and the route's length on ``G_k``.
+    """
+    graph = route.graph
+    instructions = Instruction.of_track(graph)
     lines = [
         f"instruction: {route.instruction.value}",
         f"homotopy class: {class_label(route)}, regions "
@@ -49,8 +103,20 @@ def format_route(route: Route) -> str:
         f"travel: vehicle 1 {route.travel[0]:g} m, vehicle 2 {route.travel[1]:g} m",
         "waypoints (vehicle 1, vehicle 2):",
     ]
+    if graph.cycle is None:  # four or more legs: the planner's three instructions and the route on G_k
+        lines[0] += f" (of {', '.join(i.value for i in instructions)} on {graph.leg_count} legs)"
+        lines.insert(
+            2,
+            f"length on G_{graph.leg_count}: {route.arc_length:g} m (of {graph.boundary_length:g} m in all)",
+        )
     lines += [f"  {k:2d}  {w}" for k, w in enumerate(route.waypoints)]
     return "\n".join(lines)
+
+
+def _route_class_text(route: dict) -> str:
+    """The class line of a run's route summary (:func:`route_summary`)."""
+    circle = "class" not in route
+    return _class_text(route["way_round"] if circle else route["class"], route["paper_class"], circle)
 
 
 def format_run(summary: dict) -> str:
@@ -66,11 +132,11 @@ def format_run(summary: dict) -> str:
         f"worst margins: separation {margins['min_separation_m']:.4f} m "
         f"(margin {margins['separation_margin_m']:.4f} m), |v|/limit {max(margins['velocity_ratio']):.6f}, "
         f"|a|/limit {max(margins['acceleration_ratio']):.6f}{jerk}",
-        f"homotopy class: {_class_text(summary['route']['way_round'], summary['route']['paper_class'])}",
+        f"homotopy class: {_route_class_text(summary['route'])}",
     ]
     if summary["solver"] is not None:
         lines += [
-            f"class {c['way_round']} ({c['homotopy']}): "
+            f"class {c.get('class', c['way_round'])} ({c['homotopy']}): "
             + _class_makespan(c)
             + f", lower bound {c['lower_bound_s']:.3f} s"
             + (" <- chosen" if c["chosen"] else "")

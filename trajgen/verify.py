@@ -548,7 +548,10 @@ def _check_maps(schedule: Schedule, failures: list[str]) -> None:
             if not np.all(np.isin(axis_map.outward, (-1, 0, 1))):
                 failures.append(f"{where}: map slopes {axis_map.outward.tolist()} are not -1, 0 or +1")
             if not np.all((axis_map.legs >= JUNCTION_INDEX) & (axis_map.legs < legs)):
-                failures.append(f"{where}: map legs {axis_map.legs.tolist()} are not track legs")
+                failures.append(
+                    f"{where}: map legs {axis_map.legs.tolist()} are not track legs: expected "
+                    f"{JUNCTION_INDEX} (the junction) or a leg index 0 to {legs - 1} ({legs} legs)"
+                )
                 continue
             at_junction = axis_map.legs == JUNCTION_INDEX
             if np.any(at_junction & ((axis_map.outward != 0) | (axis_map.s_start != 0.0))):

@@ -29,6 +29,7 @@ def _command_check(args: argparse.Namespace) -> int:
             f"points: {summary['points'][0]} and {summary['points'][1]}; closest approach "
             f"{summary['min_separation_m']:.4f} m (minimum {scenario.limits.min_separation:g} m); "
             f"homotopy class: {summary['homotopy']}"
+            + (f" ({summary['class']})" if "class" in summary else "")
         )
         failures = summary["failures"]
         for failure in failures[:SHOWN_FAILURES]:

@@ -51,7 +51,10 @@ class Commands:
 
 
 def _build() -> tuple[argparse.ArgumentParser, Commands]:
-    parser = CommandParser(prog="trajgen", description="Collision-free schedules for two AGVs on a Y-track.")
+    parser = CommandParser(
+        prog="trajgen",
+        description="Collision-free schedules for two AGVs on a junction of 3 to 8 legs (a Y, a crossing).",
+    )
     parser.add_argument("-v", "--verbose", action="store_true", help="log progress to stderr")
     commands = Commands(parser.add_subparsers(dest="command", required=True, parser_class=CommandParser))
     for module in COMMAND_MODULES:

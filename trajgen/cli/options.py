@@ -112,8 +112,10 @@ def add_method(
     parser.add_argument(
         "--homotopy",
         metavar="|".join(c.value for c in HomotopyChoice),
-        help="optimal only: 'fastest' (default) solves both ways round the configuration circle and\n"
-        "keeps the faster; 'paper' keeps the class of the paper's instruction",
+        help="optimal only: 'fastest' (default) solves two homotopy classes and keeps the faster:\n"
+        "on a Y both ways round the configuration circle, on 4 to 8 legs the shortest and\n"
+        "the second-shortest route on the retract graph G_k; 'paper' keeps the class of\n"
+        "the planner's instruction (the paper's on a Y)",
     )
 
 

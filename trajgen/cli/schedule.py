@@ -14,7 +14,7 @@ from trajgen.cli.options import (
     scenario_from,
 )
 from trajgen.pipeline import Outputs, run
-from trajgen.scenario import default_scenario
+from trajgen.scenario import BuiltinScenario, builtin_scenario
 from trajgen.summary import format_route, format_run, route_summary
 
 __all__ = ["register"]
@@ -41,11 +41,12 @@ def _command_schedule(args: argparse.Namespace) -> int:
 
 
 def _command_demo(args: argparse.Namespace) -> int:
-    scenario = default_scenario()
+    chosen = BuiltinScenario.lookup(args.scenario)
+    scenario = builtin_scenario(chosen)
     result = run(
         scenario, method=method_from(args), outputs=Outputs(csv_dir=args.output, plot_dir=args.output)
     )
-    print(f"Demo: the built-in scenario {scenario.source} (two AGVs swap ends of legs A and B).")
+    print(f"Demo: the built-in scenario {scenario.source} ({chosen.description}).")
     print(format_route(result.route))
     print(format_run(result.summary()))
     print(f"CSV profiles and plots are in {args.output}/")
@@ -56,8 +57,16 @@ def register(commands) -> None:
     """Add ``demo``, ``plan`` and ``schedule`` to the sub-commands."""
     demo = commands.add_parser(
         "demo",
-        help="run the built-in swap scenario end to end",
+        help="run a built-in scenario end to end (the swap on a Y, or a 4-way crossing)",
         formatter_class=argparse.RawTextHelpFormatter,
+    )
+    demo.add_argument(
+        "--scenario",
+        default=BuiltinScenario.SWAP.value,
+        metavar="|".join(b.value for b in BuiltinScenario),
+        help="the built-in scenario, one of:\n"
+        + "\n".join(f"{b.value}: {b.description}" for b in BuiltinScenario)
+        + f"\n(default {BuiltinScenario.SWAP.value})",
     )
     demo.add_argument("--output", default="trajgen-demo", help="folder for CSV and plots (trajgen-demo)")
     add_method(demo)
@@ -82,7 +91,8 @@ def register(commands) -> None:
         "--plot",
         metavar="DIR",
         help="write DIR/speed.png, DIR/separation.png, DIR/coordination.png,\n"
-        "DIR/configuration.png (the configuration space drawn flat: route and retraction)",
+        "DIR/configuration.png (the configuration space drawn flat: route and retraction;\n"
+        "4 to 8 legs: the retract graph G_k with the route)",
     )
     schedule.add_argument("--json", action="store_true", help="print a machine-readable summary")
     add_csv_options(schedule)

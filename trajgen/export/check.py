@@ -5,8 +5,10 @@ read is bad input) and verified as the controllers interpolate them
 (:func:`trajgen.tables.check_tables`): the separation along the track
 between the two vehicles, the limits, the start and goal, the homotopy class,
 plus what their format requires (line ends, header, point count). The files
-do not say which way round the configuration circle they go, so both of the
-planner's classes are tried; the files pass if they pass along one.
+do not say which homotopy class they take, so both of the planner's classes
+are tried (on a Y both ways round the configuration circle; on 4 to 8 legs
+the shortest and the second-shortest route on the retract graph ``G_k``, the
+classes ``trajgen schedule`` takes); the files pass if they pass along one.
 """
 
 from __future__ import annotations
@@ -25,6 +27,7 @@ from trajgen.export.dialects import DIALECTS, Dialect, TableDialect
 from trajgen.export.plc import table_paths
 from trajgen.reading import FileKind, file_label, read_bounded
 from trajgen.scenario import Scenario
+from trajgen.summary import class_name
 from trajgen.tables import ProfileTable, TableCheck, check_tables
 
 __all__ = ["MAX_FILE_BYTES", "ProfileCheck", "check_profiles", "profile_files"]
@@ -70,7 +73,7 @@ class ProfileCheck:
         return self.problems + self.check.failures
 
     def summary(self) -> dict:
-        """JSON-ready verdict (``trajgen check --json``)."""
+        """JSON-ready verdict (``trajgen check --json``); 4 to 8 legs add ``class`` (a route on ``G_k``)."""
         return {
             "dialect": self.dialect.name.value,
             "files": [str(path) for path in self.files],
@@ -79,6 +82,7 @@ class ProfileCheck:
             "points": [int(table.times.size) for table in self.tables],
             "min_separation_m": self.check.report.min_separation,
             "homotopy": self.check.route.homotopy.value,
+            **({} if self.check.route.graph.cycle is not None else {"class": class_name(self.check.route)}),
             "ratios": {k: (list(v) if v is not None else None) for k, v in self.check.ratios.items()},
         }
 
@@ -91,7 +95,7 @@ def profile_files(scenario: Scenario, directory: str | Path, dialect: Dialect) -
 
 
 def _routes(scenario: Scenario) -> tuple[Route, ...]:
-    """The planner's route in the paper's class, then the other class's (if there is another way round)."""
+    """The planner's route in its instruction's class, then the other class's (if there is another)."""
     separation = scenario.limits.min_separation
     routes = [plan(scenario.track, scenario.start, scenario.goal, min_separation=separation)]
     # where start and goal retract to one boundary point, the other way round is a full turn: none
@@ -129,13 +133,19 @@ def _generic_columns(parsed, vehicle: int, check: TableCheck, scenario: Scenario
     angles = np.radians(np.array(scenario.track.angles_deg))
     legs = columns["leg"].astype(int)
     known = (legs >= 0) & (legs <= len(angles))
+    if np.any(~known):
+        k = int(np.argmax(~known))
+        failures.append(
+            f"{name} row at t={table.times[k]:.6f} s: leg {legs[k]} is not on the track: expected 0 "
+            f"(the junction) or a leg 1 to {len(angles)} (1-based, {len(angles)} legs)"
+        )
     angle = angles[np.where(legs > 0, legs - 1, 0)[known]]
     off = np.hypot(
         columns["x"][known] - columns["s"][known] * np.cos(angle),
         columns["y"][known] - columns["s"][known] * np.sin(angle),
     )
-    if np.any(~known) or np.any(off > 1e-6):
-        k = int(np.argmax(~known)) if np.any(~known) else int(np.nonzero(known)[0][np.argmax(off)])
+    if np.any(off > 1e-6):
+        k = int(np.nonzero(known)[0][np.argmax(off)])
         failures.append(
             f"{name} row at t={table.times[k]:.6f} s: x, y do not lie at leg {legs[k]}, "
             f"s {columns['s'][k]:.9g} m"

@@ -14,7 +14,7 @@ from pathlib import Path
 
 import numpy as np
 
-from topology import JUNCTION_INDEX, Option, YGraph
+from topology import JUNCTION_INDEX, Option, StarGraph
 from topology.validation import short_repr
 from trajgen.errors import InputError, OptionError, OutputLimitError
 from trajgen.export.atomic import commit_files
@@ -121,7 +121,7 @@ def _usable_delimiter(value: object) -> bool:
     )
 
 
-def _xy(graph: YGraph, state: ScheduleState, vehicle: int) -> tuple[np.ndarray, np.ndarray]:
+def _xy(graph: StarGraph, state: ScheduleState, vehicle: int) -> tuple[np.ndarray, np.ndarray]:
     angles = np.radians(np.array(graph.angles_deg))
     leg = state.leg[vehicle]
     s = state.s[vehicle]
@@ -129,7 +129,7 @@ def _xy(graph: YGraph, state: ScheduleState, vehicle: int) -> tuple[np.ndarray, 
     return s * np.cos(angle), s * np.sin(angle)
 
 
-def format_rows(graph: YGraph, state: ScheduleState, vehicle: int, options: CsvOptions) -> list[str]:
+def format_rows(graph: StarGraph, state: ScheduleState, vehicle: int, options: CsvOptions) -> list[str]:
     """Rows of one vehicle's CSV profile for the sampled ``state`` on ``graph``, without line ends.
 
     Also the format of executed motion (``trajgen simulate --trace``).

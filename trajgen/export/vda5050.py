@@ -55,7 +55,7 @@ from pathlib import Path, PurePosixPath
 
 import numpy as np
 
-from topology import JUNCTION_INDEX, JUNCTION_NAME, Option, YGraph
+from topology import JUNCTION_INDEX, JUNCTION_NAME, Option, StarGraph
 from topology.validation import short_repr
 from trajgen.errors import OptionError, ScheduleError
 from trajgen.export.atomic import check_output_paths, commit_files
@@ -758,13 +758,15 @@ def _number(value: float) -> str:
     return "0" if text in ("", "-0") else text
 
 
-def node_id(graph: YGraph, leg: int, s: float) -> str:
+def node_id(graph: StarGraph, leg: int, s: float) -> str:
     """The id of the node at ``s`` metres on leg ``leg``: ``"O"`` or ``"<leg name>:<metres>"`` (µm).
 
     Examples
     --------
-    >>> node_id(YGraph({"A": 10.0, "B": 10.0, "C": 10.0}), 0, 1.5)
+    >>> node_id(StarGraph({"A": 10.0, "B": 10.0, "C": 10.0}), 0, 1.5)
     'A:1.5'
+    >>> node_id(StarGraph({"N": 10.0, "W": 10.0, "S": 10.0, "E": 10.0}), 3, 10.0)
+    'E:10'
     """
     if leg == JUNCTION_INDEX or s == 0.0:
         return JUNCTION_NAME
@@ -796,7 +798,7 @@ def _node_description(node: PathNode) -> str:
     return ", ".join(parts)
 
 
-def _node_json(graph: YGraph, node: PathNode, sequence: int, released: bool, map_id: str) -> dict:
+def _node_json(graph: StarGraph, node: PathNode, sequence: int, released: bool, map_id: str) -> dict:
     angle = math.radians(graph.angles_deg[node.leg]) if node.leg != JUNCTION_INDEX else 0.0
     return {
         "nodeId": node_id(graph, node.leg, node.s),
@@ -812,7 +814,7 @@ def _node_json(graph: YGraph, node: PathNode, sequence: int, released: bool, map
     }
 
 
-def _edge_json(graph: YGraph, path: OrderPath, edge: PathEdge, released: bool) -> dict:
+def _edge_json(graph: StarGraph, path: OrderPath, edge: PathEdge, released: bool) -> dict:
     start, end = path.nodes[edge.index], path.nodes[edge.index + 1]
     first, second = node_id(graph, start.leg, start.s), node_id(graph, end.leg, end.s)
     data = {

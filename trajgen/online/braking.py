@@ -89,8 +89,8 @@ class BrakingCheck:
     limits : tuple of 2 VehicleLimits
     emergency : tuple of 2 float
         Emergency deceleration of each vehicle, m/s².
-    leg_lengths : tuple of 3 float
-        The track's legs, metres.
+    leg_lengths : tuple of float, shape (k,)
+        The track's legs (3 to 8), metres.
     """
 
     __slots__ = ("_braking", "_emergency", "_lengths", "_pad_acceleration")

@@ -9,9 +9,10 @@ speed limit).
   the setpoints are the verified schedule's.
 * **Recovering**: on a departure (or a request) it replans with the
   topological planner from the measured configuration, keeping the homotopy
-  class (the way round the configuration circle) unless the other class is
-  shorter by ``hysteresis`` metres of travel, and drives each vehicle with
-  Ruckig from its current state towards a *hold point*: the next reversal of
+  class (on a Y the way round the configuration circle; on more legs the
+  class whose region sequence continues the current route's) unless the
+  other class is shorter by ``hysteresis`` metres of travel, and drives
+  each vehicle with Ruckig from its current state towards a *hold point*: the next reversal of
   its path, or how far the route lets it go while the other vehicle is
   where it is (so a vehicle whose partner is late brakes and waits).
 * **The braking invariant**: whatever the mode, a setpoint pair is issued
@@ -36,7 +37,7 @@ import numpy as np
 from ruckig import InputParameter, Result, Ruckig, RuckigError, Trajectory
 
 from limits import Limits, VehicleLimits
-from topology import JUNCTION_INDEX, Configuration, Position, Route, plan
+from topology import JUNCTION_INDEX, Configuration, Position, Route, StarGraph, plan, reduce_regions
 from topology.indexed import separation as indexed_separation
 from topology.options import Option
 from topology.route import Homotopy, WayRound
@@ -46,6 +47,7 @@ from trajgen.online.braking import BrakingCheck, PathState
 from trajgen.paths import Coordination, VehiclePath, set_distance
 from trajgen.pieces import schedule_pieces
 from trajgen.schedule import TimingMethod, check_period
+from trajgen.summary import class_name
 from trajgen.verify import VerifiedSchedule, certify, require_verified
 
 __all__ = [
@@ -57,6 +59,8 @@ __all__ = [
     "Mode",
     "Setpoint",
     "VehicleState",
+    "continues_class",
+    "default_hysteresis",
     "execution_margin",
     "plan_for_execution",
     "ruckig_jerk",
@@ -378,6 +382,43 @@ def plan_for_execution(
     return certify(make_schedule(route, limits, method=method))
 
 
+def default_hysteresis(graph: StarGraph) -> float:
+    """The executor's default hysteresis on ``graph``, metres of travel: ``0.4 (L_0 + ... + L_{k-1})``.
+
+    On a Y that is 10 % of the perimeter ``4 (L_0 + L_1 + L_2)`` of the configuration circle (and
+    computed so); on more legs the same share of the leg lengths, whatever ``k``.
+
+    Examples
+    --------
+    >>> from topology import StarGraph
+    >>> default_hysteresis(StarGraph({"N": 10.0, "W": 10.0, "S": 10.0, "E": 10.0}))
+    16.0
+    """
+    if graph.cycle is not None:
+        return 0.1 * graph.cycle.perimeter
+    return 0.4 * math.fsum(graph.lengths)
+
+
+def continues_class(current: Route, candidate: Route) -> bool:
+    """Whether ``candidate``, planned from a point along ``current`` to its goal, stays in its class.
+
+    True when, after some prefix of ``current``'s reduced region sequence (the part driven), the
+    candidate's regions reduce to exactly ``current``'s: driving the prefix and then ``candidate`` is
+    homotopic to ``current`` (ALGORITHM.md section 6). Used on four or more legs, where no way round
+    a circle tells the classes apart.
+
+    Parameters
+    ----------
+    current : Route
+        The route being driven.
+    candidate : Route
+        A route from where the vehicles are now to ``current``'s goal.
+    """
+    keys = current.region_keys
+    rest = candidate.region_keys
+    return any(reduce_regions(keys[:driven] + rest) == keys for driven in range(len(keys) + 1))
+
+
 class Executor:
     """Runs a verified schedule in closed loop, recovering from departures with Ruckig.
 
@@ -396,7 +437,8 @@ class Executor:
         off by this much (localisation) and the true separation still holds.
     hysteresis : float or None, optional
         Travel, metres, by which the other homotopy class must be shorter before a replan switches to it;
-        ``None``: 10 % of the perimeter of the configuration circle.
+        ``None``: :func:`default_hysteresis`, ``0.4 (L_0 + ... + L_{k-1})`` (40 % of the leg lengths'
+        sum; on a Y, 10 % of the perimeter of the configuration circle).
     latency : float, optional
         How late a drive may follow its setpoints, seconds (0.2): a vehicle within the tolerances of
         any setpoint of that window is on track, not departed.
@@ -458,9 +500,8 @@ class Executor:
         self.latency = float(latency)
         window = math.ceil(self.latency / period) + 1
         self._recent = (collections.deque(maxlen=window), collections.deque(maxlen=window))
-        perimeter = self.graph.cycle.perimeter
         if hysteresis is None:
-            hysteresis = 0.1 * perimeter
+            hysteresis = default_hysteresis(self.graph)
         if not (isinstance(hysteresis, (int, float)) and math.isfinite(hysteresis) and hysteresis >= 0.0):
             raise InputError(f"hysteresis (m) must be a finite number >= 0, got {hysteresis!r}")
         self.hysteresis = float(hysteresis)
@@ -776,22 +817,31 @@ class Executor:
         remainder : float or None
             Travel left on the current route, metres, or ``None`` if it cannot be continued.
         """
-        current = self._route.way_round
         paper = plan(self.graph, configuration, self._goal, min_separation=keep)
         try:
             other = plan(self.graph, configuration, self._goal, min_separation=keep, homotopy=Homotopy.OTHER)
         except InputError:
             other = None
-        if current is WayRound.NONE or other is None:
-            same, different = paper, other
-        else:
-            same, different = (paper, other) if paper.way_round is current else (other, paper)
+        if self.graph.cycle is not None:  # a Y: the classes are the two ways round the circle
+            current = self._route.way_round.value
+            if self._route.way_round is WayRound.NONE or other is None:
+                same, different = paper, other
+            else:
+                same_way = paper.way_round is self._route.way_round
+                same, different = (paper, other) if same_way else (other, paper)
+        else:  # more legs: the class of the candidate that continues the current route's regions
+            current = "the current class"
+            continues = other is not None and continues_class(self._route, other)
+            if continues and not continues_class(self._route, paper):
+                same, different = other, paper
+            else:
+                same, different = paper, other
         kept = min(same.length, remainder) if remainder is not None else same.length
         if different is not None and different.length < kept - self.hysteresis:
             self._log(
                 "switch-class",
-                f"{different.way_round.value} ({different.length:.3f} m) is shorter than "
-                f"{current.value} ({kept:.3f} m) by more than the hysteresis {self.hysteresis:.3f} m",
+                f"{class_name(different)} ({different.length:.3f} m) is shorter than "
+                f"{current} ({kept:.3f} m) by more than the hysteresis {self.hysteresis:.3f} m",
             )
             return different
         if remainder is not None and remainder <= same.length:
@@ -1061,8 +1111,12 @@ class Executor:
             value = getattr(state, name)
             if not isinstance(value, (int, float)) or not math.isfinite(value):
                 raise InputError(f"vehicle {number} measured {name} must be a finite number, got {value!r}")
-        if state.leg != JUNCTION_INDEX and not 0 <= state.leg < 3:
-            raise InputError(f"vehicle {number} measured leg must be 0, 1, 2 or -1, got {state.leg!r}")
+        count = self.graph.leg_count
+        if state.leg != JUNCTION_INDEX and not 0 <= state.leg < count:
+            raise InputError(
+                f"vehicle {number} measured leg must be a leg index 0 to {count - 1} of the {count} legs "
+                f"or {JUNCTION_INDEX} (the junction), got {state.leg!r}"
+            )
         top = self.graph.lengths[state.leg] if state.leg != JUNCTION_INDEX else 0.0
         if state.s < 0.0 or state.s > top + 1e-6:
             raise InputError(
@@ -1073,10 +1127,8 @@ class Executor:
         return state
 
     def _describe(self, route: Route) -> str:
-        return (
-            f"{len(route.waypoints)} waypoints, {route.length:.3f} m of travel, "
-            f"way round {route.way_round.value}"
-        )
+        kind = f"way round {route.way_round.value}" if route.graph.cycle is not None else class_name(route)
+        return f"{len(route.waypoints)} waypoints, {route.length:.3f} m of travel, {kind}"
 
     def _log(self, kind: str, detail: str) -> None:
         self.events.append(Event(self._time, kind, detail))

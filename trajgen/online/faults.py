@@ -20,7 +20,7 @@ import math
 import re
 from dataclasses import dataclass
 
-from topology import Option, Position, YGraph
+from topology import Option, Position, StarGraph
 from topology.validation import short_repr
 from trajgen.errors import InputError
 
@@ -87,7 +87,7 @@ def parse_fault(
     spec: object,
     *,
     names: tuple[str, str],
-    graph: YGraph,
+    graph: StarGraph,
     max_velocity: tuple[float, float],
     max_jump: float,
 ) -> Fault:
@@ -99,7 +99,7 @@ def parse_fault(
         For example ``stop:agv1@5+3``.
     names : tuple of 2 str
         The vehicles' names.
-    graph : YGraph
+    graph : StarGraph
         The track (for ``goal``).
     max_velocity : tuple of 2 float
         The vehicles' top speeds, m/s (a ``slow`` speed must be below it).

@@ -29,7 +29,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from limits import Limits
-from topology import JUNCTION_INDEX, YGraph
+from topology import JUNCTION_INDEX, StarGraph
 from topology.indexed import leg_travel
 from topology.indexed import separation as indexed_separation
 from trajgen.errors import InputError
@@ -234,12 +234,12 @@ class Trace:
 
     Parameters
     ----------
-    graph : YGraph
+    graph : StarGraph
     options : CsvOptions
         Dialect of the rows (the sample period is the simulation's control period).
     """
 
-    def __init__(self, graph: YGraph, options: CsvOptions) -> None:
+    def __init__(self, graph: StarGraph, options: CsvOptions) -> None:
         self.graph = graph
         self.options = options
         self._files = [tempfile.TemporaryFile(), tempfile.TemporaryFile()]  # noqa: SIM115 - closed by close()
@@ -456,7 +456,7 @@ def _between(before, bodies, first: float, second: float, bend: float) -> float:
     return 0.5 * (first + second - moved)
 
 
-def _time_limit(planned: float, faults: Sequence[Fault], limits: Limits, graph: YGraph) -> float:
+def _time_limit(planned: float, faults: Sequence[Fault], limits: Limits, graph: StarGraph) -> float:
     """Simulated time after which the run counts as stuck, seconds."""
     slowest = min(v.max_velocity for v in limits.vehicles)
     for fault in faults:

@@ -1,4 +1,4 @@
-"""The animation: the Y-track from above, both vehicles moving per a verified schedule, as GIF bytes.
+"""The animation: a track of 3 to 8 legs seen from above, both vehicles moving per a schedule, as GIF bytes.
 
 Each frame shows the track to scale, each vehicle at its position (a dot, and
 a disc of diameter the minimum separation: on one leg the discs touch exactly
@@ -25,7 +25,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from topology import JUNCTION_INDEX, YGraph
+from topology import JUNCTION_INDEX, StarGraph
 from topology.indexed import track_distance
 from topology.validation import short_repr
 from trajgen.errors import InputError, OptionError
@@ -33,6 +33,7 @@ from trajgen.plots.figure import frame_painter, new_figure
 from trajgen.plots.gif import GIF_DELAY_UNIT_MS, gif_bytes
 from trajgen.plots.speed import VEHICLE_COLOURS
 from trajgen.progress import progress
+from trajgen.summary import class_name
 from trajgen.values import ArrayValue, frozen
 from trajgen.verify import VerifiedSchedule, require_verified
 
@@ -191,7 +192,7 @@ class FrameGeometry(ArrayValue):
         Schedule time of each frame, seconds.
     x, y : ndarray, shape (2, n)
         Each vehicle's position from above, metres, junction at the origin
-        (the legs' directions ``YGraph.angles_deg``, as in the CSV export).
+        (the legs' directions ``StarGraph.angles_deg``, as in the CSV export).
     velocity : ndarray, shape (2, n)
         Each vehicle's velocity along its signed axis, m/s.
     distance : ndarray, shape (n,)
@@ -305,7 +306,7 @@ def _box(fraction: tuple[float, float, float, float]) -> tuple[float, float, flo
     return (left * FRAME_WIDTH_PX, bottom * FRAME_HEIGHT_PX, width * FRAME_WIDTH_PX, height * FRAME_HEIGHT_PX)
 
 
-def frame_layout(graph: YGraph, geometry: FrameGeometry) -> FrameLayout:
+def frame_layout(graph: StarGraph, geometry: FrameGeometry) -> FrameLayout:
     """The layout of the frames of ``geometry`` on ``graph``: the whole track to scale, and the bar's range.
 
     The track area shows every leg with a margin for the labels and the vehicles' discs,
@@ -360,7 +361,7 @@ def _round_length(target: float) -> float:
     return max(digit * decade for digit in (1, 2, 5) if digit * decade <= target)
 
 
-def _free_corners(graph: YGraph, layout: FrameLayout) -> list[str]:
+def _free_corners(graph: StarGraph, layout: FrameLayout) -> list[str]:
     """The track area's corners, farthest from the legs first, as legend locations."""
     angles = np.radians(np.array(graph.angles_deg))
     ends = np.stack([np.array(graph.lengths) * np.cos(angles), np.array(graph.lengths) * np.sin(angles)], 1)
@@ -382,7 +383,8 @@ def _free_corners(graph: YGraph, layout: FrameLayout) -> list[str]:
 def _widest_gap(angles_deg: Sequence[float]) -> float:
     """The direction halfway across the widest angle between two neighbouring legs, radians."""
     angles = sorted(a % 360.0 for a in angles_deg)
-    gaps = [((angles[(k + 1) % 3] - angles[k]) % 360.0, k) for k in range(3)]
+    count = len(angles)
+    gaps = [((angles[(k + 1) % count] - angles[k]) % 360.0, k) for k in range(count)]
     width, k = max(gaps)
     return math.radians(angles[k] + 0.5 * width)
 
@@ -414,7 +416,7 @@ class _Scene:
             0.5,
             0.965,
             f"{names[0]} and {names[1]}: {schedule.method.name} schedule, {schedule.duration:.2f} s, "
-            f"{schedule.route.way_round.value}",
+            f"{class_name(schedule.route)}",
             ha="center",
             va="center",
             fontsize=11,
@@ -439,7 +441,7 @@ class _Scene:
         sizes = (FRAME_WIDTH_PX, FRAME_HEIGHT_PX, FRAME_WIDTH_PX, FRAME_HEIGHT_PX)
         return self.figure.add_axes([value / size for value, size in zip(box, sizes, strict=True)])
 
-    def _draw_track(self, graph: YGraph, layout: FrameLayout) -> list:
+    def _draw_track(self, graph: StarGraph, layout: FrameLayout) -> list:
         geometry = self.geometry
         axis = self._axes(layout.track_box)
         axis.set_xlim(*layout.track_xlim)

@@ -45,6 +45,7 @@ from topology.cycle import retract_indexed
 from topology.indexed import IndexedConfiguration, region_key
 from trajgen.errors import InputError
 from trajgen.plots.figure import new_figure, png_bytes
+from trajgen.plots.retract_graph import configuration_subject, render_retract_graph
 from trajgen.plots.speed import plot_period
 from trajgen.summary import class_label
 from trajgen.values import ArrayValue, readonly
@@ -113,7 +114,10 @@ class ConfigurationLayout(ArrayValue):
     def of(cls, graph: YGraph, *, min_separation: float = 0.0) -> ConfigurationLayout:
         """The layout of ``graph``'s configuration space; ``min_separation`` in metres (0 to shortest leg)."""
         if not isinstance(graph, YGraph):
-            raise InputError(f"a configuration layout needs a YGraph, got {type(graph).__name__}")
+            raise InputError(
+                f"a configuration layout needs a YGraph (three legs), got {type(graph).__name__}: with "
+                "four or more legs draw the retract graph (trajgen.plots.retract_graph.RetractGraphLayout)"
+            )
         if not 0.0 <= min_separation <= graph.shortest_leg:
             raise InputError(
                 f"min_separation {min_separation!r} m is out of range: expected 0 m to the shortest leg "
@@ -515,6 +519,9 @@ def _draw_retraction(
 def render_configuration(subject: Route | VerifiedSchedule, *, names: tuple[str, str] | None = None) -> bytes:
     """The configuration space drawn flat with the route, the motion and its retraction, as PNG bytes.
 
+    Four or more legs: the retract graph ``G_k`` with the route on it instead
+    (:func:`trajgen.plots.retract_graph.render_retract_graph`): the space has no flat drawing.
+
     Drawn: the six quadrangles and six triangles (folded out beside their valleys, see
     :class:`ConfigurationLayout`) round the deleted point, the too-close parts, the rays,
     the boundary circle with its peaks and valleys named, the route (the planner's
@@ -537,19 +544,13 @@ def render_configuration(subject: Route | VerifiedSchedule, *, names: tuple[str,
     InputError
         ``subject`` is neither a Route nor a VerifiedSchedule, or ``names`` is not two strings.
     """
-    if names is not None and (
-        not isinstance(names, (tuple, list)) or len(names) != 2 or not all(isinstance(n, str) for n in names)
-    ):
-        raise InputError(f"configuration plot names must be two strings, got {names!r}")
-    if isinstance(subject, Route):
-        route, verified = subject, None
-        required = route.min_separation
-    else:
-        verified = require_verified(subject, "render_configuration")
-        schedule = verified.schedule
-        route = schedule.route
-        required = max(schedule.limits.min_separation, route.min_separation)
+    route, verified = configuration_subject(subject, names)
+    required = route.min_separation
+    if verified is not None:
+        required = max(verified.schedule.limits.min_separation, required)
     graph = route.graph
+    if graph.cycle is None:  # four or more legs: no flat drawing, the retract graph G_k instead
+        return render_retract_graph(subject, names=names)
     layout = ConfigurationLayout.of(graph, min_separation=required)
     who = "vehicle 1 and vehicle 2" if names is None else f"{names[0]} (vehicle 1) and {names[1]} (vehicle 2)"
     figure = new_figure(figsize=(8.6, 9.6))

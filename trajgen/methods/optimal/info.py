@@ -22,7 +22,9 @@ class Source(enum.Enum):
 class HomotopyChoice(Option):
     """Which homotopy classes ``optimal`` solves."""
 
-    FASTEST = "fastest"  #: the route's class and the other way round; the faster wins
+    #: the route's class and the other (the other way round a Y's boundary circle; the
+    #: second-shortest route on ``G_k`` for more legs); the faster wins
+    FASTEST = "fastest"
     PAPER = "paper"  #: the route's class only (the paper's instruction, for a route from ``plan``)
 
 
@@ -33,9 +35,10 @@ class ClassComparison:
     Attributes
     ----------
     homotopy : Homotopy
-        Whether it is the paper's class or the other way round.
+        Whether it is the planner's class or the other (the other way round a Y's circle, the
+        second-shortest route on ``G_k`` for more legs).
     way_round : WayRound
-        Its direction round the boundary circle.
+        Its direction round the boundary circle (``GRAPH`` for four or more legs).
     lower_bound : float
         :func:`~trajgen.analysis.class_lower_bound`, seconds.
     makespan : float or None
@@ -47,6 +50,10 @@ class ClassComparison:
     failure : FallbackReason or None
         Why the class has no makespan although it was to be solved (its solvers failed, ran
         out of time, or its setup raised); ``None`` otherwise.
+    label : str or None
+        Four or more legs: which route on ``G_k`` it is, for people
+        (:func:`trajgen.summary.class_name`, e.g. ``second-shortest route on G_4``); ``None``
+        for three legs, where ``way_round`` says it.
     """
 
     homotopy: Homotopy
@@ -55,10 +62,11 @@ class ClassComparison:
     makespan: float | None
     chosen: bool
     failure: FallbackReason | None = None
+    label: str | None = None
 
     def summary(self) -> dict:
-        """JSON-ready fields."""
-        return {
+        """JSON-ready fields (``class`` too where there is a :attr:`label`)."""
+        fields = {
             "homotopy": self.homotopy.value,
             "way_round": self.way_round.value,
             "lower_bound_s": self.lower_bound,
@@ -66,6 +74,9 @@ class ClassComparison:
             "chosen": self.chosen,
             "failure": None if self.failure is None else self.failure.value,
         }
+        if self.label is not None:
+            fields["class"] = self.label
+        return fields
 
 
 @dataclass(frozen=True, slots=True)

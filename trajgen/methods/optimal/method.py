@@ -14,7 +14,7 @@ from typing import ClassVar
 import numpy as np
 
 from limits import Limits
-from topology import Homotopy, Route, plan
+from topology import Homotopy, OptionError, Route, plan
 from trajgen.analysis import class_lower_bound
 from trajgen.errors import InputError, SolverError
 from trajgen.methods.exact import Exact
@@ -27,6 +27,7 @@ from trajgen.methods.optimal.phases import NlpShape, default_fractions, route_ph
 from trajgen.methods.optimal.solve import SolverCache, solve
 from trajgen.methods.optimal.transcription import ParameterLayout
 from trajgen.schedule import FallbackReason, Schedule, TimingMethod, check_request
+from trajgen.summary import class_name
 from trajgen.verify import verify
 
 __all__ = ["DEFAULT_NODES", "DEFAULT_REFINEMENT_TOLERANCE", "Optimal"]
@@ -106,8 +107,10 @@ class Optimal(TimingMethod):
         :data:`DEFAULT_REFINEMENT_TOLERANCE`, 0.15 %), in (0, 1); 15 times smaller for a
         solution within 1 % of its class lower bound, where refinement converges slowly.
     homotopy : HomotopyChoice or str, optional
-        ``"fastest"`` (default): solve the route's class and the other way round the boundary
-        circle, return the faster. ``"paper"``: the route's class only.
+        ``"fastest"`` (default): solve the route's class and the other one, return the faster:
+        the other way round the boundary circle (three legs), or the second-shortest route on
+        ``G_k`` (four to eight legs, ``plan(..., homotopy="other")``). ``"paper"``: the route's
+        class only.
     cache : SolverCache or None, optional
         Where compiled NLPs are kept; ``None`` (default) uses the process-wide
         :meth:`shared_cache`.
@@ -190,22 +193,27 @@ class Optimal(TimingMethod):
         return any(built)
 
     def class_routes(self, route: Route) -> list[Route]:
-        """The routes of the classes this method considers: ``route``'s own first, then the other way round.
+        """The routes of the classes this method considers: ``route``'s own first, then the other.
 
-        With ``homotopy="paper"``, or where start and goal retract to one boundary point (the
-        other way would be a full turn), only ``route``.
+        The other is the other way round the boundary circle (three legs) or the other of the
+        planner's shortest and second-shortest routes on ``G_k`` (four to eight legs). With
+        ``homotopy="paper"``, or where start and goal retract to one boundary point (the other
+        way would be a full turn), only ``route``.
         """
         if self.homotopy is HomotopyChoice.PAPER or route.arc_length == 0.0:
             return [route]
         other = Homotopy.OTHER if route.homotopy is Homotopy.PAPER else Homotopy.PAPER
         graph, start, goal, separation = route.graph, route.start, route.goal, route.min_separation
-        return [route, plan(graph, start, goal, min_separation=separation, homotopy=other)]
+        try:
+            return [route, plan(graph, start, goal, min_separation=separation, homotopy=other)]
+        except OptionError:  # start and goal retract to one boundary point up to round-off
+            return [route]
 
     def schedule(self, route: Route, limits: Limits) -> Schedule:
         """The optimal schedule from ``route``'s start to its goal (verified), or the flagged ``exact`` one.
 
-        With ``homotopy="fastest"`` the route's class and the other way round
-        the boundary circle are both considered: a class whose lower bound
+        With ``homotopy="fastest"`` the route's class and the other
+        (:meth:`class_routes`) are both considered: a class whose lower bound
         (:func:`~trajgen.analysis.class_lower_bound`) cannot beat the faster
         of the two ``exact`` schedules is skipped, the others are solved
         concurrently, and the fastest solution that verifies is returned
@@ -269,12 +277,13 @@ class Optimal(TimingMethod):
                     makespan=solved[k].makespan if k in solved else None,
                     chosen=r is winner,
                     failure=solved[k].failure if k in solved else None,
+                    label=None if r.graph.cycle is not None else class_name(r),
                 )
                 for k, r in enumerate(routes)
             )
 
         unsolved_notes = tuple(
-            f"class {routes[k].way_round.value} ({routes[k].homotopy.value}) not solved "
+            f"class {class_name(routes[k])} ({routes[k].homotopy.value}) not solved "
             f"({solved[k].failure.value}): {solved[k].detail}"
             for k in wanted
             if solved[k].failure is not None
