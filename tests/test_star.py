@@ -36,7 +36,7 @@ from topology import (
     plan,
     retract,
 )
-from topology.errors import OptionError, SeparationError, TrackError
+from topology.errors import OptionError, PositionError, SeparationError, TrackError
 from topology.retract_graph import LENGTH_PERTURBATION, TIE_TOLERANCE
 
 #: Leg index of a vehicle at the junction in the indexed form ``(leg1, s1, leg2, s2)``.
@@ -1160,3 +1160,9 @@ def test_boundary_angle_of_a_star_is_a_clear_error():
     crossing = StarGraph(LEGS4)
     with pytest.raises(TrackError, match="no boundary circle"):
         boundary_angle(crossing, Configuration(Position("N", 10.0), Position("S", 1.0)))
+
+
+def test_locating_a_configuration_off_the_boundary_is_a_position_error():
+    graph = StarGraph(LEGS4).retract_graph
+    with pytest.raises(PositionError, match=r"configuration \(0, 3\.0, 2, 1\.0\) is not on the boundary"):
+        graph.locate((0, 3.0, 2, 1.0))

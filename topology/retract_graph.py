@@ -35,6 +35,7 @@ from typing import NamedTuple
 
 import numpy as np
 
+from topology.errors import PositionError
 from topology.indexed import JUNCTION_INDEX, IndexedConfiguration
 from topology.legs import LegTable
 from topology.positions import Configuration
@@ -250,7 +251,10 @@ class RetractGraph:
                 return GraphPoint(peak, -1, 0.0)
             return GraphPoint(-1, 2 * peak + 1, lengths[l2] - s2)
         if l2 == JUNCTION_INDEX or s2 != lengths[l2]:
-            raise ValueError(f"{c!r} is not a boundary configuration: expected a vehicle at a leg's end")
+            raise PositionError(
+                f"configuration {c!r} is not on the boundary: expected a vehicle at a leg's end "
+                "(retract it first)"
+            )
         if l1 == JUNCTION_INDEX:
             return GraphPoint(self._valley_first_at_junction[l2], -1, 0.0)
         return GraphPoint(-1, 2 * self._peak[(l1, l2)], lengths[l1] - s1)
