@@ -339,12 +339,10 @@ class Schedule:
     continuity: int | None = None
     end_tolerance: float | None = None
     checked_limits: int | None = None
-    _starts: np.ndarray = field(init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "sections", tuple(self.sections))
         object.__setattr__(self, "notes", tuple(self.notes))
-        object.__setattr__(self, "_starts", readonly([section.start_time for section in self.sections]))
 
     @property
     def smoothness(self) -> int:
@@ -367,7 +365,9 @@ class Schedule:
         t : float or array_like, shape (n,)
         """
         t = np.clip(np.atleast_1d(np.asarray(t, dtype=float)), 0.0, self.duration)
-        index = np.clip(np.searchsorted(self._starts, t, side="right") - 1, 0, len(self.sections) - 1)
+        # section starts are read from the sections each time: no cached copy can disagree with them
+        starts = np.array([section.start_time for section in self.sections])
+        index = np.clip(np.searchsorted(starts, t, side="right") - 1, 0, len(self.sections) - 1)
         kin = np.zeros((2, 4, t.size))
         leg = np.zeros((2, t.size), dtype=int)
         s = np.zeros((2, t.size))
