@@ -63,8 +63,8 @@ def mutants():
         True,
     )
     for column, name in ((0, "position"), (1, "velocity"), (2, "acceleration")):
-        yield f"NaN in one {name} coefficient", with_coefficient(exact, 1, column, math.nan), True
-        yield f"inf in one {name} coefficient", with_coefficient(exact, 1, column, math.inf), True
+        yield f"NaN in one {name} coefficient", with_coefficient(exact, 1, column, math.nan)[0], True
+        yield f"inf in one {name} coefficient", with_coefficient(exact, 1, column, math.inf)[0], True
     fast = VehicleLimits(1.2, 0.6, 1.2)
     quick = Exact().schedule(route_of(*SWAP), Limits((fast, fast), min_separation=1.5))
     yield "20 % too fast throughout", Schedule(quick.route, LIMITS, quick.method, quick.sections, True), True

@@ -6,6 +6,7 @@ import dataclasses
 
 import numpy as np
 
+from tests.corruption import corrupted
 from trajgen import Schedule
 from trajgen.profiles import PiecewiseCubic
 from trajgen.schedule import CubicKinematics
@@ -94,12 +95,15 @@ def free_window(
     raise ValueError("no free window")
 
 
-def with_coefficient(schedule: Schedule, vehicle: int, column: int, value: float) -> Schedule:
-    """One initial-state coefficient (0 position, 1 velocity, 2 acceleration) of section 0 replaced."""
-    section = schedule.sections[0]
-    profiles = list(section.kinematics.vehicles)
-    initial = np.array(profiles[vehicle].initial)
-    initial[len(initial) // 2, column] = value
-    profiles[vehicle] = PiecewiseCubic(profiles[vehicle].times, initial, profiles[vehicle].jerk)
-    changed = dataclasses.replace(section, kinematics=CubicKinematics(tuple(profiles)))
-    return dataclasses.replace(schedule, sections=(changed, *schedule.sections[1:]))
+def with_coefficient(schedule: Schedule, vehicle: int, column: int, value: float) -> tuple[Schedule, str]:
+    """One initial-state coefficient (0 position, 1 velocity, 2 acceleration) of section 0 replaced.
+
+    The constructors refuse non-finite numbers, so the array is replaced behind them
+    (:func:`tests.corruption.corrupted`), as a bug or a stray write would. Returns the
+    schedule and the path of the entry replaced (``sections[0]...initial[3, 1]``).
+    """
+    path = f"sections[0].kinematics.vehicles[{vehicle}].initial"
+    initial = np.array(schedule.sections[0].kinematics.vehicles[vehicle].initial)
+    row = len(initial) // 2
+    initial[row, column] = value
+    return corrupted(schedule, path, initial), f"{path}[{row}, {column}]"

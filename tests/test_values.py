@@ -72,8 +72,14 @@ def test_equality_and_hash_agree_on_signed_zero_and_nan():
     parked = AxisMap.parked(0.0, 1, 2.0)
     assert parked == parked.flipped()
     assert hash(parked) == hash(parked.flipped())
-    with_nan = AxisMap(np.array([np.nan]), np.array([1.0]), np.array([0]), np.array([1.0]), np.array([1]))
-    twin = AxisMap(np.array([-np.nan]), np.array([1.0]), np.array([0]), np.array([1.0]), np.array([1]))
+    # (an axis map refuses a NaN; a sampled state may hold one, e.g. of an executed motion)
+    from trajgen.schedule import ScheduleState
+
+    def state(value):
+        one = np.array([[value], [1.0]])
+        return ScheduleState(np.array([0.0]), one, one, one, one, np.zeros((2, 1), dtype=int), one)
+
+    with_nan, twin = state(np.nan), state(-np.nan)
     assert with_nan == twin
     assert hash(with_nan) == hash(twin)
 

@@ -5,16 +5,18 @@ from __future__ import annotations
 import dataclasses
 import logging
 import math
+import re
 
 import numpy as np
 import pytest
 
+from tests.corruption import corrupted
 from tests.helpers import LIMITS, route_of, too_close
 from tests.mutants import with_coefficient
 from trajgen import Exact, VerifiedSchedule, certify, verify
 from trajgen.errors import InputError, UnverifiedScheduleError, VerificationError
 from trajgen.profiles import PiecewiseCubic
-from trajgen.schedule import CubicKinematics
+from trajgen.schedule import AxisMap
 
 SWAP = ((10.0, 10.0, 10.0), ("A:10", "B:10"), ("B:10", "A:10"))
 
@@ -67,30 +69,50 @@ def test_a_failing_report_cannot_make_a_certificate():
 @pytest.mark.parametrize("value", [math.nan, math.inf, -math.inf], ids=["nan", "inf", "-inf"])
 @pytest.mark.parametrize(("column", "name"), [(0, "axis"), (1, "velocity"), (2, "acceleration")])
 def test_non_finite_values_fail_and_are_never_certified(value, column, name):
-    schedule = with_coefficient(Exact().schedule(route_of(*SWAP), LIMITS), 1, column, value)
+    schedule, entry = with_coefficient(Exact().schedule(route_of(*SWAP), LIMITS), 1, column, value)
     report = verify(schedule)
     assert not report.passed
-    assert any("is not finite" in f for f in report.failures), report.failures
-    with pytest.raises(VerificationError, match="is not finite"):
+    expected = f"{entry} is {value!r}: expected a finite number"
+    assert report.failures == (expected,), report.failures
+    with pytest.raises(VerificationError, match=re.escape(expected)):
         certify(schedule)
 
 
-def test_a_non_finite_duration_fails_without_sampling():
+def test_a_non_finite_duration_fails_naming_the_knot():
     schedule = Exact().schedule(route_of(*SWAP), LIMITS)
-    section = schedule.sections[-1]
-    profiles = list(section.kinematics.vehicles)
-    times = np.array(profiles[0].times)
+    path = f"sections[{len(schedule.sections) - 1}].kinematics.vehicles[0].times"
+    times = np.array(schedule.sections[-1].kinematics.vehicles[0].times)
     times[-1] = math.nan
-    profiles[0] = PiecewiseCubic(times, profiles[0].initial, profiles[0].jerk)
-    broken = dataclasses.replace(
-        schedule,
-        sections=(
-            *schedule.sections[:-1],
-            dataclasses.replace(section, kinematics=CubicKinematics(tuple(profiles))),
-        ),
-    )
-    report = verify(broken)
-    assert report.failures == ("schedule duration is nan s: expected finite, >= 0",)
+    report = verify(corrupted(schedule, path, times))
+    assert report.failures == (f"{path}[{times.size - 1}] is nan: expected a finite number",)
+
+
+@pytest.mark.parametrize(
+    ("arrays", "message"),
+    [
+        (([0.0, 1.0, math.nan], [[0, 0, 0], [0, 0, 0]], [1.0, -1.0]), "times holds a non-finite value"),
+        (([0.0, 1.0, 2.0], [[0, 0, 0], [0, math.inf, 0]], [1.0, -1.0]), "initial holds a non-finite value"),
+        (([0.0, 1.0, 2.0], [[0, 0, 0], [0, 0, 0]], [1.0, -math.inf]), "jerk holds a non-finite value"),
+        (([0.0, 2.0, 1.0], [[0, 0, 0], [0, 0, 0]], [1.0, -1.0]), r"times do not increase at \[2\]"),
+        (([0.0, 1.0, 1.0], [[0, 0, 0], [0, 0, 0]], [1.0, -1.0]), r"times do not increase at \[2\]"),
+        (([0.0, 1.0], [[0, 0, 0], [0, 0, 0]], [1.0]), r"initial of shape \(2, 3\)"),
+    ],
+    ids=["nan-knot", "inf-velocity", "inf-jerk", "unsorted", "repeated", "shapes"],
+)
+def test_a_piecewise_cubic_refuses_numbers_no_motion_has(arrays, message):
+    times, initial, jerk = (np.array(a, dtype=float) for a in arrays)
+    with pytest.raises(InputError, match=message):
+        PiecewiseCubic(times, initial, jerk)
+
+
+def test_a_profile_of_no_time_at_rest_is_allowed():
+    profile = PiecewiseCubic(np.array([0.0, 0.0]), np.array([[2.0, 0.0, 0.0]]), np.zeros(1))
+    assert profile.duration == 0.0
+
+
+def test_an_axis_map_refuses_a_non_finite_number():
+    with pytest.raises(InputError, match="axis map: s_start holds a non-finite value"):
+        AxisMap(np.array([0.0]), np.array([1.0]), np.array([0]), np.array([math.nan]), np.array([1]))
 
 
 def test_a_certificate_is_bound_to_its_own_schedule():

@@ -18,7 +18,7 @@ from trajgen.polynomials import evaluate, root_in
 from trajgen.schedule import AxisMap, CubicKinematics, Schedule, Section
 from trajgen.values import ArrayValue, readonly
 
-__all__ = ["DEGREE", "Pieces", "UncheckableKinematicsError", "schedule_pieces", "shift"]
+__all__ = ["DEGREE", "Pieces", "UncheckableKinematicsError", "motion_arrays", "schedule_pieces", "shift"]
 
 #: Highest power of the axis polynomials (TOPPRA sections: a quadratic path of a quadratic s(t)).
 DEGREE = 4
@@ -49,6 +49,9 @@ class Pieces(ArrayValue):
         The axis range the section's map covers, metres (outside it the map would clip).
     section : ndarray of int, shape (n,)
         Index of the section each piece belongs to.
+    interval : ndarray of int, shape (2, n)
+        Per vehicle, the interval of its section's kinematics the piece lies in (a knot
+        interval of its piecewise cubic, or of a TOPPRA section's grid): where its numbers are.
     """
 
     start: np.ndarray
@@ -60,11 +63,12 @@ class Pieces(ArrayValue):
     axis_low: np.ndarray
     axis_high: np.ndarray
     section: np.ndarray
+    interval: np.ndarray
 
     def __post_init__(self) -> None:
         for name in ("start", "length", "axis", "s_offset", "s_sign", "axis_low", "axis_high"):
             object.__setattr__(self, name, readonly(getattr(self, name), float))
-        for name in ("leg", "section"):
+        for name in ("leg", "section", "interval"):
             object.__setattr__(self, name, readonly(getattr(self, name), int))
 
     @property
@@ -95,8 +99,8 @@ def shift(c: np.ndarray, delta: np.ndarray) -> np.ndarray:
     return out
 
 
-def _cubic_section(kinematics: CubicKinematics) -> tuple[np.ndarray, np.ndarray]:
-    """Breakpoints (m + 1,) and axis polynomials (2, m, DEGREE + 1) of a piecewise-cubic section."""
+def _cubic_section(kinematics: CubicKinematics) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Breakpoints (m + 1,), axis polynomials (2, m, DEGREE + 1), knot intervals (2, m): a cubic section."""
     duration = kinematics.duration
     times = np.unique(
         np.concatenate([np.clip(p.times, 0.0, duration) for p in kinematics.vehicles] + [[0.0]])
@@ -104,8 +108,10 @@ def _cubic_section(kinematics: CubicKinematics) -> tuple[np.ndarray, np.ndarray]
     times = np.append(times[times < duration], duration) if duration > 0 else np.array([0.0, 0.0])
     begin = times[:-1]
     coefficients = np.zeros((2, begin.size, DEGREE + 1))
+    intervals = np.zeros((2, begin.size), dtype=int)
     for vehicle, profile in enumerate(kinematics.vehicles):
         k = np.clip(np.searchsorted(profile.times, begin, side="right") - 1, 0, len(profile.jerk) - 1)
+        intervals[vehicle] = k
         delta = begin - profile.times[k]
         p0, v0, a0 = profile.initial[k, 0], profile.initial[k, 1], profile.initial[k, 2]
         j = profile.jerk[k]
@@ -119,11 +125,11 @@ def _cubic_section(kinematics: CubicKinematics) -> tuple[np.ndarray, np.ndarray]
         coefficients[vehicle, :, 1] = np.where(ended, 0.0, v0 + delta * (a0 + delta * j / 2.0))
         coefficients[vehicle, :, 2] = np.where(ended, 0.0, (a0 + delta * j) / 2.0)
         coefficients[vehicle, :, 3] = np.where(ended, 0.0, j / 6.0)
-    return times, coefficients
+    return times, coefficients, intervals
 
 
-def _toppra_section(kinematics) -> tuple[np.ndarray, np.ndarray]:
-    """Breakpoints and axis polynomials of a TOPPRA section: q(s(t)), quadratic of a quadratic."""
+def _toppra_section(kinematics) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Breakpoints, axis polynomials and grid intervals of a TOPPRA section: q(s(t)), quadratic in time."""
     grid, speed, times, path = kinematics.grid, kinematics.speed, kinematics.times, kinematics.path
     width = np.diff(grid)
     with np.errstate(divide="ignore", invalid="ignore"):
@@ -143,23 +149,57 @@ def _toppra_section(kinematics) -> tuple[np.ndarray, np.ndarray]:
         coefficients[vehicle, :, 2] = b * gamma + c * (beta**2 + 2.0 * alpha * gamma)
         coefficients[vehicle, :, 3] = 2.0 * c * beta * gamma
         coefficients[vehicle, :, 4] = c * gamma**2
-    return np.asarray(times, dtype=float), coefficients
+    intervals = np.tile(np.arange(grid.size - 1), (2, 1))
+    return np.asarray(times, dtype=float), coefficients, intervals
 
 
-def _section_polynomials(section: Section) -> tuple[np.ndarray, np.ndarray]:
-    kinematics = section.kinematics
+def _is_toppra(kinematics: object) -> bool:
+    # by name: the verifier does not import the method it checks
     kind = type(kinematics)
+    return (kind.__module__, kind.__qualname__) == ("trajgen.methods.toppra", "ToppraKinematics")
+
+
+def _section_polynomials(section: Section) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    kinematics = section.kinematics
     # exact types only: a subclass could evaluate (and so export) something else than this form
-    if kind is CubicKinematics:
+    if type(kinematics) is CubicKinematics:
         return _cubic_section(kinematics)
-    if (kind.__module__, kind.__qualname__) == ("trajgen.methods.toppra", "ToppraKinematics"):
+    if _is_toppra(kinematics):
         return _toppra_section(kinematics)
     raise UncheckableKinematicsError(
         f"section kinematics {type(kinematics).__name__} have no polynomial form the verifier knows"
     )
 
 
-def _split_at_map_boundaries(times: np.ndarray, axis: np.ndarray, maps: tuple[AxisMap, AxisMap]):
+def motion_arrays(schedule: Schedule, section: int, vehicle: int, interval: int | None = None) -> str:
+    """The arrays that define one vehicle's motion in a section, by their paths from the schedule.
+
+    Parameters
+    ----------
+    schedule : Schedule
+    section, vehicle : int
+        Section index; 0 for vehicle 1, 1 for vehicle 2.
+    interval : int, optional
+        The knot (or grid) interval of the section's kinematics, when one is meant.
+
+    Returns
+    -------
+    str
+        For example ``sections[2].kinematics.vehicles[0].{times,initial,jerk} interval 4,
+        sections[2].maps[0].{axis_start,axis_end,s_start}``.
+    """
+    kinematics = schedule.sections[section].kinematics
+    if _is_toppra(kinematics):
+        arrays = f"sections[{section}].kinematics.{{grid,speed,times}}"
+    else:
+        arrays = f"sections[{section}].kinematics.vehicles[{vehicle}].{{times,initial,jerk}}"
+    at = "" if interval is None else f" interval {interval}"
+    return f"{arrays}{at}, sections[{section}].maps[{vehicle}].{{axis_start,axis_end,s_start}}"
+
+
+def _split_at_map_boundaries(
+    times: np.ndarray, axis: np.ndarray, intervals: np.ndarray, maps: tuple[AxisMap, AxisMap]
+):
     """Split pieces where an axis crosses from one sub-range of its map to the next."""
     splits = [[] for _ in range(times.size - 1)]
     for vehicle, axis_map in enumerate(maps):
@@ -175,7 +215,7 @@ def _split_at_map_boundaries(times: np.ndarray, axis: np.ndarray, maps: tuple[Ax
             for k in np.nonzero(inside)[0]:
                 splits[k].append(float(roots[k]))
     if not any(splits):
-        return times[:-1], np.diff(times), axis
+        return times[:-1], np.diff(times), axis, intervals
     starts, lengths, rows = [], [], []
     for k, points in enumerate(splits):
         cuts = [0.0, *sorted(points), float(times[k + 1] - times[k])]
@@ -186,7 +226,7 @@ def _split_at_map_boundaries(times: np.ndarray, axis: np.ndarray, maps: tuple[Ax
                 rows.append((k, a))
     index = np.array([r[0] for r in rows])
     offset = np.array([r[1] for r in rows])
-    return np.array(starts), np.array(lengths), shift(axis[:, index], offset[None, :])
+    return np.array(starts), np.array(lengths), shift(axis[:, index], offset[None, :]), intervals[:, index]
 
 
 def _map_of(axis_map: AxisMap, middle: np.ndarray):
@@ -218,12 +258,14 @@ def schedule_pieces(schedule: Schedule) -> Pieces:
     """
     parts = []
     for index, section in enumerate(schedule.sections):
-        times, axis = _section_polynomials(section)
-        starts, lengths, axis = _split_at_map_boundaries(times, axis, section.maps)
+        times, axis, intervals = _section_polynomials(section)
+        starts, lengths, axis, intervals = _split_at_map_boundaries(times, axis, intervals, section.maps)
         keep = lengths > 0.0
-        starts, lengths, axis = starts[keep], lengths[keep], axis[:, keep]
+        starts, lengths, axis, intervals = starts[keep], lengths[keep], axis[:, keep], intervals[:, keep]
         columns = [_map_of(section.maps[v], evaluate(axis[v], 0.5 * lengths)) for v in range(2)]
-        parts.append((section.start_time + starts, lengths, axis, columns, np.full(lengths.size, index)))
+        parts.append(
+            (section.start_time + starts, lengths, axis, columns, np.full(lengths.size, index), intervals)
+        )
     if not parts or sum(p[1].size for p in parts) == 0:
         empty = np.zeros((2, 0))
         return Pieces(
@@ -236,6 +278,7 @@ def schedule_pieces(schedule: Schedule) -> Pieces:
             empty,
             empty,
             np.zeros(0),
+            np.zeros((2, 0)),
         )
     start = np.concatenate([p[0] for p in parts])
     length = np.concatenate([p[1] for p in parts])
@@ -244,9 +287,10 @@ def schedule_pieces(schedule: Schedule) -> Pieces:
         np.stack([np.concatenate([p[3][v][field] for p in parts]) for v in range(2)]) for field in range(5)
     ]
     section = np.concatenate([p[4] for p in parts])
+    interval = np.concatenate([p[5] for p in parts], axis=1)
     leg, offset, sign = stacked[0], stacked[1], stacked[2]
     # a vehicle standing exactly at the junction for a whole piece is on no leg (as Schedule.state says)
     track = axis * sign[:, :, None]
     track[:, :, 0] += offset
     leg = np.where(np.all(track == 0.0, axis=2), JUNCTION_INDEX, leg)
-    return Pieces(start, length, axis, leg, offset, sign, stacked[3], stacked[4], section)
+    return Pieces(start, length, axis, leg, offset, sign, stacked[3], stacked[4], section, interval)

@@ -10,6 +10,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from trajgen.errors import InputError
 from trajgen.values import ArrayValue, readonly
 
 __all__ = ["PiecewiseCubic", "rest_to_rest_time", "scurve_phases", "trapezoid_phases"]
@@ -95,7 +96,8 @@ class PiecewiseCubic(ArrayValue):
     Attributes
     ----------
     times : ndarray, shape (m + 1,)
-        Breakpoints, seconds, from 0 increasing.
+        Breakpoints, seconds, from 0 strictly increasing (``[0, 0]``: one interval of no
+        time, at rest).
     initial : ndarray, shape (m, 3)
         Position (m), velocity (m/s) and acceleration (m/s²) at the start of
         each interval. Acceleration may jump at a breakpoint (trapezoids).
@@ -111,6 +113,25 @@ class PiecewiseCubic(ArrayValue):
         object.__setattr__(self, "times", readonly(self.times, float))
         object.__setattr__(self, "initial", readonly(self.initial, float))
         object.__setattr__(self, "jerk", readonly(self.jerk, float))
+        times = self.times
+        if times.ndim != 1 or times.size < 2 or self.initial.shape != (times.size - 1, 3):
+            raise InputError(
+                f"piecewise cubic: times of shape {times.shape} and initial of shape {self.initial.shape}: "
+                "expected (m + 1,) and (m, 3) with m >= 1"
+            )
+        if self.jerk.shape != (times.size - 1,):
+            raise InputError(
+                f"piecewise cubic: jerk of shape {self.jerk.shape}: expected ({times.size - 1},)"
+            )
+        for name in ("times", "initial", "jerk"):
+            if not np.all(np.isfinite(getattr(self, name))):
+                raise InputError(f"piecewise cubic: {name} holds a non-finite value: expected finite numbers")
+        if not (np.all(np.diff(times) > 0.0) or (times.size == 2 and times[1] == 0.0)):
+            k = int(np.argmax(~(np.diff(times) > 0.0)))
+            raise InputError(
+                f"piecewise cubic: times do not increase at [{k + 1}] ({float(times[k])!r}, then "
+                f"{float(times[k + 1])!r} s): expected strictly increasing knot times"
+            )
 
     @classmethod
     def from_phases(

@@ -168,6 +168,8 @@ class AxisMap(ArrayValue):
             ("outward", int),
         ):
             object.__setattr__(self, name, readonly(np.atleast_1d(getattr(self, name)), dtype))
+            if dtype is float and not np.all(np.isfinite(getattr(self, name))):
+                raise InputError(f"axis map: {name} holds a non-finite value: expected finite numbers")
 
     @classmethod
     def parked(cls, axis: float, leg: int, s: float) -> AxisMap:
@@ -255,6 +257,9 @@ class Section:
     kinematics: Kinematics
     maps: tuple[AxisMap, AxisMap]
 
+    def __post_init__(self) -> None:
+        finite_real(self.start_time, "section start_time (seconds)", InputError)
+
     @property
     def duration(self) -> float:
         """Seconds."""
@@ -321,6 +326,9 @@ class Schedule:
         How far from the route's start and goal the motion may begin and end,
         and past a leg's end it may reach, metres (``None``: the verifier's
         1e-9 m and 1e-6 m; PLC tables: 1e-6 m; a generic CSV read back: 1e-5 m).
+        When set (a table as a controller interpolates it), continuity from
+        piece to piece is held to 1e-6 of each limit (1e-6 m for positions);
+        ``None`` (a method's schedule) holds it to round-off.
     checked_limits : int or None
         How many derivatives (1: velocity, 2: acceleration, 3: jerk) the
         verifier checks against the limits in closed form. ``None``: velocity

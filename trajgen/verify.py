@@ -13,12 +13,17 @@ number of pieces, not with the duration. It checks:
   vehicle's limits, to a relative tolerance of 1e-6;
 - every position is on its leg (at most 1e-6 m past its end) and within the
   range its section's position map covers;
-- position, velocity (and, where jerk is limited, acceleration) are
-  continuous from piece to piece (as many derivatives as the schedule's
-  ``smoothness`` says), and the pieces tile ``[0, duration]``;
+- position, the axis, velocity (and, where jerk is limited, acceleration)
+  are continuous from piece to piece (as many derivatives as the schedule's
+  ``smoothness`` says) to round-off (:data:`CONTINUITY_TOLERANCE`), and the
+  pieces tile ``[0, duration]``;
 - the start and the goal are the route's, to 1e-9 m, at rest (1e-6 m/s);
 - the sequence of regions visited (the homotopy class) is the route's;
-- every number is finite.
+- every number is finite, every knot sequence increases, and every array
+  derived from others agrees with them (:mod:`trajgen.integrity`).
+
+A failure names the arrays where it occurs, by their paths from the schedule
+(``sections[2].kinematics.vehicles[0].{times,initial,jerk} interval 4``).
 
 Each schedule object is verified once: the report is kept (for the last
 :data:`_REMEMBERED` schedules) and returned again, also to concurrent callers.
@@ -42,10 +47,12 @@ from topology import Region, RegionKey, reduce_regions
 from topology.indexed import JUNCTION_INDEX, track_distance
 from trajgen import polynomials
 from trajgen.errors import InputError, UnverifiedScheduleError, VerificationError
-from trajgen.pieces import Pieces, UncheckableKinematicsError, schedule_pieces
+from trajgen.integrity import array_failures
+from trajgen.pieces import Pieces, UncheckableKinematicsError, motion_arrays, schedule_pieces
 from trajgen.schedule import Schedule
 
 __all__ = [
+    "CONTINUITY_TOLERANCE",
     "POSITION_TOLERANCE",
     "RELATIVE_TOLERANCE",
     "REST_TOLERANCE",
@@ -67,6 +74,9 @@ POSITION_TOLERANCE = 1e-9
 REST_TOLERANCE = 1e-6
 #: How far past the end of its leg a position may be (solver round-off), metres; also the largest jump.
 TRACK_END_TOLERANCE = 1e-6
+#: Continuity from piece to piece, relative to the quantity's scale (round-off: every method integrates its
+#: knots from the ones before, so a jump above this is a number that disagrees with the others).
+CONTINUITY_TOLERANCE = 1e-12
 #: Reports kept for schedules already verified (by identity).
 _REMEMBERED = 64
 _reports: collections.OrderedDict[int, tuple[weakref.ref, VerificationReport]] = collections.OrderedDict()
@@ -242,7 +252,17 @@ def _failed(schedule: Schedule, failures: list[str], pieces: int = 0) -> Verific
     return VerificationReport.failed(tuple(failures), pieces=pieces)
 
 
-def _check_ends(schedule: Schedule, state, failures: list[str]) -> tuple[float, float, float]:
+def _where(schedule: Schedule, pieces: Pieces, k: int, vehicles: tuple[int, ...] = (0, 1)) -> str:
+    """The arrays that define piece ``k`` of the given vehicles, by their paths (for failure messages)."""
+    if not pieces.count:
+        return "sections[0]"
+    section = int(pieces.section[k])
+    return "; ".join(
+        motion_arrays(schedule, section, vehicle, int(pieces.interval[vehicle, k])) for vehicle in vehicles
+    )
+
+
+def _check_ends(schedule: Schedule, pieces: Pieces, state, failures: list[str]) -> tuple[float, float, float]:
     """Start and goal errors (metres), at rest; and the separation at the start, metres.
 
     ``state`` is the schedule's state at 0 and at its end (what is exported there).
@@ -251,6 +271,7 @@ def _check_ends(schedule: Schedule, state, failures: list[str]) -> tuple[float, 
     errors = []
     for label, index, expected in (("start", 0, route.start), ("goal", -1, route.goal)):
         error = 0.0
+        piece = 0 if index == 0 else pieces.count - 1
         for vehicle, position in enumerate(expected):
             leg = JUNCTION_INDEX if position.leg is None else graph.index(position.leg)
             error += float(
@@ -263,12 +284,14 @@ def _check_ends(schedule: Schedule, state, failures: list[str]) -> tuple[float, 
                 residue += abs(state.acceleration[vehicle, index])
             if not residue <= REST_TOLERANCE:
                 failures.append(
-                    f"vehicle {vehicle + 1} is not at rest at the {label} (|v| + |a| = {residue:.3g})"
+                    f"vehicle {vehicle + 1} is not at rest at the {label} (|v| + |a| = {residue:.3g}): "
+                    f"{_where(schedule, pieces, piece, (vehicle,))}"
                 )
         tolerance = POSITION_TOLERANCE if schedule.end_tolerance is None else schedule.end_tolerance
         if not error <= tolerance:
             failures.append(
-                f"{label} is off the route's {label} by {error:.3g} m (expected <= {tolerance:g} m)"
+                f"{label} is off the route's {label} by {error:.3g} m (expected <= {tolerance:g} m): "
+                f"{_where(schedule, pieces, piece)}"
             )
         errors.append(error)
     start_gap = float(track_distance(state.leg[0, 0], state.s[0, 0], state.leg[1, 0], state.s[1, 0]))
@@ -296,22 +319,31 @@ def _check_exported_ends(
             if not gap <= _allowance(schedule, vehicle, "position"):
                 failures.append(
                     f"vehicle {vehicle + 1} is {gap:.3g} m from where its motion puts it at the {label}: "
-                    "the schedule reports a position its motion does not reach"
+                    "the schedule reports a position its motion does not reach: "
+                    f"{_where(schedule, pieces, 0 if index == 0 else pieces.count - 1, (vehicle,))}"
                 )
 
 
-def _check_tiling(pieces: Pieces, duration: float, failures: list[str]) -> None:
+def _check_tiling(schedule: Schedule, pieces: Pieces, failures: list[str]) -> None:
     """The pieces follow one another without gaps from 0 to the duration."""
     if not pieces.count:
         return
+    duration = schedule.duration
     ends = pieces.start + pieces.length
     gaps = np.abs(np.concatenate([[pieces.start[0]], pieces.start[1:] - ends[:-1], [duration - ends[-1]]]))
     k = int(np.argmax(gaps))
     if not gaps[k] <= 1e-9 * max(1.0, duration):
-        failures.append(f"the motion has a gap of {gaps[k]:.3g} s in time (piece {k}): expected none")
+        section = int(pieces.section[min(k, pieces.count - 1)])
+        failures.append(
+            f"the motion has a gap of {gaps[k]:.3g} s in time (piece {k}): expected none: "
+            f"sections[{section}].start_time; {_where(schedule, pieces, min(k, pieces.count - 1))}"
+        )
 
 
 def _verify(schedule: Schedule) -> VerificationReport:
+    own = array_failures(schedule)
+    if own:  # the motion is read from these numbers: broken ones make every other check meaningless
+        return _failed(schedule, own)
     duration = schedule.duration
     if not math.isfinite(duration) or duration < 0.0:
         return _failed(schedule, [f"schedule duration is {duration!r} s: expected finite, >= 0"])
@@ -326,7 +358,10 @@ def _verify(schedule: Schedule) -> VerificationReport:
         bad = int(np.argmax(~np.all(np.isfinite(pieces.axis), axis=(0, 2)) | ~np.isfinite(pieces.start)))
         return _failed(
             schedule,
-            [f"the motion is not finite in piece {bad} (from t={pieces.start[bad]!r} s): expected finite"],
+            [
+                f"the motion is not finite in piece {bad} (from t={pieces.start[bad]!r} s): expected finite: "
+                f"{_where(schedule, pieces, bad)}"
+            ],
             pieces.count,
         )
     failures: list[str] = []
@@ -335,14 +370,14 @@ def _verify(schedule: Schedule) -> VerificationReport:
         return _failed(schedule, failures, pieces.count)
     ends = schedule.state([0.0, duration])
     track = pieces.track()
-    start_error, goal_error, start_gap = _check_ends(schedule, ends, failures)
+    start_error, goal_error, start_gap = _check_ends(schedule, pieces, ends, failures)
     _check_exported_ends(pieces, track, schedule, ends, failures)
-    _check_tiling(pieces, duration, failures)
+    _check_tiling(schedule, pieces, failures)
     _check_parked(pieces, schedule, failures)
     ratios = _check_piece_limits(pieces, schedule, failures)
     past_end = max(TRACK_END_TOLERANCE, schedule.end_tolerance or 0.0)
-    _check_piece_track(pieces, track, route.graph, failures, past_end)
-    closest, regions = _check_piece_separation(pieces, track, required, failures)
+    _check_piece_track(pieces, track, schedule, failures, past_end)
+    closest, regions = _check_piece_separation(pieces, track, schedule, required, failures)
     closest = min(closest, start_gap)
     if not pieces.count and start_gap < required - POSITION_TOLERANCE:
         failures.append(f"separation {start_gap:.9g} m at rest is below the minimum {required:g} m")
@@ -352,7 +387,8 @@ def _verify(schedule: Schedule) -> VerificationReport:
     if sequence != expected:
         show = lambda keys: " ".join(str(Region.from_key(route.graph, key)) for key in keys)  # noqa: E731
         failures.append(
-            f"homotopy class differs: schedule visits [{show(sequence)}], route [{show(expected)}]"
+            f"homotopy class differs: schedule visits [{show(sequence)}], route [{show(expected)}]: "
+            f"{_where(schedule, pieces, _first_departure(regions, expected))}"
         )
     if failures:
         logger.info("schedule (%s) failed verification: %s", schedule.method, "; ".join(failures))
@@ -369,6 +405,21 @@ def _verify(schedule: Schedule) -> VerificationReport:
         goal_error=goal_error,
         regions_match=sequence == expected,
     )
+
+
+def _first_departure(regions: list, expected: tuple) -> int:
+    """The first piece at which the region sequence leaves the route's (the last piece if none does)."""
+    position = 0
+    for k, region in enumerate(regions):
+        if region is None:
+            continue
+        if position < len(expected) and region == expected[position]:
+            continue
+        if position + 1 < len(expected) and region == expected[position + 1]:
+            position += 1
+            continue
+        return k
+    return max(len(regions) - 1, 0)
 
 
 def _time_resolution(schedule: Schedule) -> float:
@@ -391,6 +442,23 @@ def _allowance(schedule: Schedule, vehicle: int, name: str) -> float:
     if name == "acceleration":
         return RELATIVE_TOLERANCE * limits.max_acceleration + limits.max_jerk * eps
     return RELATIVE_TOLERANCE * limits.max_jerk
+
+
+def _continuity_allowance(schedule: Schedule, vehicle: int, name: str, length_scale: float) -> float:
+    """What a quantity may jump by from piece to piece, in its units: round-off of its scale.
+
+    ``length_scale``: metres, the largest position of the schedule (at least 1 m). A table
+    read back (``end_tolerance`` set) is held to its interpolation's allowances instead.
+    """
+    if schedule.end_tolerance is not None:
+        return _allowance(schedule, vehicle, name)
+    limits = schedule.limits.vehicles[vehicle]
+    eps = _time_resolution(schedule)
+    if name == "position":
+        return CONTINUITY_TOLERANCE * length_scale + limits.max_velocity * eps
+    if name == "velocity":
+        return CONTINUITY_TOLERANCE * limits.max_velocity + limits.max_acceleration * eps
+    return CONTINUITY_TOLERANCE * limits.max_acceleration + limits.max_jerk * eps
 
 
 def _check_piece_limits(pieces: Pieces, schedule: Schedule, failures: list[str]) -> dict:
@@ -421,16 +489,21 @@ def _check_piece_limits(pieces: Pieces, schedule: Schedule, failures: list[str])
                 when = pieces.start[k] + (t_high[k] if abs(high[k]) >= abs(low[k]) else t_low[k])
                 failures.append(
                     f"vehicle {vehicle + 1} {name} reaches {peak[k]:.9g} {unit} at t={when:.6f} s "
-                    f"exceeds its {limit_name} {limit:g} {unit}"
+                    f"exceeds its {limit_name} {limit:g} {unit}: {_where(schedule, pieces, k, (vehicle,))}"
                 )
             c = pieces.axis[vehicle]
     return ratios
 
 
 def _check_piece_track(
-    pieces: Pieces, track: np.ndarray, graph, failures: list[str], past_end: float = TRACK_END_TOLERANCE
+    pieces: Pieces,
+    track: np.ndarray,
+    schedule: Schedule,
+    failures: list[str],
+    past_end: float = TRACK_END_TOLERANCE,
 ) -> None:
     """Each vehicle stays on its leg and in its map's range; ``track``: s polynomials, shape (2, n, 5)."""
+    graph = schedule.route.graph
     lengths = np.array(graph.lengths)
     for vehicle in range(2):
         low, t_low, high, t_high = polynomials.extrema(track[vehicle], pieces.length)
@@ -441,14 +514,16 @@ def _check_piece_track(
             k = int(over[0])
             failures.append(
                 f"vehicle {vehicle + 1} is {high[k] - length[k]:.3g} m past the end of leg "
-                f"{graph.names[pieces.leg[vehicle, k]]!r} at t={pieces.start[k] + t_high[k]:.6f} s"
+                f"{graph.names[pieces.leg[vehicle, k]]!r} at t={pieces.start[k] + t_high[k]:.6f} s: "
+                f"{_where(schedule, pieces, k, (vehicle,))}"
             )
         under = np.nonzero(low < -TRACK_END_TOLERANCE)[0]
         if under.size:
             k = int(under[0])
             failures.append(
                 f"vehicle {vehicle + 1} passes the junction inside a piece (s = {low[k]:.3g} m) "
-                f"at t={pieces.start[k] + t_low[k]:.6f} s: its position map does not cover it"
+                f"at t={pieces.start[k] + t_low[k]:.6f} s: its position map does not cover it: "
+                f"{_where(schedule, pieces, k, (vehicle,))}"
             )
         axis_low, _, axis_high, _ = polynomials.extrema(pieces.axis[vehicle], pieces.length)
         outside = np.nonzero(
@@ -460,12 +535,12 @@ def _check_piece_track(
             failures.append(
                 f"vehicle {vehicle + 1} leaves the range of its position map at t={pieces.start[k]:.6f} s "
                 f"(axis {axis_low[k]:.6g} to {axis_high[k]:.6g} m, map {pieces.axis_low[vehicle, k]:.6g} to "
-                f"{pieces.axis_high[vehicle, k]:.6g} m)"
+                f"{pieces.axis_high[vehicle, k]:.6g} m): {_where(schedule, pieces, k, (vehicle,))}"
             )
 
 
 def _check_piece_separation(
-    pieces: Pieces, track: np.ndarray, required: float, failures: list[str]
+    pieces: Pieces, track: np.ndarray, schedule: Schedule, required: float, failures: list[str]
 ) -> tuple[float, list]:
     """Smallest track distance over every piece and each piece's region."""
     same = (pieces.leg[0] == pieces.leg[1]) & (pieces.leg[0] != JUNCTION_INDEX)
@@ -488,12 +563,13 @@ def _check_piece_separation(
     k = int(np.argmin(closest))
     if crossing[k]:
         failures.append(
-            f"vehicles pass each other on one leg between t={pieces.start[k]:.6f} s and the next piece"
+            f"vehicles pass each other on one leg between t={pieces.start[k]:.6f} s and the next piece: "
+            f"{_where(schedule, pieces, k)}"
         )
     elif closest[k] < required - POSITION_TOLERANCE:
         failures.append(
             f"separation {closest[k]:.9g} m at t={pieces.start[k] + when[k]:.6f} s is below the minimum "
-            f"{required:g} m"
+            f"{required:g} m: {_where(schedule, pieces, k)}"
         )
     return float(closest[k]), regions
 
@@ -505,11 +581,13 @@ def _check_piece_continuity(
 
     Velocity and acceleration are compared along the track (``ds/dt``) where a
     vehicle stays on one leg, so a reversal hidden in a map change is a jump;
-    through the junction (where ``s`` changes leg) along its own axis.
+    through the junction (where ``s`` changes leg) along its own axis. The
+    axis itself (each vehicle's odometer, exported beside ``s``) is continuous too.
     """
     if pieces.count < 2:
         return
     h = pieces.length[:-1]
+    length_scale = max(1.0, float(np.max(np.abs(pieces.axis[:, :, 0]))), *schedule.route.graph.lengths)
     for vehicle in range(2):
         end_s = polynomials.evaluate(track[vehicle, :-1], h)
         start_s = track[vehicle, 1:, 0]
@@ -519,7 +597,8 @@ def _check_piece_continuity(
         )
         sign_before = np.where(same_leg, pieces.s_sign[vehicle, :-1], 1.0)
         sign_after = np.where(same_leg, pieces.s_sign[vehicle, 1:], 1.0)
-        checks = [("position", jump)]
+        axis_end = polynomials.evaluate(pieces.axis[vehicle, :-1], h)
+        checks = [("position", jump), ("axis", np.abs(axis_end - pieces.axis[vehicle, 1:, 0]))]
         derivative = pieces.axis[vehicle]
         names = ["velocity", "acceleration"][: schedule.smoothness]
         for name in names:
@@ -528,14 +607,17 @@ def _check_piece_continuity(
             after = sign_after * derivative[1:, 0]
             checks.append((name, np.abs(before - after)))
         for name, values in checks:
-            tolerance = _allowance(schedule, vehicle, name)
-            unit = {"position": "m", "velocity": "m/s", "acceleration": "m/s^2"}[name]
+            quantity = "position" if name == "axis" else name
+            tolerance = _continuity_allowance(schedule, vehicle, quantity, length_scale)
+            unit = {"position": "m", "axis": "m", "velocity": "m/s", "acceleration": "m/s^2"}[name]
             jumps = np.nonzero(~(values <= tolerance))[0]
             if jumps.size:
                 k = int(jumps[0])
                 failures.append(
                     f"vehicle {vehicle + 1} {name} jumps by {values[k]:.3g} {unit} "
-                    f"at t={pieces.start[k + 1]:.6f} s (tolerance {tolerance:.3g} {unit})"
+                    f"at t={pieces.start[k + 1]:.6f} s (tolerance {tolerance:.3g} {unit}): between "
+                    f"{_where(schedule, pieces, k, (vehicle,))} and "
+                    f"{_where(schedule, pieces, k + 1, (vehicle,))}"
                 )
 
 
@@ -544,20 +626,24 @@ def _check_maps(schedule: Schedule, failures: list[str]) -> None:
     legs = len(schedule.route.graph.lengths)
     for index, section in enumerate(schedule.sections):
         for vehicle, axis_map in enumerate(section.maps):
-            where = f"section {index} vehicle {vehicle + 1}"
+            where = f"sections[{index}].maps[{vehicle}]"
             if not np.all(np.isin(axis_map.outward, (-1, 0, 1))):
-                failures.append(f"{where}: map slopes {axis_map.outward.tolist()} are not -1, 0 or +1")
+                failures.append(
+                    f"{where}.outward: map slopes {axis_map.outward.tolist()} are not -1, 0 or +1"
+                )
             if not np.all((axis_map.legs >= JUNCTION_INDEX) & (axis_map.legs < legs)):
                 failures.append(
-                    f"{where}: map legs {axis_map.legs.tolist()} are not track legs: expected "
+                    f"{where}.legs: map legs {axis_map.legs.tolist()} are not track legs: expected "
                     f"{JUNCTION_INDEX} (the junction) or a leg index 0 to {legs - 1} ({legs} legs)"
                 )
                 continue
             at_junction = axis_map.legs == JUNCTION_INDEX
             if np.any(at_junction & ((axis_map.outward != 0) | (axis_map.s_start != 0.0))):
-                failures.append(f"{where}: a map sub-range at the junction moves or lies off it")
+                failures.append(
+                    f"{where}.{{legs,outward,s_start}}: a map sub-range at the junction moves or lies off it"
+                )
             if np.any(~at_junction & (axis_map.s_start < -TRACK_END_TOLERANCE)):
-                failures.append(f"{where}: a map sub-range starts before the junction (s < 0)")
+                failures.append(f"{where}.s_start: a map sub-range starts before the junction (s < 0)")
             if axis_map.legs.size > 1:
                 s_end = axis_map.s_start + axis_map.outward * (axis_map.axis_end - axis_map.axis_start)
                 scale = max(1.0, float(np.max(np.abs(axis_map.axis_end))))
@@ -567,7 +653,10 @@ def _check_maps(schedule: Schedule, failures: list[str]) -> None:
                     same, np.abs(s_end[:-1] - axis_map.s_start[1:]), s_end[:-1] + axis_map.s_start[1:]
                 )
                 if np.any(gaps > 1e-12 * scale) or np.any(broken > TRACK_END_TOLERANCE):
-                    failures.append(f"{where}: map sub-ranges do not join (axis or track gap)")
+                    failures.append(
+                        f"{where}.{{axis_start,axis_end,s_start}}: map sub-ranges do not join "
+                        "(axis or track gap)"
+                    )
 
 
 def _check_parked(pieces: Pieces, schedule: Schedule, failures: list[str]) -> None:
@@ -583,7 +672,8 @@ def _check_parked(pieces: Pieces, schedule: Schedule, failures: list[str]) -> No
         if moving.any():
             k = int(np.nonzero(parked)[0][np.argmax(moving)])
             failures.append(
-                f"vehicle {vehicle + 1} moves at t={pieces.start[k]:.6f} s where its map says it stands"
+                f"vehicle {vehicle + 1} moves at t={pieces.start[k]:.6f} s where its map says it stands: "
+                f"{_where(schedule, pieces, k, (vehicle,))}"
             )
 
 

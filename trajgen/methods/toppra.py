@@ -101,6 +101,8 @@ class BlendedPath(ArrayValue):
 
     def __post_init__(self) -> None:
         vertices = readonly(self.vertices, float)
+        if not np.all(np.isfinite(vertices)):
+            raise InputError("blended path: vertices hold a non-finite value: expected finite numbers")
         blends = tuple(self.blends)
         object.__setattr__(self, "vertices", vertices)
         object.__setattr__(self, "blends", blends)
@@ -212,6 +214,10 @@ class ToppraKinematics(ArrayValue, Kinematics):
     def __post_init__(self) -> None:
         for name in ("grid", "speed", "times"):
             object.__setattr__(self, name, readonly(getattr(self, name), float))
+            if not np.all(np.isfinite(getattr(self, name))):
+                raise InputError(f"TOPPRA section: {name} holds a non-finite value: expected finite numbers")
+        if not np.all(np.diff(self.times) > 0.0):
+            raise InputError("TOPPRA section: knot times do not increase: expected strictly increasing times")
 
     @property
     def duration(self) -> float:

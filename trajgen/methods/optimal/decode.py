@@ -72,41 +72,61 @@ def unpack(
     return out
 
 
-def _spread(initial: np.ndarray, times: np.ndarray, drift: float, *, towards_end: bool) -> np.ndarray:
-    """``initial`` with a position residual ``drift`` spread linearly over the phase (adds drift/T to v)."""
-    corrected = initial.copy()
-    weight = times[:-1] / times[-1]
-    corrected[:, 0] += drift * (weight if towards_end else 1.0 - weight)
-    corrected[:, 1] += drift / times[-1] if towards_end else -drift / times[-1]
-    return corrected
+def _integrate(start: np.ndarray, times: np.ndarray, jerk: np.ndarray) -> np.ndarray:
+    """States ``s, v, a`` at each breakpoint, shape (m + 1, 3), from ``start`` under constant jerks."""
+    states = np.empty((times.size, 3))
+    states[0] = start
+    for k, (h, j) in enumerate(zip(np.diff(times), jerk, strict=True)):
+        s, v, a = states[k]
+        states[k + 1] = (s + h * (v + h * (a / 2.0 + h * j / 6.0)), v + h * (a + h * j / 2.0), a + h * j)
+    return states
+
+
+def _consistent(start: np.ndarray, end: np.ndarray, times: np.ndarray, jerk: np.ndarray) -> np.ndarray:
+    """Jerks closest to ``jerk`` (least squares) that drive ``start`` exactly to ``end`` (states s, v, a).
+
+    The solver meets its dynamics, start and goal to ~1e-10; integrating its jerks instead of
+    taking its node states makes every knot of the profile agree with its intervals to round-off,
+    so the verifier can hold continuity to round-off. The end state is linear in the jerks: one
+    jerk ``j`` over an interval of ``h`` followed by ``r`` seconds adds ``j h`` to ``a``,
+    ``j (h^2 / 2 + h r)`` to ``v`` and ``j (h^3 / 6 + h^2 r / 2 + h r^2 / 2)`` to ``s``.
+    """
+    h = np.diff(times)
+    rest = times[-1] - times[1:]
+    effect = np.vstack([h**3 / 6.0 + h * h * rest / 2.0 + h * rest * rest / 2.0, h * h / 2.0 + h * rest, h])
+    residual = end - _integrate(start, times, jerk)[-1]
+    return jerk + np.linalg.lstsq(effect, residual, rcond=None)[0]
 
 
 def _phase_section(
     route: Route, limits: Limits, phases: tuple[Phase, ...], p: int, solved: PhaseSolution, outward, axis
 ):
-    """Profiles and axis maps of both vehicles in phase ``p``; advances ``axis`` (per vehicle) in place."""
+    """Profiles and axis maps of both vehicles in phase ``p``; advances ``axis`` (per vehicle) in place.
+
+    Each moving vehicle's profile runs from the solver's state at the phase start (the route's
+    start, at rest, in the first phase) exactly to its state at the phase end (the route's goal,
+    at rest, in the last), every knot integrated from the one before.
+    """
     phase = phases[p]
     profiles, maps = [], []
     for vehicle in range(2):
         sign = outward[vehicle]
-        node = solved.states[:-1, 3 * vehicle : 3 * vehicle + 3].copy()
+        columns = slice(3 * vehicle, 3 * vehicle + 3)
         moving = not phase.parked(vehicle)
-        if p == 0 and moving:
-            # the solver meets the start to ~1e-8 m: spread the residual over the first phase (~1e-9 m/s)
-            node = _spread(node, solved.times, route.start[vehicle].s - node[0, 0], towards_end=False)
+        jerk = limits.vehicles[vehicle].max_jerk * solved.controls[:, vehicle]
+        start, end = solved.states[0, columns].copy(), solved.states[-1, columns].copy()
+        if moving:
+            if p == 0:
+                start = np.array([route.start[vehicle].s, 0.0, 0.0])
+            if p == len(phases) - 1:
+                end = np.array([route.goal[vehicle].s, 0.0, 0.0])
+            jerk = _consistent(start, end, solved.times, jerk)
+        node = _integrate(start, solved.times, jerk)[:-1] if moving else solved.states[:-1, columns]
         s0 = node[0, 0]
         initial = np.column_stack(
             [axis[vehicle] + sign * (node[:, 0] - s0), sign * node[:, 1], sign * node[:, 2]]
         )
-        jerk = sign * limits.vehicles[vehicle].max_jerk * solved.controls[:, vehicle]
-        profile = PiecewiseCubic(solved.times, initial, jerk)
-        if p == len(phases) - 1 and moving:
-            # likewise the goal: spread the residual (~1e-8 m) over the last phase
-            end_s = s0 + sign * (profile.end_state()[0] - axis[vehicle])
-            drift = sign * (route.goal[vehicle].s - end_s)
-            profile = PiecewiseCubic(
-                solved.times, _spread(initial, solved.times, drift, towards_end=True), jerk
-            )
+        profile = PiecewiseCubic(solved.times, initial, sign * jerk)
         end_axis = profile.end_state()[0]
         leg = phase.legs[vehicle]
         maps.append(

@@ -93,7 +93,8 @@ class Optimal(TimingMethod):
     fatrop_iterations : int, optional
         Iteration limit of fatrop (default 500; it converges in < 150 when it converges).
     time_budget : float, optional
-        Seconds the solvers may take (default 2.0): no solver starts after it is spent, no
+        Seconds the solvers may take (default 2.0; the one-time build of an NLP the cache does
+        not hold yet is not counted): no solver starts after it is spent, no
         refinement pass starts unless the previous one would fit in what is left, and Ipopt stops
         by itself at half of it (a fatrop run under way finishes: fatrop has no wall-time limit).
         If no class was solved by then, the ``exact`` schedule is returned, flagged ``time-budget``.
@@ -344,7 +345,11 @@ class Optimal(TimingMethod):
         for makespan, k, p in ranked:
             if makespan >= exact_duration:
                 break
-            candidate = finish(solved[k].schedule(self, p, segments=self.segments, nodes=self.nodes))
+            try:
+                candidate = finish(solved[k].schedule(self, p, segments=self.segments, nodes=self.nodes))
+            except InputError as error:  # numbers no schedule can hold (e.g. not finite): not a result
+                failures.append(f"class {k} pass {p + 1} does not form a schedule: {error}")
+                continue
             report = verify(candidate)
             if report.passed:
                 return candidate, failures
@@ -373,7 +378,10 @@ class Optimal(TimingMethod):
         shape = dataclasses.replace(self.shape(route), slot=slot)
         outcome = ClassSolve(route, limits, phases, shape, built=False)
         try:
+            building = time.perf_counter()
             compiled, outcome.built = self._cache().get(shape)
+            if outcome.built:  # the budget is the solvers' time: a one-time build of the NLP does not count
+                deadline += time.perf_counter() - building
             self._first_pass(outcome, compiled, exact, deadline)
         except Exception as error:  # a bug or a build failure must not lose the other class's result
             logger.exception("optimal: class %d could not be set up", slot)
