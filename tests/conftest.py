@@ -1,4 +1,4 @@
-"""Test configuration: seeded (derandomized) hypothesis runs, shared paths."""
+"""Test configuration: seeded (derandomized) hypothesis runs, the repository's path."""
 
 from __future__ import annotations
 
@@ -16,5 +16,5 @@ settings.register_profile(
 )
 settings.load_profile(os.environ.get("HYPOTHESIS_PROFILE", "seeded"))
 
+#: The repository (a clone of it): the tests read nothing outside it (tests/test_clone.py).
 REPO = Path(__file__).resolve().parent.parent
-SHARED = REPO.parent / "shared"

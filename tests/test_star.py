@@ -8,7 +8,7 @@ taken from the planner (matched edge by edge through the vertices' configuration
 because the ties of rules 2 and 3 are ties under those lengths.
 
 The continuity cases (:func:`continuity_cases`) are shared with the measuring script
-``/tmp/s13/continuity.py``, which prints the worst constants over thousands of cases.
+``benchmarks/bench_continuity.py``, which prints the worst constants over thousands of cases.
 """
 
 from __future__ import annotations
@@ -807,7 +807,7 @@ QUERIES_PER_TRACK = 5
 
 #: Bound on :attr:`Comparison.normalized`: ``max_tau d(route_a.at(tau), route_b.at(tau))`` over the
 #: distance the start and goal moved, divided by the retraction gain. Measured worst over 3000
-#: seeded cases per kind and k = 4, 6, 8 (``/tmp/s13/continuity.py``, seed 1): generic 1.00, 0.98,
+#: seeded cases per kind and k = 4, 6, 8 (``benchmarks/bench_continuity.py``, seed 1): generic 1.00, 0.98,
 #: 0.96; along tie sets 1.50, 1.51, 1.52; across vertices 1.81, 1.27, 1.50 (the raw ratio, before
 #: dividing by the gain, reaches 49 for generic queries, 3.1 for the others). The cases of this
 #: test (seed 0) stay below 1.19. A discontinuity gives a ratio of order (route length) / DELTA.

@@ -1,7 +1,12 @@
-"""VDA 5050 orders: schema-valid messages, paths on the route, safe releases, factsheet limits, CLI."""
+"""VDA 5050 orders: valid and accepted messages, paths on the route, safe releases, factsheet limits, CLI.
+
+The messages are checked against references of the ``vda5050-sdk`` package (:mod:`tests.vda5050_reference`):
+the official schemas, the sdk's pydantic models, and its order acceptance (VDA 5050 figure 8).
+"""
 
 from __future__ import annotations
 
+import copy
 import functools
 import itertools
 import json
@@ -12,9 +17,11 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from jsonschema import Draft202012Validator
+from pydantic import ValidationError
+from vda5050.domain.order import AcceptanceDecision
 
 from tests.conftest import REPO
+from tests.vda5050_reference import SimulatedVehicle, parse_order, schema_errors
 from topology import JUNCTION_INDEX, Homotopy
 from trajgen import Exact, Optimal, Toppra, certify, make_schedule, parse_scenario, run
 from trajgen.cli import EXIT_BAD_INPUT, EXIT_FAILURE, EXIT_OK, main
@@ -33,17 +40,9 @@ from trajgen.export.vda5050 import (
 from trajgen.factsheet import MAX_FACTSHEET_BYTES, read_factsheet
 from trajgen.scenario import PLAUSIBLE, load_scenario
 
-SCHEMAS = REPO.parent / "shared" / "vda5050"
 SWAP = REPO / "examples" / "swap.toml"
 START = datetime(2025, 5, 1, 8, 0, tzinfo=UTC)
 OPTIONS = Vda5050Options(start_time=START, map_id="hall-1", manufacturers=("Acme", "Acme"))
-
-
-@functools.cache
-def validator(name: str) -> Draft202012Validator:
-    schema = json.loads((SCHEMAS / name).read_text(encoding="utf-8"))
-    Draft202012Validator.check_schema(schema)
-    return Draft202012Validator(schema, format_checker=Draft202012Validator.FORMAT_CHECKER)
 
 
 def scenario_data(legs, first, second, *, separation=1.5, angles=None) -> dict:
@@ -166,8 +165,7 @@ def vehicle_paths(name: str):
 @pytest.mark.parametrize("name", CASES, ids=list(CASES))
 def test_every_message_validates_against_the_order_schema(name):
     for document in documents(name):
-        errors = [error.message for error in validator("order.schema").iter_errors(document)]
-        assert errors == [], errors
+        assert schema_errors(document) == []
         assert document["version"] == "2.1.0"
         stamp = document["timestamp"]
         assert re.fullmatch(r"\d{4}-\d\d-\d\dT\d\d:\d\d:\d\d\.\d{3}Z", stamp), stamp
@@ -177,8 +175,162 @@ def test_every_message_validates_against_the_order_schema(name):
 def test_the_schema_check_is_not_vacuous():
     document = documents("swap-optimal")[0]
     broken = {**document, "nodes": [{**document["nodes"][0], "sequenceId": -1}]}
-    assert list(validator("order.schema").iter_errors(broken))
-    assert list(validator("order.schema").iter_errors({k: v for k, v in document.items() if k != "edges"}))
+    assert schema_errors(broken) == ["nodes/0/sequenceId: -1 is less than the minimum of 0"]
+    assert schema_errors({k: v for k, v in document.items() if k != "edges"}) == [
+        ": 'edges' is a required property"
+    ]
+
+
+@pytest.mark.parametrize("name", CASES, ids=list(CASES))
+def test_every_message_parses_as_the_sdks_order_unchanged(name):
+    for document in documents(name):
+        order = parse_order(document)  # refuses a field it lacks, a wrong type, or a changed value
+        assert (order.order_id, order.order_update_id) == (document["orderId"], document["orderUpdateId"])
+
+
+def edge_field(document: dict, key: str, value) -> dict:
+    """``document`` with its first edge's ``key`` set to ``value`` (removed for ``None``)."""
+    broken = copy.deepcopy(document)
+    broken["edges"][0].pop(key, None)
+    if value is not None:
+        broken["edges"][0][key] = value
+    return broken
+
+
+#: mutation -> (message of swap-optimal's agv1 order, the error and its message)
+BROKEN_FOR_THE_MODEL = {
+    "no-released": (lambda d: edge_field(d, "released", None), ValidationError, r"edges\.0\.released"),
+    "unknown-orientation-type": (
+        lambda d: edge_field(d, "orientationType", "SIDEWAYS"),
+        ValidationError,
+        r"edges\.0\.orientationType",
+    ),
+    "misspelt-field": (
+        lambda d: edge_field(d, "maxspeed", 1.0),
+        ValueError,
+        r"does not define: \['edges\[0\]\.maxspeed'\]",
+    ),
+    "coerced-value": (lambda d: {**d, "orderUpdateId": "0"}, ValueError, "back unchanged"),
+}
+
+
+@pytest.mark.parametrize(
+    ("mutate", "error", "match"), BROKEN_FOR_THE_MODEL.values(), ids=list(BROKEN_FOR_THE_MODEL)
+)
+def test_the_sdk_model_check_is_not_vacuous(mutate, error, match):
+    document = documents("swap-optimal")[0]
+    parse_order(document)
+    with pytest.raises(error, match=match):
+        parse_order(mutate(document))
+
+
+def start_point(name: str, vehicle: str) -> tuple[float, float]:
+    """Where ``vehicle`` of case ``name`` stands before its first order (m), from the scenario."""
+    scenario = case(name)[0]
+    position = scenario.start[scenario.names.index(vehicle)]
+    if position.leg is None:
+        return 0.0, 0.0
+    angle = math.radians(scenario.track.angles_deg[scenario.track.index(position.leg)])
+    return position.s * math.cos(angle), position.s * math.sin(angle)
+
+
+def decisions(name: str, vehicle: str, messages: list[dict]) -> list[AcceptanceDecision]:
+    """The sdk's acceptance decisions of ``messages`` sent in turn to ``vehicle`` standing at its start."""
+    receiver = SimulatedVehicle(messages[0], *start_point(name, vehicle), map_id=OPTIONS.map_id)
+    return [receiver.receive(message).decision for message in messages]
+
+
+@pytest.mark.parametrize("name", CASES, ids=list(CASES))
+def test_each_vehicle_accepts_its_order_as_new_and_each_update_as_stitched(name):
+    for vehicle, messages in by_vehicle(name).items():
+        expected = [AcceptanceDecision.ACCEPT_NEW] + [AcceptanceDecision.ACCEPT_UPDATE] * (len(messages) - 1)
+        assert decisions(name, vehicle, messages) == expected, vehicle
+
+
+def without_stitching_node(update: dict) -> dict:
+    """The update starting at the node after its stitching node."""
+    return {**update, "nodes": update["nodes"][1:], "edges": update["edges"][1:]}
+
+
+def stitched_one_node_early(previous: dict, update: dict) -> dict:
+    """The update starting at the base node before the previous message's last one."""
+    last_base = max(k for k, node in enumerate(previous["nodes"]) if node["released"])
+    nodes = [previous["nodes"][last_base - 1], *update["nodes"]]
+    return {**update, "nodes": nodes, "edges": [previous["edges"][last_base - 1], *update["edges"]]}
+
+
+def moved_first_node(order: dict, metres: float) -> dict:
+    """The order with its first node moved ``metres`` along x (its edge left as it is)."""
+    broken = copy.deepcopy(order)
+    broken["nodes"][0]["nodePosition"]["x"] += metres
+    return broken
+
+
+def on_map(order: dict, map_id: str) -> dict:
+    """The order with every node placed on map ``map_id``."""
+    broken = copy.deepcopy(order)
+    for node in broken["nodes"]:
+        node["nodePosition"]["mapId"] = map_id
+    return broken
+
+
+#: mutation -> (case, vehicle, messages sent in turn (from the vehicle's messages), decision on the last)
+BROKEN_FOR_THE_VEHICLE = {
+    "update-without-its-stitching-node": (
+        "swap-optimal",
+        "agv1",
+        lambda m: [m[0], without_stitching_node(m[1])],
+        AcceptanceDecision.REJECT_NOT_CONTINUATION,
+    ),
+    "update-stitched-one-node-early": (
+        "swap-optimal",
+        "agv1",
+        lambda m: [m[0], stitched_one_node_early(m[0], m[1])],
+        AcceptanceDecision.REJECT_NOT_CONTINUATION,
+    ),
+    "update-repeating-the-order-update-id": (
+        "swap-optimal",
+        "agv2",
+        lambda m: [m[0], {**m[1], "orderUpdateId": m[0]["orderUpdateId"]}],
+        AcceptanceDecision.IGNORE_DUPLICATE,
+    ),
+    "older-update-after-a-newer": (
+        "angled-shared-leg",
+        "agv2",
+        lambda m: [m[0], m[1], m[2], m[1]],
+        AcceptanceDecision.REJECT_DEPRECATED,
+    ),
+    "update-under-a-new-order-id": (
+        "swap-exact",
+        "agv1",
+        lambda m: [m[0], {**m[1], "orderId": "another-order"}],
+        AcceptanceDecision.REJECT_BUSY,
+    ),
+    "first-node-away-from-the-vehicle": (
+        "swap-exact",
+        "agv1",
+        lambda m: [moved_first_node(m[0], 0.01)],
+        AcceptanceDecision.REJECT_NOT_REACHABLE,
+    ),
+    "order-on-another-map": (
+        "swap-exact",
+        "agv2",
+        lambda m: [on_map(m[0], "hall-2")],
+        AcceptanceDecision.REJECT_MAP_UNAVAILABLE,
+    ),
+}
+
+
+@pytest.mark.parametrize(
+    ("name", "vehicle", "broken", "decision"),
+    BROKEN_FOR_THE_VEHICLE.values(),
+    ids=list(BROKEN_FOR_THE_VEHICLE),
+)
+def test_the_acceptance_refuses_a_broken_message(name, vehicle, broken, decision):
+    sent = broken(by_vehicle(name)[vehicle])
+    accepted = [AcceptanceDecision.ACCEPT_NEW] + [AcceptanceDecision.ACCEPT_UPDATE] * (len(sent) - 1)
+    # the messages before the broken one are the exporter's own, accepted; the broken one is not
+    assert decisions(name, vehicle, sent) == [*accepted[:-1], decision]
 
 
 @pytest.mark.parametrize("name", CASES, ids=list(CASES))
@@ -659,11 +811,10 @@ def write_factsheet_scenario(folder: Path, sheet: str | None = "agv.json", extra
 
 
 def test_the_test_factsheet_is_valid_against_the_factsheet_schema():
-    errors = [e.message for e in validator("factsheet.schema").iter_errors(factsheet())]
-    assert errors == []
+    assert schema_errors(factsheet(), "factsheet") == []
     broken = factsheet()
     del broken["physicalParameters"]["speedMax"]
-    assert list(validator("factsheet.schema").iter_errors(broken))
+    assert schema_errors(broken, "factsheet") == ["physicalParameters: 'speedMax' is a required property"]
 
 
 def test_limits_are_read_from_a_factsheet(tmp_path):
@@ -892,4 +1043,6 @@ def test_schedules_of_every_method_can_be_certified_and_exported():
         verified = certify(make_schedule(scenario.plan(), scenario.limits, method=method))
         messages = render_orders(verified, scenario.names, options=OPTIONS)
         for message in messages:
-            assert not list(validator("order.schema").iter_errors(json.loads(message.data)))
+            document = json.loads(message.data)
+            assert schema_errors(document) == []
+            parse_order(document)
