@@ -18,6 +18,7 @@ from topology import JUNCTION_INDEX, Option, StarGraph
 from topology.validation import short_repr
 from trajgen.errors import InputError, OptionError, OutputLimitError
 from trajgen.export.atomic import commit_files
+from trajgen.export.numbers import format_number_rows
 from trajgen.naming import check_vehicle_names
 from trajgen.schedule import ScheduleState, check_period, sample_block, sample_rows
 from trajgen.verify import VerifiedSchedule, require_verified
@@ -29,6 +30,7 @@ __all__ = [
     "CsvOptions",
     "Units",
     "check_row_limit",
+    "format_block",
     "format_rows",
     "profile_chunks",
     "profile_paths",
@@ -129,38 +131,59 @@ def _xy(graph: StarGraph, state: ScheduleState, vehicle: int) -> tuple[np.ndarra
     return s * np.cos(angle), s * np.sin(angle)
 
 
-def format_rows(graph: StarGraph, state: ScheduleState, vehicle: int, options: CsvOptions) -> list[str]:
-    """Rows of one vehicle's CSV profile for the sampled ``state`` on ``graph``, without line ends.
-
-    Also the format of executed motion (``trajgen simulate --trace``).
-    """
+def _columns(
+    graph: StarGraph, state: ScheduleState, vehicle: int, options: CsvOptions
+) -> list[tuple[np.ndarray, int | None]]:
+    """The nine columns of a vehicle's rows and their decimal places (``None``: the integer leg)."""
     scale = options.units.scale
     decimals = options.units.decimals
     x, y = _xy(graph, state, vehicle)
-    columns = [
+    return [
         (state.t, 6),
         (state.axis[vehicle] * scale, decimals),
         (state.velocity[vehicle] * scale, decimals),
         (state.acceleration[vehicle] * scale, decimals),
         (state.jerk[vehicle] * scale, decimals),
-        None,  # leg
+        (state.leg[vehicle] + 1, None),  # 1-based, 0 at the junction
         (state.s[vehicle] * scale, decimals),
         (x * scale, decimals),
         (y * scale, decimals),
     ]
-    formatted = []
-    for column in columns:
-        if column is None:
-            formatted.append(
-                [str(v) for v in (state.leg[vehicle] + 1).tolist()]
-            )  # 1-based, 0 at the junction
-            continue
-        values, places = column
-        text = [f"{round(float(v), places) + 0.0:.{places}f}" for v in values]  # + 0.0: no "-0"
-        if options.decimal != ".":
-            text = [t.replace(".", options.decimal) for t in text]
-        formatted.append(text)
-    return [options.delimiter.join(fields) for fields in zip(*formatted, strict=True)]
+
+
+def format_block(graph: StarGraph, state: ScheduleState, vehicle: int, options: CsvOptions) -> bytes:
+    """Rows of one vehicle's CSV profile for the sampled ``state`` on ``graph``: ASCII, CRLF after each row.
+
+    Numbers as :func:`~trajgen.export.numbers.fixed_point_text` writes them (time with 6 decimals,
+    lengths with ``options.units.decimals``), the decimal mark and delimiter of ``options``; formatted
+    with numpy (:func:`~trajgen.export.numbers.format_number_rows`).
+
+    Parameters
+    ----------
+    graph : StarGraph
+        The track (its leg angles give x and y).
+    state : ScheduleState
+        Both vehicles at n sample times.
+    vehicle : int
+        0 or 1.
+    options : CsvOptions
+
+    Returns
+    -------
+    bytes
+        n rows.
+    """
+    separators = (options.delimiter,) * (len(HEADER_NAMES[options.units]) - 1) + ("\r\n",)
+    return format_number_rows(_columns(graph, state, vehicle, options), separators, decimal=options.decimal)
+
+
+def format_rows(graph: StarGraph, state: ScheduleState, vehicle: int, options: CsvOptions) -> list[str]:
+    """Rows of one vehicle's CSV profile for the sampled ``state`` on ``graph``, without line ends.
+
+    Also the format of executed motion (``trajgen simulate --trace``); :func:`format_block` gives the
+    same rows as bytes.
+    """
+    return format_block(graph, state, vehicle, options).decode("ascii").split("\r\n")[:-1]
 
 
 def profile_rows(duration: float, options: CsvOptions) -> int:
@@ -218,8 +241,7 @@ def profile_chunks(
         yield (options.delimiter.join(HEADER_NAMES[options.units]) + "\r\n").encode("ascii")
         for first in range(0, rows, ROWS_PER_CHUNK):
             times = sample_block(schedule.duration, options.sample_period, first, first + ROWS_PER_CHUNK)
-            lines = format_rows(schedule.route.graph, schedule.state(times), vehicle, options)
-            yield ("\r\n".join(lines) + "\r\n").encode("ascii")
+            yield format_block(schedule.route.graph, schedule.state(times), vehicle, options)
 
     return chunks()
 
