@@ -12,21 +12,35 @@ from hypothesis import strategies as st
 from trajgen.export.numbers import exact_limit, fixed_point_text, format_number_rows
 
 PLACES = (6, 9)
+#: How the values are laid out: a column alone, one short line per value (rows too short to be written
+#: word by word at their own offsets: the padded rows are compacted), or the middle one of three columns
+#: (rows of one width per column written word by word, when the widths change less than 64 times).
+LAYOUTS = ("alone", "among-columns")
 
 
-def vectorized_texts(values, places: int, decimal: str = ".") -> list[str]:
-    """Each value's text from :func:`format_number_rows` (one column, a line per value)."""
-    data = format_number_rows([(np.array(values, dtype=np.float64), places)], ["\n"], decimal=decimal)
-    return data.decode("ascii").split("\n")[:-1]
+def vectorized_texts(values, places: int, decimal: str = ".", layout: str = "alone") -> list[str]:
+    """Each value's text from :func:`format_number_rows`, the values laid out as ``layout`` says."""
+    column = np.array(values, dtype=np.float64)
+    if layout == "alone":
+        data = format_number_rows([(column, places)], ["\n"], decimal=decimal)
+        return data.decode("ascii").split("\n")[:-1]
+    times, legs = np.arange(column.size) * 0.25, np.arange(column.size)
+    data = format_number_rows(
+        [(times, 6), (column, places), (legs, None)], [";", "\t", "\r\n"], decimal=decimal
+    )
+    rows = [row.split(";")[1].split("\t") for row in data.decode("ascii").split("\r\n")[:-1]]
+    assert [int(leg) for _, leg in rows] == legs.tolist()
+    return [text for text, _ in rows]
 
 
 def python_texts(values, places: int, decimal: str = ".") -> list[str]:
     return [fixed_point_text(value, places).replace(".", decimal) for value in values]
 
 
-def first_mismatch(values, places: int, decimal: str = ".") -> tuple | None:
+def first_mismatch(values, places: int, decimal: str = ".", layout: str = "alone") -> tuple | None:
     """``None`` if every entry agrees, else (index, value, vectorized text, Python text)."""
-    got, expected = vectorized_texts(values, places, decimal), python_texts(values, places, decimal)
+    got = vectorized_texts(values, places, decimal, layout)
+    expected = python_texts(values, places, decimal)
     assert len(got) == len(expected)
     for index, (mine, theirs) in enumerate(zip(got, expected, strict=True)):
         if mine != theirs:
@@ -75,12 +89,32 @@ def values(places: int):
     )
 
 
+@pytest.mark.parametrize("layout", LAYOUTS, ids=LAYOUTS)
 @pytest.mark.parametrize("places", PLACES, ids=[f"{p}-places" for p in PLACES])
 @given(data=st.data())
-def test_every_entry_is_the_python_text(places, data):
+def test_every_entry_is_the_python_text(places, layout, data):
     drawn = data.draw(st.lists(values(places), max_size=40), label="values")
     decimal = data.draw(st.sampled_from([".", ","]), label="decimal")
-    assert first_mismatch(drawn, places, decimal) is None
+    assert first_mismatch(drawn, places, decimal, layout) is None
+
+
+@pytest.mark.parametrize("places", PLACES, ids=[f"{p}-places" for p in PLACES])
+@pytest.mark.parametrize(
+    "pattern",
+    [
+        pytest.param("a-width-change-every-row", id="a-width-change-every-row"),
+        pytest.param("few-width-changes", id="few-width-changes"),
+    ],
+)
+def test_long_columns_of_changing_widths(places, pattern):
+    """Thousands of rows: every row a new width (compacted), or long runs of one width (written in runs)."""
+    rng = np.random.default_rng(7)
+    if pattern == "a-width-change-every-row":
+        magnitudes = 10.0 ** rng.integers(-3, 6, 5000) * rng.uniform(1.0, 9.99, 5000)
+        column = np.where(np.arange(5000) % 2 == 0, magnitudes, -magnitudes)
+    else:  # a smooth motion through zero and past 10, 100 and 1000, as a schedule's columns go
+        column = 1500.0 * np.sin(np.linspace(-4.0, 4.0, 5000)) + rng.uniform(-1e-7, 1e-7, 5000)
+    assert first_mismatch(column, places, ",", "among-columns") is None
 
 
 @given(

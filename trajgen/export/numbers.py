@@ -38,6 +38,7 @@ written by the Python expression itself, each in its own slot.
 from __future__ import annotations
 
 import functools
+import itertools
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -235,53 +236,161 @@ def _layout(
     return tuple(made)
 
 
-def _field_layout(
-    column: _Prepared, separator: bytes, mark: int
-) -> tuple[tuple[_Word, ...], np.ndarray | None]:
-    """The words of a column's slots in this block, and each row's look-up key (``None``: not needed)."""
+@dataclass(frozen=True, slots=True)
+class _Field:
+    """One column's slots in a block: its words (right to left), the rows' look-up keys, its text widths.
+
+    ``key`` is ``None`` where every row has one integer digit and none is negative; the text of a
+    row with ``d`` integer digits, negative or not, is ``fixed + d + negative`` bytes long (separator
+    included).
+    """
+
+    words: tuple[_Word, ...]
+    key: np.ndarray | None
+    most: int
+    fixed: int
+    separator: bytes
+
+    def width(self, row: int) -> int:
+        """Bytes of row ``row``'s text and separator."""
+        if self.key is None:
+            return self.fixed + 1
+        key = int(self.key[row])
+        return self.fixed + key % (self.most + 1) + (key > self.most)
+
+
+def _field(column: _Prepared, separator: bytes, mark: int) -> _Field:
+    """How a column's slots are made in this block."""
     most = len(str(int(column.magnitude.max()) // 10**column.places))
     signed = bool(column.negative.any())
-    length = len(separator) + (column.places + 1 if column.point else 0) + most + signed
+    fixed = len(separator) + (column.places + 1 if column.point else 0)
     longest = max((len(text) + len(separator) for text in column.texts), default=0)
-    words = _layout(column.places, column.point, separator, mark, most, signed, -(-max(length, longest) // 4))
+    words = _layout(
+        column.places,
+        column.point,
+        separator,
+        mark,
+        most,
+        signed,
+        -(-max(fixed + most + signed, longest) // 4),
+    )
     if all(word.keep is None for word in words):
-        return words, None
+        return _Field(words, None, most, fixed, separator)
     key = np.ones(column.magnitude.shape, dtype=np.intp)  # integer digits
     for digit in range(1, most):
         key += column.magnitude >= np.uint64(10 ** (column.places + digit))
     if signed:
         key += (most + 1) * column.negative
-    return words, key
+    return _Field(words, key, most, fixed, separator)
+
+
+def _word_values(columns: Sequence[_Prepared], fields: Sequence[_Field]) -> np.ndarray:
+    """Every word of every row, shape (words, rows): the slots of all columns left to right."""
+    values = np.empty((sum(len(field.words) for field in fields), columns[0].magnitude.size), dtype=_WORD)
+    end = 0
+    for column, field in zip(columns, fields, strict=True):
+        end += len(field.words)
+        remaining = column.magnitude
+        for number, word in enumerate(field.words):  # right to left
+            value = values[end - 1 - number]
+            if word.digits:
+                power = np.uint64(10**word.digits)
+                higher = remaining // power
+                np.take(word.table, (remaining - higher * power).view(np.int64), out=value)
+                remaining = higher
+            else:
+                value[...] = word.table[0]
+            if word.keep is not None:
+                np.bitwise_and(value, word.keep[field.key], out=value)
+                np.bitwise_or(value, word.sign[field.key], out=value)
+    return values
+
+
+#: Most runs of rows with one text width per column that a block is written in (else it is compacted).
+_MOST_RUNS = 64
+
+
+def _runs(fields: Sequence[_Field], rows: int) -> list[tuple[int, int, tuple[int, ...]]] | None:
+    """Runs ``(start, stop, widths)`` of rows whose every column has one text width; ``None``: too many.
+
+    Also ``None`` where writing a run's words from the right could leave a wrong byte: a row of
+    fewer than four bytes after its first field, or a field whose leftmost word reaches past the row's
+    start (its padding is overwritten by the fields to its left, written later).
+    """
+    change = np.zeros(max(rows - 1, 0), dtype=bool)
+    for field in fields:
+        if field.key is not None:
+            change |= field.key[1:] != field.key[:-1]
+    starts = np.flatnonzero(change) + 1
+    if starts.size >= _MOST_RUNS:
+        return None
+    bounds = [0, *starts.tolist(), rows]
+    runs = []
+    for start, stop in itertools.pairwise(bounds):
+        widths = tuple(field.width(start) for field in fields)
+        if sum(widths) - widths[0] < 4:
+            return None
+        before = 0
+        for width in widths:
+            if before and 4 * -(-width // 4) - width > before:
+                return None
+            before += width
+        runs.append((start, stop, widths))
+    return runs
+
+
+#: Bytes before the first row in the buffer of a block written in runs (the first word may reach there).
+_MARGIN = 4
+
+
+def _write_runs(values: np.ndarray, fields: Sequence[_Field], runs) -> bytes:
+    """The rows, each run written word by word at the text's own offsets (no padding to drop).
+
+    Each field's words are right-aligned at the field's end; the padding of its leftmost word falls on
+    the field to its left, which is written later. The first field's padding falls on the end of the
+    row before (or the margin): that end is saved before the first field is written and put back.
+    """
+    total = sum((stop - start) * sum(widths) for start, stop, widths in runs)
+    out = np.empty(_MARGIN + total, dtype=np.uint8)
+    slots = np.cumsum([len(field.words) for field in fields])  # the slot ends in ``values``
+    base = _MARGIN
+    for start, stop, widths in runs:
+        count, width = stop - start, sum(widths)
+        ends = np.cumsum(widths).tolist()
+
+        def words_at(offset: int, count: int = count, width: int = width) -> np.ndarray:
+            return np.ndarray((count,), dtype=_WORD, buffer=out, offset=offset, strides=(width,))
+
+        for index in [*range(len(fields) - 1, 0, -1), 0]:
+            if index == 0:
+                tail = words_at(base - 4).copy()  # the last four bytes of each row before
+            for number in range(-(-widths[index] // 4)):
+                words_at(base + ends[index] - 4 * (number + 1))[...] = values[
+                    slots[index] - 1 - number, start:stop
+                ]
+            if index == 0:
+                words_at(base - 4)[...] = tail
+        base += count * width
+    return out[_MARGIN:].tobytes()
 
 
 def _render(columns: Sequence[_Prepared], separators: Sequence[bytes], mark: int) -> bytes:
     rows = columns[0].magnitude.size
     if rows == 0:
         return b""
-    layouts = [
-        _field_layout(column, separator, mark) for column, separator in zip(columns, separators, strict=True)
-    ]
-    block = np.empty((rows, sum(len(words) for words, _ in layouts)), dtype=_WORD)
-    end = block.shape[1]
-    for column, separator, (words, key) in zip(
-        reversed(columns), reversed(separators), reversed(layouts), strict=True
-    ):  # right to left
-        remaining = column.magnitude
-        for word in words:
-            end -= 1
-            if word.digits:
-                power = np.uint64(10**word.digits)
-                higher = remaining // power
-                value = word.table[(remaining - higher * power).view(np.int64)]
-                remaining = higher
-            else:
-                value = word.table[0]
-            if word.keep is not None:
-                value = (value & word.keep[key]) | word.sign[key]
-            block[:, end] = value
+    fields = [_field(column, separator, mark) for column, separator in zip(columns, separators, strict=True)]
+    values = _word_values(columns, fields)
+    if not any(column.texts for column in columns):
+        runs = _runs(fields, rows)
+        if runs is not None:
+            return _write_runs(values, fields, runs)
+    block = np.ascontiguousarray(values.T)  # slots left to right, row by row; padding dropped below
+    end = 0
+    for column, field in zip(columns, fields, strict=True):
+        end += len(field.words)
         for row, text in zip(column.python.tolist(), column.texts, strict=True):
-            slot = (text + separator).rjust(4 * len(words), bytes([_PAD]))
-            block[row, end : end + len(words)] = np.frombuffer(slot, dtype=_WORD)
+            slot = (text + field.separator).rjust(4 * len(field.words), bytes([_PAD]))
+            block[row, end - len(field.words) : end] = np.frombuffer(slot, dtype=_WORD)
     text = block.view(np.uint8)
     return text[text != _PAD].tobytes()
 
