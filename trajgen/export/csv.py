@@ -20,7 +20,7 @@ from trajgen.errors import InputError, OptionError, OutputLimitError
 from trajgen.export.atomic import commit_files
 from trajgen.export.numbers import format_number_rows
 from trajgen.naming import check_vehicle_names
-from trajgen.schedule import ScheduleState, check_period, sample_block, sample_rows
+from trajgen.schedule import Schedule, ScheduleState, check_period, sample_block, sample_rows
 from trajgen.verify import VerifiedSchedule, require_verified
 
 __all__ = [
@@ -32,6 +32,7 @@ __all__ = [
     "check_row_limit",
     "format_block",
     "format_rows",
+    "profile_chunk_pair",
     "profile_chunks",
     "profile_paths",
     "profile_rows",
@@ -217,6 +218,44 @@ def check_row_limit(duration: float, options: CsvOptions, *, lower_bound: bool =
     return rows
 
 
+class _SampledBlocks:
+    """Both vehicles' states, a block of :data:`ROWS_PER_CHUNK` rows at a time; the last block is kept.
+
+    Shared by both vehicles' chunk iterators: consumed in step, each block is sampled once.
+    """
+
+    def __init__(self, schedule: Schedule, period: float) -> None:
+        self.schedule = schedule
+        self.period = period
+        self.first: int | None = None
+        self.state: ScheduleState | None = None
+
+    def block(self, first: int) -> ScheduleState:
+        """The states of rows ``first`` to ``first + ROWS_PER_CHUNK - 1``."""
+        if first != self.first:
+            times = sample_block(self.schedule.duration, self.period, first, first + ROWS_PER_CHUNK)
+            self.state, self.first = self.schedule.state(times), first
+        return self.state
+
+
+def _checked(
+    verified: VerifiedSchedule, options: CsvOptions | None, caller: str
+) -> tuple[Schedule, CsvOptions]:
+    schedule = require_verified(verified, caller).schedule
+    options = CsvOptions() if options is None else options
+    if not isinstance(options, CsvOptions):
+        raise OptionError(f"CSV options must be CsvOptions, got {type(options).__name__}")
+    return schedule, options
+
+
+def _chunks(
+    schedule: Schedule, vehicle: int, options: CsvOptions, rows: int, blocks: _SampledBlocks
+) -> Iterator[bytes]:
+    yield (options.delimiter.join(HEADER_NAMES[options.units]) + "\r\n").encode("ascii")
+    for first in range(0, rows, ROWS_PER_CHUNK):
+        yield format_block(schedule.route.graph, blocks.block(first), vehicle, options)
+
+
 def profile_chunks(
     verified: VerifiedSchedule, vehicle: int, options: CsvOptions | None = None
 ) -> Iterator[bytes]:
@@ -229,21 +268,32 @@ def profile_chunks(
     OutputLimitError
         The profile would have more than ``options.max_rows`` rows (raised at once, not when iterating).
     """
-    schedule = require_verified(verified, "profile_chunks").schedule
+    schedule, options = _checked(verified, options, "profile_chunks")
     if vehicle not in (0, 1):
         raise InputError(f"vehicle must be 0 or 1, got {short_repr(vehicle)}")
-    options = CsvOptions() if options is None else options
-    if not isinstance(options, CsvOptions):
-        raise OptionError(f"CSV options must be CsvOptions, got {type(options).__name__}")
     rows = check_row_limit(schedule.duration, options)
+    return _chunks(schedule, vehicle, options, rows, _SampledBlocks(schedule, options.sample_period))
 
-    def chunks() -> Iterator[bytes]:
-        yield (options.delimiter.join(HEADER_NAMES[options.units]) + "\r\n").encode("ascii")
-        for first in range(0, rows, ROWS_PER_CHUNK):
-            times = sample_block(schedule.duration, options.sample_period, first, first + ROWS_PER_CHUNK)
-            yield format_block(schedule.route.graph, schedule.state(times), vehicle, options)
 
-    return chunks()
+def profile_chunk_pair(
+    verified: VerifiedSchedule, options: CsvOptions | None = None
+) -> tuple[Iterator[bytes], Iterator[bytes]]:
+    """Both vehicles' CSV profiles as chunks (as :func:`profile_chunks`), sampling each block once.
+
+    The two iterators share the sampled states of the block of rows they are at: taken in step, a
+    chunk of one then the same chunk of the other (as :func:`~trajgen.export.atomic.commit_files`
+    does), each block of :data:`ROWS_PER_CHUNK` rows is sampled once for both files. Taken otherwise,
+    the chunks are the same, only sampled twice. Memory stays bounded by one block.
+
+    Raises
+    ------
+    OutputLimitError
+        The profiles would have more than ``options.max_rows`` rows (raised at once).
+    """
+    schedule, options = _checked(verified, options, "profile_chunk_pair")
+    rows = check_row_limit(schedule.duration, options)
+    blocks = _SampledBlocks(schedule, options.sample_period)
+    return _chunks(schedule, 0, options, rows, blocks), _chunks(schedule, 1, options, rows, blocks)
 
 
 def render_profile(verified: VerifiedSchedule, vehicle: int, options: CsvOptions | None = None) -> bytes:
@@ -312,5 +362,5 @@ def write_profiles(
     """
     require_verified(verified, "write_profiles")
     paths = profile_paths(names, directory)
-    commit_files({path: profile_chunks(verified, vehicle, options) for vehicle, path in enumerate(paths)})
+    commit_files(dict(zip(paths, profile_chunk_pair(verified, options), strict=True)))
     return paths
