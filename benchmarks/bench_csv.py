@@ -8,11 +8,11 @@ equal legs (end of A to end of B; 1 m/s, 0.5 m/s², 1 m/s³, separation 1.5 m):
 legs of 533 m take 3,205.5 s (about 1 h), legs of 2133 m 12,805.5 s (about
 4 h). Planning, timing and verifying are not timed; the CSV step is
 :func:`trajgen.export.write_profiles` at the default options (0.01 s,
-metres) into a temporary folder: sampling, formatting, writing both files,
-``fsync`` and the atomic commit. With ``--repeat N`` the fastest of N runs is
-reported. The files are then checked against the SHA-256 digests that the
-per-value formatter wrote (``ok``; ``MISMATCH``; ``-`` for a size with no
-recorded digest).
+metres) into a new folder: sampling, formatting, writing both files, ``fsync``
+and the atomic commit. With ``--repeat N`` the fastest of N runs is reported
+(each into its own folder, removed untimed). The files are checked against
+the SHA-256 digests that the per-value Python formatter wrote (``ok``;
+``MISMATCH``; ``-`` for a size with no recorded digest).
 """
 
 from __future__ import annotations
@@ -21,6 +21,7 @@ import argparse
 import hashlib
 import json
 import resource
+import shutil
 import subprocess
 import sys
 import tempfile
@@ -77,12 +78,14 @@ def measure(leg_length: float, repeat: int, directory: str | None) -> dict:
     rss_before = _peak_rss_mib()
     times = []
     with tempfile.TemporaryDirectory(prefix="bench-csv-", dir=directory) as folder:
-        for _ in range(repeat):
+        for attempt in range(repeat):
+            target = Path(folder) / f"run-{attempt}"  # a new folder each time: no files to replace
             begin = time.perf_counter()
-            paths = write_profiles(verified, ("agv1", "agv2"), folder, options=options)
+            paths = write_profiles(verified, ("agv1", "agv2"), target, options=options)
             times.append(time.perf_counter() - begin)
-        size = sum(path.stat().st_size for path in paths)
-        digests = tuple(_file_digest(path) for path in paths)
+            size = sum(path.stat().st_size for path in paths)
+            digests = tuple(_file_digest(path) for path in paths)
+            shutil.rmtree(target)
     known = KNOWN_DIGESTS.get(leg_length)
     if known is None:
         check = "-"
