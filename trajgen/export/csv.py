@@ -2,7 +2,8 @@
 
 Renderers return bytes and take only a :class:`~trajgen.verify.VerifiedSchedule`;
 :func:`write_profiles` commits both files together
-(:func:`~trajgen.export.atomic.commit_files`).
+(:func:`~trajgen.export.atomic.commit_files`). Numbers are formatted with numpy
+(:mod:`trajgen.export.numbers`), a block of :data:`ROWS_PER_CHUNK` rows at a time.
 """
 
 from __future__ import annotations
@@ -42,7 +43,8 @@ __all__ = [
 
 #: Most rows of one CSV profile unless ``CsvOptions.max_rows`` says otherwise (a day at 10 ms: 8.64 million).
 DEFAULT_MAX_ROWS = 10_000_000
-#: Rows sampled and formatted at a time while streaming a profile.
+#: Rows sampled (once for both vehicles' files: :func:`profile_chunk_pair`) and formatted at a time while
+#: streaming a profile; memory is bounded by this many rows whatever the duration.
 ROWS_PER_CHUNK = 20_000
 
 
