@@ -98,6 +98,14 @@ def test_every_entry_is_the_python_text(places, layout, data):
     assert first_mismatch(drawn, places, decimal, layout) is None
 
 
+@given(data=st.data())
+def test_every_entry_is_the_python_text_at_any_number_of_places(data):
+    places = data.draw(st.integers(0, 15), label="places")
+    drawn = data.draw(st.lists(values(places), max_size=20), label="values")
+    layout = data.draw(st.sampled_from(LAYOUTS), label="layout")
+    assert first_mismatch(drawn, places, ".", layout) is None
+
+
 @pytest.mark.parametrize("places", PLACES, ids=[f"{p}-places" for p in PLACES])
 @pytest.mark.parametrize(
     "pattern",
@@ -166,6 +174,9 @@ CLOSED_FORM = [
     pytest.param(8388607.999999999, 9, "8388607.999999999", id="above-the-9-place-limit"),
     pytest.param(4294967295.9999995, 6, "4294967296.000000", id="above-the-6-place-limit"),
     pytest.param(1e22, 6, "10000000000000000000000.000000", id="huge"),
+    pytest.param(2.5, 0, "2", id="no-places-half-to-even"),
+    pytest.param(-0.4, 0, "0", id="no-places-negative-to-zero"),
+    pytest.param(0.0625, 3, "0.062", id="three-places-exact-half"),
     pytest.param(float("nan"), 9, "nan", id="nan"),
     pytest.param(float("inf"), 6, "inf", id="inf"),
     pytest.param(-float("inf"), 9, "-inf", id="minus-inf"),

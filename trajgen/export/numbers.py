@@ -155,7 +155,7 @@ def _prepare_fixed(values: np.ndarray, places: int, decimal: str) -> _Prepared:
     texts = tuple(
         fixed_point_text(value, places).replace(".", decimal).encode("ascii") for value in values[python]
     )
-    return _Prepared(np.abs(units).view(np.uint64), units < 0, python, texts, places, True)
+    return _Prepared(np.abs(units).view(np.uint64), units < 0, python, texts, places, places > 0)
 
 
 def _prepare_integers(values: np.ndarray) -> _Prepared:
