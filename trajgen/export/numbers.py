@@ -143,15 +143,19 @@ def _prepare_fixed(values: np.ndarray, places: int, decimal: str) -> _Prepared:
         scaled = values * factor
         nearest = np.rint(scaled)
         in_range = np.abs(values) < exact_limit(places)  # NaN compares False
-        halves = np.flatnonzero(in_range & (np.abs(scaled - nearest) == 0.5))
+        everywhere = bool(in_range.all())
+        distance = np.abs(scaled - nearest)
+    halves = np.flatnonzero(distance == 0.5)
+    if not everywhere:
+        halves = halves[in_range[halves]]
     if halves.size:  # y is a half-integer: the exact product says which way to round
         error = _product_error(values[halves], factor, scaled[halves])
         half = scaled[halves]
         nearest[halves] = np.where(
             error > 0.0, half + 0.5, np.where(error < 0.0, half - 0.5, nearest[halves])
         )
-    units = np.where(in_range, nearest, 0.0).astype(np.int64)
-    python = np.flatnonzero(~in_range)
+    units = (nearest if everywhere else np.where(in_range, nearest, 0.0)).astype(np.int64)
+    python = np.flatnonzero(~in_range) if not everywhere else np.empty(0, dtype=np.intp)
     texts = tuple(
         fixed_point_text(value, places).replace(".", decimal).encode("ascii") for value in values[python]
     )
