@@ -270,9 +270,10 @@ def profile_chunks(
     OutputLimitError
         The profile would have more than ``options.max_rows`` rows (raised at once, not when iterating).
     """
-    schedule, options = _checked(verified, options, "profile_chunks")
+    require_verified(verified, "profile_chunks")
     if vehicle not in (0, 1):
         raise InputError(f"vehicle must be 0 or 1, got {short_repr(vehicle)}")
+    schedule, options = _checked(verified, options, "profile_chunks")
     rows = check_row_limit(schedule.duration, options)
     return _chunks(schedule, vehicle, options, rows, _SampledBlocks(schedule, options.sample_period))
 
