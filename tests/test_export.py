@@ -6,9 +6,19 @@ import numpy as np
 import pytest
 
 from tests.helpers import LIMITS, MIXED, route_of, too_close
-from trajgen import Exact, Toppra, certify
+from trajgen import Exact, Schedule, Toppra, certify
 from trajgen.errors import OptionError, UnverifiedScheduleError, VerificationError
-from trajgen.export import CsvOptions, Units, write_profiles
+from trajgen.export import (
+    CsvOptions,
+    Units,
+    commit_files,
+    format_block,
+    format_rows,
+    profile_chunk_pair,
+    write_profiles,
+)
+from trajgen.export import csv as csv_export
+from trajgen.export.csv import render_profile
 
 SWAP = ((10.0, 10.0, 10.0), ("A:10", "B:10"), ("B:10", "A:10"))
 NAMES = ("agv1", "agv2")
@@ -133,3 +143,57 @@ def test_bad_csv_options(options, match):
 def test_option_errors_are_option_errors():
     with pytest.raises(OptionError):
         CsvOptions(delimiter=",", decimal=",")
+
+
+@pytest.fixture(scope="module")
+def swap_exact():
+    return certify(Exact().schedule(route_of(*SWAP), LIMITS))
+
+
+def test_both_files_sample_each_block_once_and_any_block_size_gives_the_same_bytes(
+    tmp_path, monkeypatch, swap_exact
+):
+    options = CsvOptions(sample_period=0.1)  # 676 rows
+    expected = [render_profile(swap_exact, vehicle, options) for vehicle in (0, 1)]
+    samplings = []
+    real_state = Schedule.state
+
+    def counting_state(schedule, t):
+        samplings.append(np.size(t))
+        return real_state(schedule, t)
+
+    monkeypatch.setattr(Schedule, "state", counting_state)
+    monkeypatch.setattr(csv_export, "ROWS_PER_CHUNK", 100)
+    paths = write_profiles(swap_exact, NAMES, tmp_path, options=options)
+    assert [path.read_bytes() for path in paths] == expected
+    assert samplings == [100] * 6 + [76]  # one sampling per block for both files
+    samplings.clear()
+    first, second = profile_chunk_pair(swap_exact, options)
+    assert b"".join(first) + b"".join(second) == expected[0] + expected[1]  # one file, then the other
+    assert len(samplings) == 14  # each block sampled for each file
+
+
+def test_format_rows_are_the_lines_of_format_block(swap_exact):
+    schedule = swap_exact.schedule
+    state = schedule.sample(0.5)
+    options = CsvOptions(delimiter="\t", decimal=",", units=Units.MILLIMETRES)
+    block = format_block(schedule.route.graph, state, 1, options)
+    rows = format_rows(schedule.route.graph, state, 1, options)
+    assert len(rows) == state.t.size
+    assert "".join(row + "\r\n" for row in rows).encode("ascii") == block
+    assert rows[0].split("\t")[:2] == ["0,000000", "0,000000"]
+
+
+def test_commit_files_takes_a_chunk_of_each_file_in_turn(tmp_path):
+    taken = []
+
+    def chunks(name: str, count: int):
+        for k in range(count):
+            taken.append(f"{name}{k}")
+            yield f"{name}{k};".encode()
+
+    paths = commit_files(
+        {tmp_path / "a.csv": chunks("a", 3), tmp_path / "b.csv": b"whole", tmp_path / "c.csv": chunks("c", 1)}
+    )
+    assert taken == ["a0", "c0", "a1", "a2"]
+    assert [path.read_bytes() for path in paths] == [b"a0;a1;a2;", b"whole", b"c0;"]

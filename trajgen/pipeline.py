@@ -20,7 +20,7 @@ from trajgen.export import (
     check_output_paths,
     check_row_limit,
     commit_files,
-    profile_chunks,
+    profile_chunk_pair,
     profile_paths,
 )
 from trajgen.export.dialects import DIALECTS, Dialect, TableDialect
@@ -218,8 +218,8 @@ def run(
         ):
             files[path] = content
     elif outputs.csv_dir is not None:  # streamed into the commit, a block of rows at a time
-        for vehicle, path in enumerate(profile_paths(scenario.names, outputs.csv_dir)):
-            files[path] = profile_chunks(verified, vehicle, outputs.csv)
+        paths = profile_paths(scenario.names, outputs.csv_dir)
+        files.update(zip(paths, profile_chunk_pair(verified, outputs.csv), strict=True))
     if outputs.plot_dir is not None:
         compared, notes = _comparison(route, scenario, chosen, verified)
         speed, separation, coordination, configuration = (outputs.plot_dir / name for name in PLOT_NAMES)

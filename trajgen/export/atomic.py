@@ -22,7 +22,7 @@ import os
 import shutil
 import tempfile
 import uuid
-from collections.abc import Iterable, Mapping
+from collections.abc import Iterable, Mapping, Sequence
 from pathlib import Path
 
 from trajgen.errors import OutputError
@@ -117,19 +117,48 @@ def _read_umask() -> int:
 _FILE_MODE = 0o666 & ~_read_umask()
 
 
-def _stage(path: Path, data: bytes | Iterable[bytes], mode: int) -> str:
-    handle, temporary = tempfile.mkstemp(prefix=f".{path.name}.", suffix=_TMP_SUFFIX, dir=path.parent)
+#: Marks an exhausted payload while staging.
+_EXHAUSTED = object()
+
+
+def _stage(
+    paths: Sequence[Path],
+    payloads: Sequence[bytes | Iterable[bytes]],
+    mode: int,
+    staged: list[tuple[str, Path]],
+) -> None:
+    """Write each payload to a hidden temporary file beside its path and flush them all to disk.
+
+    Chunks are taken from the payloads in turn, one of each at a time, so that payloads made from one
+    source in step (both vehicles' CSV profiles, :func:`trajgen.export.csv.profile_chunk_pair`) are
+    consumed in step. Each temporary file is appended to ``staged`` as soon as it exists: the caller
+    removes them if anything fails.
+    """
+    streams = []
     try:
-        os.chmod(temporary, mode)  # mkstemp makes 0600; the files are for other tools too
-        with os.fdopen(handle, "wb") as stream:
-            for chunk in [data] if isinstance(data, bytes | bytearray) else data:
-                stream.write(chunk)
+        for path in paths:
+            handle, temporary = tempfile.mkstemp(prefix=f".{path.name}.", suffix=_TMP_SUFFIX, dir=path.parent)
+            staged.append((temporary, path))
+            streams.append(os.fdopen(handle, "wb"))
+            os.chmod(temporary, mode)  # mkstemp makes 0600; the files are for other tools too
+        pending = [
+            (stream, iter([data] if isinstance(data, bytes | bytearray) else data))
+            for stream, data in zip(streams, payloads, strict=True)
+        ]
+        while pending:
+            still = []
+            for stream, chunks in pending:
+                chunk = next(chunks, _EXHAUSTED)
+                if chunk is not _EXHAUSTED:
+                    stream.write(chunk)
+                    still.append((stream, chunks))
+            pending = still
+        for stream in streams:
             stream.flush()
             os.fsync(stream.fileno())
-    except BaseException:
-        os.unlink(temporary)
-        raise
-    return temporary
+    finally:
+        for stream in streams:
+            stream.close()
 
 
 def _keep_previous(path: Path) -> Path | None:
@@ -366,7 +395,8 @@ def commit_files(contents: Mapping[Path | str, bytes | Iterable[bytes]]) -> tupl
     ----------
     contents : mapping of path to bytes or iterable of bytes
         Every file of the run and its content, whole or as chunks streamed to
-        disk one at a time (memory stays bounded). Missing folders are made.
+        disk one at a time (memory stays bounded), a chunk of each file in
+        turn. Missing folders are made.
 
     Returns
     -------
@@ -394,8 +424,7 @@ def commit_files(contents: Mapping[Path | str, bytes | Iterable[bytes]]) -> tupl
                 _make_folders(path.parent, created)
             with _FolderLocks(os.path.realpath(path.parent) for path in paths) as locks:
                 locks.recover()
-                for path, payload in zip(paths, data, strict=True):
-                    staged.append((_stage(path, payload, _FILE_MODE), path))
+                _stage(paths, data, _FILE_MODE, staged)
                 _replace_all(staged)
                 succeeded = True
                 for folder in locks.folders:

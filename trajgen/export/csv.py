@@ -2,7 +2,8 @@
 
 Renderers return bytes and take only a :class:`~trajgen.verify.VerifiedSchedule`;
 :func:`write_profiles` commits both files together
-(:func:`~trajgen.export.atomic.commit_files`).
+(:func:`~trajgen.export.atomic.commit_files`). Numbers are formatted with numpy
+(:mod:`trajgen.export.numbers`), a block of :data:`ROWS_PER_CHUNK` rows at a time.
 """
 
 from __future__ import annotations
@@ -18,8 +19,9 @@ from topology import JUNCTION_INDEX, Option, StarGraph
 from topology.validation import short_repr
 from trajgen.errors import InputError, OptionError, OutputLimitError
 from trajgen.export.atomic import commit_files
+from trajgen.export.numbers import format_number_rows
 from trajgen.naming import check_vehicle_names
-from trajgen.schedule import ScheduleState, check_period, sample_block, sample_rows
+from trajgen.schedule import Schedule, ScheduleState, check_period, sample_block, sample_rows
 from trajgen.verify import VerifiedSchedule, require_verified
 
 __all__ = [
@@ -29,7 +31,9 @@ __all__ = [
     "CsvOptions",
     "Units",
     "check_row_limit",
+    "format_block",
     "format_rows",
+    "profile_chunk_pair",
     "profile_chunks",
     "profile_paths",
     "profile_rows",
@@ -39,7 +43,8 @@ __all__ = [
 
 #: Most rows of one CSV profile unless ``CsvOptions.max_rows`` says otherwise (a day at 10 ms: 8.64 million).
 DEFAULT_MAX_ROWS = 10_000_000
-#: Rows sampled and formatted at a time while streaming a profile.
+#: Rows sampled (once for both vehicles' files: :func:`profile_chunk_pair`) and formatted at a time while
+#: streaming a profile; memory is bounded by this many rows whatever the duration.
 ROWS_PER_CHUNK = 20_000
 
 
@@ -129,38 +134,59 @@ def _xy(graph: StarGraph, state: ScheduleState, vehicle: int) -> tuple[np.ndarra
     return s * np.cos(angle), s * np.sin(angle)
 
 
-def format_rows(graph: StarGraph, state: ScheduleState, vehicle: int, options: CsvOptions) -> list[str]:
-    """Rows of one vehicle's CSV profile for the sampled ``state`` on ``graph``, without line ends.
-
-    Also the format of executed motion (``trajgen simulate --trace``).
-    """
+def _columns(
+    graph: StarGraph, state: ScheduleState, vehicle: int, options: CsvOptions
+) -> list[tuple[np.ndarray, int | None]]:
+    """The nine columns of a vehicle's rows and their decimal places (``None``: the integer leg)."""
     scale = options.units.scale
     decimals = options.units.decimals
     x, y = _xy(graph, state, vehicle)
-    columns = [
+    return [
         (state.t, 6),
         (state.axis[vehicle] * scale, decimals),
         (state.velocity[vehicle] * scale, decimals),
         (state.acceleration[vehicle] * scale, decimals),
         (state.jerk[vehicle] * scale, decimals),
-        None,  # leg
+        (state.leg[vehicle] + 1, None),  # 1-based, 0 at the junction
         (state.s[vehicle] * scale, decimals),
         (x * scale, decimals),
         (y * scale, decimals),
     ]
-    formatted = []
-    for column in columns:
-        if column is None:
-            formatted.append(
-                [str(v) for v in (state.leg[vehicle] + 1).tolist()]
-            )  # 1-based, 0 at the junction
-            continue
-        values, places = column
-        text = [f"{round(float(v), places) + 0.0:.{places}f}" for v in values]  # + 0.0: no "-0"
-        if options.decimal != ".":
-            text = [t.replace(".", options.decimal) for t in text]
-        formatted.append(text)
-    return [options.delimiter.join(fields) for fields in zip(*formatted, strict=True)]
+
+
+def format_block(graph: StarGraph, state: ScheduleState, vehicle: int, options: CsvOptions) -> bytes:
+    """Rows of one vehicle's CSV profile for the sampled ``state`` on ``graph``: ASCII, CRLF after each row.
+
+    Numbers as :func:`~trajgen.export.numbers.fixed_point_text` writes them (time with 6 decimals,
+    lengths with ``options.units.decimals``), the decimal mark and delimiter of ``options``; formatted
+    with numpy (:func:`~trajgen.export.numbers.format_number_rows`).
+
+    Parameters
+    ----------
+    graph : StarGraph
+        The track (its leg angles give x and y).
+    state : ScheduleState
+        Both vehicles at n sample times.
+    vehicle : int
+        0 or 1.
+    options : CsvOptions
+
+    Returns
+    -------
+    bytes
+        n rows.
+    """
+    separators = (options.delimiter,) * (len(HEADER_NAMES[options.units]) - 1) + ("\r\n",)
+    return format_number_rows(_columns(graph, state, vehicle, options), separators, decimal=options.decimal)
+
+
+def format_rows(graph: StarGraph, state: ScheduleState, vehicle: int, options: CsvOptions) -> list[str]:
+    """Rows of one vehicle's CSV profile for the sampled ``state`` on ``graph``, without line ends.
+
+    Also the format of executed motion (``trajgen simulate --trace``); :func:`format_block` gives the
+    same rows as bytes.
+    """
+    return format_block(graph, state, vehicle, options).decode("ascii").split("\r\n")[:-1]
 
 
 def profile_rows(duration: float, options: CsvOptions) -> int:
@@ -194,6 +220,44 @@ def check_row_limit(duration: float, options: CsvOptions, *, lower_bound: bool =
     return rows
 
 
+class _SampledBlocks:
+    """Both vehicles' states, a block of :data:`ROWS_PER_CHUNK` rows at a time; the last block is kept.
+
+    Shared by both vehicles' chunk iterators: consumed in step, each block is sampled once.
+    """
+
+    def __init__(self, schedule: Schedule, period: float) -> None:
+        self.schedule = schedule
+        self.period = period
+        self.first: int | None = None
+        self.state: ScheduleState | None = None
+
+    def block(self, first: int) -> ScheduleState:
+        """The states of rows ``first`` to ``first + ROWS_PER_CHUNK - 1``."""
+        if first != self.first:
+            times = sample_block(self.schedule.duration, self.period, first, first + ROWS_PER_CHUNK)
+            self.state, self.first = self.schedule.state(times), first
+        return self.state
+
+
+def _checked(
+    verified: VerifiedSchedule, options: CsvOptions | None, caller: str
+) -> tuple[Schedule, CsvOptions]:
+    schedule = require_verified(verified, caller).schedule
+    options = CsvOptions() if options is None else options
+    if not isinstance(options, CsvOptions):
+        raise OptionError(f"CSV options must be CsvOptions, got {type(options).__name__}")
+    return schedule, options
+
+
+def _chunks(
+    schedule: Schedule, vehicle: int, options: CsvOptions, rows: int, blocks: _SampledBlocks
+) -> Iterator[bytes]:
+    yield (options.delimiter.join(HEADER_NAMES[options.units]) + "\r\n").encode("ascii")
+    for first in range(0, rows, ROWS_PER_CHUNK):
+        yield format_block(schedule.route.graph, blocks.block(first), vehicle, options)
+
+
 def profile_chunks(
     verified: VerifiedSchedule, vehicle: int, options: CsvOptions | None = None
 ) -> Iterator[bytes]:
@@ -206,22 +270,33 @@ def profile_chunks(
     OutputLimitError
         The profile would have more than ``options.max_rows`` rows (raised at once, not when iterating).
     """
-    schedule = require_verified(verified, "profile_chunks").schedule
+    require_verified(verified, "profile_chunks")
     if vehicle not in (0, 1):
         raise InputError(f"vehicle must be 0 or 1, got {short_repr(vehicle)}")
-    options = CsvOptions() if options is None else options
-    if not isinstance(options, CsvOptions):
-        raise OptionError(f"CSV options must be CsvOptions, got {type(options).__name__}")
+    schedule, options = _checked(verified, options, "profile_chunks")
     rows = check_row_limit(schedule.duration, options)
+    return _chunks(schedule, vehicle, options, rows, _SampledBlocks(schedule, options.sample_period))
 
-    def chunks() -> Iterator[bytes]:
-        yield (options.delimiter.join(HEADER_NAMES[options.units]) + "\r\n").encode("ascii")
-        for first in range(0, rows, ROWS_PER_CHUNK):
-            times = sample_block(schedule.duration, options.sample_period, first, first + ROWS_PER_CHUNK)
-            lines = format_rows(schedule.route.graph, schedule.state(times), vehicle, options)
-            yield ("\r\n".join(lines) + "\r\n").encode("ascii")
 
-    return chunks()
+def profile_chunk_pair(
+    verified: VerifiedSchedule, options: CsvOptions | None = None
+) -> tuple[Iterator[bytes], Iterator[bytes]]:
+    """Both vehicles' CSV profiles as chunks (as :func:`profile_chunks`), sampling each block once.
+
+    The two iterators share the sampled states of the block of rows they are at: taken in step, a
+    chunk of one then the same chunk of the other (as :func:`~trajgen.export.atomic.commit_files`
+    does), each block of :data:`ROWS_PER_CHUNK` rows is sampled once for both files. Taken otherwise,
+    the chunks are the same, only sampled twice. Memory stays bounded by one block.
+
+    Raises
+    ------
+    OutputLimitError
+        The profiles would have more than ``options.max_rows`` rows (raised at once).
+    """
+    schedule, options = _checked(verified, options, "profile_chunk_pair")
+    rows = check_row_limit(schedule.duration, options)
+    blocks = _SampledBlocks(schedule, options.sample_period)
+    return _chunks(schedule, 0, options, rows, blocks), _chunks(schedule, 1, options, rows, blocks)
 
 
 def render_profile(verified: VerifiedSchedule, vehicle: int, options: CsvOptions | None = None) -> bytes:
@@ -290,5 +365,5 @@ def write_profiles(
     """
     require_verified(verified, "write_profiles")
     paths = profile_paths(names, directory)
-    commit_files({path: profile_chunks(verified, vehicle, options) for vehicle, path in enumerate(paths)})
+    commit_files(dict(zip(paths, profile_chunk_pair(verified, options), strict=True)))
     return paths

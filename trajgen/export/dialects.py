@@ -29,6 +29,7 @@ from topology import Option
 from topology.validation import short_repr
 from trajgen.errors import OptionError, ProfileFileError
 from trajgen.export.csv import HEADER_NAMES, Units
+from trajgen.export.numbers import format_number_rows
 from trajgen.tables import Interpolation, ProfileTable
 
 __all__ = [
@@ -153,10 +154,6 @@ def _number(field: str, source: str, line: int, what: str) -> tuple[float, int]:
     return value, len(text.partition(".")[2])
 
 
-def _number_text(value: float, decimals: int) -> str:
-    return f"{round(float(value), decimals) + 0.0:.{decimals}f}"  # + 0.0: no "-0"
-
-
 @dataclass(frozen=True, slots=True)
 class TableDialect(Dialect):
     """A table of points ``master<delimiter>slave[<delimiter>extra]``, one per line.
@@ -231,19 +228,21 @@ class TableDialect(Dialect):
 
     def lines(self, table: ProfileTable) -> Iterator[str]:
         """The file's lines, without line ends."""
-        if self.header is not None:
-            yield self.header
-        values = table.values * 1000.0  # metres to millimetres (m/s to mm/s)
-        for t, value in zip(table.times, values, strict=True):
-            fields = [_number_text(t, DECIMALS), _number_text(value, DECIMALS)]
-            if self.extra is not None:
-                fields.append(self.extra)
-            yield self.delimiter.join(fields)
+        end = "\r\n" if self.crlf else "\n"
+        yield from self.render(table).decode("ascii").split(end)[:-1]
 
     def render(self, table: ProfileTable) -> bytes:
-        """The whole file as ASCII bytes."""
+        """The whole file as ASCII bytes.
+
+        Times in seconds and slave values in millimetres (mm/s), :data:`DECIMALS` decimals each, as
+        :func:`~trajgen.export.numbers.fixed_point_text` writes them.
+        """
         end = "\r\n" if self.crlf else "\n"
-        return "".join(line + end for line in self.lines(table)).encode("ascii")
+        header = b"" if self.header is None else (self.header + end).encode("ascii")
+        last = end if self.extra is None else self.delimiter + self.extra + end
+        values = table.values * 1000.0  # metres to millimetres (m/s to mm/s)
+        columns = [(table.times, DECIMALS), (values, DECIMALS)]
+        return header + format_number_rows(columns, [self.delimiter, last])
 
     def read(self, data: bytes, *, source: str) -> ParsedProfile:
         """The table in ``data`` and its format problems (see :meth:`Dialect.read`)."""

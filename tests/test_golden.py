@@ -1,0 +1,67 @@
+"""Golden files: every dialect and unit setting renders, byte for byte, what the per-value formatter wrote.
+
+The cases and the stored files are those of :mod:`tests.golden_profiles`; a long schedule is compared
+by SHA-256 digest.
+"""
+
+from __future__ import annotations
+
+import pytest
+
+from tests.golden_profiles import (
+    CASES,
+    GOLDEN,
+    LONG_DIGESTS,
+    first_difference,
+    long_swap,
+    profile_digests,
+)
+from trajgen.export.csv import CsvOptions
+
+
+@pytest.mark.parametrize("case", CASES, ids=[case.name for case in CASES])
+def test_the_files_are_byte_identical_to_the_golden_files(case):
+    rendered = case.render()
+    folder = GOLDEN / case.name
+    assert sorted(rendered) == sorted(path.name for path in folder.iterdir())
+    for name, data in rendered.items():
+        problem = first_difference((folder / name).read_bytes(), data)
+        assert problem is None, f"{case.name}/{name}: {problem}"
+
+
+def test_every_golden_folder_belongs_to_a_case():
+    assert sorted(path.name for path in GOLDEN.iterdir()) == sorted(case.name for case in CASES)
+
+
+@pytest.mark.parametrize(
+    ("expected", "actual", "message"),
+    [
+        pytest.param(b"a\r\nb\r\n", b"a\r\nb\r\n", None, id="equal"),
+        pytest.param(
+            b"t\r\n1.5\r\n2.5\r\n",
+            b"t\r\n1.5\r\n2.4\r\n",
+            "line 3 differs: expected b'2.5\\r\\n', got b'2.4\\r\\n'",
+            id="a-value",
+        ),
+        pytest.param(
+            b"a\r\nb\r\n", b"a\r\nb\n", "line 2 differs: expected b'b\\r\\n', got b'b\\n'", id="a-lost-cr"
+        ),
+        pytest.param(
+            b"a\r\nb\r\n",
+            b"a\r\n",
+            "the files agree on 1 lines, then the expected one has 1 more and the rendered one 0 more",
+            id="a-missing-line",
+        ),
+    ],
+)
+def test_first_difference_names_the_first_differing_line(expected, actual, message):
+    assert first_difference(expected, actual) == message
+
+
+@pytest.mark.parametrize("length", sorted(LONG_DIGESTS), ids=[f"legs-{n:g}m" for n in sorted(LONG_DIGESTS)])
+def test_a_long_schedule_hashes_to_the_golden_digests(length):
+    duration, digests = LONG_DIGESTS[length]
+    verified = long_swap(length)
+    # a different duration means the schedule changed, not its formatting
+    assert verified.schedule.duration == duration
+    assert profile_digests(verified, CsvOptions()) == digests
