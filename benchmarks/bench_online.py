@@ -22,25 +22,25 @@ import statistics
 import time
 
 from trajgen.online import Executor
-from trajgen.online.executor import execution_margin, plan_for_execution
+from trajgen.online.goals import execution_margin, plan_for_execution
 from trajgen.online.simulation import parse_faults, simulate
 from trajgen.progress import progress
 from trajgen.sampling import campaign_faults, online_campaign
 
 
-def run_case(args: tuple[int, int]) -> dict:
+def run_case(args: tuple[int, int, str | None]) -> dict:
     """One campaign scenario: its faults and the summary of its simulation."""
-    k, seed = args
+    k, seed, method = args
     logging.disable(logging.WARNING)
     scenario = online_campaign(k + 1, seed=seed)[k]
-    verified = plan_for_execution(scenario)
+    verified = plan_for_execution(scenario, method=method)
     margin = execution_margin(scenario, 0.05)
     specs = campaign_faults(scenario, verified.schedule.duration, seed=1000 + k, margin=margin)
     result, _ = simulate(scenario, parse_faults(scenario, specs), verified=verified)
     return {"k": k, "specs": specs, **result.summary()}
 
 
-def timed_cycles(count: int, seed: int) -> tuple[list[float], list[float]]:
+def timed_cycles(count: int, seed: int, method: str | None) -> tuple[list[float], list[float]]:
     """Wall time of every executor step (µs) and of the steps that replanned (ms)."""
     logging.disable(logging.WARNING)
     cycles: list[float] = []
@@ -60,7 +60,7 @@ def timed_cycles(count: int, seed: int) -> tuple[list[float], list[float]]:
     Executor.step = step
     try:
         for k in progress(range(count), description="timed scenarios"):
-            run_case((k, seed))
+            run_case((k, seed, method))
     finally:
         Executor.step = original
     return cycles, replans
@@ -77,9 +77,10 @@ def main() -> None:
     parser.add_argument("--seed", type=int, default=11)
     parser.add_argument("--timed", type=int, default=20)
     parser.add_argument("--workers", type=int, default=2)
+    parser.add_argument("--method", default=None, help="timing method of the plans (default: the registry's)")
     args = parser.parse_args()
 
-    cycles, replans = timed_cycles(args.timed, args.seed)
+    cycles, replans = timed_cycles(args.timed, args.seed, args.method)
     print(f"executor cycle (both vehicles), {len(cycles)} cycles of {args.timed} scenarios:")
     print(
         f"  median {statistics.median(cycles):.1f} us, p99 {percentile(cycles, 0.99):.1f} us, "
@@ -93,7 +94,7 @@ def main() -> None:
 
     started = time.perf_counter()
     with multiprocessing.Pool(args.workers) as pool:
-        cases = [(k, args.seed) for k in range(args.count)]
+        cases = [(k, args.seed, args.method) for k in range(args.count)]
         done = progress(pool.imap_unordered(run_case, cases), total=len(cases), description="campaign")
         rows = sorted(done, key=lambda r: r["k"])
     wall = time.perf_counter() - started
@@ -110,6 +111,8 @@ def main() -> None:
         f"{max(r['jerk_ratio'] for r in rows):.9f}"
     )
     print(f"  rejected goal requests: {sum(r['rejected_goals'] for r in rows)}")
+    print(f"  emergency brakes: {sum(r['emergency_brakes'] for r in rows)} cycles")
+    print(f"  braking-check holds: {sum(r['holds'] for r in rows)} cycles")
     if lost:
         print(
             f"  time lost against the undisturbed schedule: median {statistics.median(lost):.2f} s "

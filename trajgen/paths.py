@@ -188,6 +188,25 @@ class VehiclePath:
         k = self.segment(p)
         return self.axis_starts[k] + self.headings[k] * (p - self.starts[k])
 
+    def travel_at_axis(self, axis: float, near: float, velocity: float) -> float:
+        """The travel at which the vehicle's signed axis is ``axis``, moving at ``velocity`` along it.
+
+        The axis runs back and forth through reversals, so one value can be met more than once:
+        the first segment from ``near``'s that holds ``axis`` and is driven in the direction of
+        ``velocity`` (m/s, along the axis) is taken. The end segments run on beyond the path's ends.
+        """
+        if not self.legs:
+            return 0.0
+        k = self.segment(near)
+        last = len(self.legs) - 1
+        while True:
+            p = self.starts[k] + self.headings[k] * (axis - self.axis_starts[k])
+            end = self.starts[k + 1] if k < last else math.inf
+            forward = self.headings[k] * velocity >= 0.0
+            if k == last or (p <= end + 1e-9 and forward):
+                return max(p, self.starts[k]) if k else p
+            k += 1
+
     def next_stop(self, p: float, tolerance: float) -> float:
         """The first reversal ahead of travel ``p`` (more than ``tolerance`` ahead), or the path's end."""
         k = bisect.bisect_right(self.stops, p + tolerance)

@@ -19,6 +19,9 @@ number of pieces, not with the duration. It checks:
   pieces tile ``[0, duration]``;
 - the start and the goal are the route's, to 1e-9 m, at rest (1e-6 m/s);
 - the sequence of regions visited (the homotopy class) is the route's;
+- the braking rule (:mod:`trajgen.braking_rule`): each vehicle that follows at a
+  conflict can always stop short of its frontier, so what is planned is what
+  the online executor plays;
 - every number is finite, every knot sequence increases, and every array
   derived from others agrees with them (:mod:`trajgen.integrity`).
 
@@ -46,6 +49,7 @@ import numpy as np
 from topology import Region, RegionKey, reduce_regions
 from topology.indexed import JUNCTION_INDEX, track_distance
 from trajgen import polynomials
+from trajgen.braking_rule import braking_rule_failures
 from trajgen.errors import InputError, UnverifiedScheduleError, VerificationError
 from trajgen.integrity import array_failures
 from trajgen.pieces import Pieces, UncheckableKinematicsError, motion_arrays, schedule_pieces
@@ -382,6 +386,10 @@ def _verify(schedule: Schedule) -> VerificationReport:
     if not pieces.count and start_gap < required - POSITION_TOLERANCE:
         failures.append(f"separation {start_gap:.9g} m at rest is below the minimum {required:g} m")
     _check_piece_continuity(pieces, track, schedule, failures)
+    if not failures and schedule.end_tolerance is None:
+        # a method's plan: each follower can always stop short of its frontier (a table read back
+        # follows a plan that was checked; its own round-off is not an execution)
+        failures += braking_rule_failures(schedule)
     expected = route.region_keys
     sequence = reduce_regions(regions)
     if sequence != expected:

@@ -34,16 +34,9 @@ from topology.indexed import leg_travel
 from topology.indexed import separation as indexed_separation
 from trajgen.errors import InputError
 from trajgen.export.csv import HEADER_NAMES, CsvOptions, format_rows
-from trajgen.online.executor import (
-    Command,
-    Event,
-    Executor,
-    Mode,
-    VehicleState,
-    execution_margin,
-    plan_for_execution,
-)
+from trajgen.online.executor import Command, Event, Executor, Mode, VehicleState
 from trajgen.online.faults import Fault, FaultError, FaultKind, parse_fault
+from trajgen.online.goals import execution_margin, plan_for_execution
 from trajgen.scenario import Scenario
 from trajgen.schedule import ScheduleState, TimingMethod
 from trajgen.values import frozen
@@ -179,7 +172,7 @@ class _Plant:
         for v, (body, setpoint) in enumerate(zip(self.bodies, command.setpoints, strict=True)):
             self.lags[v].push(command.time, setpoint)
             stop = self._active(FaultKind.STOP, v, t)
-            if stop is not None:
+            if stop is not None or command.emergency:  # a stop fault, or the executor's emergency brake
                 decel = self.limits.vehicles[v].emergency_braking
                 speed = abs(body.v)
                 new = max(speed - decel * dt, 0.0)
@@ -337,14 +330,21 @@ class SimulationResult:
     velocity_ratio, acceleration_ratio, jerk_ratio : float
         Worst ``|v|, |a|, |j|`` of the setpoints over the vehicle's limit.
     replans : int
+        Re-plans (a new goal's).
     rejected_goals : int
+    holds : int
+        Cycles in which the braking invariant held a vehicle back.
+    emergency_brakes : int
+        Cycles in which nothing but both braking hard could be certified (must be 0).
     separation_violations, limit_violations : int
         Cycles with the true separation below the minimum, or a setpoint beyond a limit.
     events : tuple of Event
     faults : tuple of Fault
     cycles : int
     plot : dict
-        Decimated samples for the plot: ``t`` (n,), ``speed`` (2, n), ``separation`` (n,) (read-only arrays).
+        Decimated samples for the plot (read-only arrays): ``t`` (n,), ``speed`` (2, n) m/s,
+        ``separation`` (n,) m, ``travel`` (2, n) each vehicle's travel along its path, m, and
+        ``frontier`` (2, n) its frontier, m of travel (``inf`` where none binds it).
     schedule : VerifiedSchedule
         The undisturbed plan.
     """
@@ -360,6 +360,8 @@ class SimulationResult:
     jerk_ratio: float
     replans: int
     rejected_goals: int
+    holds: int
+    emergency_brakes: int
     separation_violations: int
     limit_violations: int
     events: tuple[Event, ...]
@@ -387,6 +389,8 @@ class SimulationResult:
             "jerk_ratio": round(self.jerk_ratio, 6),
             "replans": self.replans,
             "rejected_goals": self.rejected_goals,
+            "holds": self.holds,
+            "emergency_brakes": self.emergency_brakes,
             "violations": self.violations,
             "separation_violations": self.separation_violations,
             "limit_violations": self.limit_violations,
@@ -516,10 +520,7 @@ def simulate(
     if verified is None:
         verified = plan_for_execution(scenario, method=method, position_margin=position_margin)
     executor = Executor(
-        verified,
-        period=period,
-        position_margin=margin,
-        min_separation=scenario.limits.min_separation,
+        verified, period=period, position_margin=margin, min_separation=scenario.limits.min_separation
     )
     plant = _Plant(executor, faults, period)
     limits = scenario.limits
@@ -537,7 +538,7 @@ def simulate(
     required = limits.min_separation
     if spool is not None:
         spool.add(0.0, bodies)
-    plot.add((0.0, bodies[0].v, bodies[1].v, separation))
+    plot.add((0.0, bodies[0].v, bodies[1].v, separation, 0.0, 0.0, math.inf, math.inf))
     cycle = 0
     t = 0.0
     makespan = None
@@ -584,7 +585,7 @@ def simulate(
             separation = now
             if spool is not None:
                 spool.add(t, bodies)
-            plot.add((t, bodies[0].v, bodies[1].v, now))
+            plot.add((t, bodies[0].v, bodies[1].v, now, *executor.travel, *command.frontiers))
             done = (
                 command.mode is Mode.DONE
                 and not pending
@@ -598,11 +599,13 @@ def simulate(
         if spool is not None:
             spool.close()
         raise
-    rows = np.array(plot.rows) if plot.rows else np.zeros((0, 4))
+    rows = np.array(plot.rows) if plot.rows else np.zeros((0, 8))
     samples = {
         "t": frozen(rows[:, 0].copy()),
         "speed": frozen(rows[:, 1:3].T.copy()),
         "separation": frozen(rows[:, 3].copy()),
+        "travel": frozen(rows[:, 4:6].T.copy()),
+        "frontier": frozen(rows[:, 6:8].T.copy()),
     }
     reached = makespan is not None
     makespan = makespan if reached else t
@@ -618,6 +621,8 @@ def simulate(
         jerk_ratio=worst[2],
         replans=executor.replans,
         rejected_goals=executor.rejected_goals,
+        holds=executor.holds,
+        emergency_brakes=executor.emergency_brakes,
         separation_violations=separation_violations,
         limit_violations=limit_violations,
         events=tuple(executor.events),

@@ -1,0 +1,82 @@
+"""Plans meant for execution, and the one thing that re-plans: a new goal.
+
+A plan for the executor keeps twice its position margin on top of the
+separation (:func:`plan_for_execution`): the executor's conflicts keep one
+margin (room for a position correction), the other is clearance between
+them, so no frontier stops a vehicle short of a reversal. Only a goal change
+re-plans: both vehicles brake to rest, the topological planner plans from
+where they stand, the timing method times it, the verifier certifies it
+(:func:`plan_from_rest`).
+"""
+
+from __future__ import annotations
+
+from limits import Limits
+from topology import Configuration, StarGraph, plan
+from trajgen.methods import make_schedule
+from trajgen.schedule import TimingMethod
+from trajgen.verify import VerifiedSchedule, certify
+
+__all__ = ["execution_margin", "goal_refusal", "plan_for_execution", "plan_from_rest"]
+
+
+def execution_margin(scenario, position_margin: float) -> float:
+    """The position margin an executor can keep for ``scenario``, metres: at most ``position_margin``.
+
+    The plan needs twice the margin on top of the separation (:func:`plan_for_execution`), which must
+    fit the shortest leg and the start and goal; where it does not, the margin shrinks (to 0 when the
+    separation is the shortest leg).
+    """
+    track = scenario.track
+    room = min(track.shortest_leg, track.separation(scenario.start), track.separation(scenario.goal))
+    return max(0.0, min(position_margin, 0.5 * (room - scenario.limits.min_separation)))
+
+
+def plan_from_rest(
+    graph: StarGraph,
+    limits: Limits,
+    start: Configuration,
+    goal: Configuration,
+    *,
+    method: TimingMethod | str | None,
+    margin: float,
+) -> VerifiedSchedule:
+    """The verified plan from ``start`` to ``goal`` for the separation ``limits.min_separation + 2 margin``.
+
+    Raises
+    ------
+    InputError
+        The planner cannot keep that separation between ``start`` and ``goal``.
+    VerificationError
+        The timed plan fails the verifier (it is never executed).
+    """
+    separation = limits.min_separation + 2.0 * margin
+    planned = Limits(limits.vehicles, separation)
+    route = plan(graph, start, goal, min_separation=separation)
+    return certify(make_schedule(route, planned, method=method))
+
+
+def plan_for_execution(
+    scenario, *, method: TimingMethod | str | None = None, position_margin: float = 0.05
+) -> VerifiedSchedule:
+    """The verified schedule an :class:`~trajgen.online.Executor` plays for ``scenario``.
+
+    Planned for the separation ``min_separation + 2 * margin``, with the margin of
+    :func:`execution_margin`: the executor's conflicts keep ``min_separation + margin``, and the
+    second margin is the plan's clearance between them.
+    """
+    margin = execution_margin(scenario, position_margin)
+    return plan_from_rest(
+        scenario.track, scenario.limits, scenario.start, scenario.goal, method=method, margin=margin
+    )
+
+
+def goal_refusal(graph: StarGraph, goal: Configuration, required: float) -> str | None:
+    """Why ``goal`` cannot be taken (the vehicles would end closer than ``required`` metres), or ``None``."""
+    apart = graph.separation(goal)
+    if apart < required:
+        return (
+            f"goal {goal} leaves the vehicles {apart:.3f} m apart: expected at least {required:.3f} m "
+            "(separation + position margin)"
+        )
+    return None

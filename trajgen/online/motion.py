@@ -1,0 +1,216 @@
+"""Each vehicle's motion along its path: the plan played on time, or Ruckig towards a target.
+
+While a vehicle is on time and its frontier allows, its setpoints are the
+plan's (:class:`PlanPlayer`). After a departure it re-times the rest of its own
+path with Ruckig (:class:`VehicleMotion`): time-optimally, under its own
+velocity, acceleration and jerk limits, to rest at its next reversal or its
+frontier, whichever comes first, recomputed every cycle as the frontier moves.
+Travel coordinates throughout (:mod:`trajgen.paths`); plain floats: this runs
+every control cycle.
+"""
+
+from __future__ import annotations
+
+import bisect
+import math
+
+from ruckig import ControlInterface, InputParameter, Result, Ruckig, Trajectory
+
+from limits import VehicleLimits
+from topology import JUNCTION_INDEX
+from trajgen.errors import ScheduleError
+from trajgen.online.braking import PathState
+from trajgen.paths import VehiclePath
+from trajgen.pieces import schedule_pieces
+from trajgen.verify import VerifiedSchedule
+
+__all__ = ["AT_REST", "PlanPlayer", "VehicleMotion", "ruckig_jerk", "travel_state"]
+
+#: Relative slack on the acceleration limit given to Ruckig (far below the 1e-6 the limits are checked to).
+_SLACK = 1e-9
+#: A vehicle slower than this is at rest, m/s.
+AT_REST = 1e-6
+
+
+def ruckig_jerk(trajectory: Trajectory, t: float) -> float:
+    """Jerk of a one-axis Ruckig trajectory at time ``t``, m/s³ (its phases have constant jerk)."""
+    profile = trajectory.profiles[0][0]
+    brake = profile.brake
+    if t < brake.duration:
+        elapsed = 0.0
+        for duration, jerk in zip(brake.t, brake.j, strict=False):
+            elapsed += duration
+            if t < elapsed:
+                return jerk
+    t -= brake.duration
+    elapsed = 0.0
+    for duration, jerk in zip(profile.t, profile.j, strict=True):
+        elapsed += duration
+        if t < elapsed:
+            return jerk
+    return 0.0
+
+
+class PlanPlayer:
+    """A verified schedule as plain polynomial pieces per vehicle, evaluated every cycle.
+
+    Parameters
+    ----------
+    verified : VerifiedSchedule
+    """
+
+    __slots__ = ("axis", "duration", "legs", "s_offset", "s_sign", "starts")
+
+    def __init__(self, verified: VerifiedSchedule) -> None:
+        pieces = schedule_pieces(verified.schedule)
+        self.starts = [float(x) for x in pieces.start]
+        self.duration = float(verified.schedule.duration)
+        self.axis = [[[float(c) for c in row] for row in pieces.axis[v]] for v in (0, 1)]
+        self.legs = [[int(x) for x in pieces.leg[v]] for v in (0, 1)]
+        self.s_offset = [[float(x) for x in pieces.s_offset[v]] for v in (0, 1)]
+        self.s_sign = [[float(x) for x in pieces.s_sign[v]] for v in (0, 1)]
+
+    def state(self, vehicle: int, t: float) -> tuple[float, float, float, float, int, float]:
+        """Axis, velocity, acceleration, jerk, leg, s of ``vehicle`` at ``t`` (clipped to the plan)."""
+        if not self.starts:
+            return 0.0, 0.0, 0.0, 0.0, JUNCTION_INDEX, 0.0
+        t = min(max(t, 0.0), self.duration)
+        k = max(bisect.bisect_right(self.starts, t) - 1, 0)
+        u = t - self.starts[k]
+        c0, c1, c2, c3, c4 = self.axis[vehicle][k]
+        axis = c0 + u * (c1 + u * (c2 + u * (c3 + u * c4)))
+        velocity = c1 + u * (2.0 * c2 + u * (3.0 * c3 + u * 4.0 * c4))
+        acceleration = 2.0 * c2 + u * (6.0 * c3 + u * 12.0 * c4)
+        jerk = 6.0 * c3 + u * 24.0 * c4
+        if t >= self.duration:
+            velocity = acceleration = jerk = 0.0
+        s = max(self.s_offset[vehicle][k] + self.s_sign[vehicle][k] * axis, 0.0)
+        leg = self.legs[vehicle][k] if s > 0.0 else JUNCTION_INDEX
+        return axis, velocity, acceleration, jerk, leg, s
+
+
+class VehicleMotion:
+    """One vehicle's Ruckig generators along its path (travel coordinates).
+
+    A trajectory to a target is reused from cycle to cycle while the target stays the same and
+    the vehicle's state is the one it produced; anything else recalculates it from the state.
+
+    Parameters
+    ----------
+    limits : VehicleLimits
+    """
+
+    __slots__ = (
+        "_braking",
+        "_braking_input",
+        "_elapsed",
+        "_goal",
+        "_input",
+        "_output",
+        "_ruckig",
+        "trajectory",
+    )
+
+    def __init__(self, limits: VehicleLimits) -> None:
+        self._ruckig = Ruckig(1)
+        self._input = InputParameter(1)
+        self._input.max_velocity = [limits.max_velocity]
+        # a hair of slack: a state braking at exactly the limit stays solvable
+        self._input.max_acceleration = [limits.max_acceleration * (1.0 + _SLACK)]
+        self._input.max_jerk = [limits.max_jerk]
+        self._input.target_velocity = [0.0]
+        self._input.target_acceleration = [0.0]
+        self.trajectory = Trajectory(1)
+        self._braking = Trajectory(1)
+        self._braking_input = InputParameter(1)
+        self._braking_input.control_interface = ControlInterface.Velocity
+        self._braking_input.max_velocity = [math.inf]
+        self._braking_input.max_acceleration = [limits.max_acceleration * (1.0 + _SLACK)]
+        self._braking_input.max_jerk = [limits.max_jerk]
+        self._braking_input.target_velocity = [0.0]
+        self._braking_input.target_acceleration = [0.0]
+        self._goal: float | None = None
+        self._output: PathState | None = None
+        self._elapsed = 0.0
+
+    def set_speed_limit(self, speed: float) -> None:
+        """Cap the vehicle's speed at ``speed`` m/s from the next calculation."""
+        self._input.max_velocity = [speed]
+        self._goal = None
+
+    @property
+    def speed_limit(self) -> float:
+        """The speed the vehicle is held to, m/s."""
+        return float(self._input.max_velocity[0])
+
+    def toward(self, state: PathState, target: float, period: float) -> tuple[PathState, float]:
+        """The state ``period`` seconds along the time-optimal motion from ``state`` to rest at ``target``.
+
+        Returns
+        -------
+        (PathState, float)
+            The next state and the jerk over the cycle, m/s³.
+
+        Raises
+        ------
+        ScheduleError
+            Ruckig found no motion.
+        """
+        if self._goal != target or state is not self._output:
+            self._input.current_position = [state.p]
+            self._input.current_velocity = [state.v]
+            self._input.current_acceleration = [state.a]
+            self._input.target_position = [target]
+            result = self._ruckig.calculate(self._input, self.trajectory)
+            if result not in (Result.Working, Result.Finished):
+                raise ScheduleError(f"Ruckig found no motion from {state} to {target!r} m: {result}")
+            self._goal, self._elapsed = target, 0.0
+        self._elapsed += period
+        t = min(self._elapsed, self.trajectory.duration)
+        (p,), (v,), (a,) = self.trajectory.at_time(t)
+        jerk = ruckig_jerk(self.trajectory, t) if t < self.trajectory.duration else 0.0
+        if t >= self.trajectory.duration:
+            p, v, a = target, 0.0, 0.0
+        self._output = PathState(p, v, a)
+        return self._output, jerk
+
+    def overshoots(self, target: float) -> bool:
+        """Whether the motion last calculated runs past ``target`` or backs up (it cannot stop in time)."""
+        extrema = self.trajectory.position_extrema[0]
+        return extrema.max > target + 1e-9
+
+    def brake(self, state: PathState, period: float) -> tuple[PathState, float]:
+        """The state ``period`` seconds into service braking from ``state`` (to rest, never backing up)."""
+        self._goal = None
+        if state.v <= AT_REST and state.a <= 0.0:
+            return PathState(state.p, 0.0, 0.0), 0.0
+        self._braking_input.current_position = [state.p]
+        self._braking_input.current_velocity = [state.v]
+        self._braking_input.current_acceleration = [state.a]
+        result = self._ruckig.calculate(self._braking_input, self._braking)
+        if result not in (Result.Working, Result.Finished):
+            raise ScheduleError(f"Ruckig found no braking motion from {state}: {result}")
+        t = min(period, self._braking.duration)
+        (p,), (v,), (a,) = self._braking.at_time(t)
+        if t >= self._braking.duration or v <= 0.0:
+            return PathState(max(p, state.p), 0.0, 0.0), 0.0
+        return PathState(p, v, a), ruckig_jerk(self._braking, t)
+
+    def stop_point(self, state: PathState) -> float:
+        """Where service braking from ``state`` comes to rest, metres of travel."""
+        if state.v <= AT_REST and state.a <= 0.0:
+            return state.p
+        self._braking_input.current_position = [state.p]
+        self._braking_input.current_velocity = [state.v]
+        self._braking_input.current_acceleration = [state.a]
+        result = self._ruckig.calculate(self._braking_input, self._braking)
+        if result not in (Result.Working, Result.Finished):
+            raise ScheduleError(f"Ruckig found no braking motion from {state}: {result}")
+        self._goal = None
+        return float(self._braking.position_extrema[0].max)
+
+
+def travel_state(path: VehiclePath, p: float, velocity: float, acceleration: float) -> PathState:
+    """A state along ``path`` from axis velocity and acceleration (m/s, m/s²) at travel ``p``."""
+    heading = path.heading(p)
+    return PathState(p, heading * velocity, heading * acceleration)

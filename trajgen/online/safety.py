@@ -1,0 +1,67 @@
+"""The braking invariant, the executor's last defence: both vehicles can always stop apart.
+
+Every cycle, before a pair of setpoints is issued, :class:`SafetyGuard` asks the
+:class:`~trajgen.online.braking.BrakingCheck` whether both vehicles, braking at
+once from here (each anywhere between its service braking from the commanded
+state and its emergency stop from the measured one), keep the separation until
+both are at rest, certified between its samples too. A follower whose next
+setpoint would break it holds (service braking, the motion the last cycle
+certified) instead; if even that cannot be certified (a fault moved a vehicle
+beyond the margins), both brake hard: an **emergency brake**, counted and
+reported. A correct frontier never lets that happen.
+"""
+
+from __future__ import annotations
+
+from limits import Limits
+from topology import StarGraph
+from topology.indexed import separation as indexed_separation
+from trajgen.online.braking import BrakingCheck, PathState
+from trajgen.paths import VehiclePath
+
+__all__ = ["SEPARATION_TOLERANCE", "SafetyGuard"]
+
+#: Track distance by which the separation may be missed (round-off of a plan parked at a leg's end), m.
+SEPARATION_TOLERANCE = 1e-7
+
+
+class SafetyGuard:
+    """Certifies setpoint pairs against the braking invariant.
+
+    Parameters
+    ----------
+    limits : Limits
+        The vehicles' limits and the separation to keep, metres.
+    graph : StarGraph
+        The track.
+    """
+
+    __slots__ = ("_check", "separation")
+
+    def __init__(self, limits: Limits, graph: StarGraph) -> None:
+        vehicles = limits.vehicles
+        self._check = BrakingCheck(vehicles, tuple(v.emergency_braking for v in vehicles), graph.lengths)
+        self.separation = limits.min_separation
+
+    def required(self, measured) -> float:
+        """The track distance to keep, metres: the separation, less if a fault already left them closer.
+
+        Closer than the separation after a fault, the vehicles may only part (to round-off: no ratchet
+        from cycle to cycle).
+
+        Parameters
+        ----------
+        measured : tuple of 2 VehicleState
+        """
+        apart = indexed_separation((measured[0].leg, measured[0].s, measured[1].leg, measured[1].s))
+        return min(self.separation - SEPARATION_TOLERANCE, apart - 1e-12)
+
+    def certifies(
+        self,
+        paths: tuple[VehiclePath, VehiclePath],
+        commanded: tuple[PathState, PathState],
+        measured: tuple[PathState, PathState],
+        required: float,
+    ) -> bool:
+        """Whether braking from ``commanded`` (service) and ``measured`` (emergency) keeps ``required``."""
+        return self._check.clearance(paths, commanded, measured, required)
