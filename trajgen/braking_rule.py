@@ -12,115 +12,162 @@ and the executor's braking check never has to hold a vehicle back.
 ``g(t) = F_j(e_i(t)) - r_j(t)`` can only fall as fast as the follower's
 service stop point ``r_j`` moves forward (the frontier ``F_j`` never moves
 back while the leader brakes no harder than its emergency deceleration), so a
-margin of ``L h`` at an instant covers the next ``h`` seconds (``L`` bounds
-how fast ``r_j`` can move); the check samples each piece and halves the step
-where the margin is thin. Its cost grows with the pieces and the thin
-stretches, not with the duration.
+margin at an instant larger than what ``r_j`` can gain in the next ``h``
+seconds (:func:`stop_point_rate`, from the state and the limits) covers them;
+the check samples each piece and halves the step where the margin is thin.
+Its cost grows with the pieces and the thin stretches, not with the duration.
 """
 
 from __future__ import annotations
 
-import itertools
 import math
+from dataclasses import dataclass
 
 import numpy as np
 
 from limits import VehicleLimits
-from trajgen.coordination import CoordinationDiagram, earliest_rest, plan_paths, stopping_distance
+from trajgen.coordination import CoordinationDiagram, plan_paths, stopping_distances
+from trajgen.pieces import Pieces
 from trajgen.schedule import Schedule
 
-__all__ = ["BRAKING_RULE_TOLERANCE", "braking_rule_failures", "stop_point_rate"]
+__all__ = ["BRAKING_RULE_TOLERANCE", "BrakingRuleFailure", "braking_rule_failures", "stop_point_rate"]
 
-#: How far a follower's service stop point may pass its frontier (round-off), metres.
-BRAKING_RULE_TOLERANCE = 1e-6
+#: How far a follower's service stop point may pass its frontier, metres: the rule is certified to this
+#: (far inside the executor's position margin), which keeps the check's cost bounded where a plan brakes
+#: straight into its frontier (its stop point stays on it throughout).
+BRAKING_RULE_TOLERANCE = 1e-3
 #: The shortest step the check halves down to, seconds.
-_SHORTEST_STEP = 1e-7
+_SHORTEST_STEP = 1e-6
+#: Most margins evaluated for one schedule: a plan that rides its frontier closer than the tolerance
+#: for long is refused rather than certified (it would leave the executor no room either).
+_EVALUATIONS = 2_000_000
 
 
-def stop_point_rate(limits: VehicleLimits) -> float:
-    """An upper bound of how fast a vehicle's service stop point can move forward, m/s.
+def stop_point_rate(
+    limits: VehicleLimits, velocity, acceleration, step, jerk_limited: bool = True
+) -> np.ndarray:
+    """An upper bound of how fast a vehicle's service stop point moves during the next ``step`` seconds, m/s.
 
-    ``d/dt (p + D(v, a))`` with ``D`` the bound of :func:`~trajgen.coordination.stopping_distance`:
-    ``v + D_v a + D_a j`` over ``|v| <= v_max``, ``|a| <= a_max``, ``|j| <= j_max``.
+    ``d/dt (p + D(v, a)) = v + D_v dv/dt + D_a da/dt`` with ``D`` the bound of
+    :func:`~trajgen.coordination.stopping_distance` (which counts only a positive acceleration),
+    over the states the vehicle can reach from ``(velocity, acceleration)`` within ``step``: the
+    speed grows by at most ``a+ h + J h^2 / 2`` and the acceleration by ``J h``, within the limits.
+    A vehicle at rest can move its stop point only by about ``A h^2``.
+
+    Without a jerk limit the stop point ``p + v^2 / (2 A)`` moves at ``v (1 + a / A) <= 2 v``.
+
+    Parameters
+    ----------
+    limits : VehicleLimits
+    velocity, acceleration, step : ndarray, shape (n,)
+        Rate of travel (m/s), its acceleration (m/s²) and the time ahead (s).
+    jerk_limited : bool, optional
+        Whether the stop is jerk-limited (see :func:`~trajgen.coordination.stopping_distance`).
     """
-    v, a, j = limits.max_velocity, limits.max_acceleration, limits.max_jerk
-    peak = v + a * a / (2.0 * j)
-    d_dv = a / j + peak / a + a / (2.0 * j)  # of the ramp term, and of peak^2 / 2a + peak a / 2j
-    d_da = v / j + a * a / (j * j) + (peak / a + a / (2.0 * j)) * (a / j)
-    return v + d_dv * a + d_da * j
+    v_max, a_max, j_max = limits.max_velocity, limits.max_acceleration, limits.max_jerk
+    if not jerk_limited:
+        return 2.0 * np.minimum(np.maximum(velocity, 0.0) + a_max * step, v_max)
+    a_plus = np.maximum(acceleration, 0.0)
+    v = np.minimum(np.maximum(velocity, 0.0) + a_plus * step + 0.5 * j_max * step * step, v_max)
+    a = np.minimum(a_plus + j_max * step, a_max)
+    peak = v + a * a / (2.0 * j_max)
+    d_peak = peak / a_max + a_max / (2.0 * j_max)  # of peak^2 / 2A + peak A / 2J
+    d_dv = a / j_max + d_peak
+    d_da = v / j_max + a * a / (j_max * j_max) + d_peak * a / j_max
+    return v + d_dv * a + d_da * j_max
 
 
-def braking_rule_failures(schedule: Schedule, *, separation: float | None = None) -> list[str]:
-    """Where a follower of ``schedule`` could not stop short of its frontier, as failure messages.
+@dataclass(frozen=True, slots=True)
+class BrakingRuleFailure:
+    """Where a follower of a plan could not stop short of its frontier.
+
+    Attributes
+    ----------
+    vehicle : int
+        0 or 1.
+    time : float
+        The worst instant found, seconds.
+    excess : float
+        How far its service stop point passes its frontier there, metres (NaN: the margin stays
+        too thin for the check to settle, which is refused too).
+    """
+
+    vehicle: int
+    time: float
+    excess: float
+
+
+def braking_rule_failures(
+    schedule: Schedule, *, separation: float | None = None, pieces: Pieces | None = None
+) -> list[BrakingRuleFailure]:
+    """Where a follower of ``schedule`` could not stop short of its frontier: its worst instant, per vehicle.
 
     Parameters
     ----------
     schedule : Schedule
     separation : float, optional
         Track distance the conflicts keep, metres (default: the schedule's own separation).
+    pieces : Pieces, optional
+        The schedule's polynomial pieces, if at hand (:func:`~trajgen.pieces.schedule_pieces`).
 
     Returns
     -------
-    list of str
-        Empty if the rule holds throughout; else one message per vehicle, at its worst instant.
+    list of BrakingRuleFailure
+        Empty if the rule holds throughout.
     """
     separation = schedule.limits.min_separation if separation is None else separation
     if schedule.duration <= 0.0:
         return []
-    paths, times, travel = plan_paths(schedule)
+    paths, times, travel = plan_paths(schedule, pieces)
     diagram = CoordinationDiagram(paths, separation, schedule, times)
     if not diagram.conflicts:
         return []
     vehicles = schedule.limits.vehicles
-    emergency = [v.emergency_braking for v in vehicles]
-    rates = [stop_point_rate(v) for v in vehicles]
+    emergency = np.array([v.emergency_braking for v in vehicles])[:, None]
+    axis_at = schedule.state(times).axis
 
-    def margins(t: np.ndarray) -> np.ndarray:
-        """``F_j(e_i) - r_j`` of both vehicles at times ``t``, shape (2, n) (``inf`` where nothing binds)."""
+    def margins(t: np.ndarray, step: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Margins ``F_j(e_i) - r_j`` at times ``t`` and how far they can fall in ``step``; (2, n) each.
+
+        A margin is ``inf`` where no conflict binds the vehicle.
+        """
         state = schedule.state(t)
         k = np.clip(np.searchsorted(times, t, side="right") - 1, 0, times.size - 2)
-        axis0 = schedule.state(times[k]).axis
-        p = travel[:, k] + np.abs(state.axis - axis0)
-        direction = np.sign(state.axis - axis0)
-        direction = np.where(direction == 0.0, np.sign(state.velocity), direction)
+        moved = state.axis - axis_at[:, k]
+        p = travel[:, k] + np.abs(moved)
+        direction = np.where(moved != 0.0, np.sign(moved), np.sign(state.velocity))
         speed = np.abs(state.velocity)
-        acceleration = direction * state.acceleration
-        out = np.full((2, t.size), math.inf)
-        for n in range(t.size):
-            earliest = [earliest_rest(p[v, n], speed[v, n], emergency[v]) for v in (0, 1)]
-            for j in (0, 1):
-                frontier = diagram.frontier(j, earliest[1 - j])
-                if frontier < math.inf:
-                    stop = p[j, n] + stopping_distance(speed[j, n], acceleration[j, n], vehicles[j])
-                    out[j, n] = frontier - stop
-        return out
-
-    worst: list[tuple[float, float] | None] = [None, None]  # (margin, time) of each vehicle's worst failure
-    grid = np.unique(np.concatenate([times, np.linspace(0.0, schedule.duration, 64)]))
-    pending = [(float(a), float(b)) for a, b in itertools.pairwise(grid) if b > a]
-    while pending:
-        starts = np.array([a for a, _ in pending])
-        values = margins(starts)
-        split = []
-        for n, (a, b) in enumerate(pending):
-            for j in (0, 1):
-                g = values[j, n]
-                if g < -BRAKING_RULE_TOLERANCE and (worst[j] is None or g < worst[j][0]):
-                    worst[j] = (float(g), a)
-            need = (
-                max(rates[j] * (b - a) for j in (0, 1) if values[j, n] < math.inf)
-                if np.any(values[:, n] < math.inf)
-                else 0.0
+        earliest = p + speed * speed / (2.0 * emergency)
+        out, fall = np.empty((2, t.size)), np.empty((2, t.size))
+        for j in (0, 1):
+            acceleration = direction[j] * state.acceleration[j]
+            stop = p[j] + stopping_distances(
+                speed[j], acceleration, vehicles[j], jerk_limited=schedule.jerk_limited
             )
-            thin = bool(np.any(values[:, n] < need - BRAKING_RULE_TOLERANCE))
-            if thin and b - a > _SHORTEST_STEP and np.all(values[:, n] >= -BRAKING_RULE_TOLERANCE):
-                middle = 0.5 * (a + b)
-                split += [(a, middle), (middle, b)]
-        pending = split
-    return [
-        f"vehicle {j + 1} cannot stop short of its frontier at t={when:.6f} s: its service stop point "
-        f"passes it by {-margin:.3g} m (the braking rule; expected <= {BRAKING_RULE_TOLERANCE:g} m)"
-        for j, found in enumerate(worst)
-        if found is not None
-        for margin, when in [found]
-    ]
+            out[j] = diagram.frontiers(j, earliest[1 - j]) - stop
+            fall[j] = stop_point_rate(vehicles[j], speed[j], acceleration, step, schedule.jerk_limited) * step
+        return out, fall
+
+    worst: list[BrakingRuleFailure | None] = [None, None]
+    grid = np.unique(np.concatenate([times, np.linspace(0.0, schedule.duration, 64)]))
+    starts, ends = grid[:-1], grid[1:]
+    evaluations = 0
+    while starts.size:
+        evaluations += starts.size
+        if evaluations > _EVALUATIONS:
+            k = int(np.argmin(ends - starts))
+            return [BrakingRuleFailure(0, float(starts[k]), math.nan)]
+        values, fall = margins(starts, ends - starts)
+        for j in (0, 1):
+            bad = np.nonzero(values[j] < -BRAKING_RULE_TOLERANCE)[0]
+            if bad.size:
+                k = bad[np.argmin(values[j, bad])]
+                if worst[j] is None or -values[j, k] > worst[j].excess:
+                    worst[j] = BrakingRuleFailure(j, float(starts[k]), float(-values[j, k]))
+        # a margin of what it can lose in the next h seconds covers them; thinner ones are looked at
+        # twice as closely
+        thin = np.any(values < fall - BRAKING_RULE_TOLERANCE, axis=0)
+        thin &= np.all(values >= -BRAKING_RULE_TOLERANCE, axis=0) & (ends - starts > _SHORTEST_STEP)
+        middle = 0.5 * (starts[thin] + ends[thin])
+        starts, ends = np.concatenate([starts[thin], middle]), np.concatenate([middle, ends[thin]])
+    return [failure for failure in worst if failure is not None]

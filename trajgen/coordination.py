@@ -26,7 +26,7 @@ import numpy as np
 
 from limits import VehicleLimits
 from trajgen.paths import VehiclePath
-from trajgen.pieces import schedule_pieces
+from trajgen.pieces import Pieces, schedule_pieces
 
 __all__ = [
     "Conflict",
@@ -37,6 +37,7 @@ __all__ = [
     "schedule_times",
     "schedule_waypoints",
     "stopping_distance",
+    "stopping_distances",
 ]
 
 #: A convex polygon of the diagram: its vertices ``(p1, p2)`` in order, metres of travel.
@@ -198,10 +199,10 @@ class _Curve:
             [np.zeros((2, 1)), np.cumsum(np.abs(np.diff(axis, axis=1)), axis=1)], axis=1
         )
 
-    def at(self, t: float) -> tuple[float, float]:
-        k = min(max(int(np.searchsorted(self.times, t, side="right")) - 1, 0), self.times.size - 2)
-        axis = self.schedule.state([t]).axis[:, 0]
-        return tuple(float(self.travel[v, k] + abs(axis[v] - self.axis[v, k])) for v in (0, 1))  # type: ignore[return-value]
+    def at(self, t: np.ndarray, k: int) -> np.ndarray:
+        """Both vehicles' travel at times ``t`` of ``[times[k], times[k + 1]]``, shape (2, n)."""
+        axis = self.schedule.state(t).axis
+        return self.travel[:, k : k + 1] + np.abs(axis - self.axis[:, k : k + 1])
 
     def second_when_first_reaches(self, a: float) -> float:
         """``p2`` at the first instant ``p1 >= a`` (the plan's curve is monotone)."""
@@ -211,13 +212,13 @@ class _Curve:
         if k >= self.times.size:
             return float(self.travel[1, -1])
         low, high = float(self.times[k - 1]), float(self.times[k])
-        for _ in range(60):
-            middle = 0.5 * (low + high)
-            if self.at(middle)[0] >= a:
-                high = middle
-            else:
-                low = middle
-        return self.at(high)[1]
+        for _ in range(4):  # 33 points a round: the bracket shrinks 32-fold each time
+            t = np.linspace(low, high, 33)
+            p = self.at(t, k - 1)
+            first = int(np.searchsorted(p[0], a, side="left"))
+            first = min(max(first, 1), 32)
+            low, high = float(t[first - 1]), float(t[first])
+        return float(self.at(np.array([high]), k - 1)[1, 0])
 
 
 class CoordinationDiagram:
@@ -236,7 +237,7 @@ class CoordinationDiagram:
         plan's piece ends and velocity roots: :func:`schedule_times`).
     """
 
-    __slots__ = ("_by_follower", "conflicts", "paths", "separation")
+    __slots__ = ("_by_follower", "_edges", "conflicts", "paths", "separation")
 
     def __init__(self, paths: tuple[VehiclePath, VehiclePath], separation: float, schedule, times) -> None:
         self.paths = paths
@@ -280,6 +281,25 @@ class CoordinationDiagram:
         conflicts.sort(key=lambda c: (c.low[c.leader], c.low[c.follower]))
         self.conflicts = tuple(conflicts)
         self._by_follower = tuple(tuple(c for c in conflicts if c.follower == v) for v in (0, 1))
+        self._edges = tuple(self._edge_table(v) for v in (0, 1))
+
+    def _edge_table(self, follower: int) -> tuple[np.ndarray, ...] | None:
+        """Every polygon edge of the conflicts ``follower`` follows, as columns (for :meth:`frontiers`).
+
+        Its ends' leader and follower travel, and how far its polygon reaches in the leader's travel.
+        """
+        rows = []
+        for conflict in self._by_follower[follower]:
+            leader = conflict.leader
+            for polygon in conflict.polygons:
+                reach = max(vertex[leader] for vertex in polygon)
+                for k, a in enumerate(polygon):
+                    b = polygon[(k + 1) % len(polygon)]
+                    rows.append((a[leader], a[1 - leader], b[leader], b[1 - leader], reach))
+        if not rows:
+            return None
+        table = np.array(rows)
+        return tuple(table[:, k] for k in range(5))
 
     def frontier(self, follower: int, earliest: float) -> float:
         """The farthest travel ``follower`` may come to rest at, metres (``inf``: nothing binds it).
@@ -298,60 +318,151 @@ class CoordinationDiagram:
             best = min(best, conflict.bound(earliest))
         return best
 
+    def frontiers(self, follower: int, earliest: np.ndarray) -> np.ndarray:
+        """:meth:`frontier` for many earliest rest points at once, shape of ``earliest`` (metres)."""
+        earliest = np.asarray(earliest, dtype=float)
+        best = np.full(earliest.shape, math.inf)
+        edges = self._edges[follower]
+        if edges is None:
+            return best
+        a_lead, a_follow, b_lead, b_follow, reach = edges  # (m,) each: every edge of every polygon
+        e = earliest[..., None]
+        alive = reach > e + _TOUCH  # polygons reaching past the earliest rest by more than a boundary
+        vertex = np.where(alive & (a_lead >= e), a_follow, math.inf)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            w = (e - a_lead) / (b_lead - a_lead)
+        crossing = alive & ((a_lead - e) * (b_lead - e) < 0.0)
+        edge = np.where(crossing, a_follow + w * (b_follow - a_follow), math.inf)
+        return np.minimum(vertex.min(axis=-1), edge.min(axis=-1))
+
     def leading(self, vehicle: int, travel: float) -> tuple[Conflict, ...]:
         """The conflicts ``vehicle`` leads that it has not yet passed at ``travel``."""
         return tuple(c for c in self.conflicts if c.leader == vehicle and c.high[vehicle] > travel)
 
 
-def stopping_distance(velocity: float, acceleration: float, limits: VehicleLimits) -> float:
-    """An upper bound of the jerk-limited service stopping distance, metres (travel coordinates).
+def stopping_distance(
+    velocity: float, acceleration: float, limits: VehicleLimits, *, jerk_limited: bool = True
+) -> float:
+    """How far the time-optimal jerk-limited stop from a state travels, metres (travel coordinates).
 
-    From rest acceleration, ``D(v) = v^2 / (2 A) + v A / (2 J)`` (exact once ``A`` is reached,
-    above the exact ``v sqrt(v / J)`` below that). A positive acceleration ``a`` is first brought
-    to 0 in ``a / J`` seconds, covering ``v a / J + a^3 / (3 J^2)`` and gaining ``a^2 / (2 J)`` of
-    speed; a negative one only shortens the stop.
+    The stop Ruckig computes (velocity control to rest, within ``max_acceleration`` ``A`` and
+    ``max_jerk`` ``J``): jerk ``-J`` until the deceleration peaks (at ``A``, or at
+    ``sqrt(J v + a^2 / 2)`` if that is less), held, then ``+J`` back to rest. A vehicle that
+    already brakes harder than that comes to rest at the first instant its speed reaches 0.
 
     Parameters
     ----------
     velocity, acceleration : float
-        Rate of travel (m/s, >= 0) and its acceleration (m/s²).
+        Rate of travel (m/s, >= 0) and its acceleration (m/s², ``|a| <= A``).
     limits : VehicleLimits
+    jerk_limited : bool, optional
+        ``False``: the deceleration steps to ``A`` at once, ``v^2 / (2 A)`` (the braking a plan
+        that does not limit jerk assumes).
 
     Examples
     --------
     >>> from limits import VehicleLimits
     >>> stopping_distance(1.0, 0.0, VehicleLimits(1.0, 0.5, 1.0))
     1.25
+    >>> stopping_distance(1.0, 0.3, VehicleLimits(1.0, 0.5, 1.0), jerk_limited=False)
+    1.0
     """
+    # plain floats (it runs every control cycle); stopping_distances is the same for arrays
     a_max, j_max = limits.max_acceleration, limits.max_jerk
-    v = max(velocity, 0.0)
-    a = max(acceleration, 0.0)
-    ramp = v * a / j_max + a**3 / (3.0 * j_max * j_max)
-    peak = v + a * a / (2.0 * j_max)
-    return ramp + peak * peak / (2.0 * a_max) + peak * a_max / (2.0 * j_max)
+    v0, a0 = max(velocity, 0.0), acceleration
+    if not jerk_limited:
+        return v0 * v0 / (2.0 * a_max)
+    if v0 <= 0.0 and a0 <= 0.0:
+        return 0.0
+    if a0 < 0.0 and v0 - a0 * a0 / (2.0 * j_max) < 0.0:  # braking harder than needed
+        t = (-a0 - math.sqrt(max(a0 * a0 - 2.0 * j_max * v0, 0.0))) / j_max
+        return v0 * t + a0 * t * t / 2.0 + j_max * t**3 / 6.0
+    peak = min(math.sqrt(j_max * v0 + 0.5 * a0 * a0), a_max)
+    t1 = max((a0 + peak) / j_max, 0.0)
+    v1 = v0 + a0 * t1 - j_max * t1 * t1 / 2.0
+    t2 = max((v1 - peak * peak / (2.0 * j_max)) / peak, 0.0) if peak > 0.0 else 0.0
+    v2 = v1 - peak * t2
+    t3 = peak / j_max
+    return (
+        v0 * t1
+        + a0 * t1 * t1 / 2.0
+        - j_max * t1**3 / 6.0
+        + v1 * t2
+        - peak * t2 * t2 / 2.0
+        + v2 * t3
+        - peak * t3 * t3 / 2.0
+        + j_max * t3**3 / 6.0
+    )
 
 
-def schedule_times(schedule) -> np.ndarray:
+def stopping_distances(
+    velocity, acceleration, limits: VehicleLimits, *, jerk_limited: bool = True
+) -> np.ndarray:
+    """:func:`stopping_distance` of arrays of states, metres; shape of the broadcast inputs."""
+    a_max, j_max = limits.max_acceleration, limits.max_jerk
+    v0 = np.maximum(np.asarray(velocity, dtype=float), 0.0)
+    a0 = np.asarray(acceleration, dtype=float)
+    v0, a0 = np.broadcast_arrays(v0, a0)
+    if not jerk_limited:
+        return v0 * v0 / (2.0 * a_max)
+    # braking harder than needed: the speed reaches 0 (under jerk +J at once) while still braking
+    overdone = (a0 < 0.0) & (v0 - a0 * a0 / (2.0 * j_max) < 0.0)
+    t_zero = (-a0 - np.sqrt(np.maximum(a0 * a0 - 2.0 * j_max * v0, 0.0))) / j_max
+    d_zero = v0 * t_zero + a0 * t_zero**2 / 2.0 + j_max * t_zero**3 / 6.0
+    peak = np.minimum(np.sqrt(j_max * v0 + 0.5 * a0 * a0), a_max)
+    t1 = np.maximum((a0 + peak) / j_max, 0.0)
+    v1 = v0 + a0 * t1 - j_max * t1 * t1 / 2.0
+    cruise = np.divide(v1 - peak * peak / (2.0 * j_max), peak, out=np.zeros_like(v1), where=peak > 0.0)
+    t2 = np.maximum(cruise, 0.0)
+    v2 = v1 - peak * t2
+    t3 = peak / j_max
+    distance = (
+        v0 * t1
+        + a0 * t1 * t1 / 2.0
+        - j_max * t1**3 / 6.0
+        + v1 * t2
+        - peak * t2 * t2 / 2.0
+        + v2 * t3
+        - peak * t3 * t3 / 2.0
+        + j_max * t3**3 / 6.0
+    )
+    at_rest = (v0 <= 0.0) & (a0 <= 0.0)
+    return np.where(at_rest, 0.0, np.where(overdone, d_zero, distance))
+
+
+def schedule_times(schedule, pieces: Pieces | None = None) -> np.ndarray:
     """Instants of a schedule between which neither vehicle turns, shape (n,), seconds.
 
-    Every piece boundary, four points inside each piece, and every instant a vehicle comes to rest
-    and turns (a root of its velocity).
+    Every piece boundary and middle, and every instant a vehicle comes to rest and turns (a root of
+    its velocity). ``pieces``: the schedule's (:func:`~trajgen.pieces.schedule_pieces`), if at hand.
     """
-    pieces = schedule_pieces(schedule)
-    times = [0.0, schedule.duration]
-    for k in range(pieces.count):
-        start, length = float(pieces.start[k]), float(pieces.length[k])
-        times.extend(start + length * f for f in (0.0, 0.2, 0.4, 0.6, 0.8))
+    pieces = schedule_pieces(schedule) if pieces is None else pieces
+    times = [np.array([0.0, schedule.duration]), pieces.start, pieces.start + 0.5 * pieces.length]
+    if pieces.count:
+        # the velocity's real roots inside each piece: eigenvalues of its companion matrices, all at once
+        velocity = pieces.axis[:, :, 1:] * np.arange(1, pieces.axis.shape[2])  # (2, n, d): increasing powers
         for v in (0, 1):
-            c = pieces.axis[v, k]
-            derivative = [i * c[i] for i in range(len(c) - 1, 0, -1)]  # highest power first
-            while derivative and abs(derivative[0]) <= 1e-300:
-                derivative.pop(0)
-            if len(derivative) > 1:
-                for root in np.roots(derivative):
-                    if abs(root.imag) <= 1e-12 and 0.0 < root.real < length:
-                        times.append(start + float(root.real))
-    return np.unique(np.clip(times, 0.0, schedule.duration))
+            c = velocity[v]
+            degree = c.shape[1] - 1
+            while degree > 0 and np.all(np.abs(c[:, degree]) <= 1e-300):
+                degree -= 1
+            for d in range(1, degree + 1):  # rows whose leading coefficient is of power d
+                rows = np.nonzero(
+                    (np.abs(c[:, d]) > 1e-300) & np.all(np.abs(c[:, d + 1 :]) <= 1e-300, axis=1)
+                )[0]
+                if not rows.size:
+                    continue
+                companion = np.zeros((rows.size, d, d))
+                companion[:, 1:, :-1] = np.eye(d - 1)
+                companion[:, :, -1] = -c[rows, :d] / c[rows, d : d + 1]
+                roots = np.linalg.eigvals(companion)
+                real = (
+                    (np.abs(roots.imag) <= 1e-12)
+                    & (roots.real > 0.0)
+                    & (roots.real < pieces.length[rows, None])
+                )
+                times.append((pieces.start[rows, None] + roots.real)[real])
+    return np.unique(np.clip(np.concatenate(times), 0.0, schedule.duration))
 
 
 def schedule_waypoints(schedule, times: np.ndarray | None = None) -> list[tuple[int, float, int, float]]:
@@ -364,7 +475,9 @@ def schedule_waypoints(schedule, times: np.ndarray | None = None) -> list[tuple[
     ]
 
 
-def plan_paths(schedule) -> tuple[tuple[VehiclePath, VehiclePath], np.ndarray, np.ndarray]:
+def plan_paths(
+    schedule, pieces: Pieces | None = None
+) -> tuple[tuple[VehiclePath, VehiclePath], np.ndarray, np.ndarray]:
     """Both vehicles' paths of a schedule, the instants of :func:`schedule_times`, and the travel there.
 
     Returns
@@ -377,7 +490,7 @@ def plan_paths(schedule) -> tuple[tuple[VehiclePath, VehiclePath], np.ndarray, n
         Each vehicle's travel at ``times``, metres: between two of them a vehicle does not turn, so
         its travel at any ``t`` is the one before plus how far its axis moved since.
     """
-    times = schedule_times(schedule)
+    times = schedule_times(schedule, pieces)
     waypoints = schedule_waypoints(schedule, times)
     axis = schedule.state(times).axis
     paths = tuple(VehiclePath.from_waypoints(waypoints, v, axis_start=float(axis[v, 0])) for v in (0, 1))

@@ -49,7 +49,7 @@ import numpy as np
 from topology import Region, RegionKey, reduce_regions
 from topology.indexed import JUNCTION_INDEX, track_distance
 from trajgen import polynomials
-from trajgen.braking_rule import braking_rule_failures
+from trajgen.braking_rule import BRAKING_RULE_TOLERANCE, braking_rule_failures
 from trajgen.errors import InputError, UnverifiedScheduleError, VerificationError
 from trajgen.integrity import array_failures
 from trajgen.pieces import Pieces, UncheckableKinematicsError, motion_arrays, schedule_pieces
@@ -389,7 +389,20 @@ def _verify(schedule: Schedule) -> VerificationReport:
     if not failures and schedule.end_tolerance is None:
         # a method's plan: each follower can always stop short of its frontier (a table read back
         # follows a plan that was checked; its own round-off is not an execution)
-        failures += braking_rule_failures(schedule)
+        for failure in braking_rule_failures(schedule, pieces=pieces):
+            k = int(
+                np.clip(np.searchsorted(pieces.start, failure.time, side="right") - 1, 0, pieces.count - 1)
+            )
+            what = (
+                f"its service stop point passes it by {failure.excess:.3g} m"
+                if math.isfinite(failure.excess)
+                else "its margin stays too thin to certify"
+            )
+            failures.append(
+                f"vehicle {failure.vehicle + 1} cannot stop short of its frontier at t={failure.time:.6f} s: "
+                f"{what} (the braking rule; expected at most {BRAKING_RULE_TOLERANCE:g} m past it): "
+                f"{_where(schedule, pieces, k)}"
+            )
     expected = route.region_keys
     sequence = reduce_regions(regions)
     if sequence != expected:

@@ -33,6 +33,7 @@ from dataclasses import dataclass
 from limits import Limits
 from topology import JUNCTION_INDEX, Configuration, Position, Route
 from topology.options import Option
+from trajgen.braking_rule import BRAKING_RULE_TOLERANCE
 from trajgen.coordination import (
     CoordinationDiagram,
     earliest_rest,
@@ -419,7 +420,10 @@ class Executor:
             p = path.travel_at_axis(axis, self._command[v].p, velocity)
             heading = path.heading(p)
             state = PathState(p, heading * velocity, heading * acceleration)
-            if self._stops_by(v, state, frontier):  # the plan itself ends at the path's end
+            # the plan itself ends at the path's end; it brakes as it was planned to (BRAKING_RULE_TOLERANCE)
+            if self._stops_by(
+                v, state, frontier + BRAKING_RULE_TOLERANCE, jerk_limited=self.schedule.jerk_limited
+            ):
                 return state, heading * jerk, axis
             self._leave_plan(v, f"vehicle {v + 1} meets its frontier at {frontier:.3f} m")
         limit = min(frontier, path.length)
@@ -448,14 +452,15 @@ class Executor:
             sign * jerk,
         )
 
-    def _stops_by(self, v: int, state: PathState, limit: float) -> bool:
-        """Whether service braking from ``state`` comes to rest by travel ``limit``."""
+    def _stops_by(self, v: int, state: PathState, limit: float, *, jerk_limited: bool = True) -> bool:
+        """Whether service braking from ``state`` comes to rest by travel ``limit``.
+
+        ``jerk_limited=False``: the braking of a plan that does not limit jerk (``v^2 / 2 A``).
+        """
         if limit == math.inf:
             return True
-        # a cheap upper bound first; Ruckig's exact stop only where it is close
-        if state.p + stopping_distance(state.v, state.a, self.limits.vehicles[v]) <= limit + 1e-9:
-            return True
-        return self._motions[v].stop_point(state) <= limit + 1e-9
+        distance = stopping_distance(state.v, state.a, self.limits.vehicles[v], jerk_limited=jerk_limited)
+        return state.p + distance <= limit + 1e-9
 
     def _issue(self, measured, along, proposals) -> Command:
         """Certify the proposals (holding followers or braking hard if need be) and issue them."""
@@ -588,7 +593,11 @@ class Executor:
         for v in (0, 1):
             path = self._paths[v]
             slack = self.position_tolerance + self.position_margin
-            p = path.project(measured[v].leg, measured[v].s, self._command[v].p, slack)
+            near = self._command[v].p
+            # next to a reversal one place is on the path twice: travel never runs back, so the later
+            p = path.project(measured[v].leg, measured[v].s, near + slack, slack)
+            if p is None or abs(p - near) > slack:
+                p = path.project(measured[v].leg, measured[v].s, near, slack)
             if p is None:
                 return None
             p = min(max(p, 0.0), path.length)
@@ -620,9 +629,17 @@ class Executor:
             self._rebased[v] = self._time
 
     def _seed(self, v: int, state: PathState) -> PathState:
-        """A state to restart from: the measured one, within the limits (never backing up)."""
+        """A state to restart from: the measured position, within the limits (never backing up).
+
+        The measured velocity and acceleration are taken where they differ from the commanded ones
+        beyond the tolerance (a stop, a slow drive); else the commanded ones go on (a position
+        correction, or a drive closing a gap, does not change the motion asked of it).
+        """
         limits = self.limits.vehicles[v]
         top = self._motions[v].speed_limit
+        command = self._command[v]
+        if abs(state.v - command.v) <= self.velocity_tolerance:
+            state = PathState(state.p, command.v, command.a)
         velocity = min(max(state.v, 0.0), top)
         acceleration = min(max(state.a, -limits.max_acceleration), limits.max_acceleration)
         room = top - velocity if acceleration > 0.0 else velocity

@@ -196,19 +196,6 @@ class VehicleMotion:
             return PathState(max(p, state.p), 0.0, 0.0), 0.0
         return PathState(p, v, a), ruckig_jerk(self._braking, t)
 
-    def stop_point(self, state: PathState) -> float:
-        """Where service braking from ``state`` comes to rest, metres of travel."""
-        if state.v <= AT_REST and state.a <= 0.0:
-            return state.p
-        self._braking_input.current_position = [state.p]
-        self._braking_input.current_velocity = [state.v]
-        self._braking_input.current_acceleration = [state.a]
-        result = self._ruckig.calculate(self._braking_input, self._braking)
-        if result not in (Result.Working, Result.Finished):
-            raise ScheduleError(f"Ruckig found no braking motion from {state}: {result}")
-        self._goal = None
-        return float(self._braking.position_extrema[0].max)
-
 
 def travel_state(path: VehiclePath, p: float, velocity: float, acceleration: float) -> PathState:
     """A state along ``path`` from axis velocity and acceleration (m/s, m/s²) at travel ``p``."""

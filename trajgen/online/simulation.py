@@ -523,6 +523,7 @@ def simulate(
         verified, period=period, position_margin=margin, min_separation=scenario.limits.min_separation
     )
     plant = _Plant(executor, faults, period)
+    jerk_limited = verified.schedule.jerk_limited
     limits = scenario.limits
     planned = verified.schedule.duration
     horizon = _time_limit(planned, faults, limits, scenario.track)
@@ -560,7 +561,8 @@ def simulate(
                 ratios = (
                     abs(setpoint.velocity) / vehicle.max_velocity,
                     abs(setpoint.acceleration) / vehicle.max_acceleration,
-                    abs(setpoint.jerk) / vehicle.max_jerk,
+                    # a plan that does not limit jerk (toppra) is played with its own jerk
+                    abs(setpoint.jerk) / vehicle.max_jerk if jerk_limited else 0.0,
                 )
                 if any(r > 1.0 + _LIMIT_TOLERANCE for r in ratios) or not all(map(math.isfinite, ratios)):
                     limit_violations += 1
