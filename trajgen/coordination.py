@@ -329,10 +329,10 @@ class CoordinationDiagram:
         e = earliest[..., None]
         alive = reach > e + _TOUCH  # polygons reaching past the earliest rest by more than a boundary
         vertex = np.where(alive & (a_lead >= e), a_follow, math.inf)
+        crossing = alive & ((a_lead - e) * (b_lead - e) < 0.0)
         with np.errstate(divide="ignore", invalid="ignore"):
             w = (e - a_lead) / (b_lead - a_lead)
-        crossing = alive & ((a_lead - e) * (b_lead - e) < 0.0)
-        edge = np.where(crossing, a_follow + w * (b_follow - a_follow), math.inf)
+            edge = np.where(crossing, a_follow + w * (b_follow - a_follow), math.inf)
         return np.minimum(vertex.min(axis=-1), edge.min(axis=-1))
 
     def leading(self, vehicle: int, travel: float) -> tuple[Conflict, ...]:

@@ -2,8 +2,8 @@
 
 The executor works in *travel* coordinates: ``p`` is the distance a vehicle
 has driven along its own path of the route (``0 <= p <= length``), so both
-vehicles' progress is monotone and a route is a monotone polyline in the
-``(p1, p2)`` plane (:class:`Coordination`). Plain floats and tuples: these
+vehicles' progress is monotone and a plan is a monotone curve in the
+``(p1, p2)`` plane (:mod:`trajgen.coordination`). Plain floats and tuples: these
 functions run every control cycle.
 """
 
@@ -15,7 +15,7 @@ from dataclasses import dataclass
 
 from topology import JUNCTION_INDEX, Route
 
-__all__ = ["Coordination", "Interval", "VehiclePath", "interval_distance", "set_distance"]
+__all__ = ["Interval", "VehiclePath", "interval_distance", "set_distance"]
 
 #: Moves of a vehicle shorter than this between two waypoints are ignored, metres.
 MOVE_RESOLUTION = 1e-9
@@ -215,11 +215,12 @@ class VehiclePath:
     def project(self, leg: int, s: float, near: float, slack: float = 1e-9) -> float | None:
         """The travel at which the path passes ``(leg, s)``, nearest ``near``; ``None`` if it never does.
 
-        A position up to ``slack`` metres beyond the end of a stretch of the path counts as that end;
-        one on the first or last segment's leg before the start or past the end of the path gives a
-        travel below 0 or above :attr:`length`.
+        A position up to ``slack`` metres beyond the end of a stretch of the path counts as that end,
+        if no stretch holds it; one on the first or last segment's leg before the start or past the
+        end of the path gives a travel below 0 or above :attr:`length`.
         """
         best = None
+        best_key = (math.inf, math.inf)  # (how far off its stretch, how far from near)
         if not self.legs:
             home_leg, home_s = self.home
             same = abs(s - home_s) <= slack and (leg == home_leg or max(s, home_s) <= slack)
@@ -238,9 +239,11 @@ class VehiclePath:
                 low, high = (low, math.inf) if outward else (-math.inf, high)
             if not low - slack <= s <= high + slack:
                 continue
-            p = self.starts[k] + (min(max(s, low), high) - self.s_from[k]) * (1.0 if outward else -1.0)
-            if best is None or abs(p - near) < abs(best - near):
-                best = p
+            clamped = min(max(s, low), high)
+            p = self.starts[k] + (clamped - self.s_from[k]) * (1.0 if outward else -1.0)
+            key = (0.0 if abs(clamped - s) <= 1e-9 else abs(clamped - s), abs(p - near))
+            if key < best_key:
+                best, best_key = p, key
         return best
 
     def sweep(self, p_low: float, p_high: float, leg_lengths: tuple[float, ...]) -> tuple[Interval, ...]:
@@ -272,61 +275,3 @@ class VehiclePath:
             leg, s = self.locate(p_low)
             return ((leg if leg != JUNCTION_INDEX else self.legs[self.segment(p_low)], s, s),)
         return tuple(out)
-
-
-@dataclass(frozen=True, slots=True)
-class Coordination:
-    """A route as a monotone polyline in the plane of both vehicles' travel.
-
-    Attributes
-    ----------
-    first, second : tuple of float, shape (n,)
-        Travel of vehicle 1 and vehicle 2 at each waypoint, metres, non-decreasing.
-    """
-
-    first: tuple[float, ...]
-    second: tuple[float, ...]
-
-    @classmethod
-    def from_route(cls, route: Route) -> Coordination:
-        """The polyline of ``route``'s waypoints in travel coordinates."""
-        return cls.from_waypoints(route.indexed_waypoints)
-
-    @classmethod
-    def from_waypoints(cls, waypoints) -> Coordination:
-        """Indexed configurations as a polyline of travel (as in :meth:`VehiclePath.from_waypoints`)."""
-        first, second = [0.0], [0.0]
-        waypoints = list(waypoints)
-        last = [waypoints[0], waypoints[0]]
-        for b in waypoints[1:]:
-            for vehicle, out in ((0, first), (1, second)):
-                a = last[vehicle]
-                leg_a, s_a, leg_b, s_b = (
-                    a[2 * vehicle],
-                    a[2 * vehicle + 1],
-                    b[2 * vehicle],
-                    b[2 * vehicle + 1],
-                )
-                move = abs(s_a - s_b) if leg_a == leg_b else s_a + s_b
-                if abs(s_a - s_b) <= MOVE_RESOLUTION and (leg_a == leg_b or max(s_a, s_b) <= MOVE_RESOLUTION):
-                    move = 0.0
-                else:
-                    last[vehicle] = b
-                out.append(out[-1] + move)
-        return cls(tuple(first), tuple(second))
-
-    def hold(self, vehicle: int, other_travel: float) -> float:
-        """How far ``vehicle`` may travel while the other has travelled ``other_travel``, metres.
-
-        The largest travel of ``vehicle`` on the route among the points where
-        the other vehicle's travel is at most ``other_travel``: the route's
-        order of passage, which keeps both in the route's homotopy class.
-        """
-        own, other = (self.first, self.second) if vehicle == 0 else (self.second, self.first)
-        k = bisect.bisect_right(other, other_travel) - 1
-        if k < 0:
-            return own[0]
-        if k >= len(own) - 1:
-            return own[-1]
-        span = other[k + 1] - other[k]  # > 0: other[k] <= other_travel < other[k + 1]
-        return own[k] + (own[k + 1] - own[k]) * (other_travel - other[k]) / span

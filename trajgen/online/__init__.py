@@ -1,18 +1,26 @@
-"""Online execution: a verified schedule played in closed loop, recovering with Ruckig under faults.
+"""Online execution: a verified plan played in closed loop, keeping its order at every conflict.
 
 :class:`Executor` is stepped once per control cycle with the measured states
-of both vehicles and returns their setpoints; :func:`simulate` runs it
-against a simulated plant with faults (:mod:`trajgen.online.faults`).
+of both vehicles and returns their setpoints: each vehicle follows the plan
+while it is on time, else Ruckig re-times it towards its frontier (where its
+leader at each conflict could still come to rest), under an independent
+braking check. :func:`~trajgen.online.goals.plan_for_execution` makes the plan
+it plays; :func:`~trajgen.online.simulation.simulate` runs it against a
+simulated plant with faults (:mod:`trajgen.online.faults`). The argument is
+in docs/online.md.
 """
 
+from trajgen.coordination import Conflict, CoordinationDiagram
 from trajgen.online.braking import BrakingCheck, PathState
 from trajgen.online.executor import Command, Event, Executor, GoalDecision, Mode, Setpoint, VehicleState
-from trajgen.paths import Coordination, VehiclePath
+from trajgen.online.goals import execution_margin, plan_for_execution
+from trajgen.paths import VehiclePath
 
 __all__ = [
     "BrakingCheck",
     "Command",
-    "Coordination",
+    "Conflict",
+    "CoordinationDiagram",
     "Event",
     "Executor",
     "GoalDecision",
@@ -21,4 +29,6 @@ __all__ = [
     "Setpoint",
     "VehiclePath",
     "VehicleState",
+    "execution_margin",
+    "plan_for_execution",
 ]

@@ -420,9 +420,13 @@ class Executor:
             p = path.travel_at_axis(axis, self._command[v].p, velocity)
             heading = path.heading(p)
             state = PathState(p, heading * velocity, heading * acceleration)
-            # the plan itself ends at the path's end; it brakes as it was planned to (BRAKING_RULE_TOLERANCE)
+            # the plan itself ends at the path's end; it brakes as it was planned to, which the verifier
+            # certified to BRAKING_RULE_TOLERANCE: within the margin the conflicts keep, if there is one
             if self._stops_by(
-                v, state, frontier + BRAKING_RULE_TOLERANCE, jerk_limited=self.schedule.jerk_limited
+                v,
+                state,
+                frontier + min(BRAKING_RULE_TOLERANCE, self.position_margin),
+                jerk_limited=self.schedule.jerk_limited,
             ):
                 return state, heading * jerk, axis
             self._leave_plan(v, f"vehicle {v + 1} meets its frontier at {frontier:.3f} m")
@@ -614,6 +618,9 @@ class Executor:
         path = self._paths[v]
         axis, velocity = path.axis(state.p), path.heading(state.p) * state.v
         tol_p, tol_v = self.position_tolerance, self.velocity_tolerance
+        last_axis, last_velocity = recent[-1]
+        if abs(axis - last_axis) <= tol_p and abs(velocity - last_velocity) <= tol_v:
+            return False  # on the last setpoint: the usual case, checked first
         return not any(abs(axis - q) <= tol_p and abs(velocity - w) <= tol_v for q, w in recent)
 
     def _leave_plan(self, v: int, reason: str, *, rebase: PathState | None = None) -> None:

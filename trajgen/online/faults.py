@@ -2,8 +2,8 @@
 
 ``stop:NAME@T+D``
     NAME brakes at its emergency deceleration at T seconds and cannot move for D seconds.
-``slow:NAME@T=V``
-    From T on, NAME's drive cannot exceed V m/s.
+``slow:NAME@T=V``, ``slow:NAME@T+D=V``
+    From T on (for D seconds), NAME's drive cannot exceed V m/s.
 ``lag:NAME@T=MS``
     From T on, NAME follows its setpoints MS milliseconds late (the delay builds up at half the
     rate of time, so the vehicle never runs backwards).
@@ -63,6 +63,8 @@ class Fault:
         The requested goal (``goal`` only).
     spec : str
         The text it was parsed from.
+    duration : float
+        How long a ``slow`` lasts, seconds (``inf``: to the end).
     """
 
     kind: FaultKind
@@ -71,6 +73,18 @@ class Fault:
     value: float
     goal: Position | None = None
     spec: str = ""
+    duration: float = math.inf
+
+    @property
+    def end(self) -> float:
+        """When the fault stops acting, seconds (``inf`` if it never does; a jump or goal acts at once)."""
+        if self.kind is FaultKind.STOP:
+            return self.time + self.value
+        if self.kind is FaultKind.SLOW:
+            return self.time + self.duration
+        if self.kind is FaultKind.LAG:
+            return math.inf
+        return self.time
 
 
 def _number(text: str, what: str, spec: str) -> float:
@@ -116,8 +130,8 @@ def parse_fault(
     match = _SPEC.match(spec.strip())
     if match is None:
         raise FaultError(
-            f"fault {short_repr(spec)} is malformed: expected KIND:NAME@T+D (stop) or KIND:NAME@T=VALUE "
-            "(slow, lag, jump, goal)"
+            f"fault {short_repr(spec)} is malformed: expected KIND:NAME@T+D (stop), KIND:NAME@T=VALUE "
+            "(slow, lag, jump, goal) or slow:NAME@T+D=VALUE"
         )
     try:
         kind = FaultKind.lookup(match["kind"])
@@ -138,10 +152,18 @@ def parse_fault(
         raise FaultError(
             f"fault {short_repr(spec)}: time {time!r} s out of range: expected {low:g} to {high:g} s"
         )
-    if (match["sep"] == "+") != (kind is FaultKind.STOP):
+    text = match["value"]
+    duration = math.inf
+    if kind is FaultKind.SLOW and match["sep"] == "+":
+        span, equals, text = text.partition("=")
+        if not equals:
+            raise FaultError(f"fault {short_repr(spec)}: slow takes NAME@T=VALUE or NAME@T+D=VALUE")
+        duration = _number(span, "duration", spec)
+        if not duration > 0.0:
+            raise FaultError(f"fault {short_repr(spec)}: slow duration {duration!r} s: expected > 0 s")
+    elif (match["sep"] == "+") != (kind is FaultKind.STOP):
         expected = "NAME@T+D" if kind is FaultKind.STOP else "NAME@T=VALUE"
         raise FaultError(f"fault {short_repr(spec)}: {kind.value} takes {expected}")
-    text = match["value"]
     if kind is FaultKind.GOAL:
         try:
             goal = graph.check(Position.parse(text))
@@ -175,4 +197,4 @@ def parse_fault(
             f"fault {short_repr(spec)}: jump {value!r} m out of range: expected 0 < |DS| <= {max_jump!r} m "
             "(the executor's position margin; a larger error could break the separation unseen)"
         )
-    return Fault(kind, vehicle, time, value, None, spec)
+    return Fault(kind, vehicle, time, value, None, spec, duration)

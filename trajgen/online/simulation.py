@@ -157,9 +157,7 @@ class _Plant:
     def _active(self, kind: FaultKind, vehicle: int, t: float) -> Fault | None:
         found = None
         for fault in self.faults:
-            if fault.kind is kind and fault.vehicle == vehicle and fault.time <= t:
-                if kind is FaultKind.STOP and t >= fault.time + fault.value:
-                    continue
+            if fault.kind is kind and fault.vehicle == vehicle and fault.time <= t < fault.end:
                 found = fault
         return found
 

@@ -1,0 +1,200 @@
+"""The coordination diagram, the frontier, the stopping distance and the braking rule plans obey.
+
+Closed-form cases on the swap of ``examples/swap.toml``; agreement of the closed-form stopping
+distance with Ruckig's braking; seeded property tests of the frontier.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from ruckig import ControlInterface, InputParameter, Ruckig, Trajectory
+
+from limits import Limits, VehicleLimits
+from tests.conftest import REPO
+from tests.helpers import conf
+from topology import YGraph, plan
+from trajgen import Exact, Optimal, Toppra, certify, load_scenario
+from trajgen.braking_rule import BRAKING_RULE_TOLERANCE, braking_rule_failures
+from trajgen.coordination import (
+    CoordinationDiagram,
+    earliest_rest,
+    plan_paths,
+    stopping_distance,
+    stopping_distances,
+)
+from trajgen.online.goals import plan_for_execution
+
+SWAP = REPO / "examples" / "swap.toml"
+CROSSING = REPO / "examples" / "crossing.toml"
+AGV = VehicleLimits(max_velocity=1.0, max_acceleration=0.5, max_jerk=1.0)
+
+
+def ruckig_stop(limits: VehicleLimits, velocity: float, acceleration: float) -> float:
+    """Where Ruckig's time-optimal braking (velocity control to rest) gets farthest from 0."""
+    generator, inp, trajectory = Ruckig(1), InputParameter(1), Trajectory(1)
+    inp.control_interface = ControlInterface.Velocity
+    inp.current_position, inp.current_velocity, inp.current_acceleration = [0.0], [velocity], [acceleration]
+    inp.target_velocity, inp.target_acceleration = [0.0], [0.0]
+    inp.max_velocity, inp.max_acceleration = [limits.max_velocity], [limits.max_acceleration]
+    inp.max_jerk = [limits.max_jerk]
+    generator.calculate(inp, trajectory)
+    return trajectory.position_extrema[0].max
+
+
+# -- the stopping distance ---------------------------------------------------------------------
+
+
+@pytest.mark.parametrize(
+    ("velocity", "acceleration", "expected"),
+    [
+        (1.0, 0.0, 1.0 / (2 * 0.5) + 1.0 * 0.5 / (2 * 1.0)),  # reaches A: v^2 / 2A + v A / 2J
+        (0.1, 0.0, 0.1 * math.sqrt(0.1 / 1.0)),  # never reaches A: v sqrt(v / J)
+        (0.0, 0.0, 0.0),
+        (0.0, -0.3, 0.0),
+    ],
+    ids=["reaches-the-limit", "below-the-limit", "at-rest", "at-rest-braking"],
+)
+def test_the_stopping_distance_in_closed_form(velocity, acceleration, expected):
+    assert stopping_distance(velocity, acceleration, AGV) == pytest.approx(expected, rel=1e-12, abs=1e-15)
+
+
+def test_without_a_jerk_limit_the_stop_is_v_squared_over_2a():
+    assert stopping_distance(1.0, 0.4, AGV, jerk_limited=False) == pytest.approx(1.0)
+
+
+@settings(max_examples=200)
+@given(
+    top=st.tuples(st.floats(0.1, 3.0), st.floats(0.1, 2.0), st.floats(0.1, 5.0)),
+    fraction=st.floats(0.0, 1.0),
+    acceleration=st.floats(-1.0, 1.0),
+)
+def test_the_stopping_distance_is_where_ruckig_comes_to_rest(top, fraction, acceleration):
+    limits = VehicleLimits(*top)
+    velocity, a = fraction * limits.max_velocity, acceleration * limits.max_acceleration
+    exact = ruckig_stop(limits, velocity, a)
+    assert stopping_distance(velocity, a, limits) == pytest.approx(exact, abs=1e-7)
+    vector = stopping_distances(np.array([velocity, velocity]), np.array([a, a]), limits)
+    assert vector == pytest.approx([exact, exact], abs=1e-7)
+
+
+def test_the_earliest_rest_point_counts_only_forward_speed():
+    assert earliest_rest(3.0, 1.0, 2.0) == pytest.approx(3.25)
+    assert earliest_rest(3.0, -1.0, 2.0) == 3.0
+
+
+# -- the coordination diagram -------------------------------------------------------------------
+
+
+@pytest.fixture(scope="module")
+def swap_plan():
+    scenario = load_scenario(SWAP)
+    return scenario, Exact().schedule(scenario.plan(), scenario.limits)
+
+
+def test_the_swap_has_two_conflicts_at_the_junction_each_led_by_the_vehicle_the_plan_sends_first(swap_plan):
+    """Legs of 10 m, d = 1.5 m: agv2 dodges into C first, then agv1 passes to B, then agv2 to A."""
+    scenario, schedule = swap_plan
+    paths, times, _ = plan_paths(schedule)
+    d = scenario.limits.min_separation
+    diagram = CoordinationDiagram(paths, d, schedule, times)
+    assert [round(path.length, 9) for path in paths] == [20.0, 40.0]
+    first, second = diagram.conflicts
+    # agv2 leaves B through the junction (its travel 10) first: agv1 within d of the junction, or on B
+    # (its travel beyond 10) while agv2 is still there, is in conflict with it
+    assert first.leader == 1
+    assert first.low == pytest.approx((10.0 - d, 0.0))
+    assert first.high == pytest.approx((20.0, 10.0 + d))
+    # then agv1 crosses (its travel 10) while agv2 waits at the end of C (its travel 20), before agv2
+    # comes back out (its travel 30) onto A, which agv1 has left
+    assert second.leader == 0
+    assert second.low == pytest.approx((0.0, 30.0 - d))
+    assert second.high == pytest.approx((10.0 + d, 40.0))
+
+
+def test_the_frontier_in_closed_form_on_the_swap(swap_plan):
+    scenario, schedule = swap_plan
+    paths, times, _ = plan_paths(schedule)
+    diagram = CoordinationDiagram(paths, 1.5, schedule, times)
+    # agv1 follows at the first crossing: until agv2 can no longer stop short of the junction's
+    # surroundings, agv1 stops 1.5 m before the junction
+    assert diagram.frontier(0, 0.0) == pytest.approx(8.5)
+    assert diagram.frontier(0, 10.0) == pytest.approx(8.5)
+    # agv2's earliest rest 0.5 m into C: agv1 may come 0.5 m closer
+    assert diagram.frontier(0, 10.5) == pytest.approx(9.0)
+    assert diagram.frontier(0, 11.5) == math.inf  # agv2 cannot rest within 1.5 m of the junction
+    # agv2 follows at the second crossing: it waits in C until agv1 is past
+    assert diagram.frontier(1, 5.0) == pytest.approx(28.5)
+    assert diagram.frontier(1, 11.0) == pytest.approx(29.5)
+    assert diagram.frontier(1, 12.0) == math.inf
+
+
+@settings(max_examples=100)
+@given(st.lists(st.floats(0.0, 45.0), min_size=2, max_size=20))
+def test_a_frontier_never_moves_back_as_the_leaders_earliest_rest_moves_on(earliest):
+    scenario = load_scenario(SWAP)
+    schedule = Exact().schedule(scenario.plan(), scenario.limits)
+    paths, times, _ = plan_paths(schedule)
+    diagram = CoordinationDiagram(paths, 1.5, schedule, times)
+    for follower in (0, 1):
+        values = [diagram.frontier(follower, e) for e in sorted(earliest)]
+        assert all(b >= a for a, b in zip(values, values[1:], strict=False))
+        vector = diagram.frontiers(follower, np.array(sorted(earliest)))
+        assert vector.tolist() == pytest.approx(values)
+
+
+def test_a_plan_without_clearance_runs_between_two_conflicts_that_touch_at_a_point():
+    """Separation = the shortest leg: agv2 dodges to the very end of C, exactly d from the junction.
+
+    The two conflicts (agv1 crossing while agv2 enters C, and while agv2 leaves it) meet at a single
+    point, where the distance is exactly d: two conflicts, each with its own leader, not one.
+    """
+    track = YGraph({"A": 10.0, "B": 10.0, "C": 1.5})
+    route = plan(track, conf("A:10", "B:10"), conf("B:10", "A:10"), min_separation=1.5)
+    schedule = Exact().schedule(route, Limits((AGV, AGV), 1.5))
+    paths, times, _ = plan_paths(schedule)
+    diagram = CoordinationDiagram(paths, 1.5, schedule, times)
+    leaders = sorted(c.leader for c in diagram.conflicts)
+    assert leaders == [0, 1]
+
+
+# -- the braking rule --------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize(
+    "method", [Exact(), Toppra(), Optimal(time_budget=60.0)], ids=["exact", "toppra", "optimal"]
+)
+@pytest.mark.parametrize("path", [SWAP, CROSSING], ids=["swap", "crossing"])
+def test_every_methods_plan_for_execution_obeys_the_braking_rule(path, method):
+    scenario = load_scenario(path)
+    verified = plan_for_execution(scenario, method=method)
+    assert verified.schedule.fallback_reason is None, verified.schedule.notes
+    assert braking_rule_failures(verified.schedule) == []
+
+
+def test_the_rule_is_tight_a_plan_braking_into_its_frontier_fails_with_a_larger_separation(swap_plan):
+    """The exact swap brakes agv1 into its frontier 1.5 m from the junction: 1 cm more is refused."""
+    _, schedule = swap_plan
+    assert braking_rule_failures(schedule) == []
+    failures = braking_rule_failures(schedule, separation=1.51)
+    assert [f.vehicle for f in failures] == [0, 1]
+    assert all(f.excess == pytest.approx(0.01, abs=2e-3) for f in failures)
+    assert all(f.excess > BRAKING_RULE_TOLERANCE for f in failures)
+
+
+def test_verify_refuses_a_plan_that_breaks_the_rule_naming_when_and_where(swap_plan):
+    from trajgen.errors import VerificationError
+    from trajgen.schedule import Schedule
+
+    _, schedule = swap_plan
+    # the same motion claimed for a larger separation: it still keeps 1.51 m (10 m legs), but its
+    # followers brake into frontiers that are now 1 cm further back
+    relabelled = Schedule(
+        schedule.route, Limits(schedule.limits.vehicles, 1.51), schedule.method, schedule.sections, True
+    )
+    with pytest.raises(VerificationError, match=r"vehicle 1 cannot stop short of its frontier at t=\d"):
+        certify(relabelled)
