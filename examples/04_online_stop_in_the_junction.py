@@ -1,15 +1,17 @@
-"""04 — A plan meets the floor: the first AGV is stopped in the junction, and the executor recovers.
+"""04 — A plan meets the floor: the first AGV is stopped in the junction, and the other waits for it.
 
 The verified optimal swap is played in closed loop by the online executor, once
 per 10 ms control cycle, against a simulated plant. Just as AGV 1 reaches the
 junction, the plant makes it brake at its emergency deceleration and hold for
 4 s (a blocked path, an emergency stop). The executor is not told: it sees AGV 1
-fall behind its setpoints, replans from where both vehicles are (keeping the
-homotopy class), and drives each with Ruckig towards a hold point along the
-route, so AGV 2 waits where the route lets it wait and nothing ever comes
-closer than the separation. Every cycle it only commands motion for which it
-has checked that, if both vehicles started braking now (the other even at its
-emergency deceleration), the separation would still hold.
+fall behind its setpoints and re-times it with Ruckig from where it stands. It
+keeps the plan's paths and, at every conflict, the plan's order: AGV 2, which
+passes the junction after AGV 1, may come no farther than its frontier (short
+of where AGV 1 could still come to rest), waits there, and starts the moment
+AGV 1 moves on. Nothing re-routes, and the stop costs about its own length.
+Every cycle it only commands motion for which it has checked that, if both
+vehicles started braking now (the other even at its emergency deceleration),
+the separation would still hold.
 """
 
 import os
@@ -20,7 +22,7 @@ import numpy as np
 
 from trajgen import load_scenario
 from trajgen.export import commit_files
-from trajgen.online.executor import plan_for_execution
+from trajgen.online import plan_for_execution
 from trajgen.online.simulation import parse_faults, simulate
 from trajgen.plots import render_simulation
 
@@ -59,6 +61,8 @@ print(
 )
 assert result.reached_goal
 assert result.violations == 0
+assert result.replans == 0  # nothing re-routes
+assert result.emergency_brakes == 0
 
 path = output / "simulation.png"
 commit_files(

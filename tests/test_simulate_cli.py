@@ -27,6 +27,8 @@ SUMMARY_KEYS = {
     "reached_goal",
     "makespan_s",
     "planned_s",
+    "holds",
+    "emergency_brakes",
     "time_lost_s",
     "min_separation_m",
     "certified_separation_m",
@@ -97,7 +99,10 @@ def test_a_stop_is_recovered_from_exit_0_and_the_summary_has_every_key(stopped_r
     assert summary["reached_goal"] is True
     assert summary["violations"] == 0
     assert summary["faults"] == ["stop:agv1@8+3"]
-    assert summary["makespan_s"] > summary["planned_s"]  # a 3 s stop costs time
+    # a 3 s stop costs at most its own length plus the slack (often nothing: re-timing catches up)
+    assert summary["makespan_s"] <= summary["planned_s"] + 3.0 + 3.0 * (1.0 / 0.5 + 0.5 / 1.0) + 1.0
+    assert summary["replans"] == 0
+    assert summary["emergency_brakes"] == 0
     assert summary["min_separation_m"] >= 1.5
     assert summary["files"] == [
         str(stopped_run.trace / "agv1.csv"),

@@ -20,7 +20,6 @@ from importlib import resources
 import numpy as np
 import pytest
 from hypothesis import assume, given, settings
-from hypothesis import strategies as st
 from vda5050.domain.order import AcceptanceDecision
 
 from limits import Limits, VehicleLimits
@@ -45,9 +44,9 @@ from trajgen.cli import EXIT_BAD_INPUT, EXIT_FAILURE, EXIT_OK, main
 from trajgen.errors import InputError, ScenarioError
 from trajgen.export.check import check_profiles
 from trajgen.export.dialects import DIALECTS, TableDialect
-from trajgen.online.executor import Executor, VehicleState, continues_class, default_hysteresis
+from trajgen.online.executor import Executor, VehicleState
 from trajgen.sampling import online_campaign, random_scenarios, random_track
-from trajgen.summary import class_label, class_name
+from trajgen.summary import class_label
 
 CROSSING = REPO / "trajgen" / "data" / "crossing.toml"
 #: export-vda5050's default --map-id (docs/formats/vda5050.md): the map the vehicles have
@@ -567,12 +566,10 @@ def test_simulate_under_faults_on_a_crossing_keeps_the_separation(tmp_path, caps
         assert "route on G_4" in replan
 
 
-def test_the_executor_on_a_crossing_checks_legs_by_count_and_scales_its_hysteresis():
+def test_the_executor_on_a_crossing_checks_legs_by_count():
     scenario = builtin_scenario("crossing")
     verified = certify(make_schedule(scenario.plan(), scenario.limits, method="exact"))
     executor = Executor(verified)
-    assert executor.hysteresis == 16.0  # 0.4 (10 + 10 + 10 + 10) m
-    assert default_hysteresis(scenario.track) == 16.0
     with pytest.raises(
         InputError,
         match=r"measured leg must be a leg index 0 to 3 of the 4 legs or -1 \(the junction\), got 4",
@@ -580,34 +577,6 @@ def test_the_executor_on_a_crossing_checks_legs_by_count_and_scales_its_hysteres
         executor.step(VehicleState(4, 1.0), VehicleState(2, 10.0))
     command = executor.step(VehicleState(0, 10.0), VehicleState(2, 10.0))  # leg 3 (E) is known: no error
     assert len(command.setpoints) == 2
-
-
-def test_the_default_hysteresis_of_a_y_is_a_tenth_of_its_perimeter():
-    track = random_track(random.Random(5))
-    assert default_hysteresis(track) == 0.1 * track.perimeter
-
-
-@settings(max_examples=60, derandomize=True, deadline=None)
-@given(query=star_queries(4, 8), tau=st.floats(0.01, 0.99))
-def test_the_planners_route_from_a_point_of_a_route_continues_its_class(query, tau):
-    graph, start, goal, separation = query
-    route = plan(graph, start, goal, min_separation=separation)
-    assert continues_class(route, route)
-    here = route.at(tau)
-    apart = graph.separation(here)
-    if apart == 0.0:
-        return
-    rest = plan(graph, here, goal, min_separation=min(separation, apart))
-    assert continues_class(route, rest)
-
-
-def test_the_other_class_does_not_continue_the_planners():
-    scenario = builtin_scenario("crossing")
-    route = scenario.plan()
-    here = route.at(0.3)
-    other = plan(scenario.track, here, route.goal, min_separation=1.5, homotopy="other")
-    assert not continues_class(route, other)
-    assert class_name(other) == "second-shortest route on G_4"
 
 
 # ---- random scenarios of k legs ---------------------------------------------------------------------

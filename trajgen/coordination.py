@@ -237,7 +237,7 @@ class CoordinationDiagram:
         plan's piece ends and velocity roots: :func:`schedule_times`).
     """
 
-    __slots__ = ("_by_follower", "_edges", "conflicts", "paths", "separation")
+    __slots__ = ("_by_follower", "_edges", "_last", "conflicts", "paths", "separation")
 
     def __init__(self, paths: tuple[VehiclePath, VehiclePath], separation: float, schedule, times) -> None:
         self.paths = paths
@@ -282,6 +282,7 @@ class CoordinationDiagram:
         self.conflicts = tuple(conflicts)
         self._by_follower = tuple(tuple(c for c in conflicts if c.follower == v) for v in (0, 1))
         self._edges = tuple(self._edge_table(v) for v in (0, 1))
+        self._last = [(math.nan, math.inf), (math.nan, math.inf)]  # (earliest, frontier) per follower
 
     def _edge_table(self, follower: int) -> tuple[np.ndarray, ...] | None:
         """Every polygon edge of the conflicts ``follower`` follows, as columns (for :meth:`frontiers`).
@@ -311,11 +312,15 @@ class CoordinationDiagram:
         earliest : float
             The other vehicle's earliest rest point (:func:`earliest_rest`), metres of its travel.
         """
+        last_earliest, last_frontier = self._last[follower]
+        if earliest == last_earliest:  # a leader at rest: the same frontier as the cycle before
+            return last_frontier
         best = math.inf
         for conflict in self._by_follower[follower]:
             if conflict.high[conflict.leader] <= earliest + _TOUCH:
                 continue  # the leader cannot stop before it is past this conflict
             best = min(best, conflict.bound(earliest))
+        self._last[follower] = (earliest, best)
         return best
 
     def frontiers(self, follower: int, earliest: np.ndarray) -> np.ndarray:

@@ -29,6 +29,9 @@ __all__ = ["BrakingCheck", "PathState", "ServiceBraking", "emergency_position"]
 
 #: Time intervals tried in turn: a coarse pass is enough while the vehicles are far apart.
 _REFINEMENTS = (1, 6, 40)
+#: Below these a vehicle stands still (m/s, m/s²): it moves less than a micrometre while it brakes.
+_STILL_VELOCITY = 1e-7
+_STILL_ACCELERATION = 1e-6
 
 
 @dataclass(frozen=True, slots=True)
@@ -137,8 +140,12 @@ class BrakingCheck:
         )
         # the extra acceleration a measured state may carry beyond the limits widens the pad
         # a vehicle at rest in both states does not move at all: no pad
+        # a vehicle at rest in both states (to the drive's noise) does not move at all: no pad, so a
+        # plan with no clearance, where a vehicle waits exactly the separation away, can be certified
         pads = [
-            max(pad, abs(c.a), abs(m.a)) if (c.v, c.a, m.v) != (0.0, 0.0, 0.0) else abs(m.a)
+            max(pad, abs(c.a), abs(m.a))
+            if abs(c.v) > _STILL_VELOCITY or abs(c.a) > _STILL_ACCELERATION or abs(m.v) > _STILL_VELOCITY
+            else 0.0
             for pad, c, m in zip(self._pad_acceleration, commanded, measured, strict=True)
         ]
         for count in _REFINEMENTS:

@@ -28,11 +28,9 @@ from __future__ import annotations
 import collections
 import logging
 import math
-from dataclasses import dataclass
 
 from limits import Limits
 from topology import JUNCTION_INDEX, Configuration, Position, Route
-from topology.options import Option
 from trajgen.braking_rule import BRAKING_RULE_TOLERANCE
 from trajgen.coordination import (
     CoordinationDiagram,
@@ -44,10 +42,12 @@ from trajgen.coordination import (
 from trajgen.errors import InputError, ScheduleError, TrajgenError
 from trajgen.online.braking import PathState
 from trajgen.online.goals import goal_refusal, plan_from_rest
+from trajgen.online.messages import Command, Event, GoalDecision, Mode, Setpoint, VehicleState, checked_state
 from trajgen.online.motion import AT_REST, PlanPlayer, VehicleMotion
 from trajgen.online.safety import SafetyGuard
 from trajgen.paths import VehiclePath
 from trajgen.schedule import check_period
+from trajgen.summary import class_name
 from trajgen.verify import VerifiedSchedule, require_verified
 
 __all__ = ["PERIOD_RANGE", "Command", "Event", "Executor", "GoalDecision", "Mode", "Setpoint", "VehicleState"]
@@ -58,124 +58,6 @@ logger = logging.getLogger(__name__)
 PERIOD_RANGE = (0.002, 0.1)
 #: A vehicle within this travel of a point is at it, metres.
 _AT = 1e-6
-
-
-class Mode(Option):
-    """What the executor is doing."""
-
-    FOLLOWING = "following"  #: both vehicles on the plan's clock
-    RETIMING = "retiming"  #: a vehicle re-timed by Ruckig, in the plan's order
-    STOPPING = "stopping"  #: both braking to rest for a new goal
-    DONE = "done"  #: both vehicles at rest at their goals
-
-
-@dataclass(frozen=True, slots=True)
-class VehicleState:
-    """A vehicle's measured state.
-
-    Attributes
-    ----------
-    leg : int
-        Leg index in the track's order, ``JUNCTION_INDEX`` (-1) at the junction.
-    s : float
-        Distance from the junction, metres.
-    velocity, acceleration : float
-        Along the vehicle's axis, m/s and m/s².
-    """
-
-    leg: int
-    s: float
-    velocity: float = 0.0
-    acceleration: float = 0.0
-
-
-@dataclass(frozen=True, slots=True)
-class Setpoint:
-    """A vehicle's setpoint for the end of a cycle.
-
-    Attributes
-    ----------
-    axis, velocity, acceleration, jerk : float
-        On the vehicle's signed axis: m, m/s, m/s², m/s³.
-    leg : int
-        Leg index (``JUNCTION_INDEX`` at the junction).
-    s : float
-        Distance from the junction, metres.
-    branch : int
-        The leg the vehicle takes when it next passes the junction (its own leg if it turns back there).
-    """
-
-    axis: float
-    velocity: float
-    acceleration: float
-    jerk: float
-    leg: int
-    s: float
-    branch: int
-
-
-@dataclass(frozen=True, slots=True)
-class Command:
-    """What one :meth:`Executor.step` returns.
-
-    Attributes
-    ----------
-    time : float
-        The time the setpoints are for, seconds since the executor started.
-    setpoints : tuple of 2 Setpoint
-    mode : Mode
-    braking : tuple of 2 bool
-        Whether each vehicle holds (service braking) because the braking invariant says so.
-    certified : bool
-        Whether the braking check passed for these setpoints.
-    emergency : bool
-        Both vehicles brake as hard as they can: nothing else could be certified.
-    frontiers : tuple of 2 float
-        Each vehicle's frontier this cycle, metres of its travel (``inf``: none binds it).
-    """
-
-    time: float
-    setpoints: tuple[Setpoint, Setpoint]
-    mode: Mode
-    braking: tuple[bool, bool] = (False, False)
-    certified: bool = True
-    emergency: bool = False
-    frontiers: tuple[float, float] = (math.inf, math.inf)
-
-
-@dataclass(frozen=True, slots=True)
-class Event:
-    """Something the executor did.
-
-    Attributes
-    ----------
-    time : float
-        Seconds since the executor started.
-    kind : str
-        ``retime`` (a vehicle leaves the plan's clock), ``hold`` (the braking invariant holds a
-        vehicle), ``emergency`` (both brake hard), ``goal-accepted``, ``goal-refused``, ``replan``
-        (a new goal's plan), ``speed-limit``, ``done``.
-    detail : str
-    """
-
-    time: float
-    kind: str
-    detail: str
-
-
-@dataclass(frozen=True, slots=True)
-class GoalDecision:
-    """The executor's answer to a goal request.
-
-    Attributes
-    ----------
-    accepted : bool
-    reason : str
-        Why it was refused (empty when accepted).
-    """
-
-    accepted: bool
-    reason: str = ""
 
 
 def _finite_positive(value: object, name: str) -> float:
@@ -394,7 +276,7 @@ class Executor:
         -------
         Command
         """
-        measured = (self._checked(first, 1), self._checked(second, 2))
+        measured = (checked_state(first, 1, self.graph), checked_state(second, 2, self.graph))
         along = self._locate(measured)
         if along is None:
             return self._emergency_stop(measured, "a vehicle is off its path beyond the margins")
@@ -425,7 +307,7 @@ class Executor:
             if self._stops_by(
                 v,
                 state,
-                frontier + min(BRAKING_RULE_TOLERANCE, self.position_margin),
+                frontier + max(_AT, min(BRAKING_RULE_TOLERANCE, self.position_margin)),
                 jerk_limited=self.schedule.jerk_limited,
             ):
                 return state, heading * jerk, axis
@@ -583,7 +465,13 @@ class Executor:
                 orientation = [self._orientation(v) for v in (0, 1)]
                 self.replans += 1
                 self._load(verified, axis_start=axes, orientation=orientation)
-                self._log("replan", f"from {start} to {goal}: {verified.schedule.duration:.3f} s planned")
+                route = verified.schedule.route
+                way = route.way_round.value
+                kind = f"way round {way}" if route.graph.cycle is not None else class_name(route)
+                self._log(
+                    "replan",
+                    f"new goal: from {start} to {goal}, {kind}, {verified.schedule.duration:.3f} s planned",
+                )
                 along = self._locate(measured) or along
         proposals = [(*self._motions[v].brake(self._command[v], self.period), None) for v in (0, 1)]
         if self._mode is Mode.STOPPING:
@@ -682,28 +570,6 @@ class Executor:
         if path.s_to[k] == 0.0 and k + 1 < len(path.legs):
             return path.legs[k + 1]
         return path.legs[k]
-
-    def _checked(self, state: VehicleState, number: int) -> VehicleState:
-        if not isinstance(state, VehicleState):
-            raise InputError(f"vehicle {number} state must be a VehicleState, got {type(state).__name__}")
-        for name in ("s", "velocity", "acceleration"):
-            value = getattr(state, name)
-            if not isinstance(value, (int, float)) or not math.isfinite(value):
-                raise InputError(f"vehicle {number} measured {name} must be a finite number, got {value!r}")
-        count = self.graph.leg_count
-        if state.leg != JUNCTION_INDEX and not 0 <= state.leg < count:
-            raise InputError(
-                f"vehicle {number} measured leg must be a leg index 0 to {count - 1} of the {count} legs "
-                f"or {JUNCTION_INDEX} (the junction), got {state.leg!r}"
-            )
-        top = self.graph.lengths[state.leg] if state.leg != JUNCTION_INDEX else 0.0
-        if state.s < 0.0 or state.s > top + 1e-6:
-            raise InputError(
-                f"vehicle {number} measured s {state.s!r} m is off leg {state.leg!r}: expected 0 to {top!r} m"
-            )
-        if state.s > top:
-            return VehicleState(state.leg, top, state.velocity, state.acceleration)
-        return state
 
     def _log(self, kind: str, detail: str) -> None:
         self.events.append(Event(self._time, kind, detail))

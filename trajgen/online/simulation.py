@@ -1,44 +1,40 @@
 """Closed-loop simulation: the executor drives a simulated plant that applies faults.
 
-The plant moves each vehicle along the track after its setpoints: it lands on
-each setpoint while it is on track. Faults (:mod:`trajgen.online.faults`) act on the plant only;
-the executor sees their effects through the measurements, and goal requests.
-A drive that is off its setpoint (after a jump, a stop) closes the gap gradually:
-its speed is the setpoint's plus twice the gap per second, at most
-``0.2 * max_velocity`` more or less.
+The plant (:mod:`trajgen.online.plant`) moves each vehicle after its setpoints;
+faults (:mod:`trajgen.online.faults`) act on the plant only, and the executor
+sees their effects through the measurements, and goal requests.
 
 Every cycle the simulation checks the *true* positions against the minimum
 separation, certified between cycles too (track distance is 1-Lipschitz in
 each vehicle's position, so between two cycles it is at least the mean of the
 two distances less half the distance both vehicles drove), and the commanded
 setpoints against the vehicle limits. Memory does not grow with the simulated
-time: the trace is spooled to temporary files a block of rows at a time and
-the plot keeps at most :data:`PLOT_SAMPLES` samples per curve.
+time (:mod:`trajgen.online.trace`).
 """
 
 from __future__ import annotations
 
-import bisect
-import collections
 import logging
 import math
-import tempfile
-from collections.abc import Callable, Iterator, Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
 
 from limits import Limits
-from topology import JUNCTION_INDEX, StarGraph
+from topology import StarGraph
 from topology.indexed import leg_travel
 from topology.indexed import separation as indexed_separation
 from trajgen.errors import InputError
-from trajgen.export.csv import HEADER_NAMES, CsvOptions, format_rows
-from trajgen.online.executor import Command, Event, Executor, Mode, VehicleState
+from trajgen.export.csv import CsvOptions
+from trajgen.online.executor import Executor
 from trajgen.online.faults import Fault, FaultError, FaultKind, parse_fault
 from trajgen.online.goals import execution_margin, plan_for_execution
+from trajgen.online.messages import Command, Event, Mode, VehicleState
+from trajgen.online.plant import Plant
+from trajgen.online.trace import PLOT_SAMPLES, Decimated, Trace
 from trajgen.scenario import Scenario
-from trajgen.schedule import ScheduleState, TimingMethod
+from trajgen.schedule import TimingMethod
 from trajgen.values import frozen
 from trajgen.verify import VerifiedSchedule
 
@@ -46,265 +42,12 @@ __all__ = ["PLOT_SAMPLES", "SimulationResult", "Trace", "parse_faults", "simulat
 
 logger = logging.getLogger(__name__)
 
-#: Most samples per curve kept for the plot.
-PLOT_SAMPLES = 20_000
-#: Rows formatted and spooled at a time.
-_ROWS_PER_BLOCK = 5_000
-#: How fast a drive closes a gap to its setpoint beyond the setpoints' own speed (fraction of max_velocity).
-_CORRECTION = 0.2
-#: How fast a drive closes a gap to its setpoint: the gap times this, m/s per m (a 0.5 s time constant).
-_GAIN = 2.0
 #: A vehicle slower than this is at rest, m/s (a drive closing its last gap creeps for a while).
 _AT_REST = 1e-3
 #: True track distance below the minimum separation that counts as a violation, metres (1 µm).
 _VIOLATION_TOLERANCE = 1e-6
 #: Relative tolerance on the commanded limits (Ruckig's jerk phases are exactly at the limit).
 _LIMIT_TOLERANCE = 1e-6
-
-
-class _Body:
-    """One vehicle's true state in the plant."""
-
-    __slots__ = ("a", "axis", "branch", "j", "leg", "orientation", "s", "v")
-
-    def __init__(self, leg: int, s: float, orientation: int, axis: float, branch: int) -> None:
-        self.leg, self.s, self.orientation, self.axis, self.branch = leg, s, orientation, axis, branch
-        self.v = self.a = self.j = 0.0
-
-    def move(self, d_axis: float, lengths: tuple[float, ...]) -> None:
-        """Drive ``d_axis`` metres along the axis, through the junction onto ``branch``.
-
-        The end of a leg (and the junction, when the branch is the same leg) stops the vehicle: it
-        does not get further, and neither does its axis; it is then at rest.
-        """
-        s = self.s + self.orientation * d_axis
-        blocked = 0.0
-        if s < 0.0:
-            if self.branch != self.leg:
-                self.leg, self.orientation = self.branch, -self.orientation
-                s = -s
-            else:
-                blocked, s = -s, 0.0
-        top = lengths[self.leg]
-        if s > top:
-            blocked, s = s - top, top
-        self.s = s
-        self.axis += d_axis - math.copysign(blocked, d_axis)
-        if blocked:
-            self.v = self.a = 0.0
-
-    def state(self) -> VehicleState:
-        return VehicleState(self.leg if self.s > 0.0 else JUNCTION_INDEX, self.s, self.v, self.a)
-
-
-class _Lag:
-    """Setpoints of one vehicle kept long enough to replay them late."""
-
-    __slots__ = ("items", "times")
-
-    def __init__(self, size: int) -> None:
-        self.times: collections.deque = collections.deque(maxlen=size)
-        self.items: collections.deque = collections.deque(maxlen=size)
-
-    def push(self, time: float, setpoint) -> None:
-        self.times.append(time)
-        self.items.append(setpoint)
-
-    def at(self, time: float):
-        """Axis, velocity, acceleration, branch at ``time`` (linear between kept setpoints)."""
-        times = list(self.times)
-        k = bisect.bisect_right(times, time) - 1
-        if k < 0:
-            first = self.items[0]
-            return first.axis, first.velocity, first.acceleration, first.branch
-        if k >= len(times) - 1:
-            last = self.items[-1]
-            return last.axis, last.velocity, last.acceleration, last.branch
-        a, b = self.items[k], self.items[k + 1]
-        w = (time - times[k]) / (times[k + 1] - times[k])
-        return (
-            a.axis + w * (b.axis - a.axis),
-            a.velocity + w * (b.velocity - a.velocity),
-            a.acceleration + w * (b.acceleration - a.acceleration),
-            a.branch,
-        )
-
-
-class _Plant:
-    """Both vehicles' true motion under setpoints and faults."""
-
-    def __init__(self, executor: Executor, faults: Sequence[Fault], period: float) -> None:
-        self.lengths = executor.graph.lengths
-        self.period = period
-        self.limits = executor.limits
-        self.bodies = []
-        for path in executor.paths:
-            leg, s = path.locate(0.0)
-            if path.legs:
-                leg = path.legs[0]
-                orientation = path.outward(0.0) * path.heading(0.0)
-            else:
-                leg = leg if leg != JUNCTION_INDEX else 0
-                orientation = 1
-            self.bodies.append(_Body(leg, s, orientation, path.axis(0.0), leg))
-        self.faults = list(faults)
-        size = math.ceil(0.25 / period) + 4
-        self.lags = (_Lag(size), _Lag(size))
-
-    def measure(self) -> tuple[VehicleState, VehicleState]:
-        return self.bodies[0].state(), self.bodies[1].state()
-
-    def _active(self, kind: FaultKind, vehicle: int, t: float) -> Fault | None:
-        found = None
-        for fault in self.faults:
-            if fault.kind is kind and fault.vehicle == vehicle and fault.time <= t < fault.end:
-                found = fault
-        return found
-
-    def jump(self, fault: Fault) -> None:
-        self.bodies[fault.vehicle].move(fault.value, self.lengths)
-
-    def advance(self, command: Command, t: float) -> None:
-        """Move both vehicles from ``t`` to ``t + period`` after ``command``."""
-        dt = self.period
-        for v, (body, setpoint) in enumerate(zip(self.bodies, command.setpoints, strict=True)):
-            self.lags[v].push(command.time, setpoint)
-            stop = self._active(FaultKind.STOP, v, t)
-            if stop is not None or command.emergency:  # a stop fault, or the executor's emergency brake
-                decel = self.limits.vehicles[v].emergency_braking
-                speed = abs(body.v)
-                new = max(speed - decel * dt, 0.0)
-                d = math.copysign(
-                    0.5 * (speed + new) * dt if new > 0.0 else speed * speed / (2 * decel), body.v
-                )
-                a_new = -math.copysign(decel, body.v) if speed > 0.0 else 0.0
-                body.j = (a_new - body.a) / dt
-                body.a = a_new
-                body.v = math.copysign(new, body.v)
-                body.move(d, self.lengths)
-                continue
-            lag = self._active(FaultKind.LAG, v, t)
-            if lag is not None:
-                delay = min(lag.value, 0.5 * (t + dt - lag.time))
-                axis, velocity, acceleration, branch = self.lags[v].at(t + dt - delay)
-                jerk = setpoint.jerk
-            else:
-                axis, velocity, acceleration, jerk, branch = (
-                    setpoint.axis,
-                    setpoint.velocity,
-                    setpoint.acceleration,
-                    setpoint.jerk,
-                    setpoint.branch,
-                )
-            body.branch = branch
-            slow = self._active(FaultKind.SLOW, v, t)
-            cap = slow.value if slow is not None else math.inf  # a throttled drive's top speed
-            wanted = axis - body.axis
-            gap = wanted - velocity * dt  # beyond the setpoint's own motion this cycle
-            on_track = abs(gap) <= abs(acceleration) * dt * dt + abs(jerk) * dt**3 + 1e-12
-            if on_track and abs(velocity) <= cap:
-                body.j, body.a, body.v = jerk, acceleration, velocity
-                body.move(wanted, self.lengths)
-                continue
-            # off its setpoint (after a fault) or throttled: the drive closes the gap gradually,
-            # within its top speed, and never runs past the setpoint
-            correction = _CORRECTION * self.limits.vehicles[v].max_velocity
-            v_new = velocity + max(-correction, min(correction, _GAIN * gap))
-            v_new = max(-cap, min(cap, v_new))
-            step = v_new * dt
-            if wanted * (wanted - step) < 0.0:
-                step, v_new = wanted, min(max(velocity, -cap), cap)
-            a_new = (v_new - body.v) / dt
-            body.j = (a_new - body.a) / dt
-            body.a, body.v = a_new, v_new
-            body.move(step, self.lengths)
-
-
-class Trace:
-    """The executed motion (true positions) of both vehicles, spooled to temporary files as CSV rows.
-
-    Parameters
-    ----------
-    graph : StarGraph
-    options : CsvOptions
-        Dialect of the rows (the sample period is the simulation's control period).
-    """
-
-    def __init__(self, graph: StarGraph, options: CsvOptions) -> None:
-        self.graph = graph
-        self.options = options
-        self._files = [tempfile.TemporaryFile(), tempfile.TemporaryFile()]  # noqa: SIM115 - closed by close()
-        header = (options.delimiter.join(HEADER_NAMES[options.units]) + "\r\n").encode("ascii")
-        for handle in self._files:
-            handle.write(header)
-        self._rows: list[list[float]] = []
-        self.rows = 0
-
-    def add(self, t: float, bodies) -> None:
-        """Record both vehicles' true state at time ``t``."""
-        row = [t]
-        for body in bodies:
-            row.extend(
-                (body.axis, body.v, body.a, body.j, body.leg if body.s > 0.0 else JUNCTION_INDEX, body.s)
-            )
-        self._rows.append(row)
-        self.rows += 1
-        if len(self._rows) >= _ROWS_PER_BLOCK:
-            self._flush()
-
-    def _flush(self) -> None:
-        if not self._rows:
-            return
-        data = np.array(self._rows)
-        self._rows = []
-        t = data[:, 0]
-        columns = {
-            name: np.stack([data[:, 1 + 6 * v + k] for v in (0, 1)])
-            for k, name in enumerate(("axis", "velocity", "acceleration", "jerk", "leg", "s"))
-        }
-        state = ScheduleState(
-            t,
-            columns["axis"],
-            columns["velocity"],
-            columns["acceleration"],
-            columns["jerk"],
-            columns["leg"].astype(int),
-            columns["s"],
-        )
-        for v, handle in enumerate(self._files):
-            lines = format_rows(self.graph, state, v, self.options)
-            handle.write(("\r\n".join(lines) + "\r\n").encode("ascii"))
-
-    def chunks(self, vehicle: int) -> Iterator[bytes]:
-        """The CSV of ``vehicle`` (0 or 1), a block at a time."""
-        self._flush()
-        handle = self._files[vehicle]
-        handle.seek(0)
-        while block := handle.read(1 << 20):
-            yield block
-
-    def close(self) -> None:
-        """Remove the temporary files."""
-        for handle in self._files:
-            handle.close()
-
-
-class _Decimated:
-    """At most ``limit`` samples of a run of any length: every other sample is dropped when full."""
-
-    def __init__(self, limit: int) -> None:
-        self.limit = limit
-        self.stride = 1
-        self.count = 0
-        self.rows: list[tuple] = []
-
-    def add(self, row: tuple) -> None:
-        if self.count % self.stride == 0:
-            self.rows.append(row)
-            if len(self.rows) >= self.limit:
-                self.rows = self.rows[::2]
-                self.stride *= 2
-        self.count += 1
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -345,6 +88,8 @@ class SimulationResult:
         ``frontier`` (2, n) its frontier, m of travel (``inf`` where none binds it).
     schedule : VerifiedSchedule
         The undisturbed plan.
+    position_margin : float
+        The margin the executor's conflicts kept beyond the separation, metres.
     """
 
     reached_goal: bool
@@ -367,6 +112,7 @@ class SimulationResult:
     cycles: int
     plot: dict = field(repr=False)
     schedule: VerifiedSchedule = field(repr=False)
+    position_margin: float = 0.0
 
     @property
     def violations(self) -> int:
@@ -520,7 +266,7 @@ def simulate(
     executor = Executor(
         verified, period=period, position_margin=margin, min_separation=scenario.limits.min_separation
     )
-    plant = _Plant(executor, faults, period)
+    plant = Plant(executor, faults, period)
     jerk_limited = verified.schedule.jerk_limited
     limits = scenario.limits
     planned = verified.schedule.duration
@@ -528,7 +274,7 @@ def simulate(
     pending = sorted((f for f in faults if f.kind in (FaultKind.JUMP, FaultKind.GOAL)), key=lambda f: f.time)
     settle = max((f.time + (f.value if f.kind is FaultKind.STOP else 0.0) for f in faults), default=0.0)
     spool = Trace(scenario.track, trace) if trace is not None else None
-    plot = _Decimated(PLOT_SAMPLES)
+    plot = Decimated(PLOT_SAMPLES)
     worst = [0.0, 0.0, 0.0]
     separation_violations = limit_violations = 0
     bodies = plant.bodies
@@ -630,5 +376,6 @@ def simulate(
         cycles=cycle,
         plot=samples,
         schedule=verified,
+        position_margin=margin,
     )
     return result, spool

@@ -1,0 +1,191 @@
+"""The simulated plant: both vehicles' true motion after the executor's setpoints, under faults.
+
+Each vehicle moves along the track after its setpoints: it lands on each
+setpoint while it is on track, passes the junction onto the leg the setpoint
+names, and is stopped by the end of a leg. Faults
+(:mod:`trajgen.online.faults`) act here only; the executor sees their effects
+through the measurements. A stop (or the executor's emergency brake) brakes at
+the vehicle's emergency deceleration; a drive that is off its setpoint (after
+a jump, a stop) closes the gap gradually: its speed is the setpoint's plus
+twice the gap per second, at most ``0.2 * max_velocity`` more or less.
+"""
+
+from __future__ import annotations
+
+import bisect
+import collections
+import math
+from collections.abc import Sequence
+
+from topology import JUNCTION_INDEX
+from trajgen.online.executor import Executor
+from trajgen.online.faults import Fault, FaultKind
+from trajgen.online.messages import Command, VehicleState
+
+__all__ = ["Body", "Plant"]
+
+#: How fast a drive closes a gap to its setpoint beyond the setpoints' own speed (fraction of max_velocity).
+_CORRECTION = 0.2
+#: How fast a drive closes a gap to its setpoint: the gap times this, m/s per m (a 0.5 s time constant).
+_GAIN = 2.0
+
+
+class Body:
+    """One vehicle's true state in the plant."""
+
+    __slots__ = ("a", "axis", "branch", "j", "leg", "orientation", "s", "v")
+
+    def __init__(self, leg: int, s: float, orientation: int, axis: float, branch: int) -> None:
+        self.leg, self.s, self.orientation, self.axis, self.branch = leg, s, orientation, axis, branch
+        self.v = self.a = self.j = 0.0
+
+    def move(self, d_axis: float, lengths: tuple[float, ...]) -> None:
+        """Drive ``d_axis`` metres along the axis, through the junction onto ``branch``.
+
+        The end of a leg (and the junction, when the branch is the same leg) stops the vehicle: it
+        does not get further, and neither does its axis; it is then at rest.
+        """
+        s = self.s + self.orientation * d_axis
+        blocked = 0.0
+        if s < 0.0:
+            if self.branch != self.leg:
+                self.leg, self.orientation = self.branch, -self.orientation
+                s = -s
+            else:
+                blocked, s = -s, 0.0
+        top = lengths[self.leg]
+        if s > top:
+            blocked, s = s - top, top
+        self.s = s
+        self.axis += d_axis - math.copysign(blocked, d_axis)
+        if blocked:
+            self.v = self.a = 0.0
+
+    def state(self) -> VehicleState:
+        """What the vehicle's sensors measure: its true state."""
+        return VehicleState(self.leg if self.s > 0.0 else JUNCTION_INDEX, self.s, self.v, self.a)
+
+
+class Lag:
+    """Setpoints of one vehicle kept long enough to replay them late."""
+
+    __slots__ = ("items", "times")
+
+    def __init__(self, size: int) -> None:
+        self.times: collections.deque = collections.deque(maxlen=size)
+        self.items: collections.deque = collections.deque(maxlen=size)
+
+    def push(self, time: float, setpoint) -> None:
+        self.times.append(time)
+        self.items.append(setpoint)
+
+    def at(self, time: float):
+        """Axis, velocity, acceleration, branch at ``time`` (linear between kept setpoints)."""
+        times = list(self.times)
+        k = bisect.bisect_right(times, time) - 1
+        if k < 0:
+            first = self.items[0]
+            return first.axis, first.velocity, first.acceleration, first.branch
+        if k >= len(times) - 1:
+            last = self.items[-1]
+            return last.axis, last.velocity, last.acceleration, last.branch
+        a, b = self.items[k], self.items[k + 1]
+        w = (time - times[k]) / (times[k + 1] - times[k])
+        return (
+            a.axis + w * (b.axis - a.axis),
+            a.velocity + w * (b.velocity - a.velocity),
+            a.acceleration + w * (b.acceleration - a.acceleration),
+            a.branch,
+        )
+
+
+class Plant:
+    """Both vehicles' true motion under setpoints and faults."""
+
+    def __init__(self, executor: Executor, faults: Sequence[Fault], period: float) -> None:
+        self.lengths = executor.graph.lengths
+        self.period = period
+        self.limits = executor.limits
+        self.bodies = []
+        for path in executor.paths:
+            leg, s = path.locate(0.0)
+            if path.legs:
+                leg = path.legs[0]
+                orientation = path.outward(0.0) * path.heading(0.0)
+            else:
+                leg = leg if leg != JUNCTION_INDEX else 0
+                orientation = 1
+            self.bodies.append(Body(leg, s, orientation, path.axis(0.0), leg))
+        self.faults = list(faults)
+        size = math.ceil(0.25 / period) + 4
+        self.lags = (Lag(size), Lag(size))
+
+    def measure(self) -> tuple[VehicleState, VehicleState]:
+        """Both vehicles' measured states."""
+        return self.bodies[0].state(), self.bodies[1].state()
+
+    def _active(self, kind: FaultKind, vehicle: int, t: float) -> Fault | None:
+        found = None
+        for fault in self.faults:
+            if fault.kind is kind and fault.vehicle == vehicle and fault.time <= t < fault.end:
+                found = fault
+        return found
+
+    def jump(self, fault: Fault) -> None:
+        """Apply a position correction: the vehicle is ``fault.value`` metres further along its axis."""
+        self.bodies[fault.vehicle].move(fault.value, self.lengths)
+
+    def advance(self, command: Command, t: float) -> None:
+        """Move both vehicles from ``t`` to ``t + period`` after ``command``."""
+        dt = self.period
+        for v, (body, setpoint) in enumerate(zip(self.bodies, command.setpoints, strict=True)):
+            self.lags[v].push(command.time, setpoint)
+            stop = self._active(FaultKind.STOP, v, t)
+            if stop is not None or command.emergency:  # a stop fault, or the executor's emergency brake
+                decel = self.limits.vehicles[v].emergency_braking
+                speed = abs(body.v)
+                new = max(speed - decel * dt, 0.0)
+                d = math.copysign(
+                    0.5 * (speed + new) * dt if new > 0.0 else speed * speed / (2 * decel), body.v
+                )
+                a_new = -math.copysign(decel, body.v) if speed > 0.0 else 0.0
+                body.j = (a_new - body.a) / dt
+                body.a = a_new
+                body.v = math.copysign(new, body.v)
+                body.move(d, self.lengths)
+                continue
+            lag = self._active(FaultKind.LAG, v, t)
+            if lag is not None:
+                delay = min(lag.value, 0.5 * (t + dt - lag.time))
+                axis, velocity, acceleration, branch = self.lags[v].at(t + dt - delay)
+                jerk = setpoint.jerk
+            else:
+                axis, velocity, acceleration, jerk, branch = (
+                    setpoint.axis,
+                    setpoint.velocity,
+                    setpoint.acceleration,
+                    setpoint.jerk,
+                    setpoint.branch,
+                )
+            body.branch = branch
+            slow = self._active(FaultKind.SLOW, v, t)
+            cap = slow.value if slow is not None else math.inf  # a throttled drive's top speed
+            wanted = axis - body.axis
+            gap = wanted - velocity * dt  # beyond the setpoint's own motion this cycle
+            on_track = abs(gap) <= abs(acceleration) * dt * dt + abs(jerk) * dt**3 + 1e-12
+            if on_track and abs(velocity) <= cap:
+                body.j, body.a, body.v = jerk, acceleration, velocity
+                body.move(wanted, self.lengths)
+                continue
+            # off its setpoint (after a fault) or throttled: the drive closes the gap gradually,
+            # within its top speed, and never runs past the setpoint
+            correction = _CORRECTION * self.limits.vehicles[v].max_velocity
+            v_new = velocity + max(-correction, min(correction, _GAIN * gap))
+            v_new = max(-cap, min(cap, v_new))
+            step = v_new * dt
+            if wanted * (wanted - step) < 0.0:
+                step, v_new = wanted, min(max(velocity, -cap), cap)
+            a_new = (v_new - body.v) / dt
+            body.j = (a_new - body.a) / dt
+            body.a, body.v = a_new, v_new
+            body.move(step, self.lengths)
