@@ -80,6 +80,22 @@ def test_project_undoes_locate(fraction, vehicle):
     assert path.project(leg, s, p) == pytest.approx(p, abs=1e-9)
 
 
+@settings(max_examples=200, derandomize=True, deadline=None)
+@given(fraction=st.floats(-0.1, 1.1), vehicle=st.sampled_from([0, 1]))
+def test_place_agrees_with_the_separate_lookups(fraction, vehicle):
+    route = default_scenario().plan()
+    path = VehiclePath.from_route(route, vehicle)
+    p = fraction * path.length
+    leg, s, heading, axis, branch = path.place(p)
+    assert (leg, s) == path.locate(p)
+    assert heading == path.heading(p)
+    assert axis == path.axis(p)
+    k = path.segment(p)
+    # the leg taken at the next junction passage: the next segment's when this one ends there
+    ahead = path.legs[k + 1] if path.s_to[k] == 0.0 and k + 1 < len(path.legs) else path.legs[k]
+    assert branch == ahead
+
+
 # -- the braking check ---------------------------------------------------------------------------
 
 

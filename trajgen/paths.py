@@ -161,6 +161,26 @@ class VehiclePath:
         """Index of the segment holding travel ``p`` (clipped to the path)."""
         return min(max(bisect.bisect_right(self.starts, p) - 1, 0), len(self.starts) - 1)
 
+    def place(self, p: float) -> tuple[int, float, int, float, int]:
+        """Everything about travel ``p`` at once: ``(leg, s, heading, axis, branch)``.
+
+        As :meth:`locate`, :meth:`heading` and :meth:`axis` give them, with ``branch`` the leg the
+        vehicle takes when it next passes the junction (its own leg if it turns back there). One
+        segment lookup: this runs every control cycle.
+        """
+        if not self.legs:
+            leg, s = self.home
+            return leg, s, 1, self.axis(p), leg
+        k = self.segment(p)
+        length = abs(self.s_to[k] - self.s_from[k])
+        local = min(max(p - self.starts[k], 0.0), length)
+        s = self.s_from[k] + (local if self.s_to[k] > self.s_from[k] else -local)
+        heading = self.headings[k]
+        axis = self.axis_starts[k] + heading * (p - self.starts[k])
+        leg = self.legs[k] if s > 0.0 else JUNCTION_INDEX
+        branch = self.legs[k + 1] if self.s_to[k] == 0.0 and k + 1 < len(self.legs) else self.legs[k]
+        return leg, s, heading, axis, branch
+
     def locate(self, p: float) -> tuple[int, float]:
         """``(leg, s)`` at travel ``p`` (clipped to [0, length]); leg is ``JUNCTION_INDEX`` at s = 0."""
         if not self.legs:

@@ -386,23 +386,13 @@ class Executor:
         setpoints = []
         for v in (0, 1):
             state, jerk, axis = proposals[v]
-            path = self._paths[v]
             self._command[v] = state
-            heading = path.heading(state.p)
-            leg, s = path.locate(state.p)
+            leg, s, heading, on_path, branch = self._paths[v].place(state.p)
             if axis is None:
-                axis = path.axis(state.p)
+                axis = on_path
             self._recent[v].append((axis, heading * state.v))
             setpoints.append(
-                Setpoint(
-                    axis,
-                    heading * state.v,
-                    heading * state.a,
-                    heading * jerk,
-                    leg,
-                    s,
-                    self._branch(v, state.p),
-                )
+                Setpoint(axis, heading * state.v, heading * state.a, heading * jerk, leg, s, branch)
             )
         if self._mode is not Mode.DONE and all(
             self._command[v].p >= self._paths[v].length - _AT
@@ -503,8 +493,8 @@ class Executor:
         recent = self._recent[v]
         if not recent or self._time - self._rebased[v] < self.latency:
             return False  # a restart shows in the measurements only after the drive's latency
-        path = self._paths[v]
-        axis, velocity = path.axis(state.p), path.heading(state.p) * state.v
+        _, _, heading, axis, _ = self._paths[v].place(state.p)
+        velocity = heading * state.v
         tol_p, tol_v = self.position_tolerance, self.velocity_tolerance
         last_axis, last_velocity = recent[-1]
         if abs(axis - last_axis) <= tol_p and abs(velocity - last_velocity) <= tol_v:
@@ -560,16 +550,6 @@ class Executor:
             return None
         p = self._command[v].p
         return path.legs[path.segment(p)], path.outward(p) * path.heading(p)
-
-    def _branch(self, v: int, p: float) -> int:
-        """The leg ``v`` takes when it next passes the junction."""
-        path = self._paths[v]
-        if not path.legs:
-            return path.home[0]
-        k = path.segment(p)
-        if path.s_to[k] == 0.0 and k + 1 < len(path.legs):
-            return path.legs[k + 1]
-        return path.legs[k]
 
     def _log(self, kind: str, detail: str) -> None:
         self.events.append(Event(self._time, kind, detail))
