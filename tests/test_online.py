@@ -96,6 +96,21 @@ def test_place_agrees_with_the_separate_lookups(fraction, vehicle):
     assert branch == ahead
 
 
+def test_a_round_off_overshoot_of_a_tiny_first_move_is_not_read_as_the_far_end():
+    """Campaign scenario 132: a re-plan nudged the vehicle 6.7 um outwards before turning it back.
+
+    The drive overshot that nudge by 0.15 um; the run-on of the last segment (C, outwards past the
+    goal) holds the point exactly, 26 m away. The vehicle is where it was told to be: travel ~0.
+    """
+    waypoints = [(2, 7.612807, 0, 2.0), (2, 7.6128137, 0, 2.0), (1, 5.6, 0, 2.0), (2, 0.8895, 0, 2.0)]
+    path = VehiclePath.from_waypoints(waypoints, 0)
+    assert path.legs == (2, 2, 1, 1, 2)
+    p = path.project(2, 7.6128137 + 1.5e-7, near=1e-5, slack=0.05)
+    assert p == pytest.approx(6.7e-6, abs=1e-6)
+    # well past the goal, the run-on is the only place: a travel beyond the length
+    assert path.project(2, 3.0, near=path.length, slack=0.05) == pytest.approx(path.length + 3.0 - 0.8895)
+
+
 # -- the braking check ---------------------------------------------------------------------------
 
 

@@ -235,9 +235,11 @@ class VehiclePath:
     def project(self, leg: int, s: float, near: float, slack: float = 1e-9) -> float | None:
         """The travel at which the path passes ``(leg, s)``, nearest ``near``; ``None`` if it never does.
 
-        A position up to ``slack`` metres beyond the end of a stretch of the path counts as that end,
-        if no stretch holds it; one on the first or last segment's leg before the start or past the
-        end of the path gives a travel below 0 or above :attr:`length`.
+        A position up to ``slack`` metres beyond the end of a stretch of the path counts as that end;
+        within ``slack`` of ``near`` a stretch that holds the position is preferred to one it
+        overshoots, beyond that the nearer place wins. A position on the first or last segment's
+        leg before the start or past the end of the path gives a travel below 0 or above
+        :attr:`length`.
         """
         best = None
         best_key = (math.inf, math.inf)  # (how far off its stretch, how far from near)
@@ -261,7 +263,11 @@ class VehiclePath:
                 continue
             clamped = min(max(s, low), high)
             p = self.starts[k] + (clamped - self.s_from[k]) * (1.0 if outward else -1.0)
-            key = (0.0 if abs(clamped - s) <= 1e-9 else abs(clamped - s), abs(p - near))
+            # how far off its stretch plus how far outside the window of ``slack`` about ``near``: a
+            # stretch that holds the point exactly but lies far away (the run-on past the path's end)
+            # loses to a nearby one the point overshoots by round-off
+            off = 0.0 if abs(clamped - s) <= 1e-9 else abs(clamped - s)
+            key = (off + max(abs(p - near) - slack, 0.0), abs(p - near))
             if key < best_key:
                 best, best_key = p, key
         return best
