@@ -111,6 +111,22 @@ def test_a_round_off_overshoot_of_a_tiny_first_move_is_not_read_as_the_far_end()
     assert path.project(2, 3.0, near=path.length, slack=0.05) == pytest.approx(path.length + 3.0 - 0.8895)
 
 
+@pytest.mark.parametrize("dust", [0.0, 3.1e-15, 1.07e-14], ids=["exact", "3e-15", "1e-14"])
+def test_a_pass_through_the_junction_is_one_turn_whatever_the_round_off(dust):
+    """Campaign scenario 40: a timed vertex at the junction came out 3e-15 m up the leg.
+
+    The path must still pass straight from leg B onto C (no sliver of B after the junction), so
+    that on B its next leg is C: a drive told to stay on B would stop dead at the junction.
+    """
+    waypoints = [(1, 1.7, 0, 9.0), (1, dust, 0, 9.0), (2, 0.09, 0, 9.0), (2, 20.0, 0, 9.0)]
+    path = VehiclePath.from_waypoints(waypoints, 0)
+    assert path.legs == (1, 2)
+    assert path.s_to[0] == 0.0 and path.s_from[1] == 0.0
+    assert path.place(1.0)[4] == 2  # on B, heading for C
+    assert path.length == pytest.approx(1.7 + 20.0, abs=1e-12)
+    assert path.stops == ()
+
+
 # -- the braking check ---------------------------------------------------------------------------
 
 

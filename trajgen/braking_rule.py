@@ -125,6 +125,15 @@ def braking_rule_failures(
     vehicles = schedule.limits.vehicles
     emergency = np.array([v.emergency_braking for v in vehicles])[:, None]
     axis_at = schedule.state(times).axis
+    # each vehicle's reversals and its end, in travel: where its earliest rest is capped
+    tips = [np.array([*path.stops, path.length]) for path in paths]
+
+    def reversal(p: np.ndarray) -> np.ndarray:
+        """The next reversal (or end) ahead of travel ``p``, per vehicle; (2, n)."""
+        out = np.empty_like(p)
+        for i in (0, 1):
+            out[i] = tips[i][np.minimum(np.searchsorted(tips[i], p[i], side="left"), tips[i].size - 1)]
+        return out
 
     def margins(t: np.ndarray, step: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Margins ``F_j(e_i) - r_j`` at times ``t`` and how far they can fall in ``step``; (2, n) each.
@@ -137,7 +146,7 @@ def braking_rule_failures(
         p = travel[:, k] + np.abs(moved)
         direction = np.where(moved != 0.0, np.sign(moved), np.sign(state.velocity))
         speed = np.abs(state.velocity)
-        earliest = p + speed * speed / (2.0 * emergency)
+        earliest = np.minimum(p + speed * speed / (2.0 * emergency), np.maximum(reversal(p), p))
         out, fall = np.empty((2, t.size)), np.empty((2, t.size))
         for j in (0, 1):
             acceleration = direction[j] * state.acceleration[j]

@@ -50,7 +50,7 @@ _TOUCH = 1e-9
 _SHARED = 1e-6
 
 
-def earliest_rest(p: float, velocity: float, deceleration: float) -> float:
+def earliest_rest(p: float, velocity: float, deceleration: float, reversal: float = math.inf) -> float:
     """Earliest travel at which a vehicle at travel ``p`` moving at ``velocity`` (m/s) can be at rest.
 
     Parameters
@@ -61,14 +61,20 @@ def earliest_rest(p: float, velocity: float, deceleration: float) -> float:
         Rate of travel, m/s (a negative rate counts as rest: travel never runs back).
     deceleration : float
         The hardest braking possible (emergency), m/s².
+    reversal : float, optional
+        Travel of the next reversal (or the path's end), metres. A vehicle too fast to stop there
+        would come to rest beyond the tip, off its path; the tip stands for it, which only adds
+        places to rest (the frontier is a minimum over all places from here on).
 
     Examples
     --------
     >>> earliest_rest(3.0, 1.0, 2.0)
     3.25
+    >>> earliest_rest(3.0, 1.0, 2.0, reversal=3.1)
+    3.1
     """
     v = max(velocity, 0.0)
-    return p + v * v / (2.0 * deceleration)
+    return min(p + v * v / (2.0 * deceleration), max(reversal, p))
 
 
 @dataclass(frozen=True, slots=True)

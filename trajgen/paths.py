@@ -112,11 +112,14 @@ class VehiclePath:
         for b in waypoints[1:]:
             a = last
             leg_a, s_a, leg_b, s_b = a[2 * vehicle], a[2 * vehicle + 1], b[2 * vehicle], b[2 * vehicle + 1]
+            # round-off next to the junction (3e-15 for a timed vertex at it) is the junction: else the
+            # path would pass it through slivers of a segment that never quite reach it
+            s_a, s_b = (0.0 if s <= MOVE_RESOLUTION else s for s in (s_a, s_b))
             if abs(s_a - s_b) <= MOVE_RESOLUTION and (leg_a == leg_b or max(s_a, s_b) <= MOVE_RESOLUTION):
                 continue
             last = b
             if leg_a == leg_b or s_b == 0.0 or s_a == 0.0:
-                leg = leg_a if leg_a != JUNCTION_INDEX else leg_b
+                leg = leg_b if s_a == 0.0 else leg_a  # from the junction: the leg it enters
                 if pieces and pieces[-1][0] == leg and (pieces[-1][2] - pieces[-1][1]) * (s_b - s_a) > 0.0:
                     pieces[-1][2] = s_b  # the same move, split by the other vehicle's waypoint
                 else:

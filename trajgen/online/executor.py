@@ -26,6 +26,7 @@ The argument (separation, no deadlock, what a stop costs) is in docs/online.md.
 from __future__ import annotations
 
 import collections
+import bisect
 import logging
 import math
 
@@ -285,7 +286,10 @@ class Executor:
                 self._leave_plan(v, f"vehicle {v + 1} is off its setpoints", rebase=along[v])
         if self._next_goal is not None:
             return self._stop_for_goal(measured, along)
-        earliest = [earliest_rest(along[v].p, along[v].v, self._emergency[v]) for v in (0, 1)]
+        earliest = [
+            earliest_rest(s.p, s.v, self._emergency[v], self._paths[v].next_stop(s.p, 0.0))
+            for v, s in enumerate(along)
+        ]
         frontiers = (self._diagram.frontier(0, earliest[1]), self._diagram.frontier(1, earliest[0]))
         self._frontiers = frontiers
         proposals = [self._propose(v, frontiers[v]) for v in (0, 1)]
@@ -484,9 +488,31 @@ class Executor:
                 return None
             p = min(max(p, 0.0), path.length)
             heading = path.heading(p)
+            if heading * measured[v].velocity <= 0.0:
+                p = self._not_yet_reversed(v, p, slack)
+                heading = path.heading(p)
             out.append(PathState(p, heading * measured[v].velocity, heading * measured[v].acceleration))
             self._travel[v] = p
         return out[0], out[1]
+
+    def _not_yet_reversed(self, v: int, p: float, slack: float) -> float:
+        """``p``, or the same place before the reversal just behind it if ``v`` has not turned there yet.
+
+        Either side of a reversal, travel ``c - x`` and ``c + x`` are one place. A vehicle that was
+        before ``c`` in the last cycle and is not moving away from the tip now (a lagging drive still
+        approaching it, or resting short of it) is still before it: reading it as past the tip would
+        move its earliest rest point, and its follower's frontier, back.
+        """
+        path = self._paths[v]
+        k = bisect.bisect_right(path.stops, p) - 1
+        if k < 0:
+            return p
+        tip = path.stops[k]
+        mirrored = 2.0 * tip - p
+        before = path.stops[k - 1] if k else 0.0
+        if self._travel[v] < tip < p <= tip + slack and mirrored >= before:
+            return mirrored
+        return p
 
     def _departed(self, v: int, state: PathState) -> bool:
         """Whether ``v`` is off every setpoint of the last ``latency`` seconds (a drive may follow late)."""
