@@ -25,8 +25,8 @@ The argument (separation, no deadlock, what a stop costs) is in docs/online.md.
 
 from __future__ import annotations
 
-import collections
 import bisect
+import collections
 import logging
 import math
 
