@@ -6,6 +6,7 @@ distance with Ruckig's braking; seeded property tests of the frontier.
 
 from __future__ import annotations
 
+import itertools
 import math
 
 import numpy as np
@@ -117,7 +118,7 @@ def test_the_swap_has_two_conflicts_at_the_junction_each_led_by_the_vehicle_the_
 
 
 def test_the_frontier_in_closed_form_on_the_swap(swap_plan):
-    scenario, schedule = swap_plan
+    _scenario, schedule = swap_plan
     paths, times, _ = plan_paths(schedule)
     diagram = CoordinationDiagram(paths, 1.5, schedule, times)
     # agv1 follows at the first crossing: until agv2 can no longer stop short of the junction's
@@ -142,7 +143,7 @@ def test_a_frontier_never_moves_back_as_the_leaders_earliest_rest_moves_on(earli
     diagram = CoordinationDiagram(paths, 1.5, schedule, times)
     for follower in (0, 1):
         values = [diagram.frontier(follower, e) for e in sorted(earliest)]
-        assert all(b >= a for a, b in zip(values, values[1:], strict=False))
+        assert all(b >= a for a, b in itertools.pairwise(values))
         vector = diagram.frontiers(follower, np.array(sorted(earliest)))
         assert vector.tolist() == pytest.approx(values)
 

@@ -252,10 +252,17 @@ class VehiclePath:
             return 0.0 if same else None
         last = len(self.legs) - 1
         for k, seg_leg in enumerate(self.legs):
-            if seg_leg != leg and s != 0.0:
-                continue
             low, high = min(self.s_from[k], self.s_to[k]), max(self.s_from[k], self.s_to[k])
             outward = self.s_to[k] > self.s_from[k]
+            if seg_leg != leg and s != 0.0:
+                # on another leg, ``s`` from the junction: as far from this segment's junction end
+                if low > 0.0 or s > slack:
+                    continue
+                p = self.starts[k] + (low - self.s_from[k]) * (1.0 if outward else -1.0)
+                key = (s + max(abs(p - near) - slack, 0.0), abs(p - near))
+                if key < best_key:
+                    best, best_key = p, key
+                continue
             # the first and last segments run on along their leg: a vehicle before the start or past
             # the end of its path is at a travel below 0 or above the length
             if k == 0:

@@ -320,7 +320,7 @@ class Executor:
         command = self._command[v]
         motion = self._motions[v]
         at_rest = command.v <= AT_REST and abs(command.a) <= AT_REST
-        target = min(limit, path.next_stop(command.p, 1e-9 if at_rest else 0.0))
+        target = min(limit, path.next_stop(command.p, _AT if at_rest else 0.0))
         if target <= command.p + _AT and at_rest:
             return PathState(command.p, 0.0, 0.0), 0.0, None  # waits at its frontier or reversal
         if not self._stops_by(v, command, target):
@@ -376,12 +376,17 @@ class Executor:
         return self._emit(proposals, tuple(holding), certified=True)
 
     def _hold_orders(self) -> tuple[tuple[int, ...], ...]:
-        """Which vehicles to hold first: the followers of conflicts not yet passed, then both."""
+        """Which vehicles to hold first: the followers of conflicts not yet passed, then both.
+
+        The one with less room to its frontier first: a vehicle that leads now and follows only at a
+        later conflict keeps going, its follower waits.
+        """
         followers = [
             v
             for v in (0, 1)
             if any(c.follower == v for c in self._diagram.leading(1 - v, self._travel[1 - v]))
         ]
+        followers.sort(key=lambda v: self._frontiers[v] - self._travel[v])
         orders = [(v,) for v in followers] + [(0, 1)]
         return tuple(dict.fromkeys(orders))
 
@@ -556,7 +561,15 @@ class Executor:
         room = top - velocity if acceleration > 0.0 else velocity
         most = math.sqrt(max(2.0 * limits.max_jerk * room, 0.0))  # a must reach 0 within [0, top]
         acceleration = min(max(acceleration, -most), most)
-        return PathState(state.p, velocity, acceleration)
+        seed = PathState(state.p, velocity, acceleration)
+        # a drive closing a gap measures a transient acceleration; kept, it could carry the vehicle
+        # past its next reversal, which coasting from the same speed would not
+        tip = self._paths[v].next_stop(state.p, 0.0)
+        if acceleration > 0.0 and not self._stops_by(v, seed, tip):
+            coasting = PathState(state.p, velocity, 0.0)
+            if self._stops_by(v, coasting, tip):
+                return coasting
+        return seed
 
     # -- helpers ---------------------------------------------------------------------------------
     def _refuse(self, reason: str) -> GoalDecision:
