@@ -8,7 +8,7 @@ import numpy as np
 
 from limits import Limits
 from topology import Route
-from trajgen.methods.optimal.phases import NO_SWITCH, STATE_SIZE, NlpShape, Phase, stages
+from trajgen.methods.optimal.phases import DEPTH, DURATION, NO_SWITCH, STATE_SIZE, NlpShape, Phase, stages
 from trajgen.profiles import PiecewiseCubic
 from trajgen.schedule import AxisMap, CubicKinematics, Section
 
@@ -27,11 +27,15 @@ class PhaseSolution:
         ``s, v, a`` of vehicle 1 then vehicle 2 at each breakpoint (metres, m/s, m/s²).
     controls : ndarray, shape (m, 2)
         Jerk / max jerk of each vehicle on each interval.
+    depth : float, optional
+        The state ``c``: where the phase's reversing vehicle turns, metres from the junction
+        (0 if no vehicle reverses in it, or the value carried from an earlier phase).
     """
 
     times: np.ndarray
     states: np.ndarray
     controls: np.ndarray
+    depth: float = 0.0
 
 
 def unpack(
@@ -47,6 +51,7 @@ def unpack(
     intervals = shape.intervals
     out = []
     times = states = controls = None
+    depth = 0.0
     cursor = STATE_SIZE
     x = solution[:STATE_SIZE]
     for stage in stages(shape):
@@ -58,7 +63,8 @@ def unpack(
             )
             states[0] = x[:6]
         k = stage.interval
-        times[k + 1] = times[k] + x[STATE_SIZE - 1] * fractions[stage.phase, k]
+        times[k + 1] = times[k] + x[DURATION] * fractions[stage.phase, k]
+        depth = float(x[DEPTH])
         controls[k] = solution[cursor : cursor + 2]
         cursor += stage.control_size
         x = solution[cursor : cursor + STATE_SIZE]
@@ -68,7 +74,7 @@ def unpack(
             if stage.phase_end:
                 switching = phases[stage.phase].switching
                 states[-1, 3 * switching + 1 : 3 * switching + 3] *= -1.0
-            out.append(PhaseSolution(times, states, controls))
+            out.append(PhaseSolution(times, states, controls, depth))
     return out
 
 

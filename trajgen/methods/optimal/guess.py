@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from trajgen.errors import SolverError
-from trajgen.methods.optimal.phases import STATE_SIZE, NlpShape, Phase, stages
+from trajgen.methods.optimal.phases import DEPTH, DURATION, NlpShape, Phase, stages
 from trajgen.schedule import Schedule
 
 __all__ = ["assemble", "initial_guess", "phase_windows"]
@@ -27,16 +27,51 @@ def phase_windows(
     return [(float(edges[p]), float(max(edges[p + 1], edges[p] + _MIN_PHASE))) for p in range(len(phases))]
 
 
-def _phase_states(
-    exact: Schedule, phase: Phase, window: tuple[float, float], shape: NlpShape, fractions: np.ndarray
-) -> np.ndarray:
-    """Node states of one phase sampled from the exact schedule, shape (intervals + 1, 7), leg coordinates.
+def _split(exact: Schedule, phase: Phase, kind, window: tuple[float, float]) -> float:
+    """When the guess's first part of a phase ends: where its reversing vehicle turns, else halfway.
 
-    ``fractions`` (intervals,) is the phase's grid; each segment gets an equal share of the window.
+    The reversing vehicle's turning point in the exact schedule is the last instant of the window
+    at which it is farthest from the junction (sampled).
     """
     begin, end = window
-    intervals = shape.intervals
-    times = begin + (end - begin) * np.concatenate([[0.0], np.cumsum(fractions / shape.segments)])
+    vehicle = kind.reversing
+    if vehicle < 0:
+        return 0.5 * (begin + end)
+    times = np.linspace(begin, end, 401)
+    state = exact.state(times)
+    s = np.where(state.leg[vehicle] == phase.legs[vehicle], state.s[vehicle], 0.0)
+    turn = float(times[len(s) - 1 - int(np.argmax(s[::-1]))])
+    least = _MIN_PHASE / 2.0
+    return min(max(turn, begin + least), end - least)
+
+
+def _phase_states(
+    exact: Schedule,
+    phase: Phase,
+    window: tuple[float, float],
+    shape: NlpShape,
+    fractions: np.ndarray,
+    kind,
+    depth: float,
+) -> tuple[np.ndarray, float]:
+    """Node states of one phase sampled from the exact schedule, shape (intervals + 1, 8), leg coordinates.
+
+    ``fractions`` (intervals,) is the phase's grid. With two parts (``shape.braking``) the first
+    ends where the phase's reversing vehicle turns (:func:`_split`); each segment gets an equal
+    share of its part. ``depth`` is the state ``c`` carried from the phase before; returns the
+    states and the ``c`` this phase carries on.
+    """
+    begin, end = window
+    intervals, segments = shape.intervals, shape.segments
+    parts = 2 if shape.braking else 1
+    edges = [begin, _split(exact, phase, kind, window), end] if parts == 2 else [begin, end]
+    per_part = segments // parts
+    durations = np.concatenate(
+        [np.full(per_part, (edges[j + 1] - edges[j]) / per_part) for j in range(parts)]
+    )
+    steps = fractions * np.repeat(durations, shape.nodes)
+    times = begin + np.concatenate([[0.0], np.cumsum(steps)])
+    times[-1] = end
     state = exact.state(times)
     columns = []
     for vehicle in range(2):
@@ -46,7 +81,11 @@ def _phase_states(
         s = np.where(state.leg[vehicle] == phase.legs[vehicle], state.s[vehicle], 0.0)
         v = np.gradient(s, times)
         columns += [s, v, np.gradient(v, times)]
-    return np.column_stack([*columns, np.full(intervals + 1, (end - begin) / shape.segments)])
+    if kind.reversing >= 0 and parts == 2:
+        depth = float(columns[3 * kind.reversing][shape.part_intervals])
+    segment = np.repeat(durations, shape.nodes)
+    columns += [np.concatenate([segment, segment[-1:]]), np.full(intervals + 1, depth)]
+    return np.column_stack(columns), depth
 
 
 def initial_guess(
@@ -67,18 +106,18 @@ def initial_guess(
         The guess does not fit the NLP's layout (a bug: the caller falls back to ``exact``).
     """
     windows = phase_windows(phases, waypoint_times, exact.duration)
-    states = [
-        _phase_states(exact, phase, window, shape, fractions[p])
-        for p, (phase, window) in enumerate(zip(phases, windows, strict=True))
-    ]
+    states, depth = [], 0.0
+    for p, (phase, window) in enumerate(zip(phases, windows, strict=True)):
+        nodes, depth = _phase_states(exact, phase, window, shape, fractions[p], shape.kinds[p], depth)
+        states.append(nodes)
     return assemble(states, shape, size)
 
 
 def assemble(states: list[np.ndarray], shape: NlpShape, size: int) -> np.ndarray:
     """The stage-ordered variable vector from per-phase node states, shape (size,).
 
-    ``states[p]`` (intervals + 1, 7) are phase ``p``'s nodes in leg coordinates
-    with the segment duration last; controls start at 0.
+    ``states[p]`` (intervals + 1, 8) are phase ``p``'s nodes in leg coordinates
+    with the segment duration (of the segment each node starts) and ``c`` last; controls start at 0.
 
     Raises
     ------
@@ -88,7 +127,8 @@ def assemble(states: list[np.ndarray], shape: NlpShape, size: int) -> np.ndarray
     guess = list(states[0][0])
     for stage in stages(shape):
         node = states[stage.phase + 1][0] if stage.phase_end else states[stage.phase][stage.interval + 1]
-        guess += [0.0, 0.0] + ([float(node[STATE_SIZE - 1])] if stage.new_segment else [])
+        guess += [0.0, 0.0] + ([float(node[DURATION])] if stage.new_segment else [])
+        guess += [float(node[DEPTH])] if stage.new_depth else []
         guess += list(node)
     vector = np.array(guess, dtype=float)
     if vector.size != size:

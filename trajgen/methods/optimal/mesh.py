@@ -35,11 +35,13 @@ def _switch_strength(controls: np.ndarray) -> np.ndarray:
     return np.concatenate([[0.0], change, [0.0]])
 
 
-def _phase_nodes(phase: PhaseSolution, intervals: int) -> np.ndarray:
-    """New node times of one phase, shape (intervals + 1,), from 0 to the phase's duration."""
-    times = phase.times
-    duration = times[-1]
-    strength = _switch_strength(phase.controls)
+def _segment_nodes(times: np.ndarray, controls: np.ndarray, intervals: int) -> np.ndarray:
+    """New node times of one segment, shape (intervals + 1,), from its first time to its last."""
+    start, duration = times[0], times[-1] - times[0]
+    if duration <= 0.0:
+        return np.full(intervals + 1, start)
+    times = times - start
+    strength = _switch_strength(controls)
     around = 0.5 * (strength[:-1] + strength[1:])  # each switch spread over its two intervals
     mass = _EVEN_SHARE * np.diff(times) / duration
     total = around.sum()
@@ -48,7 +50,20 @@ def _phase_nodes(phase: PhaseSolution, intervals: int) -> np.ndarray:
     cumulative /= cumulative[-1]
     nodes = np.interp(np.linspace(0.0, 1.0, intervals + 1), cumulative, times)
     nodes[0], nodes[-1] = 0.0, duration
-    return nodes
+    return start + nodes
+
+
+def _phase_nodes(phase: PhaseSolution, segments: int, nodes: int) -> np.ndarray:
+    """New node times of one phase, shape (segments * nodes + 1,), segment by segment.
+
+    Each segment keeps its start and end (a part boundary, where a vehicle turns back, stays
+    one) and its nodes move within it.
+    """
+    out = [np.zeros(1)]
+    for j in range(segments):
+        span = slice(j * nodes, (j + 1) * nodes + 1)
+        out.append(_segment_nodes(phase.times[span], phase.controls[j * nodes : (j + 1) * nodes], nodes)[1:])
+    return np.concatenate(out)
 
 
 def refine(
@@ -68,13 +83,13 @@ def refine(
     -------
     fractions : ndarray, shape (phase_count, intervals)
         The new grid; each segment's shares sum to 1.
-    states : list of ndarray, shape (intervals + 1, 7) each
+    states : list of ndarray, shape (intervals + 1, 8) each
         Per phase, the previous solution at the new nodes in closed form, with
-        the new segment durations last (the phase durations are kept).
+        the new segment durations and the state ``c`` last (the segment durations are kept).
     """
     rows, states = [], []
     for phase in solution:
-        nodes = _phase_nodes(phase, shape.intervals)
+        nodes = _phase_nodes(phase, shape.segments, shape.nodes)
         h = np.diff(nodes).reshape(shape.segments, shape.nodes)
         durations = h.sum(axis=1)
         rows.append((h / durations[:, None]).ravel())
@@ -90,6 +105,6 @@ def refine(
                 a + dt * jerk,
             ]
         segment = np.repeat(durations, shape.nodes)
-        columns.append(np.concatenate([segment, segment[-1:]]))
+        columns += [np.concatenate([segment, segment[-1:]]), np.full(len(nodes), phase.depth)]
         states.append(np.column_stack(columns))
     return np.array(rows), states

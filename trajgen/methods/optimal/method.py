@@ -93,10 +93,11 @@ class Optimal(TimingMethod):
     fatrop_iterations : int, optional
         Iteration limit of fatrop (default 500; it converges in < 150 when it converges).
     time_budget : float, optional
-        Seconds the solvers may take (default 2.0; the one-time build of an NLP the cache does
+        Seconds the solvers may take (default 5.0; the one-time build of an NLP the cache does
         not hold yet is not counted): no solver starts after it is spent, no
-        refinement pass starts unless the previous one would fit in what is left, and Ipopt stops
-        by itself at half of it (a fatrop run under way finishes: fatrop has no wall-time limit).
+        refinement pass starts unless the previous one would fit in what is left, Ipopt stops
+        by itself at half of it, and a fatrop run that is not back by then is abandoned (fatrop
+        has no wall-time limit; its result is not used).
         If no class was solved by then, the ``exact`` schedule is returned, flagged ``time-budget``.
     refinements : int, optional
         Most mesh-refinement passes after the first solve (default 6): the grid's nodes move to the
@@ -127,11 +128,14 @@ class Optimal(TimingMethod):
     segments: int = 1
     max_iterations: int = 3000
     fatrop_iterations: int = 500
-    time_budget: float = 2.0
+    time_budget: float = 5.0
     refinements: int = 6
     refinement_tolerance: float = DEFAULT_REFINEMENT_TOLERANCE
     homotopy: HomotopyChoice = HomotopyChoice.FASTEST
     cache: SolverCache | None = field(default=None, compare=False, repr=False)
+    #: Internal: False leaves the braking rule out of the NLP (its schedules then fail verification;
+    #: for tests and benchmarks that show what the rule costs). Not an option of the method.
+    _braking: bool = field(default=True, repr=False)
 
     def __post_init__(self) -> None:
         _positive_int(self.nodes, "nodes")
@@ -181,6 +185,7 @@ class Optimal(TimingMethod):
             max_iterations=self.max_iterations,
             fatrop_iterations=self.fatrop_iterations,
             time_budget=float(self.time_budget),
+            braking=self._braking,
         )
 
     def warm_up(self, route: Route) -> bool:
@@ -475,6 +480,7 @@ def _parameters(route: Route, limits: Limits, phases, fractions: np.ndarray) -> 
         max_velocity=[v.max_velocity for v in vehicles],
         max_acceleration=[v.max_acceleration for v in vehicles],
         max_jerk=[v.max_jerk for v in vehicles],
+        emergency=[v.emergency_braking for v in vehicles],
         separation=separation,
         start=[p.s for p in route.start],
         goal=[p.s for p in route.goal],

@@ -6,10 +6,17 @@ phase has ``segments`` segments of free duration, each of ``nodes`` control
 intervals at fixed fractions of it (:func:`grid_fractions`). The stage
 sequence (:func:`stages`) is the one definition of the variable layout that
 the transcription, the initial guess and the decoding all walk.
+
+For the braking rule (:mod:`~.braking`) each phase also fixes which way each
+vehicle may move in it (:class:`Motion`, from the route's structure), and its
+segments form two **parts** of equal count: a vehicle whose motion is
+:attr:`Motion.REVERSING` moves outward in the first part and inward in the
+second, so that its one reversal is the boundary between the parts.
 """
 
 from __future__ import annotations
 
+import enum
 from collections.abc import Iterator
 from dataclasses import dataclass
 from typing import NamedTuple
@@ -19,8 +26,11 @@ import numpy as np
 from topology import JUNCTION_INDEX, Route
 
 __all__ = [
+    "DEPTH",
+    "DURATION",
     "NO_SWITCH",
     "STATE_SIZE",
+    "Motion",
     "NlpShape",
     "Phase",
     "PhaseKind",
@@ -33,10 +43,27 @@ __all__ = [
 
 #: ``Phase.switching`` of the last phase: nobody changes leg after it.
 NO_SWITCH = -1
-#: Node state: s1, v1, a1, s2, v2, a2 and T (the current segment's duration, carried as a state).
-STATE_SIZE = 7
+#: Node state: s1, v1, a1, s2, v2, a2, T (the current segment's duration) and c (where the phase's
+#: reversing vehicle turns, metres from the junction), the last two carried as states.
+STATE_SIZE = 8
+#: Index of T in the node state.
+DURATION = 6
+#: Index of c in the node state.
+DEPTH = 7
+#: A vehicle that starts at rest within this share of the separation beyond it may first have to back
+#: off from the junction before the other passes it: its first phase is :attr:`Motion.REVERSING`.
+_BACK_OFF = 1.05
 #: Weight of cosine (end-dense) spacing in the grid, 0 for uniform.
 _END_DENSITY = 0.35
+
+
+class Motion(enum.IntEnum):
+    """Which way a vehicle may move along its leg in a phase (``s`` grows outward)."""
+
+    FREE = 0  #: either way: the braking rule is stated for both
+    OUTWARD = 1  #: ``v >= 0`` all phase
+    INWARD = 2  #: ``v <= 0`` all phase
+    REVERSING = 3  #: ``v >= 0`` in the first part, ``v <= 0`` in the second: it turns at most once
 
 
 @dataclass(frozen=True, slots=True)
@@ -53,12 +80,15 @@ class Phase:
         Vehicle (0 or 1) that changes leg at the end of the phase; ``NO_SWITCH`` for the last.
     entry_waypoint : int
         Route waypoint at which the phase's region is entered (0 for the first phase).
+    motion : tuple of 2 Motion
+        Which way each vehicle may move in the phase (:func:`phase_motions`).
     """
 
     legs: tuple[int, int]
     nearer: int
     switching: int
     entry_waypoint: int
+    motion: tuple[Motion, Motion] = (Motion.FREE, Motion.FREE)
 
     def parked(self, vehicle: int) -> bool:
         """Whether ``vehicle`` stays at the junction for the whole phase."""
@@ -72,19 +102,75 @@ def route_phases(route: Route) -> tuple[Phase, ...]:
     junction while the other moves on one leg) has one phase.
     """
     entries = route.region_entries
+    start, goal = route.indexed_waypoints[0], route.indexed_waypoints[-1]
     if not entries:
-        start = route.indexed_waypoints[0]
         parked = 0 if start[0] == JUNCTION_INDEX else 1
-        moving_leg = start[2 * (1 - parked)]
+        mover = 1 - parked
+        moving_leg = start[2 * mover]
         legs = (JUNCTION_INDEX, moving_leg) if parked == 0 else (moving_leg, JUNCTION_INDEX)
-        return (Phase(legs, 0, NO_SWITCH, 0),)
+        motion = [Motion.FREE, Motion.FREE]
+        motion[mover] = Motion.OUTWARD if goal[2 * mover + 1] >= start[2 * mover + 1] else Motion.INWARD
+        return (Phase(legs, 0, NO_SWITCH, 0, (motion[0], motion[1])),)
     phases = []
     for p, (key, segment) in enumerate(entries):
         following = entries[p + 1][0] if p + 1 < len(entries) else None
         # the vehicle whose leg differs in the next region changes leg at the end of this phase
         switching = NO_SWITCH if following is None else (0 if following.first_leg != key.first_leg else 1)
         phases.append(Phase((key.first_leg, key.second_leg), key.nearer, switching, 0 if p == 0 else segment))
-    return tuple(phases)
+    return phase_motions(tuple(phases), start, goal, route.min_separation)
+
+
+def phase_motions(
+    phases: tuple[Phase, ...], start: tuple, goal: tuple, separation: float
+) -> tuple[Phase, ...]:
+    """``phases`` with the way each vehicle may move in each, for the braking rule (:mod:`~.braking`).
+
+    In a phase on two legs at whose end a vehicle ``w`` passes the junction, ``w`` moves
+    inward; the other, ``o``:
+
+    * if it has just passed the junction itself (or starts at it), moves outward: it leads, and
+      ``w`` follows it. If it comes back at the end of the next phase (it makes room for ``w`` on
+      its leg), it is :attr:`Motion.REVERSING`: it turns back in this phase, before ``w`` passes.
+    * otherwise (the route's first phase) it makes for the junction (if it passes it later) or
+      for its goal: outward if that lies outward, else inward; :attr:`Motion.REVERSING` if it
+      starts within about the separation of the junction and so may have to back off first.
+
+    Shared legs, the last phase and later phases that a vehicle starts on its leg are
+    :attr:`Motion.FREE`.
+
+    Parameters
+    ----------
+    phases : tuple of Phase
+    start, goal : tuple
+        The route's first and last indexed waypoints ``(leg1, s1, leg2, s2)``.
+    separation : float
+        The route's minimum separation, metres.
+    """
+    out = []
+    for p, phase in enumerate(phases):
+        motion = [Motion.FREE, Motion.FREE]
+        w = phase.switching
+        if phase.nearer == 0 and w != NO_SWITCH and not (phase.parked(0) or phase.parked(1)):
+            o = 1 - w
+            motion[w] = Motion.INWARD
+            returns_next = p + 1 < len(phases) and phases[p + 1].switching == o
+            passes_later = any(q.switching == o for q in phases[p + 1 :])
+            entered = (p > 0 and phases[p - 1].switching == o) or (p == 0 and start[2 * o] == JUNCTION_INDEX)
+            if entered:
+                motion[o] = Motion.REVERSING if returns_next else Motion.OUTWARD
+            elif p == 0:
+                here = start[2 * o + 1]
+                target = 0.0 if passes_later else (goal[2 * o + 1] if goal[2 * o] == phase.legs[o] else 0.0)
+                if target > here:
+                    motion[o] = Motion.OUTWARD
+                elif here < _BACK_OFF * separation:
+                    motion[o] = Motion.REVERSING
+                else:
+                    motion[o] = Motion.INWARD
+        out.append(
+            Phase(phase.legs, phase.nearer, phase.switching, phase.entry_waypoint, (motion[0], motion[1]))
+        )
+    return tuple(out)
 
 
 class PhaseKind(NamedTuple):
@@ -98,11 +184,23 @@ class PhaseKind(NamedTuple):
         0 on different legs; on a shared leg the vehicle (1 or 2) nearer the junction.
     switching : int
         Vehicle (0 or 1) that changes leg at the end of the phase; ``NO_SWITCH`` for the last.
+    motion : tuple of 2 Motion
+        Which way each vehicle may move in the phase.
+    joins : bool
+        The vehicle that changes leg at the phase end enters the other's leg (the next phase
+        is on a shared leg).
     """
 
     parked: tuple[bool, bool]
     nearer: int
     switching: int
+    motion: tuple[Motion, Motion] = (Motion.FREE, Motion.FREE)
+    joins: bool = False
+
+    @property
+    def reversing(self) -> int:
+        """The vehicle (0 or 1) that turns back between the phase's two parts, or -1."""
+        return next((v for v in (0, 1) if self.motion[v] is Motion.REVERSING), -1)
 
 
 @dataclass(frozen=True, slots=True)
@@ -116,7 +214,8 @@ class NlpShape:
     nodes : int
         Control intervals per segment.
     segments : int
-        Segments of free duration per phase.
+        Segments of free duration per phase (with ``braking``, an even number: half of them form
+        each of the phase's two parts).
     max_iterations : int
         Iteration limit of Ipopt.
     fatrop_iterations : int
@@ -125,6 +224,8 @@ class NlpShape:
         Wall time of the whole solve, seconds (each Ipopt attempt may take half of it).
     slot : int
         Which compiled copy: concurrent solves of one shape (two classes) use two copies.
+    braking : bool
+        Whether the NLP carries the braking rule (:mod:`~.braking`); off only to show what it costs.
     """
 
     kinds: tuple[PhaseKind, ...]
@@ -134,6 +235,7 @@ class NlpShape:
     fatrop_iterations: int
     time_budget: float = 2.0
     slot: int = 0
+    braking: bool = True
 
     @classmethod
     def of(
@@ -145,10 +247,26 @@ class NlpShape:
         max_iterations: int,
         fatrop_iterations: int,
         time_budget: float = 2.0,
+        braking: bool = True,
     ) -> NlpShape:
-        """The shape of the problem for ``phases`` with these options."""
-        kinds = tuple(PhaseKind((p.parked(0), p.parked(1)), p.nearer, p.switching) for p in phases)
-        return cls(kinds, nodes, segments, max_iterations, fatrop_iterations, time_budget)
+        """The shape of the problem for ``phases`` with these options.
+
+        With ``braking``, each phase has two parts of ``segments`` segments of ``ceil(nodes / 2)``
+        intervals (about as many intervals as without it): the layout :mod:`~.braking` needs.
+        """
+        kinds = tuple(
+            PhaseKind(
+                (p.parked(0), p.parked(1)),
+                p.nearer,
+                p.switching,
+                p.motion if braking else (Motion.FREE, Motion.FREE),
+                braking and k + 1 < len(phases) and phases[k + 1].nearer != 0,
+            )
+            for k, p in enumerate(phases)
+        )
+        if braking:
+            nodes, segments = max(1, (nodes + 1) // 2), 2 * segments
+        return cls(kinds, nodes, segments, max_iterations, fatrop_iterations, time_budget, braking=braking)
 
     @property
     def phase_count(self) -> int:
@@ -159,6 +277,15 @@ class NlpShape:
     def intervals(self) -> int:
         """Control intervals per phase."""
         return self.nodes * self.segments
+
+    @property
+    def part_intervals(self) -> int:
+        """Control intervals in the first part of a phase (all of them without ``braking``)."""
+        return self.intervals // 2 if self.braking else self.intervals
+
+    def reset_depth(self, phase: int) -> bool:
+        """Whether ``phase`` has a reversing vehicle, whose turning point ``c`` is a new state value."""
+        return self.braking and self.kinds[phase].reversing >= 0
 
 
 @dataclass(frozen=True, slots=True)
@@ -175,6 +302,12 @@ class Stage:
         A new segment starts after this interval: its control carries the next duration.
     phase_end : bool
         The last interval of a phase that is not the last: a vehicle changes leg after it.
+    part : int
+        0 in the first part of the phase, 1 in the second (:attr:`NlpShape.part_intervals`).
+    part_end : bool
+        The last interval of a phase's first part (with ``braking``): a reversing vehicle turns after it.
+    new_depth : bool
+        The next phase has a reversing vehicle: its control carries that phase's turning point ``c``.
     """
 
     phase: int
@@ -183,11 +316,14 @@ class Stage:
     last: bool
     new_segment: bool
     phase_end: bool
+    part: int = 0
+    part_end: bool = False
+    new_depth: bool = False
 
     @property
     def control_size(self) -> int:
-        """Controls of the stage: two jerks, plus the next segment's duration at a segment boundary."""
-        return 3 if self.new_segment else 2
+        """Controls: two jerks, the next segment's duration at a segment boundary, the next ``c``."""
+        return 2 + int(self.new_segment) + int(self.new_depth)
 
 
 def grid_fractions(nodes: int) -> np.ndarray:
@@ -209,15 +345,19 @@ def default_fractions(shape: NlpShape) -> np.ndarray:
 
 def stages(shape: NlpShape) -> Iterator[Stage]:
     """The stages in variable order: ``x_0, u_0, x_1, u_1, ...`` phase by phase."""
-    count, intervals = shape.phase_count, shape.intervals
+    count, intervals, half = shape.phase_count, shape.intervals, shape.part_intervals
     for p in range(count):
         for k in range(intervals):
             last = p == count - 1 and k == intervals - 1
+            phase_end = k == intervals - 1 and p < count - 1
             yield Stage(
                 phase=p,
                 interval=k,
                 first=p == 0 and k == 0,
                 last=last,
                 new_segment=(k + 1) % shape.nodes == 0 and not last,
-                phase_end=k == intervals - 1 and p < count - 1,
+                phase_end=phase_end,
+                part=int(k >= half),
+                part_end=shape.braking and k == half - 1,
+                new_depth=phase_end and shape.reset_depth(p + 1),
             )

@@ -13,6 +13,7 @@ from __future__ import annotations
 import collections
 import enum
 import logging
+import os
 import threading
 import time
 from collections.abc import Callable
@@ -27,6 +28,9 @@ __all__ = ["CompiledNlp", "Outcome", "SolveResult", "Solver", "SolverAttempt", "
 
 logger = logging.getLogger(__name__)
 
+#: Longest wait for one fatrop call without a deadline, and the grace past a deadline, seconds.
+_WATCHDOG_CAP = 60.0
+_WATCHDOG_GRACE = 0.05
 #: Iteration limit of the warm-started polish: it converges in < 20 when it is near a solution.
 _POLISH_MAX_ITER = 60
 
@@ -46,6 +50,7 @@ class Outcome(enum.Enum):
     NOT_CONVERGED = "not-converged"
     RAISED = "raised"
     OUT_OF_TIME = "out-of-time"  #: not tried: the time budget was spent
+    ABANDONED = "abandoned"  #: started, but not back by the deadline: left running, its result unused
 
 
 @dataclass(frozen=True, slots=True)
@@ -72,6 +77,8 @@ class SolverAttempt:
             return f"{self.solver.value} solved in {self.iterations} iterations"
         if self.outcome is Outcome.RAISED:
             return f"{self.solver.value} raised: {self.status}"
+        if self.outcome is Outcome.ABANDONED:
+            return f"{self.solver.value} {self.status}"
         if self.outcome is Outcome.OUT_OF_TIME:
             return f"{self.solver.value} not tried: {self.status}"
         return f"{self.solver.value} did not converge ({self.status}, {self.iterations} iterations)"
@@ -83,7 +90,7 @@ class CompiledNlp:
     Calls are serialized by a lock: a CasADi solver object is not reentrant.
     """
 
-    __slots__ = ("_lock", "_solvers", "shape", "transcription")
+    __slots__ = ("_lock", "_solvers", "abandoned", "shape", "transcription")
 
     def __init__(self, shape: NlpShape) -> None:
         import casadi as ca
@@ -91,6 +98,9 @@ class CompiledNlp:
         self.shape = shape
         self.transcription: Transcription = transcribe(shape)
         self._lock = threading.Lock()
+        #: Set when a solver call on this NLP never returned: its solver object stays busy in the
+        #: abandoned call, so the cache builds the shape afresh rather than reuse it.
+        self.abandoned = False
         nlp = self.transcription.nlp
         self._solvers: dict[Solver, object] = {
             Solver.FATROP: ca.nlpsol(
@@ -199,6 +209,9 @@ class SolverCache:
     def _cached(self, shape: NlpShape) -> CompiledNlp | None:
         with self._lock:
             entry = self._entries.get(shape)
+            if entry is not None and entry.abandoned:
+                del self._entries[shape]
+                return None
             if entry is not None:
                 self._entries.move_to_end(shape)
             return entry
@@ -250,6 +263,54 @@ class SolveResult:
         return self.attempts[-1].solver if self.solution is not None else None
 
 
+#: Status of a fatrop call that did not return by the deadline.
+_ABANDONED = "did not return by the deadline; abandoned (its NLP is rebuilt for the next solve)"
+
+
+def _call_with_watchdog(
+    solver, start: dict, parameters, bounds: dict, compiled: CompiledNlp, deadline: float
+):
+    """Run ``solver`` in a daemon thread; its ``(result, stats)``, or ``None`` if not back by the deadline.
+
+    fatrop 1.1.8 can loop forever in its inertia correction (seen on an NLP with the braking rule:
+    no iteration limit stops it). CasADi releases the GIL while it solves, so the caller goes on;
+    the abandoned call keeps its thread until the process ends, and ``compiled`` is marked so that
+    no later solve waits on it.
+    """
+    box: dict = {}
+
+    def run() -> None:
+        try:
+            box["result"] = solver(**start, p=parameters, **bounds)
+            box["stats"] = solver.stats()
+        except BaseException as error:  # handed to the caller's thread
+            box["error"] = error
+
+    thread = threading.Thread(target=run, name="trajgen-fatrop", daemon=True)
+    thread.start()
+    wait = deadline - time.perf_counter()
+    thread.join(min(max(wait, 0.0), _WATCHDOG_CAP) + _WATCHDOG_GRACE)
+    if thread.is_alive():
+        compiled.abandoned = True
+        _lowest_priority(thread)
+        logger.warning("optimal: fatrop %s", _ABANDONED)
+        return None
+    if "error" in box:
+        raise box["error"]
+    return box["result"], box["stats"]
+
+
+def _lowest_priority(thread: threading.Thread) -> None:
+    """Give an abandoned solver thread the lowest CPU priority, where the OS allows it per thread.
+
+    A thread cannot be stopped from outside; at ``nice 19`` it only takes otherwise idle CPU time.
+    """
+    try:
+        os.setpriority(os.PRIO_PROCESS, thread.native_id, 19)
+    except (AttributeError, OSError, TypeError):  # not Linux, or no native id: it keeps its priority
+        logger.debug("optimal: could not lower the priority of an abandoned solver thread")
+
+
 def solve(
     compiled: CompiledNlp, guess: np.ndarray, parameters: np.ndarray, *, deadline: float = float("inf")
 ) -> SolveResult:
@@ -274,8 +335,15 @@ def solve(
                 start = {"x0": guess}
             solver = compiled.solver(which)
             try:
-                result = solver(**start, p=parameters, **bounds)
-                stats = solver.stats()
+                if which is Solver.FATROP:
+                    call = _call_with_watchdog(solver, start, parameters, bounds, compiled, deadline)
+                    if call is None:
+                        attempts.append(SolverAttempt(which, Outcome.ABANDONED, -1, _ABANDONED))
+                        break
+                    result, stats = call
+                else:
+                    result = solver(**start, p=parameters, **bounds)
+                    stats = solver.stats()
             except RuntimeError as error:  # CasADi reports evaluation and solver errors as RuntimeError
                 attempts.append(SolverAttempt(which, Outcome.RAISED, -1, str(error)[:200]))
                 previous = None

@@ -1,8 +1,10 @@
 """Transcription of the multi-phase optimal-control problem into a parametric NLP (CasADi).
 
-Stage ``k`` has state ``x_k = (s1, v1, a1, s2, v2, a2, T)`` (``T`` the current
-segment's duration) and control ``u_k = (w1, w2)`` (jerk / max jerk), plus the
-next segment's duration on the last interval of a segment. Variables are
+Stage ``k`` has state ``x_k = (s1, v1, a1, s2, v2, a2, T, c)`` (``T`` the
+current segment's duration, ``c`` where the phase's reversing vehicle turns,
+:mod:`~.braking`) and control ``u_k = (w1, w2)`` (jerk / max jerk), plus the
+next segment's duration on the last interval of a segment and the next
+phase's ``c`` on the last interval of a phase before one with a reversal. Variables are
 ordered ``x_0, u_0, x_1, ...`` and each stage's constraints are its
 gap-closing dynamics ``x_{k+1} - F(x_k, u_k)`` followed by its path
 constraints: the layout fatrop's structure detection needs.
@@ -24,7 +26,14 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from trajgen.methods.optimal.phases import NO_SWITCH, STATE_SIZE, NlpShape, Stage, stages
+from trajgen.methods.optimal.braking import (
+    BRAKING_CURVATURE,
+    BRAKING_MARGIN,
+    BRAKING_SAMPLES,
+    VehicleSymbols,
+    braking_terms,
+)
+from trajgen.methods.optimal.phases import DEPTH, DURATION, STATE_SIZE, NlpShape, PhaseKind, Stage, stages
 
 __all__ = ["ParameterLayout", "Transcription", "transcribe"]
 
@@ -40,7 +49,8 @@ class ParameterLayout:
 
     Parameters, in order: per phase the two vehicles' leg lengths (metres,
     0 for a vehicle parked at the junction), then ``max_velocity``,
-    ``max_acceleration``, ``max_jerk`` (2 each), ``separation`` (1),
+    ``max_acceleration``, ``max_jerk``, ``emergency`` (the emergency
+    decelerations, m/s²) (2 each), ``separation`` (1),
     ``start`` and ``goal`` (each vehicle's ``s``, 2 each), and the grid:
     per phase and interval its share of its segment's duration
     (``phase_count * intervals``; each segment's shares sum to 1). The grid
@@ -58,6 +68,7 @@ class ParameterLayout:
             ("max_velocity", 2),
             ("max_acceleration", 2),
             ("max_jerk", 2),
+            ("emergency", 2),
             ("separation", 1),
             ("start", 2),
             ("goal", 2),
@@ -120,38 +131,63 @@ def _stacked(terms):
     return expression, (np.array([t[1] for t in terms]), np.array([t[2] for t in terms]))
 
 
+def _interior_state(s, v, a, jerk, tau):
+    """``(s, v, a)`` a time ``tau`` into an interval of constant ``jerk`` from ``(s, v, a)``."""
+    return (
+        s + tau * (v + tau * (a / 2.0 + tau * jerk / 6.0)),
+        v + tau * (a + tau * jerk / 2.0),
+        a + tau * jerk,
+    )
+
+
 @functools.lru_cache(maxsize=256)
 def _stage_function(
-    parked: tuple[bool, bool], nearer: int, switching: int, *, path: bool, between: bool
+    kind: PhaseKind,
+    *,
+    phase_end: bool,
+    path: bool,
+    between: bool,
+    braking: bool = False,
+    part: int = 0,
+    part_end: bool = False,
 ) -> _StageFunction:
     """The interval function of one kind of stage, built once and inlined into every NLP.
 
-    Inputs: ``x`` (7,) the node state, ``w`` (2,) jerk / max jerk, ``fraction``
-    the interval's share of the segment duration, ``limits`` (9,) the two leg
-    lengths, max velocities, accelerations, jerks and the separation. Outputs:
-    the exactly integrated next state (6,) (``v`` and ``a`` of the ``switching``
-    vehicle negated: it enters its new leg), the node constraints, the
-    between-node (Bernstein) constraints and the jerk regularization.
+    Inputs: ``x`` (8,) the node state, ``w`` (2,) jerk / max jerk, ``fraction``
+    the interval's share of the segment duration, ``limits`` (11,) the two leg
+    lengths, max velocities, accelerations, jerks, emergency decelerations and
+    the separation. Outputs: the exactly integrated next state (6,) (at a
+    ``phase_end``, ``v`` and ``a`` of the vehicle that switches negated: it
+    enters its new leg), the node constraints, the between-node (Bernstein)
+    constraints and the jerk regularization.
+
+    With ``braking``, the braking rule
+    (:mod:`~.braking`) joins the node constraints (``path``) and, at
+    :data:`~.braking.BRAKING_SAMPLES` inside the interval, the between-node
+    ones (``between``). At a ``part_end`` the reversing vehicle ends the
+    interval at rest at its turning point, the state ``c``.
     """
     import casadi as ca
 
-    x, w, fraction, limits = ca.SX.sym("x", STATE_SIZE), ca.SX.sym("w", 2), ca.SX.sym("f"), ca.SX.sym("q", 9)
-    lengths, v_max, a_max, j_max, separation = limits[0:2], limits[2:4], limits[4:6], limits[6:8], limits[8]
-    h = x[6] * fraction
+    x, w, fraction, limits = ca.SX.sym("x", STATE_SIZE), ca.SX.sym("w", 2), ca.SX.sym("f"), ca.SX.sym("q", 11)
+    lengths, v_max, a_max, j_max = limits[0:2], limits[2:4], limits[4:6], limits[6:8]
+    emergency, separation = limits[8:10], limits[10]
+    h = x[DURATION] * fraction
     following, cost = [], 0
     path_terms, between_terms = [], []  # (expression, low, high)
     inner: list[list] = [[], []]
+    reversing = kind.reversing if braking else -1
     for vehicle in range(2):
         s, v, a = x[3 * vehicle], x[3 * vehicle + 1], x[3 * vehicle + 2]
         jerk = j_max[vehicle] * w[vehicle]
         # exact integration of constant jerk over h
-        s_next = s + h * (v + h * (a / 2.0 + h * jerk / 6.0))
-        v_next = v + h * (a + h * jerk / 2.0)
-        a_next = a + h * jerk
-        if switching == vehicle:
+        s_next, v_next, a_next = _interior_state(s, v, a, jerk, h)
+        if part_end and vehicle == reversing:  # it turns back here, at rest, at c or beyond
+            path_terms += [(v_next / v_max[vehicle], 0.0, 0.0), (s_next - x[DEPTH], 0.0, np.inf)]
+        if phase_end and kind.switching == vehicle:
             v_next, a_next = -v_next, -a_next
         following += [s_next, v_next, a_next]
-        if parked[vehicle]:
+        if kind.parked[vehicle]:
             continue
         cost += _JERK_WEIGHT * h * w[vehicle] ** 2
         if path:
@@ -169,12 +205,30 @@ def _stage_function(
                 between_terms += [(c, 0.0, np.inf), (c - lengths[vehicle], -np.inf, 0.0)]
                 inner[vehicle].append(c)
     if path:
-        path_terms.append((_gap(nearer, x[0], x[3]) - separation, 0.0, np.inf))
+        path_terms.append((_gap(kind.nearer, x[0], x[3]) - separation, 0.0, np.inf))
     if inner[0] and inner[1]:
         for c_first, c_second in zip(inner[0], inner[1], strict=True):
-            between_terms.append((_gap(nearer, c_first, c_second) - separation, 0.0, np.inf))
+            between_terms.append((_gap(kind.nearer, c_first, c_second) - separation, 0.0, np.inf))
     elif inner[0] or inner[1]:  # the other vehicle is parked at the junction (s = 0)
         between_terms += [(c - separation, 0.0, np.inf) for c in inner[0] or inner[1]]
+    if braking:
+        margin = BRAKING_MARGIN + BRAKING_CURVATURE * h * h
+
+        def rule(tau):
+            symbols = []
+            for vehicle in range(2):
+                jerk = j_max[vehicle] * w[vehicle]
+                state = _interior_state(x[3 * vehicle], x[3 * vehicle + 1], x[3 * vehicle + 2], jerk, tau)
+                limits_of = (v_max[vehicle], a_max[vehicle], j_max[vehicle], emergency[vehicle])
+                symbols.append(VehicleSymbols(*state, *limits_of))
+            terms = braking_terms(kind, part, (symbols[0], symbols[1]), x[DEPTH], separation, margin)
+            return [(term, 0.0, np.inf) for term in terms]
+
+        if path:
+            path_terms += rule(0.0)
+        if between:
+            for share in BRAKING_SAMPLES:
+                between_terms += rule(share * h)
     path_expression, path_bounds = _stacked(path_terms)
     between_expression, between_bounds = _stacked(between_terms)
     function = ca.Function(
@@ -243,7 +297,7 @@ class _Builder:
                 high[3 * vehicle : 3 * vehicle + 3] = [0.0, 0.0, 0.0]
             elif vehicle not in pinned:
                 low[3 * vehicle] = 0.0
-        low[6] = MIN_SEGMENT
+        low[DURATION] = MIN_SEGMENT
         self.variables.append(x)
         self.lower.extend(low)
         self.upper.extend(high)
@@ -261,17 +315,20 @@ class _Builder:
         kind = kinds[stage.phase]
         u = ca.SX.sym(f"u{stage.phase}_{stage.interval}", stage.control_size)
         self.variables.append(u)
-        self.lower.extend([-1.0, -1.0] + ([MIN_SEGMENT] if stage.new_segment else []))
-        self.upper.extend([1.0, 1.0] + ([np.inf] if stage.new_segment else []))
+        extra_low = ([MIN_SEGMENT] if stage.new_segment else []) + ([-np.inf] if stage.new_depth else [])
+        self.lower.extend([-1.0, -1.0, *extra_low])
+        self.upper.extend([1.0, 1.0] + [np.inf] * len(extra_low))
         # The first and last intervals need no between-node bounds: from or to rest under constant
         # jerk, s, v and the gap there are monotone (all of the form c + d t^3), so the node values
         # bound them. Stating them anyway would tie inequalities to the rest equalities.
         function = _stage_function(
-            kind.parked,
-            kind.nearer,
-            kind.switching if stage.phase_end else NO_SWITCH,
+            kind,
+            phase_end=stage.phase_end,
             path=not stage.first,
             between=not (stage.first or stage.last),
+            braking=self.shape.braking,
+            part=stage.part,
+            part_end=stage.part_end,
         )
         lengths = parameters["lengths"][2 * stage.phase : 2 * stage.phase + 2]
         fraction = parameters["fractions"][stage.phase * self.shape.intervals + stage.interval]
@@ -280,17 +337,22 @@ class _Builder:
             parameters["max_velocity"],
             parameters["max_acceleration"],
             parameters["max_jerk"],
+            parameters["emergency"],
             parameters["separation"],
         )
         following, node_path, between, cost = function.function(x, u[:2], fraction, limits)
         next_phase = stage.phase + 1 if stage.phase_end else stage.phase
         pinned = (kind.switching,) if stage.phase_end else (0, 1) if stage.last else ()
         x_next = self.state(f"x{stage.phase}_{stage.interval + 1}", next_phase, pinned)
-        self.constrain(x_next - ca.vertcat(following, u[2] if stage.new_segment else x[6]), 0.0, 0.0)
+        duration = u[2] if stage.new_segment else x[DURATION]
+        depth = u[stage.control_size - 1] if stage.new_depth else x[DEPTH]
+        self.constrain(x_next - ca.vertcat(following, duration, depth), 0.0, 0.0)
         if stage.interval == 0 and stage.phase > 0:  # the vehicle that changed leg is at the junction
             self.constrain(x[3 * kinds[stage.phase - 1].switching], 0.0, 0.0)
         if stage.first:  # rest at the start, which the planner has checked: no node constraints
             self.at_rest(x, stage.phase, parameters["start"])
+            if not self.shape.reset_depth(0):  # no reversal in the first phase: c starts at 0
+                self.constrain(x[DEPTH], 0.0, 0.0)
         if node_path.numel():
             self.constrain(node_path, *function.path_bounds)
         if between.numel():
@@ -307,7 +369,7 @@ def transcribe(shape: NlpShape) -> Transcription:
     symbols = ca.SX.sym("p", layout.size)
     parameters = layout.split(symbols)
     x = builder.state("x0", 0, (0, 1))
-    builder.objective += x[6]
+    builder.objective += x[DURATION]
     for stage in stages(shape):
         x = builder.stage(stage, x, parameters)
     builder.at_rest(x, shape.phase_count - 1, parameters["goal"])  # checked by the planner
