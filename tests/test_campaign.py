@@ -2,7 +2,9 @@
 
 300 scenarios from :func:`trajgen.sampling.campaign_scenarios` (legs 0.5-5000 m,
 independent limits, separations up to the shortest leg, swaps and random
-goals). ``benchmarks/bench_campaign.py`` prints the same campaign's figures.
+goals): ``exact`` and ``toppra`` on all of them, ``optimal`` (seconds per solve)
+on every :data:`OPTIMAL_EVERY`-th. ``benchmarks/bench_campaign.py`` prints the
+same campaign's figures, ``optimal`` on all 300.
 """
 
 from __future__ import annotations
@@ -13,6 +15,9 @@ from trajgen import METHODS, Optimal, SolverCache, certify, make_schedule
 from trajgen.sampling import campaign_scenarios
 
 SCENARIOS = campaign_scenarios(300, seed=9)
+CHUNK = 25
+#: ``optimal`` is solved on the scenarios whose index is a multiple of this.
+OPTIMAL_EVERY = 12
 
 
 @pytest.fixture(scope="module")
@@ -28,16 +33,21 @@ def test_the_campaign_spans_the_whole_range():
     assert sum(s.goal == s.start.swapped() for s in SCENARIOS) >= 70
 
 
-@pytest.mark.parametrize("chunk", range(6), ids=lambda k: f"scenarios-{50 * k}-{50 * k + 49}")
+@pytest.mark.parametrize(
+    "chunk", range(len(SCENARIOS) // CHUNK), ids=lambda k: f"scenarios-{CHUNK * k}-{CHUNK * k + CHUNK - 1}"
+)
 def test_every_schedule_of_every_method_verifies(methods, chunk, record_property):
     fallbacks = dict.fromkeys((m.name for m in methods), 0)
-    for scenario in SCENARIOS[50 * chunk : 50 * chunk + 50]:
+    for index in range(CHUNK * chunk, CHUNK * chunk + CHUNK):
+        scenario = SCENARIOS[index]
         route = scenario.plan()
         for method in methods:
+            if method.name == "optimal" and index % OPTIMAL_EVERY:
+                continue
             schedule = make_schedule(route, scenario.limits, method=method)
             certify(schedule)  # raises VerificationError, naming every failure, if one does not verify
             fallbacks[method.name] += schedule.fallback_reason is not None
     record_property("fallbacks", fallbacks)
     assert fallbacks["exact"] == 0
     assert fallbacks["toppra"] <= 2
-    assert fallbacks["optimal"] <= 5  # flagged and verified; the campaign's count is in the benchmark
+    assert fallbacks["optimal"] <= 1  # flagged and verified; the campaign's count is in the benchmark

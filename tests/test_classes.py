@@ -17,7 +17,6 @@ from tests.helpers import AGV, LIMITS, MIXED, SLOW, route_of
 from topology import Homotopy, WayRound, plan
 from trajgen import FallbackReason, Optimal, SolverCache, lower_bound, verify
 from trajgen.analysis import class_lower_bound
-from trajgen.braking_rule import braking_rule_failures
 from trajgen.cli import EXIT_BAD_INPUT, EXIT_OK, main
 from trajgen.methods.optimal import Solver, Source
 from trajgen.sampling import random_scenarios
@@ -43,30 +42,21 @@ def swap_route(legs):
 def test_the_faster_class_wins_the_issue_swaps(legs, vehicles, baseline, before):
     limits = Limits(vehicles, 1.5)
     route = swap_route(legs)
-    # a generous budget: what is tested is the class each choice takes, not the solve time
-    fastest = Optimal(time_budget=30.0).schedule(route, limits)
-    paper = Optimal(homotopy="paper", time_budget=30.0).schedule(route, limits)
+    fastest = Optimal().schedule(route, limits)
+    paper = Optimal(homotopy="paper").schedule(route, limits)
     report = verify(fastest)
     assert report.passed, report.failures
     assert report.regions_match  # the regions of the class it says it took
     assert fastest.fallback_reason is None
+    assert paper.fallback_reason is None
     assert fastest.route.homotopy is Homotopy.OTHER
     assert fastest.route.way_round is WayRound.CLOCKWISE  # a swap's paper class is counterclockwise
     assert fastest.route.regions != route.regions
-    # the braking rule, which neither the baseline nor the plans of then kept, costs under 1 %
-    assert fastest.duration <= baseline * 1.01
-    assert braking_rule_failures(fastest) == []
-    assert verify(paper).passed
-    if paper.fallback_reason is not None:
-        # fatrop 1.1.8 loops forever on the paper class of the four-times-faster swap (the
-        # watchdog abandons it): the verified exact schedule is returned, and says why
-        assert paper.fallback_reason is FallbackReason.TIME_BUDGET
-        assert "abandoned" in paper.notes[0]
-        return
     assert paper.route.homotopy is Homotopy.PAPER
     assert paper.route.regions == route.regions
+    assert fastest.duration <= baseline * (1 + 1e-4)  # never slower than the issue's prioritized baseline
     assert fastest.duration < 0.93 * paper.duration
-    assert paper.duration < before * 1.01  # the paper's class: about as fast as with the fixed grid
+    assert paper.duration < before  # the paper's class is faster too than with the fixed grid
     classes = fastest.info.classes
     assert [(c.homotopy, c.chosen) for c in classes] == [(Homotopy.PAPER, False), (Homotopy.OTHER, True)]
     assert classes[1].makespan == pytest.approx(fastest.duration, rel=1e-12)
@@ -122,9 +112,8 @@ def test_the_default_agrees_with_a_converged_solve(legs, start, goal, limits):
 def test_mesh_refinement_makes_a_long_track_accurate():
     # issue 10: on 200/120/80 m the fixed 32-node grid was 1.1 % over the converged 404.00 s
     route = swap_route((200.0, 120.0, 80.0))
-    # a generous budget: one pass on this track takes seconds with the braking rule in the NLP
-    refined = Optimal(homotopy="paper", time_budget=60.0).schedule(route, LIMITS)
-    first_grid = Optimal(homotopy="paper", refinements=0, time_budget=60.0).schedule(route, LIMITS)
+    refined = Optimal(homotopy="paper").schedule(route, LIMITS)
+    first_grid = Optimal(homotopy="paper", refinements=0).schedule(route, LIMITS)
     assert verify(refined).passed
     assert refined.info.refinements >= 1
     assert refined.info.source is Source.NLP

@@ -6,9 +6,9 @@ distance with Ruckig's braking; seeded property tests of the frontier.
 
 from __future__ import annotations
 
+import dataclasses
 import itertools
 import math
-import re
 
 import numpy as np
 import pytest
@@ -20,7 +20,7 @@ from limits import Limits, VehicleLimits
 from tests.conftest import REPO
 from tests.helpers import conf
 from topology import YGraph, plan
-from trajgen import Exact, FallbackReason, Optimal, Toppra, certify, load_scenario
+from trajgen import Exact, Optimal, Toppra, certify, load_scenario, verify
 from trajgen.braking_rule import BRAKING_RULE_TOLERANCE, braking_rule_failures
 from trajgen.coordination import (
     CoordinationDiagram,
@@ -181,7 +181,7 @@ def test_every_methods_plan_for_execution_obeys_the_braking_rule(path, method):
 @pytest.fixture(scope="module")
 def optimal_swap():
     scenario = load_scenario(SWAP)
-    return scenario, Optimal().schedule(scenario.plan(), scenario.limits)
+    return scenario, Optimal(braking_rule=True).schedule(scenario.plan(), scenario.limits)
 
 
 def test_the_rule_binds_the_optimal_swap_two_centimetres_more_is_refused(optimal_swap):
@@ -200,12 +200,15 @@ def test_verify_refuses_a_plan_that_breaks_the_rule_naming_when_and_where(optima
     from trajgen.schedule import Schedule
 
     scenario = load_scenario(SWAP)
-    # the time-optimal swap without the rule in the NLP: agv2 follows agv1 through the junction
-    # closer than its service braking can keep: verify refuses it, so the method falls back
-    unruled = Optimal(_braking=False)
-    fallen = unruled.schedule(scenario.plan(), scenario.limits)
-    assert fallen.fallback_reason is FallbackReason.VERIFICATION_FAILED
-    assert re.search(r"vehicle [12] cannot stop short of its frontier at t=\d+\.\d+ s", fallen.notes[0])
+    # the time-optimal swap without the rule in the NLP, claimed to be a plan for execution:
+    # agv2 follows agv1 through the junction closer than its service braking can keep
+    unruled = Optimal().schedule(scenario.plan(), scenario.limits)
+    assert unruled.fallback_reason is None
+    assert verify(unruled).passed  # a timed profile: safe as long as it is followed to the letter
+    claimed = dataclasses.replace(unruled, method=Optimal(braking_rule=True))
+    frontier = r"vehicle [12] cannot stop short of its frontier at t=\d+\.\d+ s"
+    with pytest.raises(VerificationError, match=frontier):
+        certify(claimed)
     # and the optimal plan with the rule, claimed for a 5 cm larger separation, is refused by name
     _, schedule = optimal_swap
     relabelled = Schedule(

@@ -130,6 +130,14 @@ class TimingMethod(abc.ABC):
     def schedule(self, route: Route, limits: Limits) -> Schedule:
         """Time-parameterize ``route`` under ``limits`` (unverified: see :func:`trajgen.verify.certify`)."""
 
+    @property
+    def plans_for_execution(self) -> bool:
+        """Whether its schedules obey the braking rule (:mod:`trajgen.braking_rule`): verify checks it.
+
+        ``exact`` and ``toppra`` plans always do; ``optimal`` ones with ``braking_rule=True``.
+        """
+        return True
+
     def __str__(self) -> str:
         return self.name
 

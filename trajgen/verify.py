@@ -344,6 +344,12 @@ def _check_tiling(schedule: Schedule, pieces: Pieces, failures: list[str]) -> No
         )
 
 
+def _for_execution(schedule: Schedule) -> bool:
+    """Whether the schedule's method plans for execution (its plans then obey the braking rule)."""
+    method = schedule.method
+    return method is None or bool(getattr(method, "plans_for_execution", True))
+
+
 def _verify(schedule: Schedule) -> VerificationReport:
     own = array_failures(schedule)
     if own:  # the motion is read from these numbers: broken ones make every other check meaningless
@@ -386,9 +392,9 @@ def _verify(schedule: Schedule) -> VerificationReport:
     if not pieces.count and start_gap < required - POSITION_TOLERANCE:
         failures.append(f"separation {start_gap:.9g} m at rest is below the minimum {required:g} m")
     _check_piece_continuity(pieces, track, schedule, failures)
-    if not failures and schedule.end_tolerance is None:
-        # a method's plan: each follower can always stop short of its frontier (a table read back
-        # follows a plan that was checked; its own round-off is not an execution)
+    if not failures and schedule.end_tolerance is None and _for_execution(schedule):
+        # a plan for execution: each follower can always stop short of its frontier (a table read
+        # back follows a plan that was checked; its own round-off is not an execution)
         for failure in braking_rule_failures(schedule, pieces=pieces):
             k = int(
                 np.clip(np.searchsorted(pieces.start, failure.time, side="right") - 1, 0, pieces.count - 1)

@@ -11,9 +11,11 @@ where they stand, the timing method times it, the verifier certifies it
 
 from __future__ import annotations
 
+import dataclasses
+
 from limits import Limits
 from topology import Configuration, StarGraph, plan
-from trajgen.methods import make_schedule
+from trajgen.methods import METHODS, Optimal, make_schedule
 from trajgen.schedule import TimingMethod
 from trajgen.verify import VerifiedSchedule, certify
 
@@ -53,7 +55,15 @@ def plan_from_rest(
     separation = limits.min_separation + 2.0 * margin
     planned = Limits(limits.vehicles, separation)
     route = plan(graph, start, goal, min_separation=separation)
-    return certify(make_schedule(route, planned, method=method))
+    return certify(make_schedule(route, planned, method=for_execution(method)))
+
+
+def for_execution(method: TimingMethod | str | None) -> TimingMethod:
+    """``method`` as it plans for execution: ``optimal`` with the braking rule in its problem."""
+    resolved = METHODS.create(method)
+    if not resolved.plans_for_execution and isinstance(resolved, Optimal):
+        return dataclasses.replace(resolved, braking_rule=True)
+    return resolved
 
 
 def plan_for_execution(

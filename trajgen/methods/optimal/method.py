@@ -99,6 +99,12 @@ class Optimal(TimingMethod):
         by itself at half of it, and a fatrop run that is not back by then is abandoned (fatrop
         has no wall-time limit; its result is not used).
         If no class was solved by then, the ``exact`` schedule is returned, flagged ``time-budget``.
+    braking_rule : bool, optional
+        State the braking rule (:mod:`trajgen.braking_rule`) in the problem (default ``False``), so
+        that the plan can be executed by the order-keeping :class:`~trajgen.online.Executor`
+        without holds; verify then checks it. Slower (seconds per solve), and fatrop may stall on
+        it (the time budget's watchdog then abandons the call); the executor's
+        :func:`~trajgen.online.plan_for_execution` turns it on.
     refinements : int, optional
         Most mesh-refinement passes after the first solve (default 6): the grid's nodes move to the
         jerk switches of the previous pass and the same compiled NLP is solved again (see
@@ -133,9 +139,7 @@ class Optimal(TimingMethod):
     refinement_tolerance: float = DEFAULT_REFINEMENT_TOLERANCE
     homotopy: HomotopyChoice = HomotopyChoice.FASTEST
     cache: SolverCache | None = field(default=None, compare=False, repr=False)
-    #: Internal: False leaves the braking rule out of the NLP (its schedules then fail verification;
-    #: for tests and benchmarks that show what the rule costs). Not an option of the method.
-    _braking: bool = field(default=True, repr=False)
+    braking_rule: bool = False
 
     def __post_init__(self) -> None:
         _positive_int(self.nodes, "nodes")
@@ -185,8 +189,13 @@ class Optimal(TimingMethod):
             max_iterations=self.max_iterations,
             fatrop_iterations=self.fatrop_iterations,
             time_budget=float(self.time_budget),
-            braking=self._braking,
+            braking=self.braking_rule,
         )
+
+    @property
+    def plans_for_execution(self) -> bool:
+        """Whether its schedules obey the braking rule: with ``braking_rule``."""
+        return self.braking_rule
 
     def warm_up(self, route: Route) -> bool:
         """Build the NLPs that ``route``'s classes need into the cache now; returns whether any was built."""
