@@ -546,9 +546,9 @@ def test_simulate_under_faults_on_a_crossing_keeps_the_separation(tmp_path, caps
     assert summary["violations"] == 0
     assert summary["min_separation_m"] >= 1.5
     assert summary["certified_separation_m"] >= 1.5
-    assert summary["replans"] >= 1
-    kinds = [e["kind"] for e in summary["events"]]
-    assert "recover" in kinds
+    # the plan's order is kept: only a new goal re-plans, a stop never does
+    new_goals = sum(f.startswith("goal:") for f in faults)
+    assert summary["replans"] == new_goals
     # the executed motion, traced: legs 1-based up to 4, never closer than the separation
     traces = [read_csv(tmp_path / f"{name}.csv") for name in ("agv1", "agv2")]
     for columns in traces:

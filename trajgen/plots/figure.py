@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import io
 
-__all__ = ["PNG_DPI", "frame_painter", "new_figure", "png_bytes"]
+__all__ = ["PNG_DPI", "frame_painter", "new_figure", "png_bytes", "polygon_patch"]
 
 #: Resolution of the PNGs, dots per inch.
 PNG_DPI = 110
@@ -21,6 +21,13 @@ def new_figure(*, figsize: tuple[float, float]):
     from matplotlib.figure import Figure
 
     return Figure(figsize=figsize)
+
+
+def polygon_patch(vertices, *, facecolor, alpha: float, edgecolor):
+    """A closed matplotlib polygon patch through ``vertices`` (array of shape (n, 2))."""
+    from matplotlib.patches import Polygon
+
+    return Polygon(vertices, closed=True, facecolor=facecolor, alpha=alpha, edgecolor=edgecolor)
 
 
 def png_bytes(figure) -> bytes:

@@ -8,7 +8,7 @@ import numpy as np
 
 from topology.validation import short_repr
 from trajgen.errors import InputError
-from trajgen.plots.figure import new_figure, png_bytes
+from trajgen.plots.figure import new_figure, png_bytes, polygon_patch
 from trajgen.plots.speed import VEHICLE_COLOURS
 
 __all__ = ["render_simulation"]
@@ -61,8 +61,6 @@ def _progress(axis, result, names) -> None:
 
 def _coordination(axis, result, names, min_separation: float) -> None:
     """The plan's conflicts in the plane of both vehicles' travel, the plan's curve and the executed one."""
-    from matplotlib.patches import Polygon as PolygonPatch
-
     from trajgen.coordination import CoordinationDiagram, plan_paths
 
     schedule = result.schedule.schedule
@@ -71,7 +69,7 @@ def _coordination(axis, result, names, min_separation: float) -> None:
     for conflict in diagram.conflicts:
         colour = VEHICLE_COLOURS[conflict.leader]
         for polygon in conflict.polygons:
-            axis.add_patch(PolygonPatch(polygon, closed=True, facecolor=colour, alpha=0.25, edgecolor="none"))
+            axis.add_patch(polygon_patch(polygon, facecolor=colour, alpha=0.25, edgecolor="none"))
     axis.plot(travel[0], travel[1], color="black", linestyle="--", linewidth=0.9, label="plan")
     replanned = [event.time for event in result.events if event.kind == "replan"]
     t = np.asarray(result.plot["t"])

@@ -209,7 +209,7 @@ class SolverCache:
     def _cached(self, shape: NlpShape) -> CompiledNlp | None:
         with self._lock:
             entry = self._entries.get(shape)
-            if entry is not None and entry.abandoned:
+            if entry is not None and getattr(entry, "abandoned", False):
                 del self._entries[shape]
                 return None
             if entry is not None:
