@@ -392,6 +392,14 @@ def stopping_distance(
     t1 = max((a0 + peak) / j_max, 0.0)
     v1 = v0 + a0 * t1 - j_max * t1 * t1 / 2.0
     t2 = max((v1 - peak * peak / (2.0 * j_max)) / peak, 0.0) if peak > 0.0 else 0.0
+    return _three_phase_distance(v0, a0, j_max, peak, t1, v1, t2)
+
+
+def _three_phase_distance(v0, a0, j_max, peak, t1, v1, t2):
+    """Distance of the S-curve stop: jerk down to ``-peak`` (``t1``), hold it (``t2``), jerk back to 0.
+
+    Floats or arrays alike (``v1``: the speed after the first phase; the last phase lasts ``peak / j_max``).
+    """
     v2 = v1 - peak * t2
     t3 = peak / j_max
     return (
@@ -425,18 +433,7 @@ def stopping_distances(
     v1 = v0 + a0 * t1 - j_max * t1 * t1 / 2.0
     cruise = np.divide(v1 - peak * peak / (2.0 * j_max), peak, out=np.zeros_like(v1), where=peak > 0.0)
     t2 = np.maximum(cruise, 0.0)
-    v2 = v1 - peak * t2
-    t3 = peak / j_max
-    distance = (
-        v0 * t1
-        + a0 * t1 * t1 / 2.0
-        - j_max * t1**3 / 6.0
-        + v1 * t2
-        - peak * t2 * t2 / 2.0
-        + v2 * t3
-        - peak * t3 * t3 / 2.0
-        + j_max * t3**3 / 6.0
-    )
+    distance = _three_phase_distance(v0, a0, j_max, peak, t1, v1, t2)
     at_rest = (v0 <= 0.0) & (a0 <= 0.0)
     return np.where(at_rest, 0.0, np.where(overdone, d_zero, distance))
 
