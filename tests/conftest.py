@@ -7,13 +7,16 @@ from pathlib import Path
 
 from hypothesis import HealthCheck, settings
 
+# "seeded" (the default): what CI runs. "thorough": twenty times the examples, for a release or a
+# change to the planner (HYPOTHESIS_PROFILE=thorough); tests that set max_examples keep theirs.
 settings.register_profile(
     "seeded",
     derandomize=True,
-    max_examples=300,
+    max_examples=50,
     deadline=None,
     suppress_health_check=[HealthCheck.too_slow, HealthCheck.filter_too_much],
 )
+settings.register_profile("thorough", settings.get_profile("seeded"), max_examples=1000)
 settings.load_profile(os.environ.get("HYPOTHESIS_PROFILE", "seeded"))
 
 #: The repository (a clone of it): the tests read nothing outside it (tests/test_clone.py).

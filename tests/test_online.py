@@ -187,7 +187,7 @@ def track_distance(paths, first: np.ndarray, second: np.ndarray) -> np.ndarray:
     return np.array(out)
 
 
-@settings(max_examples=150, derandomize=True, deadline=None)
+@settings(max_examples=60, derandomize=True, deadline=None)
 @given(
     data=st.data(),
     fraction=st.floats(0.0, 1.0),
