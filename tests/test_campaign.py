@@ -17,7 +17,7 @@ from trajgen.sampling import campaign_scenarios
 SCENARIOS = campaign_scenarios(300, seed=9)
 CHUNK = 10
 #: ``exact`` and ``toppra`` are timed on the scenarios whose index is a multiple of this ...
-EVERY = 3
+EVERY = 6
 #: ... and ``optimal`` on those whose index is a multiple of this.
 OPTIMAL_EVERY = 24
 

@@ -187,7 +187,7 @@ def track_distance(paths, first: np.ndarray, second: np.ndarray) -> np.ndarray:
     return np.array(out)
 
 
-@settings(max_examples=60, derandomize=True, deadline=None)
+@settings(max_examples=30, derandomize=True, deadline=None)
 @given(
     data=st.data(),
     fraction=st.floats(0.0, 1.0),
@@ -289,7 +289,7 @@ def test_a_stop_costs_about_its_own_length(plans, name, method, fault):
     assert result.makespan_s - result.planned_s <= stop_bound(scenario, faults[0].value), result.summary()
 
 
-@settings(max_examples=6, deadline=None)
+@settings(max_examples=3, deadline=None)
 @given(moment=st.floats(0.0, 1.0), duration=st.floats(0.2, 8.0), vehicle=st.sampled_from([0, 1]))
 @pytest.mark.parametrize("method", ["exact", "toppra", "optimal"])
 @pytest.mark.parametrize("name", ["swap", "crossing"])
@@ -407,7 +407,7 @@ def test_nothing_but_a_goal_re_plans(plans):
     assert result.replans == 0
 
 
-@settings(max_examples=12, derandomize=True, deadline=None)
+@settings(max_examples=6, derandomize=True, deadline=None)
 @given(
     name=st.sampled_from(["swap", "crossing"]),
     vehicle=st.sampled_from(["agv1", "agv2"]),
@@ -463,8 +463,10 @@ def test_a_drive_still_short_of_its_reversal_is_read_before_it(swap):
 CAMPAIGN_SEED = 11
 
 
-CAMPAIGN_REGRESSIONS = [(k, None) for k in (121, 180, 191, 6, 113, 155, 187)]
-CAMPAIGN_REGRESSIONS += [(40, "exact"), (132, "exact")]
+# the three with the default method (optimal); the executor's own regressions with exact,
+# whose plans reach the same situations in a fraction of the planning time
+CAMPAIGN_REGRESSIONS = [(k, None) for k in (121, 180, 191)]
+CAMPAIGN_REGRESSIONS += [(k, "exact") for k in (6, 113, 155, 187, 40, 132)]
 
 
 @pytest.mark.parametrize(
