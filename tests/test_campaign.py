@@ -19,7 +19,7 @@ CHUNK = 10
 #: ``exact`` and ``toppra`` are timed on the scenarios whose index is a multiple of this ...
 EVERY = 6
 #: ... and ``optimal`` on those whose index is a multiple of this.
-OPTIMAL_EVERY = 24
+OPTIMAL_EVERY = 48
 
 
 @pytest.fixture(scope="module")

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import argparse
 import logging
+import os
 import sys
 from collections.abc import Sequence
 
@@ -17,7 +18,7 @@ from trajgen.cli import animate, check, schedule, simulate, vda5050
 from trajgen.cli.options import EXIT_BAD_INPUT, EXIT_FAILURE, CommandParser
 from trajgen.errors import InputError
 
-__all__ = ["COMMAND_MODULES", "Commands", "build_parser", "command_parsers", "main"]
+__all__ = ["COMMAND_MODULES", "Commands", "build_parser", "command_parsers", "console_main", "main"]
 
 logger = logging.getLogger(__name__)
 
@@ -70,6 +71,22 @@ def build_parser() -> argparse.ArgumentParser:
 def command_parsers() -> dict[str, tuple[str, argparse.ArgumentParser]]:
     """Every sub-command's one-line help and parser, by name, in help order."""
     return _build()[1].parsers
+
+
+def console_main() -> int:
+    """The ``trajgen`` console script: :func:`main`, and an exit that a stalled solver cannot spoil.
+
+    A fatrop call the optimal method's watchdog abandoned keeps running in its thread; the normal
+    interpreter shutdown would tear the solver down under it (``terminate called``, exit 134). The
+    script then flushes its output and ends at once with the status :func:`main` returned.
+    """
+    status = main()
+    solve = sys.modules.get("trajgen.methods.optimal.solve")
+    if solve is not None and solve.abandoned_solver_calls():
+        sys.stdout.flush()
+        sys.stderr.flush()
+        os._exit(status)
+    return status
 
 
 def main(argv: Sequence[str] | None = None) -> int:

@@ -93,7 +93,7 @@ class Optimal(TimingMethod):
     fatrop_iterations : int, optional
         Iteration limit of fatrop (default 500; it converges in < 150 when it converges).
     time_budget : float, optional
-        Seconds the solvers may take (default 5.0; the one-time build of an NLP the cache does
+        Seconds the solvers may take (default 2.0; the one-time build of an NLP the cache does
         not hold yet is not counted): no solver starts after it is spent, no
         refinement pass starts unless the previous one would fit in what is left, Ipopt stops
         by itself at half of it, and a fatrop run that is not back by then is abandoned (fatrop
@@ -134,7 +134,7 @@ class Optimal(TimingMethod):
     segments: int = 1
     max_iterations: int = 3000
     fatrop_iterations: int = 500
-    time_budget: float = 5.0
+    time_budget: float = 2.0
     refinements: int = 6
     refinement_tolerance: float = DEFAULT_REFINEMENT_TOLERANCE
     homotopy: HomotopyChoice = HomotopyChoice.FASTEST

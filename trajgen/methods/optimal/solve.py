@@ -24,7 +24,16 @@ import numpy as np
 from trajgen.methods.optimal.phases import NlpShape
 from trajgen.methods.optimal.transcription import Transcription, transcribe
 
-__all__ = ["CompiledNlp", "Outcome", "SolveResult", "Solver", "SolverAttempt", "SolverCache", "solve"]
+__all__ = [
+    "CompiledNlp",
+    "Outcome",
+    "SolveResult",
+    "Solver",
+    "SolverAttempt",
+    "SolverCache",
+    "abandoned_solver_calls",
+    "solve",
+]
 
 logger = logging.getLogger(__name__)
 
@@ -263,6 +272,8 @@ class SolveResult:
         return self.attempts[-1].solver if self.solution is not None else None
 
 
+#: Threads of solver calls abandoned by the watchdog that are still running.
+_ABANDONED_THREADS: list[threading.Thread] = []
 #: Status of a fatrop call that did not return by the deadline.
 _ABANDONED = "did not return by the deadline; abandoned (its NLP is rebuilt for the next solve)"
 
@@ -292,12 +303,18 @@ def _call_with_watchdog(
     thread.join(min(max(wait, 0.0), _WATCHDOG_CAP) + _WATCHDOG_GRACE)
     if thread.is_alive():
         compiled.abandoned = True
+        _ABANDONED_THREADS.append(thread)
         _lowest_priority(thread)
         logger.warning("optimal: fatrop %s", _ABANDONED)
         return None
     if "error" in box:
         raise box["error"]
     return box["result"], box["stats"]
+
+
+def abandoned_solver_calls() -> int:
+    """How many solver calls the watchdog abandoned are still running in this process."""
+    return sum(thread.is_alive() for thread in _ABANDONED_THREADS)
 
 
 def _lowest_priority(thread: threading.Thread) -> None:
