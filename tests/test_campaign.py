@@ -17,9 +17,9 @@ from trajgen.sampling import campaign_scenarios
 SCENARIOS = campaign_scenarios(300, seed=9)
 CHUNK = 10
 #: ``exact`` and ``toppra`` are timed on the scenarios whose index is a multiple of this ...
-EVERY = 6
+EVERY = 10
 #: ... and ``optimal`` on those whose index is a multiple of this.
-OPTIMAL_EVERY = 48
+OPTIMAL_EVERY = 60
 
 
 @pytest.fixture(scope="module")
