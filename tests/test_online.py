@@ -44,8 +44,10 @@ def _quiet():
 
 @pytest.fixture(scope="module")
 def swap():
+    # the default method, with a budget that a loaded machine cannot cut short (a fallback would be
+    # another plan)
     scenario = default_scenario()
-    return scenario, plan_for_execution(scenario)
+    return scenario, plan_for_execution(scenario, method=Optimal(time_budget=60.0))
 
 
 # -- paths and coordination --------------------------------------------------------------------
