@@ -291,7 +291,7 @@ def test_a_stop_costs_about_its_own_length(plans, name, method, fault):
     assert result.makespan_s - result.planned_s <= stop_bound(scenario, faults[0].value), result.summary()
 
 
-@settings(max_examples=3, deadline=None)
+@settings(max_examples=2, deadline=None)
 @given(moment=st.floats(0.0, 1.0), duration=st.floats(0.2, 8.0), vehicle=st.sampled_from([0, 1]))
 @pytest.mark.parametrize("method", ["exact", "toppra", "optimal"])
 @pytest.mark.parametrize("name", ["swap", "crossing"])
