@@ -30,8 +30,10 @@ Who follows whom depends on which way the vehicles move. Each phase fixes it
 that passes the junction at the phase end moves inward; the other, ``o``,
 outward, inward, or outward in the phase's first part and inward in its
 second (it makes room for ``w`` and comes back; its turning point ``c`` is a
-state of the NLP, tied to its position at the end of the first part). The
-constraints are then smooth and need no switch on the direction of motion:
+state of the NLP, tied to its position at the end of the first part). These
+directions choose the roles only: the NLP does not bound the velocity's sign
+(such bounds made fatrop 1.1.8 loop forever), so each point below is taken for
+either direction of travel, and the verifier judges the result:
 
 * ``o`` moving outward leads (it passed the junction first, or makes room):
   ``w``'s service stop comes no nearer to any point where ``o`` can still

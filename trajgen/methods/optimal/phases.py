@@ -58,7 +58,7 @@ _END_DENSITY = 0.35
 
 
 class Motion(enum.IntEnum):
-    """Which way a vehicle may move along its leg in a phase (``s`` grows outward)."""
+    """Which way a vehicle moves along its leg in a phase (``s`` grows outward): its braking-rule role."""
 
     FREE = 0  #: either way: the braking rule is stated for both
     OUTWARD = 1  #: ``v >= 0`` all phase
