@@ -138,6 +138,10 @@ class TimingMethod(abc.ABC):
         """
         return True
 
+    def for_execution(self) -> TimingMethod:
+        """The method as it plans for the online executor (its plans obey the braking rule)."""
+        return self
+
     def __str__(self) -> str:
         return self.name
 

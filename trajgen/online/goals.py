@@ -11,11 +11,9 @@ where they stand, the timing method times it, the verifier certifies it
 
 from __future__ import annotations
 
-import dataclasses
-
 from limits import Limits
 from topology import Configuration, StarGraph, plan
-from trajgen.methods import METHODS, Optimal, make_schedule
+from trajgen.methods import METHODS, make_schedule
 from trajgen.schedule import TimingMethod
 from trajgen.verify import VerifiedSchedule, certify
 
@@ -60,10 +58,7 @@ def plan_from_rest(
 
 def for_execution(method: TimingMethod | str | None) -> TimingMethod:
     """``method`` as it plans for execution: ``optimal`` with the braking rule in its problem."""
-    resolved = METHODS.create(method)
-    if not resolved.plans_for_execution and isinstance(resolved, Optimal):
-        return dataclasses.replace(resolved, braking_rule=True)
-    return resolved
+    return METHODS.create(method).for_execution()
 
 
 def plan_for_execution(

@@ -197,6 +197,10 @@ class Optimal(TimingMethod):
         """Whether its schedules obey the braking rule: with ``braking_rule``."""
         return self.braking_rule
 
+    def for_execution(self) -> Optimal:
+        """The same method with the braking rule in its problem."""
+        return self if self.braking_rule else dataclasses.replace(self, braking_rule=True)
+
     def warm_up(self, route: Route) -> bool:
         """Build the NLPs that ``route``'s classes need into the cache now; returns whether any was built."""
         if len(route.waypoints) == 1:
