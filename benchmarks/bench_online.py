@@ -3,7 +3,9 @@
 1. Per-cycle cost of :meth:`trajgen.online.Executor.step` for both vehicles (the executor only: the
    simulated plant and the bookkeeping are not timed), over the first ``--timed`` campaign scenarios
    run one at a time in this process: median, 99th percentile, worst, in microseconds. The cycles
-   that re-plan for a new goal (planner, timing method, verifier) are left out and reported apart.
+   that re-plan for a new goal (planner, timing method, verifier), and those during which Python's
+   garbage collector ran, are left out and reported apart. Beside them, the machine's own jitter: a
+   fixed loop of the median's duration, timed as often.
 2. The campaign: ``--count`` seeded random scenarios (:func:`trajgen.sampling.online_campaign`),
    each with 1-3 random faults (:func:`trajgen.sampling.campaign_faults`: stops, slow drives, lags,
    position jumps within the margin, new goals), simulated closed loop: goals reached, deadlocks
@@ -19,6 +21,7 @@ Run: ``python benchmarks/bench_online.py [--count 200] [--seed 11] [--timed 20] 
 from __future__ import annotations
 
 import argparse
+import gc
 import logging
 import multiprocessing
 import statistics
@@ -47,35 +50,77 @@ def run_case(args: tuple[int, int, str | None, bool]) -> dict:
     return row
 
 
-def timed_cycles(count: int, seed: int, method: str | None) -> tuple[list[float], list[float]]:
+def timed_cycles(count: int, seed: int, method: str | None) -> tuple[list[float], list[float], list[float]]:
     """Wall time of every executor step (µs) that does not plan, and of those that do (ms).
 
     A step plans when both vehicles have come to rest for a new goal: it re-plans, or refuses the goal
-    if no plan keeps the separation from there.
+    if no plan keeps the separation from there. Steps during which Python's cyclic garbage collector
+    ran are returned apart (µs): the collector's pause belongs to the host process, which a control
+    loop tunes (``gc.freeze()`` after loading, collections between runs), not to the executor.
     """
     logging.disable(logging.WARNING)
     cycles: list[float] = []
+    collected: list[float] = []
     replans: list[float] = []
+    collections = [0]
+
+    def count_collections(phase: str, _info: dict) -> None:
+        if phase == "start":
+            collections[0] += 1
+
     original = Executor.step
 
     def step(self, first, second):
         before = self.replans + self.rejected_goals
+        runs = collections[0]
         start = time.perf_counter_ns()
         command = original(self, first, second)
         elapsed = time.perf_counter_ns() - start
         if self.replans + self.rejected_goals > before:
             replans.append(elapsed / 1e6)
+        elif collections[0] > runs:
+            collected.append(elapsed / 1e3)
         else:
             cycles.append(elapsed / 1e3)
         return command
 
     Executor.step = step
+    gc.callbacks.append(count_collections)
     try:
         for k in progress(range(count), description="timed scenarios"):
             run_case((k, seed, method, False))
     finally:
         Executor.step = original
-    return cycles, replans
+        gc.callbacks.remove(count_collections)
+    return cycles, collected, replans
+
+
+def machine_jitter(count: int, target_us: float) -> list[float]:
+    """Wall time (µs) of a fixed pure-Python loop sized to ``target_us``, run ``count`` times.
+
+    The same work every time: its spread is the machine's (scheduler, virtualisation), which bounds
+    how flat any cycle time measured here can be.
+    """
+
+    def work(n: int) -> float:
+        total = 0.0
+        for i in range(n):
+            total += i * 0.5
+        return total
+
+    n = 100
+    while True:  # calibrate n to the target duration
+        start = time.perf_counter_ns()
+        work(n)
+        if (time.perf_counter_ns() - start) / 1e3 >= target_us or n > 10**7:
+            break
+        n *= 2
+    times = []
+    for _ in range(count):
+        start = time.perf_counter_ns()
+        work(n)
+        times.append((time.perf_counter_ns() - start) / 1e3)
+    return times
 
 
 def percentile(values: list[float], q: float) -> float:
@@ -94,18 +139,32 @@ def main() -> None:
     args = parser.parse_args()
 
     if args.timed:
-        cycles, replans = timed_cycles(args.timed, args.seed, args.method)
+        cycles, collected, replans = timed_cycles(args.timed, args.seed, args.method)
         print(f"executor cycle (both vehicles), {len(cycles)} cycles of {args.timed} scenarios:")
         print(
             f"  median {statistics.median(cycles):.1f} us, p99 {percentile(cycles, 0.99):.1f} us, "
+            f"p99.9 {percentile(cycles, 0.999):.1f} us, "
             f"worst {max(cycles):.1f} us"
         )
+        jitter = machine_jitter(len(cycles), statistics.median(cycles))
+        print(
+            f"the machine's own jitter: a fixed loop of about the median, {len(jitter)} times: "
+            f"median {statistics.median(jitter):.1f} us, p99.9 {percentile(jitter, 0.999):.1f} us, "
+            f"worst {max(jitter):.1f} us"
+        )
+        if collected:
+            print(
+                f"cycles during which the garbage collector ran ({len(collected)}): "
+                f"median {statistics.median(collected):.1f} us, worst {max(collected):.1f} us"
+            )
         if replans:
             print(
                 f"planning cycles (a new goal, planned or refused: {len(replans)}): "
                 f"median {statistics.median(replans):.1f} ms, worst {max(replans):.1f} ms"
             )
 
+    if not args.count:
+        return
     started = time.perf_counter()
     with multiprocessing.Pool(args.workers) as pool:
         cases = [(k, args.seed, args.method, args.fault_free) for k in range(args.count)]

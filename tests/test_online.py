@@ -83,6 +83,61 @@ def test_project_undoes_locate(fraction, vehicle):
     assert path.project(leg, s, p) == pytest.approx(p, abs=1e-9)
 
 
+@settings(max_examples=300, derandomize=True, deadline=None)
+@given(
+    stops=st.lists(st.tuples(st.integers(0, 2), st.floats(0.0, 10.0)), min_size=2, max_size=6),
+    fraction=st.floats(-0.05, 1.05),
+    wobble=st.floats(-0.2, 0.2),
+    lag=st.floats(-0.5, 0.5),
+    slack=st.sampled_from([1e-9, 0.05]),
+)
+def test_project_takes_the_same_place_as_the_search_over_every_segment(stops, fraction, wobble, lag, slack):
+    """The shortcut through ``near``'s own segment agrees with the search over all segments."""
+    path = VehiclePath.from_waypoints([(leg, s, 0, 10.0) for leg, s in stops], 0)
+    leg, s = path.locate(fraction * path.length)
+    s = max(s + wobble, 0.0)
+    near = fraction * path.length + lag
+    fast = path.project(leg, s, near, slack)
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setattr(VehiclePath, "_project_on_segment_of", lambda *_: None)
+        assert path.project(leg, s, near, slack) == fast
+
+
+@settings(max_examples=200, derandomize=True, deadline=None)
+@given(
+    stops=st.lists(st.tuples(st.integers(0, 2), st.floats(0.0, 10.0)), min_size=2, max_size=6),
+    ends=st.tuples(st.floats(-0.1, 1.1), st.floats(-0.1, 1.1)),
+)
+def test_sweep_covers_exactly_the_track_passed_over(stops, ends):
+    """Every place passed over a travel range lies in the sweep, and each stretch's ends are passed."""
+    path = VehiclePath.from_waypoints([(leg, s, 0, 10.0) for leg, s in stops], 0)
+    lengths = (12.0, 12.0, 12.0)
+    low, high = sorted(f * path.length for f in ends)
+    stretches = path.sweep(low, high, lengths)
+    samples = np.linspace(low, high, 2001)
+    step = (high - low) / 2000 + 1e-9
+    # a place on the track: the junction counts as s = 0 on every leg
+    places = []
+    for p in samples:
+        k = path.segment(p)
+        leg, s = path.locate(p)
+        if p < 0.0 or p > path.length:  # the run-on of the end segments along their legs
+            outward = 1.0 if path.s_to[k] > path.s_from[k] else -1.0
+            leg, s = path.legs[k], min(max(path.s_from[k] + outward * (p - path.starts[k]), 0.0), 12.0)
+        places.append((path.legs[k] if leg < 0 else leg, s))
+    def apart(a, b):  # track distance between two places (leg, s), metres
+        return abs(a[1] - b[1]) if a[0] == b[0] else a[1] + b[1]
+
+    for place in places:
+        assert any(
+            place[1] <= 1e-9 or (leg == place[0] and lo - 1e-9 <= place[1] <= hi + 1e-9)
+            for leg, lo, hi in stretches
+        ), (place, stretches)
+    for leg, lo, hi in stretches:
+        assert min(apart((leg, lo), place) for place in places) <= step
+        assert min(apart((leg, hi), place) for place in places) <= step
+
+
 @settings(max_examples=200, derandomize=True, deadline=None)
 @given(fraction=st.floats(-0.1, 1.1), vehicle=st.sampled_from([0, 1]))
 def test_place_agrees_with_the_separate_lookups(fraction, vehicle):

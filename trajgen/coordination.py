@@ -20,7 +20,7 @@ control cycle.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -95,6 +95,12 @@ class Conflict:
     leader: int
     low: tuple[float, float]
     high: tuple[float, float]
+    _reaches: tuple[float, ...] = field(init=False, repr=False, compare=False)
+
+    def __post_init__(self) -> None:
+        # the leader's largest travel over each polygon: :meth:`bound` runs every control cycle
+        reaches = tuple(max(vertex[self.leader] for vertex in polygon) for polygon in self.polygons)
+        object.__setattr__(self, "_reaches", reaches)
 
     @property
     def follower(self) -> int:
@@ -109,17 +115,19 @@ class Conflict:
         """
         leader, follower = self.leader, 1 - self.leader
         best = math.inf
-        for polygon in self.polygons:
-            if max(vertex[leader] for vertex in polygon) <= earliest + _TOUCH:
+        for polygon, reach in zip(self.polygons, self._reaches, strict=True):
+            if reach <= earliest + _TOUCH:
                 continue  # at most its boundary is left, where the distance is the separation: allowed
             count = len(polygon)
             for k in range(count):
                 a, b = polygon[k], polygon[(k + 1) % count]
-                if a[leader] >= earliest:
-                    best = min(best, a[follower])
+                if a[leader] >= earliest and a[follower] < best:
+                    best = a[follower]
                 if (a[leader] - earliest) * (b[leader] - earliest) < 0.0:  # the edge crosses the line
                     w = (earliest - a[leader]) / (b[leader] - a[leader])
-                    best = min(best, a[follower] + w * (b[follower] - a[follower]))
+                    crossing = a[follower] + w * (b[follower] - a[follower])
+                    if crossing < best:
+                        best = crossing
         return best
 
 

@@ -34,7 +34,16 @@ def interval_distance(first: Interval, second: Interval) -> float:
 
 def set_distance(first: tuple[Interval, ...], second: tuple[Interval, ...]) -> float:
     """Track distance between two unions of stretches, metres."""
-    return min(interval_distance(a, b) for a in first for b in second)
+    best = math.inf
+    for leg_a, low_a, high_a in first:
+        for leg_b, low_b, high_b in second:
+            if leg_a == leg_b:
+                gap = low_b - high_a if low_b > high_a else (low_a - high_b if low_a > high_b else 0.0)
+            else:
+                gap = low_a + low_b
+            if gap < best:
+                best = gap
+    return best
 
 
 @dataclass(frozen=True, slots=True)
@@ -162,7 +171,8 @@ class VehiclePath:
 
     def segment(self, p: float) -> int:
         """Index of the segment holding travel ``p`` (clipped to the path)."""
-        return min(max(bisect.bisect_right(self.starts, p) - 1, 0), len(self.starts) - 1)
+        k = bisect.bisect_right(self.starts, p) - 1
+        return 0 if k < 0 else k
 
     def place(self, p: float) -> tuple[int, float, int, float, int]:
         """Everything about travel ``p`` at once: ``(leg, s, heading, axis, branch)``.
@@ -250,6 +260,9 @@ class VehiclePath:
             home_leg, home_s = self.home
             same = abs(s - home_s) <= slack and (leg == home_leg or max(s, home_s) <= slack)
             return 0.0 if same else None
+        nearest = self._project_on_segment_of(leg, s, near, slack)
+        if nearest is not None:
+            return nearest
         last = len(self.legs) - 1
         for k, seg_leg in enumerate(self.legs):
             low, high = min(self.s_from[k], self.s_to[k]), max(self.s_from[k], self.s_to[k])
@@ -282,6 +295,26 @@ class VehiclePath:
                 best, best_key = p, key
         return best
 
+    def _project_on_segment_of(self, leg: int, s: float, near: float, slack: float) -> float | None:
+        """:meth:`project`'s answer if it lies on ``near``'s own segment, nearer than its ends; else None.
+
+        Every other segment lies beyond an end of this one in travel, so a place here closer to
+        ``near`` than both ends wins outright. This is the usual case, and it runs every cycle.
+        """
+        if s <= slack:
+            return None
+        k = self.segment(near)
+        if self.legs[k] != leg:
+            return None
+        s_from, s_to = self.s_from[k], self.s_to[k]
+        if not min(s_from, s_to) <= s <= max(s_from, s_to):
+            return None
+        start = self.starts[k]
+        end = self.starts[k + 1] if k + 1 < len(self.starts) else self.length
+        p = start + (s - s_from if s_to > s_from else s_from - s)
+        distance = abs(p - near)
+        return p if distance < near - start and distance < end - near else None
+
     def sweep(self, p_low: float, p_high: float, leg_lengths: tuple[float, ...]) -> tuple[Interval, ...]:
         """The track covered while travel runs over ``[p_low, p_high]``, as stretches per leg.
 
@@ -293,20 +326,35 @@ class VehiclePath:
             leg, s = self.home
             return ((leg, s, s),)
         out = []
+        starts = self.starts
         last = len(self.legs) - 1
-        for k, leg in enumerate(self.legs):
-            start = self.starts[k]
-            end = self.starts[k + 1] if k < last else self.length
-            low = start if k else min(start, p_low)
-            high = end if k < last else max(end, p_high)
-            a, b = max(p_low, low), min(p_high, high)
+        # only the segments that end at or after p_low and start at or before p_high can hold some
+        first = max(bisect.bisect_left(starts, p_low) - 1, 0)
+        final = self.segment(p_high)
+        for k in range(first, final + 1):
+            start = starts[k]
+            a = p_low if k == 0 or p_low > start else start
+            if k < last:
+                end = starts[k + 1]
+                b = p_high if p_high < end else end
+            else:  # the last segment runs on past the path's end
+                b = p_high
             if a > b:
                 continue
-            sign = 1.0 if self.s_to[k] > self.s_from[k] else -1.0
-            s_a = self.s_from[k] + sign * (a - start)
-            s_b = self.s_from[k] + sign * (b - start)
-            lo, hi = min(s_a, s_b), max(s_a, s_b)
-            out.append((leg, min(max(lo, 0.0), leg_lengths[leg]), min(max(hi, 0.0), leg_lengths[leg])))
+            s_from = self.s_from[k]
+            if self.s_to[k] > s_from:
+                lo, hi = s_from + (a - start), s_from + (b - start)
+            else:
+                lo, hi = s_from - (b - start), s_from - (a - start)
+            leg = self.legs[k]
+            top = leg_lengths[leg]
+            out.append(
+                (
+                    leg,
+                    0.0 if lo < 0.0 else (top if lo > top else lo),
+                    0.0 if hi < 0.0 else (top if hi > top else hi),
+                )
+            )
         if not out:  # an empty or reversed range: the point itself
             leg, s = self.locate(p_low)
             return ((leg if leg != JUNCTION_INDEX else self.legs[self.segment(p_low)], s, s),)
