@@ -125,6 +125,7 @@ def test_sweep_covers_exactly_the_track_passed_over(stops, ends):
             outward = 1.0 if path.s_to[k] > path.s_from[k] else -1.0
             leg, s = path.legs[k], min(max(path.s_from[k] + outward * (p - path.starts[k]), 0.0), 12.0)
         places.append((path.legs[k] if leg < 0 else leg, s))
+
     def apart(a, b):  # track distance between two places (leg, s), metres
         return abs(a[1] - b[1]) if a[0] == b[0] else a[1] + b[1]
 
