@@ -2,7 +2,7 @@
 
 Run: ``python benchmarks/bench_campaign.py [--scenarios 300] [--seed 9]``.
 
-Scenarios from :func:`trajgen.sampling.campaign_scenarios` (legs 0.5-5000 m,
+Scenarios from :func:`trajgen.scenario.sampling.campaign_scenarios` (legs 0.5-5000 m,
 independent limits 0.05-5 m/s, 0.05-5 m/s², 0.05-20 m/s³, separations up to
 the shortest leg, swaps and random goals), each scheduled by every registered
 method and verified. Prints the failures (target 0), the fallbacks per method,
@@ -21,7 +21,7 @@ from tqdm import tqdm
 
 from trajgen import METHODS, Optimal, SolverCache, make_schedule, verify
 from trajgen.progress import progress
-from trajgen.sampling import campaign_scenarios
+from trajgen.scenario.sampling import campaign_scenarios
 
 
 def main() -> None:

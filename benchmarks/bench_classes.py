@@ -32,7 +32,7 @@ from topology import Configuration, Homotopy, YGraph, plan
 from trajgen import Exact, Optimal, SolverCache, Toppra, lower_bound, verify
 from trajgen.methods.optimal import DEFAULT_NODES
 from trajgen.progress import progress
-from trajgen.sampling import random_scenarios, reference_sets
+from trajgen.scenario.sampling import random_scenarios, reference_sets
 
 AGV = VehicleLimits(1.0, 0.5, 1.0)
 SLOW = VehicleLimits(0.7, 0.35, 0.6)

@@ -23,7 +23,7 @@ from trajgen.errors import OutputLimitError, VerificationError
 from trajgen.export.dialects import DIALECTS, TableDialect
 from trajgen.export.plc import plc_tables
 from trajgen.progress import progress
-from trajgen.sampling import random_scenarios
+from trajgen.scenario.sampling import random_scenarios
 
 
 def demo() -> None:

@@ -41,7 +41,7 @@ from topology import JUNCTION_INDEX, Configuration, Position, YGraph, plan
 from trajgen import Exact, certify, make_schedule
 from trajgen.export.csv import HEADER_NAMES, ROWS_PER_CHUNK, CsvOptions, profile_rows
 from trajgen.export.numbers import exact_limit, fixed_point_text, format_number_rows
-from trajgen.schedule import sample_block
+from trajgen.model.schedule import sample_block
 
 PLACES = (6, 9, 9, 9, 9, None, 9, 9, 9)  # t, axis, v, a, j, leg, s, x, y (metres)
 SEPARATORS = (";",) * 8 + ("\r\n",)

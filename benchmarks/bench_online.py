@@ -6,8 +6,8 @@
    that re-plan for a new goal (planner, timing method, verifier), and those during which Python's
    garbage collector ran, are left out and reported apart. Beside them, the machine's own jitter: a
    fixed loop of the median's duration, timed as often.
-2. The campaign: ``--count`` seeded random scenarios (:func:`trajgen.sampling.online_campaign`),
-   each with 1-3 random faults (:func:`trajgen.sampling.campaign_faults`: stops, slow drives, lags,
+2. The campaign: ``--count`` seeded random scenarios (:func:`trajgen.scenario.sampling.online_campaign`),
+   each with 1-3 random faults (:func:`trajgen.scenario.sampling.campaign_faults`: stops, slow drives, lags,
    position jumps within the margin, new goals), simulated closed loop: goals reached, deadlocks
    (a run that never reaches its goals), separation violations computed from the true positions,
    limit violations, emergency brakes, the braking check's holds, and the time lost against the
@@ -31,7 +31,7 @@ from trajgen.online import Executor
 from trajgen.online.goals import execution_margin, plan_for_execution
 from trajgen.online.simulation import parse_faults, simulate
 from trajgen.progress import progress
-from trajgen.sampling import campaign_faults, online_campaign
+from trajgen.scenario.sampling import campaign_faults, online_campaign
 
 
 def run_case(args: tuple[int, int, str | None, bool]) -> dict:

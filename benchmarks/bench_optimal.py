@@ -28,7 +28,7 @@ from topology import plan
 from trajgen import Exact, Optimal, SolverCache, Toppra, lower_bound, verify
 from trajgen.methods.optimal import DEFAULT_NODES, Source
 from trajgen.progress import progress
-from trajgen.sampling import reference_sets
+from trajgen.scenario.sampling import reference_sets
 
 
 def emit(line: str) -> None:

@@ -14,7 +14,7 @@ import time
 
 from topology import Configuration, YGraph, plan
 from trajgen.progress import progress
-from trajgen.sampling import random_position
+from trajgen.scenario.sampling import random_position
 
 
 def random_queries(count: int, seed: int):

@@ -17,7 +17,7 @@ from limits import ILLUSTRATIVE_LIMITS
 from topology import YGraph
 from trajgen import METHODS, TimingMethod, default_scenario, make_schedule, verify
 from trajgen.progress import progress
-from trajgen.sampling import random_scenarios
+from trajgen.scenario.sampling import random_scenarios
 
 
 def scenarios(count: int, seed: int):

@@ -35,7 +35,7 @@ from limits import Limits, VehicleLimits
 from topology import Configuration, GraphPoint, Instruction, StarGraph, plan
 from trajgen import Optimal, SolverCache, verify
 from trajgen.progress import progress
-from trajgen.sampling import random_configuration, random_position
+from trajgen.scenario.sampling import random_configuration, random_position
 
 LEG_NAMES = "ABCDEFGH"
 

@@ -91,7 +91,7 @@ def _contexts(node: nodes.Element) -> list[str]:
 
     autodoc sets ``py:module`` to the package that documents the object (``trajgen`` for
     ``trajgen.Schedule``), while the docstring's short names are those of the module that defines
-    it (``trajgen.schedule``): that comes from the node's source (``docstring of NAME``) or from the
+    it (``trajgen.model.schedule``): that comes from the node's source (``docstring of NAME``) or from the
     signatures of the descriptions that hold the node.
     """
     contexts = []

@@ -8,8 +8,8 @@ import numpy as np
 
 from tests.corruption import corrupted
 from trajgen import Schedule
-from trajgen.profiles import PiecewiseCubic
-from trajgen.schedule import CubicKinematics
+from trajgen.model.profiles import PiecewiseCubic
+from trajgen.model.schedule import CubicKinematics
 
 #: A uniform cubic B-spline of knot spacing h: position, velocity, acceleration at its 5 knots
 #: (times h^0, h^-1, h^-2) and its jerk on its 4 intervals (times h^-3); scaled by 1.5 it peaks at 1.

@@ -14,7 +14,7 @@ import numpy as np
 
 from topology import Region, reduce_regions
 from topology.indexed import JUNCTION_INDEX, region_keys, track_distance
-from trajgen.schedule import Schedule, ScheduleState
+from trajgen.model.schedule import Schedule, ScheduleState
 from trajgen.verify import POSITION_TOLERANCE, RELATIVE_TOLERANCE, REST_TOLERANCE, TRACK_END_TOLERANCE
 
 

@@ -1,6 +1,6 @@
 """A seeded random campaign over a wide range of scenarios: every schedule of every method verifies.
 
-300 scenarios from :func:`trajgen.sampling.campaign_scenarios` (legs 0.5-5000 m,
+300 scenarios from :func:`trajgen.scenario.sampling.campaign_scenarios` (legs 0.5-5000 m,
 independent limits, separations up to the shortest leg, swaps and random
 goals): ``exact`` and ``toppra`` on every :data:`EVERY`-th, ``optimal`` (seconds
 per solve) on every :data:`OPTIMAL_EVERY`-th. ``benchmarks/bench_campaign.py``
@@ -12,7 +12,7 @@ from __future__ import annotations
 import pytest
 
 from trajgen import METHODS, Optimal, SolverCache, certify, make_schedule
-from trajgen.sampling import campaign_scenarios
+from trajgen.scenario.sampling import campaign_scenarios
 
 SCENARIOS = campaign_scenarios(300, seed=9)
 CHUNK = 10

@@ -16,10 +16,10 @@ from limits import Limits, VehicleLimits
 from tests.helpers import AGV, LIMITS, MIXED, SLOW, route_of
 from topology import Homotopy, WayRound, plan
 from trajgen import FallbackReason, Optimal, SolverCache, lower_bound, verify
-from trajgen.analysis import class_lower_bound
 from trajgen.cli import EXIT_BAD_INPUT, EXIT_OK, main
 from trajgen.methods.optimal import Solver, Source
-from trajgen.sampling import random_scenarios
+from trajgen.model.analysis import class_lower_bound
+from trajgen.scenario.sampling import random_scenarios
 
 FAST = VehicleLimits(2.0, 1.0, 2.0)
 QUARTER = VehicleLimits(0.5, 0.25, 0.5)

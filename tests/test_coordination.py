@@ -21,8 +21,7 @@ from tests.conftest import REPO
 from tests.helpers import conf
 from topology import YGraph, plan
 from trajgen import Exact, Optimal, Toppra, certify, load_scenario, verify
-from trajgen.braking_rule import BRAKING_RULE_TOLERANCE, braking_rule_failures
-from trajgen.coordination import (
+from trajgen.model.coordination import (
     CoordinationDiagram,
     earliest_rest,
     plan_paths,
@@ -30,6 +29,7 @@ from trajgen.coordination import (
     stopping_distances,
 )
 from trajgen.online.goals import plan_for_execution
+from trajgen.verify.braking_rule import BRAKING_RULE_TOLERANCE, braking_rule_failures
 
 SWAP = REPO / "examples" / "swap.toml"
 CROSSING = REPO / "examples" / "crossing.toml"
@@ -197,7 +197,7 @@ def test_the_rule_binds_the_optimal_swap_two_centimetres_more_is_refused(optimal
 
 def test_verify_refuses_a_plan_that_breaks_the_rule_naming_when_and_where(optimal_swap):
     from trajgen.errors import VerificationError
-    from trajgen.schedule import Schedule
+    from trajgen.model.schedule import Schedule
 
     scenario = load_scenario(SWAP)
     # the time-optimal swap without the rule in the NLP, claimed to be a plan for execution:

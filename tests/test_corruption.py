@@ -21,7 +21,7 @@ from tests.corruption import CORRUPTIONS, corrupt_array, corrupted, float_arrays
 from trajgen import Exact, Optimal, Toppra, certify, load_scenario
 from trajgen.errors import VerificationError
 from trajgen.export.csv import CsvOptions, render_profile
-from trajgen.schedule import CubicKinematics
+from trajgen.model.schedule import CubicKinematics
 
 SCENARIOS = {"swap": REPO / "examples" / "swap.toml", "crossing": REPO / "examples" / "crossing.toml"}
 #: a generous budget: the test is about the optimal method's own schedule, not its fallback

@@ -19,8 +19,9 @@ from trajgen.export.check import check_profiles
 from trajgen.export.dialects import DIALECTS, TableDialect
 from trajgen.export.plc import plc_tables
 from trajgen.export.resample import resample
+from trajgen.export.table_check import check_tables
+from trajgen.export.tables import Interpolation, ProfileTable, divided_differences
 from trajgen.pipeline import Outputs
-from trajgen.tables import Interpolation, ProfileTable, check_tables, divided_differences
 
 SWAP = str(REPO / "examples" / "swap.toml")
 TABLE_DIALECTS = [d for d in DIALECTS if isinstance(d, TableDialect)]

@@ -10,7 +10,7 @@ from tests.mutants import between_samples, free_window, with_bump
 from tests.sampled_verifier import sampled_verify
 from topology.indexed import track_distance
 from trajgen import Exact, Optimal, verify
-from trajgen.analysis import travelled
+from trajgen.model.analysis import travelled
 
 SWAP = ((10.0, 10.0, 10.0), ("A:10", "B:10"), ("B:10", "A:10"))
 
@@ -113,9 +113,9 @@ def _replace_map(schedule, index, vehicle, **changes):
 def test_a_zero_length_last_section_cannot_teleport_a_vehicle_to_the_goal(exact):
     import dataclasses
 
-    from trajgen.axes import piece_profiles
-    from trajgen.profiles import PiecewiseCubic
-    from trajgen.schedule import AxisMap, CubicKinematics, Section
+    from trajgen.model.axes import piece_profiles
+    from trajgen.model.profiles import PiecewiseCubic
+    from trajgen.model.schedule import AxisMap, CubicKinematics, Section
 
     # the last piece stops vehicle 2 at axis 9 (11 m short of its goal); a section of zero length at
     # the end reports the goal anyway
@@ -150,7 +150,7 @@ def test_malformed_position_maps_fail(exact, changes, message):
 
 
 def test_a_reversal_hidden_in_a_map_change_on_one_leg_is_a_jump(exact):
-    from trajgen.schedule import AxisMap
+    from trajgen.model.schedule import AxisMap
 
     # vehicle 2 on leg B only, but the second half of its axis range maps backwards: a U-turn at 5 m
     first = exact.sections[0].maps[1]
@@ -165,7 +165,7 @@ def test_a_reversal_hidden_in_a_map_change_on_one_leg_is_a_jump(exact):
 
 
 def test_kinematics_the_verifier_does_not_know_cannot_be_certified(exact):
-    from trajgen.schedule import CubicKinematics
+    from trajgen.model.schedule import CubicKinematics
 
     class Liar(CubicKinematics):  # evaluates (and so would export) something else than its cubics
         __slots__ = ()

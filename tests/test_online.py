@@ -27,8 +27,8 @@ from trajgen.online import BrakingCheck, Executor, Mode, PathState, VehiclePath,
 from trajgen.online.braking import emergency_position
 from trajgen.online.goals import execution_margin, plan_for_execution
 from trajgen.online.simulation import parse_faults, simulate
-from trajgen.sampling import campaign_faults, online_campaign, random_scenarios
 from trajgen.scenario import Scenario
+from trajgen.scenario.sampling import campaign_faults, online_campaign, random_scenarios
 
 AGV = VehicleLimits(max_velocity=1.0, max_acceleration=0.5, max_jerk=1.0)
 SWAP = REPO / "examples" / "swap.toml"

@@ -17,13 +17,13 @@ from limits import Limits, VehicleLimits
 from tests.helpers import LIMITS, MIXED, conf, route_of
 from topology import Homotopy, YGraph, plan, region_sequence
 from trajgen import Exact, FallbackReason, Optimal, SolverCache, certify, lower_bound, make_schedule, verify
-from trajgen.analysis import travelled
 from trajgen.errors import InputError
 from trajgen.methods.optimal import Solver, Source
 from trajgen.methods.optimal.solve import Outcome, abandoned_solver_calls, solve
+from trajgen.model.analysis import travelled
+from trajgen.model.profiles import rest_to_rest_time
 from trajgen.plots import render_coordination
-from trajgen.profiles import rest_to_rest_time
-from trajgen.sampling import random_scenarios, reference_sets
+from trajgen.scenario.sampling import random_scenarios, reference_sets
 
 EQUAL = (10.0, 10.0, 10.0)
 UNEQUAL = (12.0, 8.0, 15.0)

@@ -7,7 +7,7 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from trajgen.polynomials import evaluate, extrema
+from trajgen.model.polynomials import evaluate, extrema
 
 coefficient = st.floats(-10.0, 10.0, allow_nan=False)
 

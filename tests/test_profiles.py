@@ -11,7 +11,7 @@ from ruckig import InputParameter, Result, Ruckig, Trajectory
 from limits import Limits, VehicleLimits
 from tests.helpers import route_of
 from trajgen import Exact
-from trajgen.profiles import PiecewiseCubic, rest_to_rest_time, scurve_phases, trapezoid_phases
+from trajgen.model.profiles import PiecewiseCubic, rest_to_rest_time, scurve_phases, trapezoid_phases
 
 
 def ruckig_move(distance: float, v: float, a: float, j: float) -> Trajectory:

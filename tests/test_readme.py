@@ -1,6 +1,12 @@
-"""The README's Python example runs verbatim and says what it computes."""
+"""The README is a short landing page whose Python example runs and whose links resolve.
+
+The example runs verbatim and says what it computes; every file the README links to (the docs
+pages, the picture) is in the repository.
+"""
 
 from __future__ import annotations
+
+import re
 
 import pytest
 
@@ -8,6 +14,7 @@ from tests.conftest import REPO
 
 
 def _python_block() -> str:
+    """The README's first ``python`` block."""
     text = (REPO / "README.md").read_text(encoding="utf-8")
     begin = text.index("```python\n") + len("```python\n")
     return text[begin : text.index("```", begin)]
@@ -45,3 +52,16 @@ def test_readme_python_section_needs_at_most_two_import_lines():
     tree = ast.parse(_python_block())
     imports = [node for node in tree.body if isinstance(node, (ast.Import, ast.ImportFrom))]
     assert 1 <= len(imports) <= 2
+
+
+def test_readme_is_a_landing_page_whose_links_all_resolve():
+    text = (REPO / "README.md").read_text(encoding="utf-8")
+    assert len(text.splitlines()) <= 150  # the rest lives in docs/
+    targets = {m.group(1) for m in re.finditer(r"\]\(([^)\s#]+)(?:#[^)]*)?\)", text)}
+    local = {t for t in targets if not re.match(r"[a-zA-Z][a-zA-Z0-9+.-]*:", t)}
+    assert {"docs/cli.md", "docs/api.md", "docs/layout.md", "docs/upgrading.md"} <= local
+    for target in sorted(local):
+        assert (REPO / target).is_file(), target
+    pictures = [t for t in local if t.endswith(".png")]
+    assert len(pictures) == 1
+    assert (REPO / pictures[0]).stat().st_size < 300_000

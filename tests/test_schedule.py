@@ -11,10 +11,10 @@ from limits import Limits, VehicleLimits
 from tests.helpers import LIMITS, MIXED, route_of, too_close
 from topology import YGraph
 from trajgen import METHODS, Exact, Schedule, Toppra, certify, make_schedule, verify
-from trajgen.axes import route_axes, straight_pieces
 from trajgen.errors import OptionError, VerificationError
 from trajgen.methods.toppra import ToppraKinematics
-from trajgen.sampling import random_scenarios
+from trajgen.model.axes import route_axes, straight_pieces
+from trajgen.scenario.sampling import random_scenarios
 
 SWAP = ((10.0, 10.0, 10.0), ("A:10", "B:10"), ("B:10", "A:10"))
 TRACK = YGraph({"A": 12.0, "B": 8.0, "C": 15.0})

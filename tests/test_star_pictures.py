@@ -17,6 +17,7 @@ from topology.cycle import retract_indexed
 from trajgen import Exact, certify, load_scenario, make_schedule
 from trajgen.cli import EXIT_OK, main
 from trajgen.errors import InputError, UnverifiedScheduleError
+from trajgen.model.summary import class_label, class_name
 from trajgen.pipeline import PLOT_NAMES
 from trajgen.plots import render_animation, render_configuration
 from trajgen.plots.animation import FRAME_HEIGHT_PX, FRAME_WIDTH_PX, frame_geometry, frame_layout, playback
@@ -31,7 +32,6 @@ from trajgen.plots.retract_graph import (
     schedule_points,
 )
 from trajgen.plots.speed import VEHICLE_COLOURS
-from trajgen.summary import class_label, class_name
 
 NAMES = {
     4: ("N", "W", "S", "E"),

@@ -44,9 +44,9 @@ from trajgen.cli import EXIT_BAD_INPUT, EXIT_FAILURE, EXIT_OK, main
 from trajgen.errors import InputError, ScenarioError
 from trajgen.export.check import check_profiles
 from trajgen.export.dialects import DIALECTS, TableDialect
+from trajgen.model.summary import class_label
 from trajgen.online.executor import Executor, VehicleState
-from trajgen.sampling import online_campaign, random_scenarios, random_track
-from trajgen.summary import class_label
+from trajgen.scenario.sampling import online_campaign, random_scenarios, random_track
 
 CROSSING = REPO / "trajgen" / "data" / "crossing.toml"
 #: export-vda5050's default --map-id (docs/formats/vda5050.md): the map the vehicles have

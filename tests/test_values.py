@@ -7,7 +7,7 @@ import pytest
 
 from tests.helpers import LIMITS, route_of
 from trajgen import Exact, Optimal, Toppra
-from trajgen.axes import route_axes
+from trajgen.model.axes import route_axes
 
 SWAP = ((10.0, 10.0, 10.0), ("A:10", "B:10"), ("B:10", "A:10"))
 
@@ -53,7 +53,7 @@ def test_a_schedule_does_not_share_memory_with_its_inputs():
     with pytest.raises(ValueError, match="read-only"):
         axes.axes[0, 0] = 1.0
     source = np.array([0.0, 1.0])
-    from trajgen.schedule import AxisMap
+    from trajgen.model.schedule import AxisMap
 
     mapped = AxisMap(source, source, np.array([0, 0]), source, np.array([1, 1]))
     source[0] = 9.0
@@ -67,13 +67,13 @@ def test_frozen_fields_cannot_be_rebound():
 
 
 def test_equality_and_hash_agree_on_signed_zero_and_nan():
-    from trajgen.schedule import AxisMap
+    from trajgen.model.schedule import AxisMap
 
     parked = AxisMap.parked(0.0, 1, 2.0)
     assert parked == parked.flipped()
     assert hash(parked) == hash(parked.flipped())
     # (an axis map refuses a NaN; a sampled state may hold one, e.g. of an executed motion)
-    from trajgen.schedule import ScheduleState
+    from trajgen.model.schedule import ScheduleState
 
     def state(value):
         one = np.array([[value], [1.0]])
@@ -97,7 +97,7 @@ def test_sampled_states_cannot_be_written_through_their_base():
 
 
 def test_a_state_built_from_the_callers_arrays_copies_them():
-    from trajgen.schedule import ScheduleState
+    from trajgen.model.schedule import ScheduleState
 
     mine = np.zeros((2, 3))
     state = ScheduleState(np.zeros(3), mine, mine, mine, mine, np.zeros((2, 3), dtype=int), mine)

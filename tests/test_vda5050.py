@@ -37,8 +37,8 @@ from trajgen.export.vda5050 import (
     render_orders,
     write_orders,
 )
-from trajgen.factsheet import MAX_FACTSHEET_BYTES, read_factsheet
 from trajgen.scenario import PLAUSIBLE, load_scenario
+from trajgen.scenario.factsheet import MAX_FACTSHEET_BYTES, read_factsheet
 
 SWAP = REPO / "examples" / "swap.toml"
 START = datetime(2025, 5, 1, 8, 0, tzinfo=UTC)

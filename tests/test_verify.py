@@ -15,8 +15,8 @@ from tests.helpers import LIMITS, route_of, too_close
 from tests.mutants import with_coefficient
 from trajgen import Exact, VerifiedSchedule, certify, verify
 from trajgen.errors import InputError, UnverifiedScheduleError, VerificationError
-from trajgen.profiles import PiecewiseCubic
-from trajgen.schedule import AxisMap
+from trajgen.model.profiles import PiecewiseCubic
+from trajgen.model.schedule import AxisMap
 
 SWAP = ((10.0, 10.0, 10.0), ("A:10", "B:10"), ("B:10", "A:10"))
 

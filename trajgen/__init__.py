@@ -16,10 +16,11 @@ Examples
 
 from limits import Limits, VehicleLimits
 from topology import Configuration, Instruction, Position, Route, StarGraph, YGraph, plan
-from trajgen.analysis import lower_bound
 from trajgen.errors import InputError, TrajgenError, VerificationError
 from trajgen.export import CsvOptions, Units, write_profiles
 from trajgen.methods import METHODS, Exact, HomotopyChoice, Optimal, SolverCache, Toppra, make_schedule
+from trajgen.model.analysis import lower_bound
+from trajgen.model.schedule import FallbackReason, Schedule, TimingMethod
 from trajgen.pipeline import Outputs, RunResult, run
 from trajgen.scenario import (
     BuiltinScenario,
@@ -29,7 +30,6 @@ from trajgen.scenario import (
     load_scenario,
     parse_scenario,
 )
-from trajgen.schedule import FallbackReason, Schedule, TimingMethod
 from trajgen.verify import VerificationReport, VerifiedSchedule, certify, verify
 
 __all__ = [

@@ -18,11 +18,11 @@ from topology.validation import finite_real, short_repr
 from trajgen.errors import InputError
 from trajgen.export import CsvOptions, check_output_paths, commit_files, profile_paths
 from trajgen.methods import METHODS
+from trajgen.model.schedule import TimingMethod
 from trajgen.online.executor import PERIOD_RANGE
 from trajgen.online.simulation import SimulationResult, parse_faults, simulate
 from trajgen.plots import render_simulation
 from trajgen.scenario import Scenario
-from trajgen.schedule import TimingMethod
 
 __all__ = ["SIMULATION_PLOT_NAME", "format_simulation", "run_simulation", "simulation_paths"]
 

@@ -13,7 +13,6 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from topology import Route
-from trajgen.analysis import lower_bound
 from trajgen.errors import InputError, VerificationError
 from trajgen.export import (
     CsvOptions,
@@ -26,10 +25,11 @@ from trajgen.export import (
 from trajgen.export.dialects import DIALECTS, Dialect, TableDialect
 from trajgen.export.plc import PlcTables, check_dialect_method, plc_tables, table_paths
 from trajgen.methods import METHODS, make_schedule
+from trajgen.model.analysis import lower_bound
+from trajgen.model.schedule import TimingMethod
+from trajgen.model.summary import route_summary
 from trajgen.plots import render_configuration, render_coordination, render_separation, render_speed
 from trajgen.scenario import Scenario
-from trajgen.schedule import TimingMethod
-from trajgen.summary import route_summary
 from trajgen.verify import VerifiedSchedule, certify
 
 __all__ = ["PLOT_NAMES", "Outputs", "RunResult", "run"]

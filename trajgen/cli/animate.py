@@ -18,8 +18,8 @@ from trajgen.plots.animation import (
     MAX_FPS,
     MAX_FRAMES_LIMIT,
     playback,
-    render_animation,
 )
+from trajgen.plots.animation_drawing import render_animation
 
 __all__ = ["gif_path", "register"]
 

@@ -15,8 +15,8 @@ from trajgen.errors import InputError, OptionError
 from trajgen.export import DEFAULT_MAX_ROWS, CsvOptions, Units
 from trajgen.export.dialects import DIALECTS
 from trajgen.methods import METHODS, HomotopyChoice, Optimal
+from trajgen.model.schedule import TimingMethod
 from trajgen.scenario import Scenario, default_scenario, load_scenario
-from trajgen.schedule import TimingMethod
 
 __all__ = [
     "EXIT_BAD_INPUT",

@@ -13,9 +13,9 @@ from trajgen.cli.options import (
     method_from,
     scenario_from,
 )
+from trajgen.model.summary import format_route, format_run, route_summary
 from trajgen.pipeline import Outputs, run
 from trajgen.scenario import BuiltinScenario, builtin_scenario
-from trajgen.summary import format_route, format_run, route_summary
 
 __all__ = ["register"]
 

@@ -2,7 +2,7 @@
 
 The files alone are read with their dialect's reader (a file that cannot be
 read is bad input) and verified as the controllers interpolate them
-(:func:`trajgen.tables.check_tables`): the separation along the track
+(:func:`trajgen.export.table_check.check_tables`): the separation along the track
 between the two vehicles, the limits, the start and goal, the homotopy class,
 plus what their format requires (line ends, header, point count). The files
 do not say which homotopy class they take, so both of the planner's classes
@@ -25,10 +25,11 @@ from trajgen.errors import OptionError, ProfileFileError
 from trajgen.export.csv import profile_paths
 from trajgen.export.dialects import DIALECTS, Dialect, TableDialect
 from trajgen.export.plc import table_paths
-from trajgen.reading import FileKind, file_label, read_bounded
+from trajgen.export.table_check import TableCheck, check_tables
+from trajgen.export.tables import ProfileTable
+from trajgen.model.summary import class_name
 from trajgen.scenario import Scenario
-from trajgen.summary import class_name
-from trajgen.tables import ProfileTable, TableCheck, check_tables
+from trajgen.scenario.reading import FileKind, file_label, read_bounded
 
 __all__ = ["MAX_FILE_BYTES", "ProfileCheck", "check_profiles", "profile_files"]
 
@@ -36,7 +37,7 @@ __all__ = ["MAX_FILE_BYTES", "ProfileCheck", "check_profiles", "profile_files"]
 MAX_FILE_BYTES = 256 << 20
 #: Most points (rows) per file the checker reads.
 MAX_POINTS = 1_000_000
-#: How profile files are read (:func:`~trajgen.reading.read_bounded`).
+#: How profile files are read (:func:`~trajgen.scenario.reading.read_bounded`).
 PROFILE_FILE = FileKind("a profile file", "a profile file", MAX_FILE_BYTES, ProfileFileError)
 
 

@@ -20,8 +20,8 @@ from topology.validation import short_repr
 from trajgen.errors import InputError, OptionError, OutputLimitError
 from trajgen.export.atomic import commit_files
 from trajgen.export.numbers import format_number_rows
-from trajgen.naming import check_vehicle_names
-from trajgen.schedule import Schedule, ScheduleState, check_period, sample_block, sample_rows
+from trajgen.model.schedule import Schedule, ScheduleState, check_period, sample_block, sample_rows
+from trajgen.scenario.naming import check_vehicle_names
 from trajgen.verify import VerifiedSchedule, require_verified
 
 __all__ = [
@@ -323,7 +323,7 @@ def profile_paths(names: Sequence[str], directory: str | Path) -> tuple[Path, Pa
     Raises
     ------
     InputError
-        Not two portable, distinct file names (:func:`trajgen.naming.check_vehicle_names`).
+        Not two portable, distinct file names (:func:`trajgen.scenario.naming.check_vehicle_names`).
     """
     first, second = check_vehicle_names(names)
     if not isinstance(directory, (str, Path)) or str(directory) == "":

@@ -30,7 +30,7 @@ from topology.validation import short_repr
 from trajgen.errors import OptionError, ProfileFileError
 from trajgen.export.csv import HEADER_NAMES, Units
 from trajgen.export.numbers import format_number_rows
-from trajgen.tables import Interpolation, ProfileTable
+from trajgen.export.tables import Interpolation, ProfileTable
 
 __all__ = [
     "DIALECTS",

@@ -2,7 +2,7 @@
 
 What is verified is what is written: the rendered bytes are read back with the
 dialect's own reader and the two tables are checked along the schedule's route
-(:func:`trajgen.tables.check_tables`) as the controllers interpolate them.
+(:func:`trajgen.export.table_check.check_tables`) as the controllers interpolate them.
 A table set that fails is never returned.
 """
 
@@ -16,8 +16,9 @@ from pathlib import Path
 from trajgen.errors import OptionError, VerificationError
 from trajgen.export.dialects import DIALECTS, TableDialect
 from trajgen.export.resample import Resampled, resample
-from trajgen.naming import check_vehicle_names
-from trajgen.tables import Interpolation, TableCheck, check_tables, limit_ratios, slowdown
+from trajgen.export.table_check import TableCheck, check_tables
+from trajgen.export.tables import Interpolation, limit_ratios, slowdown
+from trajgen.scenario.naming import check_vehicle_names
 from trajgen.verify import VerifiedSchedule, require_verified
 
 __all__ = ["PlcTables", "check_dialect_method", "plc_tables", "table_paths"]

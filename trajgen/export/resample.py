@@ -21,9 +21,9 @@ import numpy as np
 
 from topology.indexed import track_distance
 from trajgen.errors import InputError, OutputLimitError
-from trajgen.pieces import schedule_pieces
-from trajgen.schedule import Schedule
-from trajgen.tables import Interpolation, ProfileTable, divided_differences, limit_ratios, slowdown
+from trajgen.export.tables import Interpolation, ProfileTable, divided_differences, limit_ratios, slowdown
+from trajgen.model.pieces import schedule_pieces
+from trajgen.model.schedule import Schedule
 from trajgen.verify import VerifiedSchedule, require_verified
 
 __all__ = ["POSITION_SCALE", "VELOCITY_SCALE", "Resampled", "resample"]

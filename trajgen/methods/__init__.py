@@ -1,4 +1,4 @@
-"""The timing methods, peers behind :class:`~trajgen.schedule.TimingMethod`, and their registry.
+"""The timing methods, peers behind :class:`~trajgen.model.schedule.TimingMethod`, and their registry.
 
 Adding a method: write its class (a frozen dataclass implementing
 ``TimingMethod``) and list it in :data:`METHODS` below; the dispatcher, the
@@ -19,7 +19,7 @@ from trajgen.methods.exact import Exact
 from trajgen.methods.optimal import ClassComparison, HomotopyChoice, Optimal, OptimalInfo, SolverCache
 from trajgen.methods.registry import MethodRegistry
 from trajgen.methods.toppra import Toppra
-from trajgen.schedule import Schedule, TimingMethod
+from trajgen.model.schedule import Schedule, TimingMethod
 
 __all__ = [
     "METHODS",

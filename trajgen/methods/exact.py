@@ -15,9 +15,9 @@ import numpy as np
 
 from limits import Limits
 from topology import Route
-from trajgen.axes import piece_maps, piece_profiles, route_axes, straight_pieces
 from trajgen.errors import InputError
-from trajgen.schedule import CubicKinematics, Schedule, Section, TimingMethod, check_request
+from trajgen.model.axes import piece_maps, piece_profiles, route_axes, straight_pieces
+from trajgen.model.schedule import CubicKinematics, Schedule, Section, TimingMethod, check_request
 
 __all__ = ["Exact"]
 

@@ -7,7 +7,7 @@ from collections.abc import Iterator, Sequence
 from limits import Limits
 from topology import Route
 from trajgen.errors import OptionError
-from trajgen.schedule import Schedule, TimingMethod
+from trajgen.model.schedule import Schedule, TimingMethod
 
 __all__ = ["MethodRegistry"]
 

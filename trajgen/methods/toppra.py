@@ -31,10 +31,10 @@ import numpy as np
 from limits import Limits
 from topology import Route, reduce_regions
 from topology.indexed import region_keys, track_distance
-from trajgen.axes import RouteAxes, piece_maps, piece_profiles, route_axes, straight_pieces
 from trajgen.errors import InputError, SolverError
 from trajgen.methods.exact import Exact
-from trajgen.schedule import (
+from trajgen.model.axes import RouteAxes, piece_maps, piece_profiles, route_axes, straight_pieces
+from trajgen.model.schedule import (
     AxisMap,
     CubicKinematics,
     FallbackReason,
@@ -44,7 +44,7 @@ from trajgen.schedule import (
     TimingMethod,
     check_request,
 )
-from trajgen.values import ArrayValue, readonly
+from trajgen.model.values import ArrayValue, readonly
 from trajgen.verify import verify
 
 __all__ = ["HEADROOM", "BlendedPath", "Toppra", "ToppraKinematics"]

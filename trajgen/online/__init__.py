@@ -10,11 +10,11 @@ simulated plant with faults (:mod:`trajgen.online.faults`). The argument is
 in docs/online.md.
 """
 
-from trajgen.coordination import Conflict, CoordinationDiagram
+from trajgen.model.coordination import Conflict, CoordinationDiagram
+from trajgen.model.paths import VehiclePath
 from trajgen.online.braking import BrakingCheck, PathState
 from trajgen.online.executor import Command, Event, Executor, GoalDecision, Mode, Setpoint, VehicleState
 from trajgen.online.goals import execution_margin, plan_for_execution
-from trajgen.paths import VehiclePath
 
 __all__ = [
     "BrakingCheck",

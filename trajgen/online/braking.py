@@ -24,7 +24,7 @@ from dataclasses import dataclass
 from ruckig import ControlInterface, InputParameter, Result, Ruckig, Trajectory
 
 from limits import VehicleLimits
-from trajgen.paths import VehiclePath, set_distance
+from trajgen.model.paths import VehiclePath, set_distance
 
 __all__ = ["BrakingCheck", "PathState", "ServiceBraking", "emergency_position"]
 

@@ -2,7 +2,7 @@
 
 Each control cycle :meth:`Executor.step` takes both vehicles' measured states
 and returns their setpoints for the end of the cycle. What the plan fixes is
-kept: each vehicle's path (:mod:`trajgen.paths`) and, at every conflict of
+kept: each vehicle's path (:mod:`trajgen.model.paths`) and, at every conflict of
 the coordination diagram, who passes first (:mod:`trajgen.online.conflicts`).
 Time is free:
 
@@ -32,24 +32,24 @@ import math
 
 from limits import Limits
 from topology import JUNCTION_INDEX, Configuration, Position, Route
-from trajgen.braking_rule import BRAKING_RULE_TOLERANCE
-from trajgen.coordination import (
+from trajgen.errors import InputError, ScheduleError, TrajgenError
+from trajgen.model.coordination import (
     CoordinationDiagram,
     earliest_rest,
     schedule_times,
     schedule_waypoints,
     stopping_distance,
 )
-from trajgen.errors import InputError, ScheduleError, TrajgenError
+from trajgen.model.paths import VehiclePath
+from trajgen.model.schedule import check_period
+from trajgen.model.summary import class_name
 from trajgen.online.braking import PathState
 from trajgen.online.goals import goal_refusal, plan_from_rest
 from trajgen.online.messages import Command, Event, GoalDecision, Mode, Setpoint, VehicleState, checked_state
 from trajgen.online.motion import AT_REST, PlanPlayer, VehicleMotion
 from trajgen.online.safety import SafetyGuard
-from trajgen.paths import VehiclePath
-from trajgen.schedule import check_period
-from trajgen.summary import class_name
 from trajgen.verify import VerifiedSchedule, require_verified
+from trajgen.verify.braking_rule import BRAKING_RULE_TOLERANCE
 
 __all__ = ["PERIOD_RANGE", "Command", "Event", "Executor", "GoalDecision", "Mode", "Setpoint", "VehicleState"]
 

@@ -14,7 +14,7 @@ from __future__ import annotations
 from limits import Limits
 from topology import Configuration, StarGraph, plan
 from trajgen.methods import METHODS, make_schedule
-from trajgen.schedule import TimingMethod
+from trajgen.model.schedule import TimingMethod
 from trajgen.verify import VerifiedSchedule, certify
 
 __all__ = ["execution_margin", "goal_refusal", "plan_for_execution", "plan_from_rest"]

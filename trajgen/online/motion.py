@@ -5,7 +5,7 @@ plan's (:class:`PlanPlayer`). After a departure it re-times the rest of its own
 path with Ruckig (:class:`VehicleMotion`): time-optimally, under its own
 velocity, acceleration and jerk limits, to rest at its next reversal or its
 frontier, whichever comes first, recomputed every cycle as the frontier moves.
-Travel coordinates throughout (:mod:`trajgen.paths`); plain floats: this runs
+Travel coordinates throughout (:mod:`trajgen.model.paths`); plain floats: this runs
 every control cycle.
 """
 
@@ -19,9 +19,9 @@ from ruckig import ControlInterface, InputParameter, Result, Ruckig, Trajectory
 from limits import VehicleLimits
 from topology import JUNCTION_INDEX
 from trajgen.errors import ScheduleError
+from trajgen.model.paths import VehiclePath
+from trajgen.model.pieces import schedule_pieces
 from trajgen.online.braking import PathState
-from trajgen.paths import VehiclePath
-from trajgen.pieces import schedule_pieces
 from trajgen.verify import VerifiedSchedule
 
 __all__ = ["AT_REST", "PlanPlayer", "VehicleMotion", "ruckig_jerk", "travel_state"]

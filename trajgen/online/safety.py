@@ -18,9 +18,9 @@ import math
 from limits import Limits
 from topology import StarGraph
 from topology.indexed import separation as indexed_separation
-from trajgen.coordination import stopping_distance
+from trajgen.model.coordination import stopping_distance
+from trajgen.model.paths import VehiclePath
 from trajgen.online.braking import BrakingCheck, PathState
-from trajgen.paths import VehiclePath
 
 __all__ = ["SEPARATION_TOLERANCE", "SafetyGuard"]
 

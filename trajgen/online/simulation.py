@@ -27,6 +27,8 @@ from topology.indexed import leg_travel
 from topology.indexed import separation as indexed_separation
 from trajgen.errors import InputError
 from trajgen.export.csv import CsvOptions
+from trajgen.model.schedule import TimingMethod
+from trajgen.model.values import frozen
 from trajgen.online.executor import Executor
 from trajgen.online.faults import Fault, FaultError, FaultKind, parse_fault
 from trajgen.online.goals import execution_margin, plan_for_execution
@@ -34,8 +36,6 @@ from trajgen.online.messages import Command, Event, Mode, VehicleState
 from trajgen.online.plant import Plant
 from trajgen.online.trace import PLOT_SAMPLES, Decimated, Trace
 from trajgen.scenario import Scenario
-from trajgen.schedule import TimingMethod
-from trajgen.values import frozen
 from trajgen.verify import VerifiedSchedule
 
 __all__ = ["PLOT_SAMPLES", "SimulationResult", "Trace", "parse_faults", "simulate"]

@@ -14,7 +14,7 @@ import numpy as np
 
 from topology import JUNCTION_INDEX, StarGraph
 from trajgen.export.csv import HEADER_NAMES, CsvOptions, format_rows
-from trajgen.schedule import ScheduleState
+from trajgen.model.schedule import ScheduleState
 
 __all__ = ["PLOT_SAMPLES", "Decimated", "Trace"]
 

@@ -3,8 +3,8 @@
 Only :mod:`trajgen.plots.figure` imports matplotlib, and only when a plot is rendered.
 """
 
-from trajgen.plots.animation import render_animation
-from trajgen.plots.configuration import render_configuration
+from trajgen.plots.animation_drawing import render_animation
+from trajgen.plots.configuration_drawing import render_configuration
 from trajgen.plots.coordination import METHOD_COLOURS, render_coordination
 from trajgen.plots.separation import render_separation
 from trajgen.plots.simulation import render_simulation

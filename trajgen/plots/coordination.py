@@ -7,12 +7,12 @@ from collections.abc import Mapping
 import numpy as np
 
 from topology.indexed import track_distance
-from trajgen.analysis import travelled
 from trajgen.errors import InputError
 from trajgen.methods import METHODS
+from trajgen.model.analysis import travelled
+from trajgen.model.schedule import Schedule
 from trajgen.plots.figure import new_figure, png_bytes
 from trajgen.plots.speed import plot_period
-from trajgen.schedule import Schedule
 from trajgen.verify import VerifiedSchedule, require_verified
 
 __all__ = ["METHOD_COLOURS", "render_coordination"]

@@ -42,10 +42,10 @@ from topology import JUNCTION_INDEX, GraphPoint, Homotopy, Instruction, Route, S
 from topology.cycle import retract_indexed
 from topology.indexed import IndexedConfiguration, step
 from trajgen.errors import InputError
+from trajgen.model.summary import class_label
+from trajgen.model.values import ArrayValue, readonly
 from trajgen.plots.figure import new_figure, png_bytes
 from trajgen.plots.speed import VEHICLE_COLOURS, plot_period
-from trajgen.summary import class_label
-from trajgen.values import ArrayValue, readonly
 from trajgen.verify import VerifiedSchedule, require_verified
 
 __all__ = [

@@ -5,9 +5,9 @@ from __future__ import annotations
 import numpy as np
 
 from topology.indexed import track_distance
+from trajgen.model.summary import class_label
 from trajgen.plots.figure import new_figure, png_bytes
 from trajgen.plots.speed import plot_period
-from trajgen.summary import class_label
 from trajgen.verify import VerifiedSchedule, require_verified
 
 __all__ = ["render_separation"]

@@ -61,7 +61,7 @@ def _progress(axis, result, names) -> None:
 
 def _coordination(axis, result, names, min_separation: float) -> None:
     """The plan's conflicts in the plane of both vehicles' travel, the plan's curve and the executed one."""
-    from trajgen.coordination import CoordinationDiagram, plan_paths
+    from trajgen.model.coordination import CoordinationDiagram, plan_paths
 
     schedule = result.schedule.schedule
     paths, times, travel = plan_paths(schedule)

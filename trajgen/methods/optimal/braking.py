@@ -1,6 +1,6 @@
 """The braking rule as constraints of the optimal-control NLP, phase by phase in leg coordinates.
 
-A plan meant for execution obeys the braking rule (:mod:`trajgen.braking_rule`):
+A plan meant for execution obeys the braking rule (:mod:`trajgen.verify.braking_rule`):
 at every instant each vehicle that follows at a conflict can still come to
 rest, under its service braking, short of every position at which it would
 meet a position where its leader could still come to rest (from the leader's
@@ -12,10 +12,10 @@ positive outward). Every expression is CasADi ``SX``.
 Points of one vehicle (leg coordinates, metres)
 -----------------------------------------------
 * **Earliest rest** ``R = s + v |v| / (2 E)`` (``E`` its emergency
-  deceleration): :func:`~trajgen.coordination.earliest_rest`.
+  deceleration): :func:`~trajgen.model.coordination.earliest_rest`.
 * **Service stop**: ``lo = s - D(-v, b_in)`` moving inward and
   ``hi = s + D(v, b_out)`` moving outward, ``D`` the bound of
-  :func:`~trajgen.coordination.stopping_distance` (with the speed and ``b``,
+  :func:`~trajgen.model.coordination.stopping_distance` (with the speed and ``b``,
   a smooth upper bound of the acceleration in the direction of travel, when
   positive; ``D`` grows with both). ``lo`` of a vehicle moving outward is
   ``s``: its stop lies outward.
@@ -141,7 +141,7 @@ def _lambda1(ca, x, width):
 
 
 def service_distance(speed, push, a_max, j_max):
-    """The stopping-distance bound of :func:`~trajgen.coordination.stopping_distance`, metres.
+    """The stopping-distance bound of :func:`~trajgen.model.coordination.stopping_distance`, metres.
 
     ``speed`` (m/s) and ``push`` (the acceleration in the direction of travel, m/s²) are taken
     as given, both >= 0: upper bounds of the two give an upper bound of the distance.

@@ -16,7 +16,7 @@ from trajgen.methods.optimal.decode import PhaseSolution, sections
 from trajgen.methods.optimal.info import OptimalInfo
 from trajgen.methods.optimal.phases import NlpShape, Phase
 from trajgen.methods.optimal.solve import SolverAttempt
-from trajgen.schedule import FallbackReason, Schedule, TimingMethod
+from trajgen.model.schedule import FallbackReason, Schedule, TimingMethod
 
 __all__ = ["ClassRace", "ClassSolve", "makespan"]
 

@@ -1,4 +1,4 @@
-"""From the NLP's solution to a :class:`~trajgen.schedule.Schedule` on the vehicles' signed axes."""
+"""From the NLP's solution to a :class:`~trajgen.model.schedule.Schedule` on the vehicles' signed axes."""
 
 from __future__ import annotations
 
@@ -9,8 +9,8 @@ import numpy as np
 from limits import Limits
 from topology import Route
 from trajgen.methods.optimal.phases import DEPTH, DURATION, NO_SWITCH, STATE_SIZE, NlpShape, Phase, stages
-from trajgen.profiles import PiecewiseCubic
-from trajgen.schedule import AxisMap, CubicKinematics, Section
+from trajgen.model.profiles import PiecewiseCubic
+from trajgen.model.schedule import AxisMap, CubicKinematics, Section
 
 __all__ = ["PhaseSolution", "sections", "unpack"]
 

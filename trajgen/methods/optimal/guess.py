@@ -6,7 +6,7 @@ import numpy as np
 
 from trajgen.errors import SolverError
 from trajgen.methods.optimal.phases import DEPTH, DURATION, NlpShape, Phase, stages
-from trajgen.schedule import Schedule
+from trajgen.model.schedule import Schedule
 
 __all__ = ["assemble", "initial_guess", "phase_windows"]
 

@@ -7,7 +7,7 @@ from dataclasses import dataclass
 
 from topology import Homotopy, Option, WayRound
 from trajgen.methods.optimal.solve import Solver, SolverAttempt
-from trajgen.schedule import FallbackReason, MethodInfo
+from trajgen.model.schedule import FallbackReason, MethodInfo
 
 __all__ = ["ClassComparison", "HomotopyChoice", "OptimalInfo", "Source"]
 
@@ -40,7 +40,7 @@ class ClassComparison:
     way_round : WayRound
         Its direction round the boundary circle (``GRAPH`` for four or more legs).
     lower_bound : float
-        :func:`~trajgen.analysis.class_lower_bound`, seconds.
+        :func:`~trajgen.model.analysis.class_lower_bound`, seconds.
     makespan : float or None
         Its best solved makespan, seconds (verified where ``chosen``; a class that another
         beat by more than refinement could gain keeps its first grid's); ``None`` when not
@@ -52,7 +52,7 @@ class ClassComparison:
         out of time, or its setup raised); ``None`` otherwise.
     label : str or None
         Four or more legs: which route on ``G_k`` it is, for people
-        (:func:`trajgen.summary.class_name`, e.g. ``second-shortest route on G_4``); ``None``
+        (:func:`trajgen.model.summary.class_name`, e.g. ``second-shortest route on G_4``); ``None``
         for three legs, where ``way_round`` says it.
     """
 

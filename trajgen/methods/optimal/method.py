@@ -15,7 +15,6 @@ import numpy as np
 
 from limits import Limits
 from topology import Homotopy, OptionError, Route, plan
-from trajgen.analysis import class_lower_bound
 from trajgen.errors import InputError, SolverError
 from trajgen.methods.exact import Exact
 from trajgen.methods.optimal.classes import ClassRace, ClassSolve
@@ -26,8 +25,9 @@ from trajgen.methods.optimal.mesh import refine
 from trajgen.methods.optimal.phases import NlpShape, default_fractions, route_phases
 from trajgen.methods.optimal.solve import SolverCache, solve
 from trajgen.methods.optimal.transcription import ParameterLayout
-from trajgen.schedule import FallbackReason, Schedule, TimingMethod, check_request
-from trajgen.summary import class_name
+from trajgen.model.analysis import class_lower_bound
+from trajgen.model.schedule import FallbackReason, Schedule, TimingMethod, check_request
+from trajgen.model.summary import class_name
 from trajgen.verify import verify
 
 __all__ = ["DEFAULT_NODES", "DEFAULT_REFINEMENT_TOLERANCE", "Optimal"]
@@ -100,7 +100,7 @@ class Optimal(TimingMethod):
         has no wall-time limit; its result is not used).
         If no class was solved by then, the ``exact`` schedule is returned, flagged ``time-budget``.
     braking_rule : bool, optional
-        State the braking rule (:mod:`trajgen.braking_rule`) in the problem (default ``False``), so
+        State the braking rule (:mod:`trajgen.verify.braking_rule`) in the problem (default ``False``), so
         that the plan can be executed by the order-keeping :class:`~trajgen.online.Executor`
         without holds; verify then checks it. Slower (seconds per solve), and fatrop may stall on
         it (the time budget's watchdog then abandons the call); the executor's
@@ -233,7 +233,7 @@ class Optimal(TimingMethod):
 
         With ``homotopy="fastest"`` the route's class and the other
         (:meth:`class_routes`) are both considered: a class whose lower bound
-        (:func:`~trajgen.analysis.class_lower_bound`) cannot beat the faster
+        (:func:`~trajgen.model.analysis.class_lower_bound`) cannot beat the faster
         of the two ``exact`` schedules is skipped, the others are solved
         concurrently, and the fastest solution that verifies is returned
         (the route's own class on a tie). Its ``route`` is its class's route.

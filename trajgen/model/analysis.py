@@ -9,8 +9,8 @@ import numpy as np
 from limits import Limits
 from topology import Route
 from topology.indexed import JUNCTION_INDEX, track_distance
-from trajgen.profiles import rest_to_rest_time
-from trajgen.schedule import Schedule
+from trajgen.model.profiles import rest_to_rest_time
+from trajgen.model.schedule import Schedule
 
 __all__ = ["class_lower_bound", "class_travel", "lower_bound", "travelled"]
 

@@ -11,7 +11,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from trajgen.errors import InputError
-from trajgen.values import ArrayValue, readonly
+from trajgen.model.values import ArrayValue, readonly
 
 __all__ = ["PiecewiseCubic", "rest_to_rest_time", "scurve_phases", "trapezoid_phases"]
 

@@ -27,7 +27,7 @@ refused, naming the legs that could not serve as sidings.
 
 A vehicle may take ``max_velocity`` and ``max_acceleration`` from a VDA 5050
 factsheet instead (``factsheet = "agv.json"``, relative to the scenario file's
-folder; see :mod:`trajgen.factsheet`); it still gives ``max_jerk``.
+folder; see :mod:`trajgen.scenario.factsheet`); it still gives ``max_jerk``.
 """
 
 from __future__ import annotations
@@ -41,9 +41,9 @@ from limits import Limits, VehicleLimits
 from topology import Configuration, Option, Position, Route, StarGraph, YGraph, plan
 from topology.validation import short_repr
 from trajgen.errors import InputError, OptionError, ScenarioError
-from trajgen.factsheet import read_factsheet
-from trajgen.naming import check_vehicle_name, check_vehicle_names
-from trajgen.reading import FileKind, file_label, read_bounded
+from trajgen.scenario.factsheet import read_factsheet
+from trajgen.scenario.naming import check_vehicle_name, check_vehicle_names
+from trajgen.scenario.reading import FileKind, file_label, read_bounded
 
 __all__ = [
     "DEFAULT_SCENARIO_NAME",
@@ -100,7 +100,7 @@ class BuiltinScenario(Option):
 
 #: Largest scenario file read, bytes; a larger one is refused unread.
 MAX_SCENARIO_BYTES = 1 << 20
-#: How scenario files are read (:func:`~trajgen.reading.read_bounded`).
+#: How scenario files are read (:func:`~trajgen.scenario.reading.read_bounded`).
 SCENARIO_FILE = FileKind("a scenario file", "a scenario TOML file", MAX_SCENARIO_BYTES, ScenarioError)
 #: Plausible range of each quantity of a scenario (SI units): outside it a scenario is refused.
 PLAUSIBLE = {

@@ -21,8 +21,8 @@ from limits import Limits
 from topology import JUNCTION_INDEX, Configuration, Position, Route
 from topology.validation import finite_real
 from trajgen.errors import InputError
-from trajgen.profiles import PiecewiseCubic
-from trajgen.values import ArrayValue, frozen, readonly
+from trajgen.model.profiles import PiecewiseCubic
+from trajgen.model.values import ArrayValue, frozen, readonly
 
 __all__ = [
     "AxisMap",
@@ -132,7 +132,7 @@ class TimingMethod(abc.ABC):
 
     @property
     def plans_for_execution(self) -> bool:
-        """Whether its schedules obey the braking rule (:mod:`trajgen.braking_rule`): verify checks it.
+        """Whether its schedules obey the braking rule (:mod:`trajgen.verify.braking_rule`): verify checks it.
 
         ``exact`` and ``toppra`` plans always do; ``optimal`` ones with ``braking_rule=True``.
         """
@@ -345,7 +345,7 @@ class Schedule:
         How many derivatives (1: velocity, 2: acceleration, 3: jerk) the
         verifier checks against the limits in closed form. ``None``: velocity
         and acceleration, and jerk if ``jerk_limited``; a table read back
-        defines fewer (:mod:`trajgen.tables` checks the rest from its points).
+        defines fewer (:mod:`trajgen.export.tables` checks the rest from its points).
     """
 
     route: Route

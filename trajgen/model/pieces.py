@@ -1,6 +1,6 @@
 """A schedule as polynomial pieces: on each, both axes are single polynomials and each vehicle on one leg.
 
-The verifier checks these pieces in closed form (:mod:`trajgen.polynomials`), so
+The verifier checks these pieces in closed form (:mod:`trajgen.model.polynomials`), so
 nothing can hide between samples, and its cost grows with the number of
 pieces, not with the duration.
 """
@@ -14,9 +14,9 @@ from math import comb
 import numpy as np
 
 from topology import JUNCTION_INDEX
-from trajgen.polynomials import evaluate, root_in
-from trajgen.schedule import AxisMap, CubicKinematics, Schedule, Section
-from trajgen.values import ArrayValue, readonly
+from trajgen.model.polynomials import evaluate, root_in
+from trajgen.model.schedule import AxisMap, CubicKinematics, Schedule, Section
+from trajgen.model.values import ArrayValue, readonly
 
 __all__ = ["DEGREE", "Pieces", "UncheckableKinematicsError", "motion_arrays", "schedule_pieces", "shift"]
 

@@ -25,8 +25,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from limits import VehicleLimits
-from trajgen.paths import VehiclePath
-from trajgen.pieces import Pieces, schedule_pieces
+from trajgen.model.paths import VehiclePath
+from trajgen.model.pieces import Pieces, schedule_pieces
 
 __all__ = [
     "Conflict",
@@ -450,7 +450,7 @@ def schedule_times(schedule, pieces: Pieces | None = None) -> np.ndarray:
     """Instants of a schedule between which neither vehicle turns, shape (n,), seconds.
 
     Every piece boundary and middle, and every instant a vehicle comes to rest and turns (a root of
-    its velocity). ``pieces``: the schedule's (:func:`~trajgen.pieces.schedule_pieces`), if at hand.
+    its velocity). ``pieces``: the schedule's (:func:`~trajgen.model.pieces.schedule_pieces`), if at hand.
     """
     pieces = schedule_pieces(schedule) if pieces is None else pieces
     times = [np.array([0.0, schedule.duration]), pieces.start, pieces.start + 0.5 * pieces.length]

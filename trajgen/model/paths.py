@@ -3,7 +3,7 @@
 The executor works in *travel* coordinates: ``p`` is the distance a vehicle
 has driven along its own path of the route (``0 <= p <= length``), so both
 vehicles' progress is monotone and a plan is a monotone curve in the
-``(p1, p2)`` plane (:mod:`trajgen.coordination`). Plain floats and tuples: these
+``(p1, p2)`` plane (:mod:`trajgen.model.coordination`). Plain floats and tuples: these
 functions run every control cycle.
 """
 
@@ -113,7 +113,7 @@ class VehiclePath:
         orientation : int, optional
             ``ds / d axis`` of the vehicle at the start (+1 if its axis grows
             away from the junction). ``None``: the axis grows in the direction of
-            the first move (the convention of :class:`~trajgen.schedule.Schedule`).
+            the first move (the convention of :class:`~trajgen.model.schedule.Schedule`).
         """
         pieces: list[list] = []  # [leg, s_from, s_to]
         waypoints = list(waypoints)

@@ -21,13 +21,13 @@ from pathlib import Path
 
 from topology.validation import short_repr
 from trajgen.errors import InputError
-from trajgen.reading import FileKind, file_label, read_bounded
+from trajgen.scenario.reading import FileKind, file_label, read_bounded
 
 __all__ = ["FACTSHEET_KEYS", "MAX_FACTSHEET_BYTES", "FactsheetLimits", "read_factsheet"]
 
 #: Largest factsheet file read, bytes; a larger one is refused unread.
 MAX_FACTSHEET_BYTES = 1 << 20
-#: How factsheets are read (:func:`~trajgen.reading.read_bounded`).
+#: How factsheets are read (:func:`~trajgen.scenario.reading.read_bounded`).
 FACTSHEET_FILE = FileKind("a factsheet", "a VDA 5050 factsheet JSON file", MAX_FACTSHEET_BYTES)
 #: The keys of ``physicalParameters`` that are read.
 FACTSHEET_KEYS = ("speedMax", "accelerationMax", "decelerationMax")

@@ -15,9 +15,9 @@ import numpy as np
 
 from limits import Limits
 from topology import JUNCTION_INDEX, Route
-from trajgen.profiles import PiecewiseCubic, scurve_phases, trapezoid_phases
-from trajgen.schedule import AxisMap
-from trajgen.values import ArrayValue, readonly
+from trajgen.model.profiles import PiecewiseCubic, scurve_phases, trapezoid_phases
+from trajgen.model.schedule import AxisMap
+from trajgen.model.values import ArrayValue, readonly
 
 __all__ = ["RouteAxes", "piece_maps", "piece_profiles", "route_axes", "straight_pieces"]
 

@@ -1,7 +1,7 @@
 """The braking rule a plan meant for execution obeys: what is planned is what executes.
 
 At every instant of a plan, each vehicle that follows at a conflict of the
-coordination diagram (:mod:`trajgen.coordination`) can still come to rest,
+coordination diagram (:mod:`trajgen.model.coordination`) can still come to rest,
 under its service braking, short of its frontier: short of every position
 that meets a position where its leader could still come to rest, from the
 leader's earliest rest point (its emergency braking) on. The online executor
@@ -26,9 +26,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from limits import VehicleLimits
-from trajgen.coordination import CoordinationDiagram, plan_paths, stopping_distances
-from trajgen.pieces import Pieces
-from trajgen.schedule import Schedule
+from trajgen.model.coordination import CoordinationDiagram, plan_paths, stopping_distances
+from trajgen.model.pieces import Pieces
+from trajgen.model.schedule import Schedule
 
 __all__ = ["BRAKING_RULE_TOLERANCE", "BrakingRuleFailure", "braking_rule_failures", "stop_point_rate"]
 
@@ -49,7 +49,7 @@ def stop_point_rate(
     """An upper bound of how fast a vehicle's service stop point moves during the next ``step`` seconds, m/s.
 
     ``d/dt (p + D(v, a)) = v + D_v dv/dt + D_a da/dt`` with ``D`` the bound of
-    :func:`~trajgen.coordination.stopping_distance` (which counts only a positive acceleration),
+    :func:`~trajgen.model.coordination.stopping_distance` (which counts only a positive acceleration),
     over the states the vehicle can reach from ``(velocity, acceleration)`` within ``step``: the
     speed grows by at most ``a+ h + J h^2 / 2`` and the acceleration by ``J h``, within the limits.
     A vehicle at rest can move its stop point only by about ``A h^2``.
@@ -62,7 +62,7 @@ def stop_point_rate(
     velocity, acceleration, step : ndarray, shape (n,)
         Rate of travel (m/s), its acceleration (m/s²) and the time ahead (s).
     jerk_limited : bool, optional
-        Whether the stop is jerk-limited (see :func:`~trajgen.coordination.stopping_distance`).
+        Whether the stop is jerk-limited (see :func:`~trajgen.model.coordination.stopping_distance`).
     """
     v_max, a_max, j_max = limits.max_velocity, limits.max_acceleration, limits.max_jerk
     if not jerk_limited:
@@ -108,7 +108,7 @@ def braking_rule_failures(
     separation : float, optional
         Track distance the conflicts keep, metres (default: the schedule's own separation).
     pieces : Pieces, optional
-        The schedule's polynomial pieces, if at hand (:func:`~trajgen.pieces.schedule_pieces`).
+        The schedule's polynomial pieces, if at hand (:func:`~trajgen.model.pieces.schedule_pieces`).
 
     Returns
     -------

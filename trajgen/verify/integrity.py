@@ -20,8 +20,8 @@ import math
 
 import numpy as np
 
-from trajgen.profiles import PiecewiseCubic
-from trajgen.schedule import AxisMap, CubicKinematics, Schedule
+from trajgen.model.profiles import PiecewiseCubic
+from trajgen.model.schedule import AxisMap, CubicKinematics, Schedule
 
 __all__ = ["array_failures"]
 

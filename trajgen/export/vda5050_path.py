@@ -1,0 +1,367 @@
+"""The node and edge graph of each vehicle's VDA 5050 path, from its verified schedule.
+
+Each vehicle's nodes are where its verified schedule starts, reverses, stops,
+passes the junction ``O`` and ends (on the legs of the schedule's route,
+``schedule.route``: ``optimal`` may take the other homotopy class and reverse
+shallower than the planner's waypoints), plus a *hold node* where the path
+crosses the edge of the junction zone, at the minimum separation from ``O``:
+there a vehicle can wait while the other passes the junction. Positions within
+:data:`NODE_TOLERANCE` of one of the route's waypoints, of a leg's end or of the
+junction are snapped to it. Each edge carries the highest speed the schedule
+reaches on it (``maxSpeed``).
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from topology import JUNCTION_INDEX, Option
+from trajgen.model.pieces import Pieces, shift
+from trajgen.model.polynomials import derivative, evaluate, extrema, root_in
+from trajgen.model.schedule import Schedule
+
+__all__ = [
+    "HOLD_MARGIN",
+    "NODE_TOLERANCE",
+    "NodeKind",
+    "OrderPath",
+    "PathEdge",
+    "PathNode",
+    "vehicle_path",
+]
+
+#: Reversals shorter than this are round-off; nodes this close to each other, to a route waypoint,
+#: a leg's end or the junction are one, metres.
+NODE_TOLERANCE = 1e-6
+#: No hold node is placed within this of another node, metres.
+HOLD_MARGIN = 1e-3
+#: A stretch of a piece moving less than this is at rest, metres.
+_REST_MOVE = 1e-9
+
+
+class NodeKind(Option):
+    """Why a node is on a vehicle's path."""
+
+    START = "start"
+    GOAL = "goal"
+    JUNCTION = "junction"  #: the vehicle passes (or stops at) the junction O
+    REVERSAL = "reversal"  #: the vehicle reverses
+    STOP = "stop"  #: the vehicle stops, and goes on in the same direction
+    HOLD = "hold"  #: the edge of the junction zone, the minimum separation from O
+
+
+@dataclass(frozen=True, slots=True)
+class PathNode:
+    """A node of one vehicle's path.
+
+    Attributes
+    ----------
+    leg : int
+        Leg index, ``JUNCTION_INDEX`` at the junction.
+    s : float
+        Distance from the junction, metres.
+    axis : float
+        The vehicle's signed axis there, metres.
+    arrival, departure : float
+        When the schedule reaches and leaves the node, seconds.
+    kinds : tuple of NodeKind
+    """
+
+    leg: int
+    s: float
+    axis: float
+    arrival: float
+    departure: float
+    kinds: tuple[NodeKind, ...]
+
+
+@dataclass(frozen=True, slots=True)
+class PathEdge:
+    """An edge of one vehicle's path, from node ``index`` to node ``index + 1`` (on one leg).
+
+    Attributes
+    ----------
+    index : int
+    leg : int
+        The leg (``JUNCTION_INDEX`` only for an edge of zero length at the junction).
+    low, high : float
+        The stretch of the leg it covers, metres from the junction.
+    max_speed : float
+        Highest speed the schedule reaches on it, m/s, at most the vehicle's limit (rounded up to 1 µm/s).
+    backward : bool
+        Whether the vehicle drives it against the direction of its first move.
+    """
+
+    index: int
+    leg: int
+    low: float
+    high: float
+    max_speed: float
+    backward: bool
+
+    @property
+    def length(self) -> float:
+        """Metres."""
+        return self.high - self.low
+
+
+@dataclass(frozen=True, slots=True)
+class OrderPath:
+    """One vehicle's nodes and edges (``len(edges) == len(nodes) - 1``)."""
+
+    nodes: tuple[PathNode, ...]
+    edges: tuple[PathEdge, ...]
+
+
+@dataclass(frozen=True, slots=True)
+class _Stretch:
+    """Part of a piece on which one vehicle's axis is monotone."""
+
+    piece: int
+    t0: float
+    t1: float
+    a0: float
+    a1: float
+    leg: int
+    offset: float
+    sign: float
+
+    def s(self, axis: float) -> float:
+        return max(self.offset + self.sign * axis, 0.0)
+
+
+def _stretches(pieces: Pieces, vehicle: int) -> list[_Stretch]:
+    """The vehicle's motion cut at every reversal inside a piece, in time order."""
+    out = []
+    for k in range(pieces.count):
+        c = pieces.axis[vehicle, k]
+        h = float(pieces.length[k])
+        velocity = np.trim_zeros(derivative(c[None])[0], "b")
+        cuts = [0.0, h]
+        if velocity.size > 1:
+            for root in np.roots(velocity[::-1]):
+                if abs(root.imag) <= 1e-9 * max(1.0, abs(root)) and 0.0 < root.real < h:
+                    cuts.append(float(root.real))
+        cuts.sort()
+        values = evaluate(c[None], np.array([cuts]))[0]
+        start = float(pieces.start[k])
+        for (ta, a0), (tb, a1) in itertools.pairwise(zip(cuts, values, strict=True)):
+            if tb > ta:
+                out.append(
+                    _Stretch(
+                        k,
+                        start + ta,
+                        start + tb,
+                        float(a0),
+                        float(a1),
+                        int(pieces.leg[vehicle, k]),
+                        float(pieces.s_offset[vehicle, k]),
+                        float(pieces.s_sign[vehicle, k]),
+                    )
+                )
+    return out
+
+
+@dataclass(slots=True)
+class _Event:
+    leg: int
+    s: float
+    axis: float
+    arrival: float
+    departure: float
+    kinds: set[NodeKind]
+
+
+def _same_place(a: _Event, b: _Event) -> bool:
+    if abs(a.axis - b.axis) > NODE_TOLERANCE:
+        return False
+    if a.s <= NODE_TOLERANCE and b.s <= NODE_TOLERANCE:
+        return True
+    return a.leg == b.leg and abs(a.s - b.s) <= NODE_TOLERANCE
+
+
+def _merged(events: list[_Event]) -> list[_Event]:
+    """Consecutive events at one place (the vehicle not moving between them) as one."""
+    out: list[_Event] = []
+    for event in events:
+        if out and _same_place(out[-1], event):
+            last = out[-1]
+            last.arrival = min(last.arrival, event.arrival)
+            last.departure = max(last.departure, event.departure)
+            last.kinds |= event.kinds
+            if NodeKind.START in event.kinds or NodeKind.GOAL in event.kinds:  # the route's exact position
+                last.leg, last.s = event.leg, event.s
+        else:
+            out.append(event)
+    return out
+
+
+def _events(schedule: Schedule, pieces: Pieces, vehicle: int) -> list[_Event]:
+    """Start, reversals, stops, junction passages and goal of one vehicle, in time order."""
+    stretches = _stretches(pieces, vehicle)
+    route = schedule.route
+    start = route.indexed_waypoints[0][2 * vehicle : 2 * vehicle + 2]
+    goal = route.indexed_waypoints[-1][2 * vehicle : 2 * vehicle + 2]
+    duration = schedule.duration
+    if not stretches:
+        first_axis = last_axis = 0.0
+    else:
+        first_axis, last_axis = stretches[0].a0, stretches[-1].a1
+    events = [_Event(start[0], start[1], first_axis, 0.0, 0.0, {NodeKind.START})]
+    # reversals: the extremes of the axis, ignoring wiggles below NODE_TOLERANCE
+    direction = 0
+    anchor = first_axis
+    extreme: tuple[float, float, _Stretch] | None = None  # (axis, time, stretch)
+    previous_leg = None
+    rest: list[_Stretch] = []
+    for stretch in stretches:
+        for t, a in ((stretch.t0, stretch.a0), (stretch.t1, stretch.a1)):
+            if direction == 0:
+                if abs(a - anchor) > NODE_TOLERANCE:
+                    direction = 1 if a > anchor else -1
+                    extreme = (a, t, stretch)
+            elif direction * (a - extreme[0]) > 0.0:
+                extreme = (a, t, stretch)
+            elif direction * (extreme[0] - a) > NODE_TOLERANCE:
+                axis, time, where = extreme
+                events.append(_Event(where.leg, where.s(axis), axis, time, time, {NodeKind.REVERSAL}))
+                direction = -direction
+                extreme = (a, t, stretch)
+        # stops: stretches at rest, merged
+        if abs(stretch.a1 - stretch.a0) <= _REST_MOVE:
+            rest.append(stretch)
+        else:
+            _flush_rest(rest, events)
+            rest = []
+        # junction passages: a change of leg
+        if stretch.leg != JUNCTION_INDEX:
+            if previous_leg is not None and stretch.leg != previous_leg:
+                events.append(
+                    _Event(JUNCTION_INDEX, 0.0, stretch.a0, stretch.t0, stretch.t0, {NodeKind.JUNCTION})
+                )
+            previous_leg = stretch.leg
+    _flush_rest(rest, events)
+    events.append(_Event(goal[0], goal[1], last_axis, duration, duration, {NodeKind.GOAL}))
+    events.sort(key=lambda event: (event.arrival, event.departure))
+    return _merged(events)
+
+
+def _flush_rest(rest: list[_Stretch], events: list[_Event]) -> None:
+    if rest:
+        first, last = rest[0], rest[-1]
+        kind = NodeKind.JUNCTION if first.s(first.a0) <= NODE_TOLERANCE else NodeKind.STOP
+        events.append(_Event(first.leg, first.s(first.a0), first.a0, first.t0, last.t1, {kind}))
+
+
+def _snap(schedule: Schedule, vehicle: int, event: _Event) -> None:
+    """Put an event within NODE_TOLERANCE of the junction, a route waypoint or a leg's end on it."""
+    graph = schedule.route.graph
+    if event.s <= NODE_TOLERANCE:
+        event.leg, event.s = JUNCTION_INDEX, 0.0
+        event.kinds.add(NodeKind.JUNCTION)
+        return
+    places = {graph.lengths[event.leg]} if event.leg != JUNCTION_INDEX else set()
+    for waypoint in schedule.route.indexed_waypoints:
+        if waypoint[2 * vehicle] == event.leg:
+            places.add(waypoint[2 * vehicle + 1])
+    nearest = min(places, key=lambda s: abs(s - event.s), default=None)
+    if nearest is not None and abs(nearest - event.s) <= NODE_TOLERANCE:
+        event.s = nearest
+
+
+def _edge_leg(a: _Event | PathNode, b: _Event | PathNode) -> int:
+    return a.leg if a.leg != JUNCTION_INDEX else b.leg
+
+
+def _crossing(pieces: Pieces, vehicle: int, t0: float, t1: float, leg: int, s: float) -> float | None:
+    """The time in ``[t0, t1]`` at which the vehicle is at ``s`` on ``leg`` (its s monotone there)."""
+    overlapping = (pieces.start < t1) & (pieces.start + pieces.length > t0)
+    for piece in np.nonzero(overlapping & (pieces.leg[vehicle] == leg))[0]:
+        sign = pieces.s_sign[vehicle, piece]
+        if sign == 0.0:
+            continue
+        low = max(t0 - pieces.start[piece], 0.0)
+        high = min(t1 - pieces.start[piece], pieces.length[piece])
+        c = pieces.axis[vehicle, piece].copy()
+        c[0] -= (s - pieces.s_offset[vehicle, piece]) / sign
+        root = root_in(c[None], np.array([low]), np.array([high]))[0]
+        if np.isfinite(root):
+            return float(pieces.start[piece] + root)
+    return None
+
+
+def _with_holds(schedule: Schedule, pieces: Pieces, vehicle: int, events: list[_Event]) -> list[_Event]:
+    """Insert a hold node where the path crosses the edge of the junction zone (the separation from O)."""
+    radius = schedule.limits.min_separation
+    out = [events[0]]
+    for a, b in itertools.pairwise(events):
+        low, high = sorted((a.s, b.s))
+        if low < radius - HOLD_MARGIN and high > radius + HOLD_MARGIN:
+            leg = _edge_leg(a, b)
+            time = _crossing(pieces, vehicle, a.departure, b.arrival, leg, radius)
+            if time is not None:
+                axis = float(schedule.state(time).axis[vehicle, 0])
+                out.append(_Event(leg, radius, axis, time, time, {NodeKind.HOLD}))
+        out.append(b)
+    return out
+
+
+def _max_speed(pieces: Pieces, vehicle: int, t0: float, t1: float) -> float:
+    """Highest |velocity| of the vehicle in ``[t0, t1]``, m/s (closed form, piece by piece)."""
+    mask = (pieces.start < t1) & (pieces.start + pieces.length > t0)
+    if not mask.any():
+        return 0.0
+    starts = pieces.start[mask]
+    low = np.maximum(t0 - starts, 0.0)
+    high = np.minimum(t1 - starts, pieces.length[mask])
+    c = shift(pieces.axis[vehicle][mask], low)
+    v_low, _, v_high, _ = extrema(derivative(c), np.maximum(high - low, 0.0))
+    return float(np.max(np.maximum(np.abs(v_low), np.abs(v_high))))
+
+
+def vehicle_path(schedule: Schedule, pieces: Pieces, vehicle: int) -> OrderPath:
+    """The nodes and edges of ``vehicle``'s (0 or 1) VDA 5050 path (see the module's description).
+
+    Parameters
+    ----------
+    schedule : Schedule
+        A verified schedule.
+    pieces : Pieces
+        ``schedule_pieces(schedule)``.
+    vehicle : int
+        0 or 1.
+
+    Returns
+    -------
+    OrderPath
+    """
+    events = _events(schedule, pieces, vehicle)
+    for event in events:
+        _snap(schedule, vehicle, event)
+    events = _with_holds(schedule, pieces, vehicle, _merged(events))
+    for event in events:  # a stop is named only where nothing else names the node
+        if len(event.kinds) > 1:
+            event.kinds.discard(NodeKind.STOP)
+    nodes = tuple(
+        PathNode(e.leg, e.s, e.axis, e.arrival, e.departure, tuple(k for k in NodeKind if k in e.kinds))
+        for e in events
+    )
+    limit = schedule.limits.vehicles[vehicle].max_velocity
+    edges = []
+    for index, (a, b) in enumerate(itertools.pairwise(nodes)):
+        peak = _max_speed(pieces, vehicle, a.departure, b.arrival)
+        edges.append(
+            PathEdge(
+                index=index,
+                leg=_edge_leg(a, b),
+                low=min(a.s, b.s),
+                high=max(a.s, b.s),
+                max_speed=min(math.ceil(peak * 1e6) / 1e6, limit),
+                backward=b.axis < a.axis,
+            )
+        )
+    return OrderPath(nodes, tuple(edges))

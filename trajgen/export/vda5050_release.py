@@ -1,0 +1,275 @@
+"""The order updates of both vehicles: which base each VDA 5050 order or order update releases, and when.
+
+A VDA 5050 order carries no timing: a vehicle drives its *base* (released
+nodes and edges) at its own pace, at most ``maxSpeed`` on each edge, and
+stops at the last base node (the *decision point*) until an order update
+extends the base, stitched at the previous decision point. So the release of
+the base, not the schedule's timing, is what keeps the two vehicles apart here:
+
+- **Claims.** A vehicle *claims* the stretch of track from the last node it
+  reached to its decision point. The claims of the two vehicles never come
+  closer than the minimum separation, so whatever the timing of either
+  vehicle within its base, they cannot collide.
+- **Order of release.** A *node plan* orders the two paths' edges: a
+  sequence of moves, each taking one vehicle to its next node while the
+  other stands at a node, every move keeping the separation, that follows
+  the schedule's order of arrivals wherever the nodes allow it. An edge that
+  comes closer than the separation to an edge the plan gives the other
+  vehicle first is released only once the other vehicle has left that edge;
+  so the vehicles pass the junction in the schedule's order, and the
+  releases cannot deadlock. The releases are found by replaying both paths,
+  node by node, in the order of the schedule's times, each vehicle waiting
+  at its decision point until released (:func:`plan_orders`).
+
+Each update is triggered by the other vehicle reaching a node (its state's
+``lastNodeId`` and ``lastNodeSequenceId``); ``send_at`` is the time of that
+event in the replay (the schedule's time plus the waits before it). A vehicle
+released after it reaches its decision point waits there (``wait``): VDA 5050
+cannot express a schedule in which both vehicles are near the junction at
+once, so a schedule that does so (``optimal``) is executed a few seconds
+slower (:attr:`OrderPlan.planned_duration`).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from topology import JUNCTION_INDEX
+from trajgen.errors import ScheduleError
+from trajgen.export.vda5050_path import OrderPath, vehicle_path
+from trajgen.model.pieces import schedule_pieces
+from trajgen.verify import POSITION_TOLERANCE, VerifiedSchedule, require_verified
+
+__all__ = ["OrderPlan", "Release", "plan_orders"]
+
+
+@dataclass(frozen=True, slots=True)
+class Release:
+    """One message of one vehicle: the order (``update == 0``) or an order update.
+
+    Attributes
+    ----------
+    vehicle : int
+        0 or 1.
+    update : int
+        The ``orderUpdateId``.
+    first : int
+        Index of the first node sent: 0, or the previous decision point (the stitching node).
+    decision_point : int
+        Index of the last base node.
+    send_at : float
+        When the release becomes safe in the replay, seconds from the start.
+    needed_at : float or None
+        When the vehicle leaves the previous decision point in the replay if it need not wait, seconds.
+    wait : float
+        How long the vehicle waits at the previous decision point, seconds.
+    trigger : tuple of (int, int) or None
+        ``(other vehicle, node index)``: send when the other vehicle reaches that node;
+        ``None``: at the start.
+    """
+
+    vehicle: int
+    update: int
+    first: int
+    decision_point: int
+    send_at: float
+    needed_at: float | None
+    wait: float
+    trigger: tuple[int, int] | None
+
+
+@dataclass(frozen=True, slots=True)
+class OrderPlan:
+    """Both vehicles' paths and every release, in the order they are sent.
+
+    Attributes
+    ----------
+    paths : tuple of 2 OrderPath
+    releases : tuple of Release
+        By ``send_at`` (and in the replay's order at equal times).
+    planned_duration : float
+        When both vehicles reach their goals in the replay (the schedule's duration plus the waits), s.
+    """
+
+    paths: tuple[OrderPath, OrderPath]
+    releases: tuple[Release, ...]
+    planned_duration: float
+
+
+def _gap(first: tuple[int, float, float], second: tuple[int, float, float]) -> float:
+    """Track distance between two stretches ``(leg, low, high)`` (leg JUNCTION_INDEX: the point O)."""
+    leg_a, low_a, high_a = first
+    leg_b, low_b, high_b = second
+    if leg_a == leg_b and leg_a != JUNCTION_INDEX:
+        return max(0.0, low_b - high_a, low_a - high_b)
+    return low_a + low_b
+
+
+class _Replay:
+    """Both paths replayed node by node in the schedule's order; a vehicle waits at its decision point.
+
+    The order of the track is a *node plan*: a sequence of moves, each taking one vehicle to its next
+    node while the other stands at a node, every move keeping the separation, that follows the
+    schedule's order of arrivals wherever the nodes allow it. A vehicle's edge is released once the
+    other vehicle has reached the node the plan has it at during that move, and its track keeps the
+    separation from the other vehicle's claim; so the replay follows the plan (with more motion at
+    once where the claims allow it) and cannot deadlock. "Reached the node" is relaxed to "left every
+    edge the plan drives before, and that comes closer than the separation".
+    """
+
+    def __init__(self, paths: tuple[OrderPath, OrderPath], separation: float) -> None:
+        self.paths = paths
+        # conflict: closer than the separation (verifier's tolerance); at 0, touching
+        self.threshold = max(separation - POSITION_TOLERANCE, POSITION_TOLERANCE)
+        self.stretches = [[(e.leg, e.low, e.high) for e in path.edges] for path in paths]
+        self.points = [[(n.leg, n.s, n.s) for n in path.nodes] for path in paths]
+        self.after = self.node_plan()
+        self.reached = [0, 0]
+        self.released = [0, 0]
+        self.delay = [0.0, 0.0]
+
+    def apart(self, first: tuple[int, float, float], second: tuple[int, float, float]) -> bool:
+        return _gap(first, second) >= self.threshold
+
+    def node_plan(self) -> tuple[list[int], list[int]]:
+        """Per vehicle and edge, the node the other vehicle must have reached before the edge is released.
+
+        Raises
+        ------
+        ScheduleError
+            No sequence of moves between the nodes keeps the separation.
+        """
+        last = (len(self.points[0]) - 1, len(self.points[1]) - 1)
+
+        def move(vehicle: int, k: int, other_node: int) -> bool:
+            """Whether ``vehicle`` may drive its edge ``k`` while the other stands at ``other_node``."""
+            return k < last[vehicle] and self.apart(
+                self.stretches[vehicle][k], self.points[1 - vehicle][other_node]
+            )
+
+        # which states (node of vehicle 1, node of vehicle 2) still lead to both goals
+        reach = [[False] * (last[1] + 1) for _ in range(last[0] + 1)]
+        for k in range(last[0], -1, -1):
+            for j in range(last[1], -1, -1):
+                reach[k][j] = self.apart(self.points[0][k], self.points[1][j]) and (
+                    (k, j) == last
+                    or (move(0, k, j) and reach[k + 1][j])
+                    or (move(1, j, k) and reach[k][j + 1])
+                )
+        if not reach[0][0]:
+            raise ScheduleError(
+                "VDA 5050 orders: no order of the two paths' edges keeps the minimum separation "
+                "node by node (the schedule relies on the vehicles' timing between nodes)"
+            )
+        at: tuple[list[int], list[int]] = ([0] * last[0], [0] * last[1])  # the other's node during a move
+        k = j = 0
+        arrival = [[n.arrival for n in path.nodes] for path in self.paths]
+        while (k, j) != last:
+            first = move(0, k, j) and reach[k + 1][j]
+            second = move(1, j, k) and reach[k][j + 1]
+            if first and second:  # both may go: the one the schedule has arrive first
+                first = arrival[0][k + 1] <= arrival[1][j + 1]
+            if first:
+                at[0][k] = j
+                k += 1
+            else:
+                at[1][j] = k
+                j += 1
+        # only the other's conflicting edges that the plan drives first must be behind it
+        return tuple(
+            [
+                max(
+                    (
+                        f + 1
+                        for f in range(at[vehicle][edge])
+                        if not self.apart(stretch, self.stretches[1 - vehicle][f])
+                    ),
+                    default=0,
+                )
+                for edge, stretch in enumerate(self.stretches[vehicle])
+            ]
+            for vehicle in (0, 1)
+        )
+
+    def claim(self, vehicle: int) -> list[tuple[int, float, float]]:
+        first, last = self.reached[vehicle], self.released[vehicle]
+        return [self.points[vehicle][first], *self.stretches[vehicle][first:last]]
+
+    def allowed(self, vehicle: int, edge: int) -> bool:
+        other = 1 - vehicle
+        if self.reached[other] < self.after[vehicle][edge]:
+            return False
+        stretch = self.stretches[vehicle][edge]
+        return all(self.apart(stretch, held) for held in self.claim(other))
+
+    def extend(self, vehicle: int) -> int:
+        edge = self.released[vehicle]
+        while edge < len(self.stretches[vehicle]) and self.allowed(vehicle, edge):
+            edge += 1
+        return edge
+
+    def time_of(self, vehicle: int, node: int) -> float:
+        return self.paths[vehicle].nodes[node].arrival + self.delay[vehicle]
+
+    def run(self) -> tuple[list[Release], float]:
+        releases: list[Release] = []
+        for vehicle in (0, 1):
+            self.released[vehicle] = self.extend(vehicle)
+            releases.append(Release(vehicle, 0, 0, self.released[vehicle], 0.0, None, 0.0, None))
+        counts = [1, 1]
+        last = [len(path.nodes) - 1 for path in self.paths]
+        while self.reached != last:
+            movable = [v for v in (0, 1) if self.reached[v] < self.released[v]]
+            if not movable:
+                raise ScheduleError(
+                    "VDA 5050 orders: the releases deadlock at nodes "
+                    f"{self.reached[0]} and {self.reached[1]}: the schedule's order of the track "
+                    "cannot be released node by node"
+                )
+            mover = min(movable, key=lambda v: (self.time_of(v, self.reached[v] + 1), v))
+            now = self.time_of(mover, self.reached[mover] + 1)
+            self.reached[mover] += 1
+            for vehicle in (1 - mover, mover):
+                end = self.extend(vehicle)
+                if end == self.released[vehicle]:
+                    continue
+                old = self.released[vehicle]
+                needed = self.paths[vehicle].nodes[old].departure + self.delay[vehicle]
+                wait = max(0.0, now - needed) if self.reached[vehicle] == old else 0.0
+                self.delay[vehicle] += wait
+                releases.append(
+                    Release(
+                        vehicle, counts[vehicle], old, end, now, needed, wait, (mover, self.reached[mover])
+                    )
+                )
+                counts[vehicle] += 1
+                self.released[vehicle] = end
+        finish = max(self.time_of(v, last[v]) for v in (0, 1))
+        return releases, finish
+
+
+def plan_orders(verified: VerifiedSchedule) -> OrderPlan:
+    """Both vehicles' VDA 5050 paths and the releases of their bases (see the module's description).
+
+    Parameters
+    ----------
+    verified : VerifiedSchedule
+        From :func:`trajgen.verify.certify`.
+
+    Returns
+    -------
+    OrderPlan
+
+    Raises
+    ------
+    UnverifiedScheduleError
+        ``verified`` is not a VerifiedSchedule.
+    ScheduleError
+        No order of the two paths' edges keeps the separation node by node (not seen on any
+        schedule: 220 random scenarios of the three methods, and the tests' cases).
+    """
+    schedule = require_verified(verified, "plan_orders").schedule
+    pieces = schedule_pieces(schedule)
+    paths = (vehicle_path(schedule, pieces, 0), vehicle_path(schedule, pieces, 1))
+    releases, finish = _Replay(paths, schedule.limits.min_separation).run()
+    return OrderPlan(paths, tuple(releases), max(finish, schedule.duration))

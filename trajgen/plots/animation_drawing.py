@@ -1,0 +1,346 @@
+"""The animation drawn: a schedule played on the track seen from above, frame by frame, as GIF bytes.
+
+Each frame shows the track to scale, each vehicle at its position (a dot, and
+a disc of diameter the minimum separation: on one leg the discs touch exactly
+when the vehicles are at the minimum), where each starts (hollow circle) and
+ends (hollow square), a clock, each vehicle's speed and, below, the track
+distance between the vehicles as a bar against the minimum (red when closer
+than :data:`~trajgen.plots.animation.NEAR_FACTOR` times the minimum).
+
+Resources are bounded whatever the duration: at most ``max_frames`` frames
+(a long schedule is played faster, by a round speed-up written on every
+frame), drawn one at a time into one figure and encoded at once
+(:func:`trajgen.plots.gif.gif_bytes`).
+
+What each frame shows (the instants, the positions, the layout in pixels, the
+texts) is computed apart from the drawing, in :mod:`trajgen.plots.animation`.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+
+import numpy as np
+
+from topology import StarGraph
+from topology.validation import short_repr
+from trajgen.errors import InputError
+from trajgen.model.summary import class_name
+from trajgen.plots.animation import (
+    DEFAULT_FPS,
+    DEFAULT_MAX_FRAMES,
+    END_HOLD_MS,
+    FRAME_DPI,
+    FRAME_HEIGHT_PX,
+    FRAME_WIDTH_PX,
+    FrameGeometry,
+    FrameLayout,
+    Playback,
+    clock_text,
+    distance_text,
+    frame_geometry,
+    frame_layout,
+    playback,
+    speed_text,
+)
+from trajgen.plots.figure import frame_painter, new_figure
+from trajgen.plots.gif import gif_bytes
+from trajgen.plots.speed import VEHICLE_COLOURS
+from trajgen.progress import progress
+from trajgen.verify import VerifiedSchedule, require_verified
+
+__all__ = ["render_animation"]
+
+
+def _round_length(target: float) -> float:
+    """A round length (1, 2 or 5 times a power of ten) at most ``target``, metres."""
+    decade = 10.0 ** math.floor(math.log10(target))
+    return max(digit * decade for digit in (1, 2, 5) if digit * decade <= target)
+
+
+def _free_corners(graph: StarGraph, layout: FrameLayout) -> list[str]:
+    """The track area's corners, farthest from the legs first, as legend locations."""
+    angles = np.radians(np.array(graph.angles_deg))
+    ends = np.stack([np.array(graph.lengths) * np.cos(angles), np.array(graph.lengths) * np.sin(angles)], 1)
+    corners = {
+        "upper left": (layout.track_xlim[0], layout.track_ylim[1]),
+        "upper right": (layout.track_xlim[1], layout.track_ylim[1]),
+        "lower left": (layout.track_xlim[0], layout.track_ylim[0]),
+        "lower right": (layout.track_xlim[1], layout.track_ylim[0]),
+    }
+
+    def clearance(corner) -> float:
+        point = np.array(corner)
+        along = np.clip((ends @ point) / np.einsum("ij,ij->i", ends, ends), 0.0, 1.0)
+        return float(np.min(np.linalg.norm(point - along[:, None] * ends, axis=1)))
+
+    return sorted(corners, key=lambda name: -clearance(corners[name]))
+
+
+def _widest_gap(angles_deg: Sequence[float]) -> float:
+    """The direction halfway across the widest angle between two neighbouring legs, radians."""
+    angles = sorted(a % 360.0 for a in angles_deg)
+    count = len(angles)
+    gaps = [((angles[(k + 1) % count] - angles[k]) % 360.0, k) for k in range(count)]
+    width, k = max(gaps)
+    return math.radians(angles[k] + 0.5 * width)
+
+
+def _disc(x: float, y: float, radius: float) -> np.ndarray:
+    angle = np.linspace(0.0, 2.0 * np.pi, 48)
+    return np.column_stack([x + radius * np.cos(angle), y + radius * np.sin(angle)])
+
+
+class _Scene:
+    """One figure: the still parts drawn once, the moving parts updated and drawn for each frame."""
+
+    def __init__(
+        self,
+        verified: VerifiedSchedule,
+        geometry: FrameGeometry,
+        layout: FrameLayout,
+        names: tuple[str, str],
+        play: Playback,
+    ) -> None:
+        schedule = verified.schedule
+        self.geometry = geometry
+        self.names = names
+        self.duration = schedule.duration
+        figure = new_figure(figsize=(FRAME_WIDTH_PX / FRAME_DPI, FRAME_HEIGHT_PX / FRAME_DPI))
+        figure.set_dpi(FRAME_DPI)
+        self.figure = figure
+        figure.text(
+            0.5,
+            0.965,
+            f"{names[0]} and {names[1]}: {schedule.method.name} schedule, {schedule.duration:.2f} s, "
+            f"{class_name(schedule.route)}",
+            ha="center",
+            va="center",
+            fontsize=11,
+        )
+        self.clock = figure.text(0.03, 0.915, "", ha="left", va="center", fontsize=12, family="monospace")
+        figure.text(0.97, 0.915, play.label, ha="right", va="center", fontsize=12, weight="bold")
+        self.speeds = [
+            figure.text(
+                x, 0.875, "", ha=ha, va="center", fontsize=11, color=VEHICLE_COLOURS[v], weight="bold"
+            )
+            for v, (x, ha) in enumerate(((0.03, "left"), (0.97, "right")))
+        ]
+        self.vehicles = self._draw_track(schedule.route.graph, layout)
+        self.bar, self.minimum, self.bar_value = self._draw_bar(layout)
+        moving = [self.clock, *self.speeds]
+        for disc, dot, name in self.vehicles:
+            moving += [disc, dot, name]
+        moving += [self.bar, *self.minimum, self.bar_value]
+        self.paint = frame_painter(figure, moving)
+
+    def _axes(self, box: tuple[float, float, float, float]):
+        sizes = (FRAME_WIDTH_PX, FRAME_HEIGHT_PX, FRAME_WIDTH_PX, FRAME_HEIGHT_PX)
+        return self.figure.add_axes([value / size for value, size in zip(box, sizes, strict=True)])
+
+    def _draw_track(self, graph: StarGraph, layout: FrameLayout) -> list:
+        geometry = self.geometry
+        axis = self._axes(layout.track_box)
+        axis.set_xlim(*layout.track_xlim)
+        axis.set_ylim(*layout.track_ylim)
+        axis.set_aspect("auto")  # the limits already give a metre the same pixels both ways
+        axis.set_axis_off()
+        span = layout.track_xlim[1] - layout.track_xlim[0]
+        height = layout.track_ylim[1] - layout.track_ylim[0]
+        for name, length, angle in zip(graph.names, graph.lengths, np.radians(graph.angles_deg), strict=True):
+            direction = np.array([math.cos(angle), math.sin(angle)])
+            axis.plot(
+                [0.0, length * direction[0]],
+                [0.0, length * direction[1]],
+                color="0.75",
+                linewidth=7,
+                solid_capstyle="round",
+                zorder=1,
+            )
+            label = length * direction + 0.075 * span * direction
+            axis.text(*label, f"{name}\n{length:g} m", ha="center", va="center", fontsize=9, color="0.3")
+        axis.plot([0.0], [0.0], "o", color="white", markeredgecolor="0.3", markersize=7, zorder=2)
+        free = _widest_gap(graph.angles_deg)
+        axis.annotate(
+            "O",
+            (0.0, 0.0),
+            xytext=(10 * math.cos(free), 10 * math.sin(free)),
+            textcoords="offset points",
+            ha="center",
+            va="center",
+            fontsize=9,
+            color="0.3",
+        )
+        for v in range(2):
+            for k, marker, what in ((0, "o", "start"), (-1, "s", "goal")):
+                axis.plot(
+                    geometry.x[v, k],
+                    geometry.y[v, k],
+                    marker,
+                    markersize=13,
+                    markerfacecolor="none",
+                    markeredgecolor=VEHICLE_COLOURS[v],
+                    markeredgewidth=1.5,
+                    zorder=3,
+                    label=f"{self.names[v]} {what}",
+                )
+        corners = _free_corners(graph, layout)
+        axis.legend(loc=corners[0], fontsize=8, framealpha=0.9, ncols=2)
+        length = _round_length(0.2 * span)
+        left = "left" in corners[1]
+        x0 = layout.track_xlim[0] + 0.04 * span if left else layout.track_xlim[1] - 0.04 * span - length
+        lower = "lower" in corners[1]
+        y0 = layout.track_ylim[0] + 0.05 * height if lower else layout.track_ylim[1] - 0.08 * height
+        axis.plot([x0, x0 + length], [y0, y0], color="black", linewidth=2, solid_capstyle="butt")
+        axis.text(
+            x0 + 0.5 * length,
+            y0 + 0.012 * height,
+            f"{length:g} m (to scale)",
+            ha="center",
+            va="bottom",
+            fontsize=8,
+        )
+        radius = 0.5 * geometry.min_separation
+        vehicles = []
+        for v in range(2):
+            colour = VEHICLE_COLOURS[v]
+            disc = axis.fill(*_disc(0.0, 0.0, radius).T, color=colour, alpha=0.3, linewidth=0, zorder=4)[0]
+            dot = axis.plot(
+                [0.0], [0.0], "o", color=colour, markersize=10, markeredgecolor="black", markeredgewidth=0.8
+            )[0]
+            name = axis.annotate(
+                self.names[v],
+                (0.0, 0.0),
+                xytext=(0.0, 0.0),
+                textcoords="offset points",
+                fontsize=10,
+                color=colour,
+                weight="bold",
+            )
+            vehicles.append((disc, dot, name))
+        self.radius = radius
+        return vehicles
+
+    def _draw_bar(self, layout: FrameLayout):
+        figure, geometry = self.figure, self.geometry
+        axis = self._axes(layout.bar_box)
+        axis.set_xlim(*layout.bar_xlim)
+        axis.set_ylim(-0.5, 0.5)
+        axis.set_yticks([])
+        axis.tick_params(axis="x", labelsize=8)
+        axis.set_xlabel("track distance between the vehicles [m]", fontsize=9, labelpad=2)
+        bar = axis.barh([0.0], [0.0], height=1.0, color="tab:green")[0]
+        required = geometry.min_separation
+        minimum = [axis.axvline(required, color="tab:red", linestyle="--", linewidth=1.5)] if required else []
+        top = (layout.bar_box[1] + layout.bar_box[3]) / FRAME_HEIGHT_PX + 0.022
+        figure.text(
+            layout.bar_box[0] / FRAME_WIDTH_PX,
+            top,
+            "separation along the track (dashed: the minimum)",
+            ha="left",
+            va="center",
+            fontsize=9,
+        )
+        value = figure.text(
+            (layout.bar_box[0] + layout.bar_box[2]) / FRAME_WIDTH_PX,
+            top,
+            "",
+            ha="right",
+            va="center",
+            fontsize=10,
+            weight="bold",
+        )
+        return bar, minimum, value
+
+    def pixels(self, k: int) -> np.ndarray:
+        """Frame ``k`` as an RGB array, shape (height, width, 3)."""
+        geometry = self.geometry
+        self.clock.set_text(clock_text(float(geometry.t[k]), self.duration))
+        for v, (disc, dot, name) in enumerate(self.vehicles):
+            x, y = float(geometry.x[v, k]), float(geometry.y[v, k])
+            disc.set_xy(_disc(x, y, self.radius))
+            dot.set_data([x], [y])
+            name.xy = (x, y)
+            # the name beside the leg (clear of the leg's label), on the side away from the other vehicle
+            away = np.array([x - geometry.x[1 - v, k], y - geometry.y[1 - v, k]])
+            away = away / np.hypot(*away) if np.hypot(*away) > 0.0 else np.array([0.0, 1.0])
+            radius = math.hypot(x, y)
+            if radius > 0.0:
+                across = np.array([-y, x]) / radius
+                away = across if across @ away >= 0.0 else -across
+            name.xyann = tuple(11.0 * away)
+            name.set_horizontalalignment("left" if away[0] > 0.3 else "right" if away[0] < -0.3 else "center")
+            name.set_verticalalignment("bottom" if away[1] > 0.3 else "top" if away[1] < -0.3 else "center")
+            self.speeds[v].set_text(speed_text(self.names[v], float(geometry.speed[v, k])))
+        distance = float(geometry.distance[k])
+        colour = "tab:red" if geometry.near[k] else "tab:green"
+        self.bar.set_width(distance)
+        self.bar.set_color(colour)
+        self.bar_value.set_text(distance_text(distance, geometry.min_separation))
+        self.bar_value.set_color(colour)
+        return self.paint()
+
+
+def _check_names(names: object) -> tuple[str, str]:
+    if (
+        not isinstance(names, Sequence)
+        or isinstance(names, str)
+        or len(names) != 2
+        or not all(isinstance(name, str) for name in names)
+    ):
+        raise InputError(
+            f"animation names must be two strings (vehicle 1, vehicle 2), got {short_repr(names)}"
+        )
+    return (names[0], names[1])
+
+
+def render_animation(
+    verified: VerifiedSchedule,
+    *,
+    names: tuple[str, str] = ("vehicle 1", "vehicle 2"),
+    fps: int = DEFAULT_FPS,
+    max_frames: int = DEFAULT_MAX_FRAMES,
+) -> bytes:
+    """The schedule played on the track seen from above, as GIF bytes (nothing is written).
+
+    Parameters
+    ----------
+    verified : VerifiedSchedule
+        From :func:`trajgen.certify`.
+    names : pair of str, optional
+        The vehicles' names, written beside them.
+    fps : int, optional
+        Frames per second of playback, 1 to :data:`~trajgen.plots.animation.MAX_FPS` (default 10).
+    max_frames : int, optional
+        Most frames, 2 to :data:`~trajgen.plots.animation.MAX_FRAMES_LIMIT` (default 300: 30 s at
+        10 fps). A schedule longer than ``max_frames / fps`` seconds is played faster (see
+        :func:`~trajgen.plots.animation.playback`).
+
+    Returns
+    -------
+    bytes
+        An animated GIF of :data:`~trajgen.plots.animation.FRAME_WIDTH_PX` x
+        :data:`~trajgen.plots.animation.FRAME_HEIGHT_PX` pixels that loops; the last frame (the
+        goal) is held :data:`~trajgen.plots.animation.END_HOLD_MS` ms.
+
+    Raises
+    ------
+    UnverifiedScheduleError
+        ``verified`` is not a VerifiedSchedule.
+    OptionError
+        ``fps`` or ``max_frames`` out of range.
+    InputError
+        ``names`` is not two strings.
+    """
+    schedule = require_verified(verified, "render_animation").schedule
+    names = _check_names(names)
+    play = playback(schedule.duration, fps=fps, max_frames=max_frames)
+    geometry = frame_geometry(verified, play.times())
+    layout = frame_layout(schedule.route.graph, geometry)
+    scene = _Scene(verified, geometry, layout, names, play)
+    count = play.frame_count
+    samples = [scene.pixels(k) for k in sorted({0, int(np.argmin(geometry.distance)), count - 1})]
+    frames = (scene.pixels(k) for k in progress(range(count), total=count, description="animation frames"))
+    delays = [play.delay_ms] * (count - 1) + [END_HOLD_MS]
+    return gif_bytes(frames, delays_ms=delays, palette_samples=samples)

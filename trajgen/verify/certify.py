@@ -1,0 +1,396 @@
+"""Independent verifier: nothing leaves the library unless it passes.
+
+The verifier takes a schedule apart into polynomial pieces
+(:mod:`trajgen.model.pieces`: on each piece both vehicles' signed axes are single
+polynomials and each vehicle is on one leg) and checks every piece in closed
+form (:mod:`trajgen.model.polynomials`: extrema at the ends and at the roots of the
+derivative), so nothing can hide between samples, and its cost grows with the
+number of pieces, not with the duration. It checks:
+
+- the track distance between the vehicles never drops below the minimum
+  separation (and they never pass each other on a leg);
+- ``|v|``, ``|a|`` (and ``|j|`` where the method limits it) stay within each
+  vehicle's limits, to a relative tolerance of 1e-6;
+- every position is on its leg (at most 1e-6 m past its end) and within the
+  range its section's position map covers;
+- position, the axis, velocity (and, where jerk is limited, acceleration)
+  are continuous from piece to piece (as many derivatives as the schedule's
+  ``smoothness`` says) to round-off (:data:`CONTINUITY_TOLERANCE`), and the
+  pieces tile ``[0, duration]``;
+- the start and the goal are the route's, to 1e-9 m, at rest (1e-6 m/s);
+- the sequence of regions visited (the homotopy class) is the route's;
+- the braking rule (:mod:`trajgen.verify.braking_rule`): each vehicle that follows at a
+  conflict can always stop short of its frontier, so what is planned is what
+  the online executor plays;
+- every number is finite, every knot sequence increases, and every array
+  derived from others agrees with them (:mod:`trajgen.verify.integrity`).
+
+A failure names the arrays where it occurs, by their paths from the schedule
+(``sections[2].kinematics.vehicles[0].{times,initial,jerk} interval 4``).
+
+Each schedule object is verified once: the report is kept (for the last
+:data:`_REMEMBERED` schedules) and returned again, also to concurrent callers.
+:func:`certify` turns a passing schedule into a :class:`VerifiedSchedule`, the
+only kind of schedule that exporters and plots accept.
+"""
+
+from __future__ import annotations
+
+import collections
+import logging
+import math
+import threading
+import time
+import weakref
+from dataclasses import dataclass
+
+import numpy as np
+
+from topology import Region, reduce_regions
+from topology.indexed import JUNCTION_INDEX, track_distance
+from trajgen.errors import InputError, UnverifiedScheduleError, VerificationError
+from trajgen.model import polynomials
+from trajgen.model.pieces import Pieces, UncheckableKinematicsError, schedule_pieces
+from trajgen.model.schedule import Schedule
+from trajgen.verify.braking_rule import BRAKING_RULE_TOLERANCE, braking_rule_failures
+from trajgen.verify.integrity import array_failures
+from trajgen.verify.piecewise import (
+    allowance,
+    check_maps,
+    check_parked,
+    check_piece_continuity,
+    check_piece_limits,
+    check_piece_separation,
+    check_piece_track,
+    piece_arrays,
+)
+from trajgen.verify.report import (
+    CONTINUITY_TOLERANCE,
+    POSITION_TOLERANCE,
+    RELATIVE_TOLERANCE,
+    REST_TOLERANCE,
+    TRACK_END_TOLERANCE,
+    VerificationReport,
+)
+
+__all__ = [
+    "CONTINUITY_TOLERANCE",
+    "POSITION_TOLERANCE",
+    "RELATIVE_TOLERANCE",
+    "REST_TOLERANCE",
+    "TRACK_END_TOLERANCE",
+    "VerificationReport",
+    "VerifiedSchedule",
+    "certify",
+    "require_verified",
+    "verify",
+]
+
+logger = logging.getLogger(__name__)
+
+#: Reports kept for schedules already verified (by identity).
+_REMEMBERED = 64
+_reports: collections.OrderedDict[int, tuple[weakref.ref, VerificationReport]] = collections.OrderedDict()
+_reports_lock = threading.Lock()
+#: One lock per schedule being verified, so that concurrent callers wait for one verification.
+_in_progress: dict[int, threading.Lock] = {}
+
+
+@dataclass(frozen=True, slots=True)
+class VerifiedSchedule:
+    """A schedule that passed the verifier, with its report: what exporters and plots accept.
+
+    Made by :func:`certify`; constructing one from a failing report raises.
+
+    Attributes
+    ----------
+    schedule : Schedule
+    report : VerificationReport
+        The passed report.
+    """
+
+    schedule: Schedule
+    report: VerificationReport
+
+    def __post_init__(self) -> None:
+        if not isinstance(self.schedule, Schedule) or not isinstance(self.report, VerificationReport):
+            raise UnverifiedScheduleError("a VerifiedSchedule holds a Schedule and its VerificationReport")
+        if not self.report.passed:
+            raise VerificationError("schedule failed verification: " + "; ".join(self.report.failures))
+        if verify(self.schedule) != self.report:
+            raise UnverifiedScheduleError("the report given is not this schedule's verification report")
+
+
+def _remembered(schedule: Schedule) -> VerificationReport | None:
+    with _reports_lock:
+        remembered = _reports.get(id(schedule))
+        if remembered is not None and remembered[0]() is schedule:
+            _reports.move_to_end(id(schedule))
+            return remembered[1]
+    return None
+
+
+def verify(schedule: Schedule) -> VerificationReport:
+    """Check a schedule independently of how it was computed, between any two instants too.
+
+    Parameters
+    ----------
+    schedule : Schedule
+
+    Returns
+    -------
+    VerificationReport
+        The same report object for the same schedule, computed once.
+
+    Raises
+    ------
+    InputError
+        ``schedule`` is not a Schedule.
+    """
+    if not isinstance(schedule, Schedule):
+        raise InputError(f"verify expects a Schedule, got {type(schedule).__name__}")
+    report = _remembered(schedule)
+    if report is not None:
+        return report
+    key = id(schedule)
+    with _reports_lock:
+        working = _in_progress.setdefault(key, threading.Lock())
+    with working:  # one thread verifies a schedule; the others wait for its report
+        report = _remembered(schedule)
+        if report is not None:
+            return report
+        began = time.perf_counter()
+        try:
+            report = _verify(schedule)
+        finally:
+            with _reports_lock:
+                _in_progress.pop(key, None)
+        logger.debug(
+            "verified a %s schedule (%d pieces) in %.1f ms: %s",
+            schedule.method,
+            report.pieces,
+            1e3 * (time.perf_counter() - began),
+            "passed" if report.passed else "FAILED",
+        )
+        with _reports_lock:
+            _reports[key] = (weakref.ref(schedule), report)
+            while len(_reports) > _REMEMBERED:
+                _reports.popitem(last=False)
+    return report
+
+
+def _failed(schedule: Schedule, failures: list[str], pieces: int = 0) -> VerificationReport:
+    """A failed report for a schedule that cannot even be taken apart."""
+    logger.info("schedule (%s) failed verification: %s", schedule.method, "; ".join(failures))
+    return VerificationReport.failed(tuple(failures), pieces=pieces)
+
+
+def _check_ends(schedule: Schedule, pieces: Pieces, state, failures: list[str]) -> tuple[float, float, float]:
+    """Start and goal errors (metres), at rest; and the separation at the start, metres.
+
+    ``state`` is the schedule's state at 0 and at its end (what is exported there).
+    """
+    route, graph = schedule.route, schedule.route.graph
+    errors = []
+    for label, index, expected in (("start", 0, route.start), ("goal", -1, route.goal)):
+        error = 0.0
+        piece = 0 if index == 0 else pieces.count - 1
+        for vehicle, position in enumerate(expected):
+            leg = JUNCTION_INDEX if position.leg is None else graph.index(position.leg)
+            error += float(
+                track_distance(state.leg[vehicle, index], state.s[vehicle, index], leg, position.s)
+            )
+            # at rest: v = 0; a jerk-limited method also starts and ends with a = 0 (a linearly
+            # interpolated table has no velocity at its ends: the drive's own ramps are checked there)
+            residue = abs(state.velocity[vehicle, index]) if schedule.smoothness >= 1 else 0.0
+            if schedule.smoothness >= 2 and schedule.jerk_limited:
+                residue += abs(state.acceleration[vehicle, index])
+            if not residue <= REST_TOLERANCE:
+                failures.append(
+                    f"vehicle {vehicle + 1} is not at rest at the {label} (|v| + |a| = {residue:.3g}): "
+                    f"{piece_arrays(schedule, pieces, piece, (vehicle,))}"
+                )
+        tolerance = POSITION_TOLERANCE if schedule.end_tolerance is None else schedule.end_tolerance
+        if not error <= tolerance:
+            failures.append(
+                f"{label} is off the route's {label} by {error:.3g} m (expected <= {tolerance:g} m): "
+                f"{piece_arrays(schedule, pieces, piece)}"
+            )
+        errors.append(error)
+    start_gap = float(track_distance(state.leg[0, 0], state.s[0, 0], state.leg[1, 0], state.s[1, 0]))
+    return errors[0], errors[1], start_gap
+
+
+def _check_exported_ends(
+    pieces: Pieces, track: np.ndarray, schedule: Schedule, state, failures: list[str]
+) -> None:
+    """What the schedule reports at 0 and at the end (what is exported) is where its pieces start and end."""
+    if not pieces.count:
+        return
+    for vehicle in range(2):
+        ends = (
+            ("start", 0, int(pieces.leg[vehicle, 0]), float(track[vehicle, 0, 0])),
+            (
+                "goal",
+                -1,
+                int(pieces.leg[vehicle, -1]),
+                float(polynomials.evaluate(track[vehicle, -1:], pieces.length[-1:])[0]),
+            ),
+        )
+        for label, index, leg, s in ends:
+            gap = float(track_distance(state.leg[vehicle, index], state.s[vehicle, index], leg, s))
+            if not gap <= allowance(schedule, vehicle, "position"):
+                failures.append(
+                    f"vehicle {vehicle + 1} is {gap:.3g} m from where its motion puts it at the {label}: "
+                    "the schedule reports a position its motion does not reach: "
+                    f"{piece_arrays(schedule, pieces, 0 if index == 0 else pieces.count - 1, (vehicle,))}"
+                )
+
+
+def _check_tiling(schedule: Schedule, pieces: Pieces, failures: list[str]) -> None:
+    """The pieces follow one another without gaps from 0 to the duration."""
+    if not pieces.count:
+        return
+    duration = schedule.duration
+    ends = pieces.start + pieces.length
+    gaps = np.abs(np.concatenate([[pieces.start[0]], pieces.start[1:] - ends[:-1], [duration - ends[-1]]]))
+    k = int(np.argmax(gaps))
+    if not gaps[k] <= 1e-9 * max(1.0, duration):
+        section = int(pieces.section[min(k, pieces.count - 1)])
+        failures.append(
+            f"the motion has a gap of {gaps[k]:.3g} s in time (piece {k}): expected none: "
+            f"sections[{section}].start_time; {piece_arrays(schedule, pieces, min(k, pieces.count - 1))}"
+        )
+
+
+def _for_execution(schedule: Schedule) -> bool:
+    """Whether the schedule's method plans for execution (its plans then obey the braking rule)."""
+    method = schedule.method
+    return method is None or bool(getattr(method, "plans_for_execution", True))
+
+
+def _verify(schedule: Schedule) -> VerificationReport:
+    own = array_failures(schedule)
+    if own:  # the motion is read from these numbers: broken ones make every other check meaningless
+        return _failed(schedule, own)
+    duration = schedule.duration
+    if not math.isfinite(duration) or duration < 0.0:
+        return _failed(schedule, [f"schedule duration is {duration!r} s: expected finite, >= 0"])
+    route = schedule.route
+    required = max(schedule.limits.min_separation, route.min_separation)
+    try:
+        with np.errstate(invalid="ignore", over="ignore"):  # non-finite numbers are reported below
+            pieces = schedule_pieces(schedule)
+    except UncheckableKinematicsError as error:
+        return _failed(schedule, [f"cannot be checked: {error}"])
+    if not (np.all(np.isfinite(pieces.axis)) and np.all(np.isfinite(pieces.start))):
+        bad = int(np.argmax(~np.all(np.isfinite(pieces.axis), axis=(0, 2)) | ~np.isfinite(pieces.start)))
+        return _failed(
+            schedule,
+            [
+                f"the motion is not finite in piece {bad} (from t={pieces.start[bad]!r} s): expected finite: "
+                f"{piece_arrays(schedule, pieces, bad)}"
+            ],
+            pieces.count,
+        )
+    failures: list[str] = []
+    check_maps(schedule, failures)
+    if failures:  # the pieces are read through the maps: a broken map makes them meaningless
+        return _failed(schedule, failures, pieces.count)
+    ends = schedule.state([0.0, duration])
+    track = pieces.track()
+    start_error, goal_error, start_gap = _check_ends(schedule, pieces, ends, failures)
+    _check_exported_ends(pieces, track, schedule, ends, failures)
+    _check_tiling(schedule, pieces, failures)
+    check_parked(pieces, schedule, failures)
+    ratios = check_piece_limits(pieces, schedule, failures)
+    past_end = max(TRACK_END_TOLERANCE, schedule.end_tolerance or 0.0)
+    check_piece_track(pieces, track, schedule, failures, past_end)
+    closest, regions = check_piece_separation(pieces, track, schedule, required, failures)
+    closest = min(closest, start_gap)
+    if not pieces.count and start_gap < required - POSITION_TOLERANCE:
+        failures.append(f"separation {start_gap:.9g} m at rest is below the minimum {required:g} m")
+    check_piece_continuity(pieces, track, schedule, failures)
+    if not failures and schedule.end_tolerance is None and _for_execution(schedule):
+        # a plan for execution: each follower can always stop short of its frontier (a table read
+        # back follows a plan that was checked; its own round-off is not an execution)
+        for failure in braking_rule_failures(schedule, pieces=pieces):
+            k = int(
+                np.clip(np.searchsorted(pieces.start, failure.time, side="right") - 1, 0, pieces.count - 1)
+            )
+            what = (
+                f"its service stop point passes it by {failure.excess:.3g} m"
+                if math.isfinite(failure.excess)
+                else "its margin stays too thin to certify"
+            )
+            failures.append(
+                f"vehicle {failure.vehicle + 1} cannot stop short of its frontier at t={failure.time:.6f} s: "
+                f"{what} (the braking rule; expected at most {BRAKING_RULE_TOLERANCE:g} m past it): "
+                f"{piece_arrays(schedule, pieces, k)}"
+            )
+    expected = route.region_keys
+    sequence = reduce_regions(regions)
+    if sequence != expected:
+        show = lambda keys: " ".join(str(Region.from_key(route.graph, key)) for key in keys)  # noqa: E731
+        failures.append(
+            f"homotopy class differs: schedule visits [{show(sequence)}], route [{show(expected)}]: "
+            f"{piece_arrays(schedule, pieces, _first_departure(regions, expected))}"
+        )
+    if failures:
+        logger.info("schedule (%s) failed verification: %s", schedule.method, "; ".join(failures))
+    return VerificationReport(
+        passed=not failures,
+        failures=tuple(failures),
+        pieces=pieces.count,
+        min_separation=closest,
+        separation_margin=closest - required,
+        velocity_ratio=ratios["velocity"],
+        acceleration_ratio=ratios["acceleration"],
+        jerk_ratio=ratios["jerk"],
+        start_error=start_error,
+        goal_error=goal_error,
+        regions_match=sequence == expected,
+    )
+
+
+def _first_departure(regions: list, expected: tuple) -> int:
+    """The first piece at which the region sequence leaves the route's (the last piece if none does)."""
+    position = 0
+    for k, region in enumerate(regions):
+        if region is None:
+            continue
+        if position < len(expected) and region == expected[position]:
+            continue
+        if position + 1 < len(expected) and region == expected[position + 1]:
+            position += 1
+            continue
+        return k
+    return max(len(regions) - 1, 0)
+
+
+def certify(schedule: Schedule) -> VerifiedSchedule:
+    """Verify ``schedule`` and return it certified, or raise.
+
+    Raises
+    ------
+    VerificationError
+        The schedule failed; the message lists every failure.
+    """
+    report = verify(schedule)
+    report.raise_if_failed()
+    return VerifiedSchedule(schedule, report)
+
+
+def require_verified(value: object, what: str) -> VerifiedSchedule:
+    """Return ``value`` if it is a :class:`VerifiedSchedule`, else raise naming ``what`` needs one.
+
+    Raises
+    ------
+    UnverifiedScheduleError
+        ``value`` is not a VerifiedSchedule (e.g. a bare Schedule).
+    """
+    if not isinstance(value, VerifiedSchedule):
+        raise UnverifiedScheduleError(
+            f"{what} takes a VerifiedSchedule (from trajgen.certify), got {type(value).__name__}"
+        )
+    return value

@@ -1,0 +1,106 @@
+"""What the verifier reports: its tolerances and the :class:`VerificationReport`."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from trajgen.errors import VerificationError
+
+__all__ = [
+    "CONTINUITY_TOLERANCE",
+    "POSITION_TOLERANCE",
+    "RELATIVE_TOLERANCE",
+    "REST_TOLERANCE",
+    "TRACK_END_TOLERANCE",
+    "VerificationReport",
+]
+
+#: Relative tolerance on velocity, acceleration and jerk limits.
+RELATIVE_TOLERANCE = 1e-6
+#: Absolute tolerance on start, goal and separation, metres.
+POSITION_TOLERANCE = 1e-9
+#: At rest at the start and goal: |v| in m/s (plus |a| in m/s² for jerk-limited methods) at most this.
+REST_TOLERANCE = 1e-6
+#: How far past the end of its leg a position may be (solver round-off), metres; also the largest jump.
+TRACK_END_TOLERANCE = 1e-6
+#: Continuity from piece to piece, relative to the quantity's scale (round-off: every method integrates its
+#: knots from the ones before, so a jump above this is a number that disagrees with the others).
+CONTINUITY_TOLERANCE = 1e-12
+
+
+@dataclass(frozen=True, slots=True)
+class VerificationReport:
+    """Outcome of :func:`verify`.
+
+    Attributes
+    ----------
+    passed : bool
+        Whether every check passed.
+    failures : tuple of str
+        One message per failed check, naming the quantity, value and limit.
+    pieces : int
+        Number of polynomial pieces checked.
+    min_separation : float
+        Smallest track distance between the vehicles, metres.
+    separation_margin : float
+        ``min_separation - required``, metres (negative: violated).
+    velocity_ratio, acceleration_ratio : tuple of 2 float
+        Per vehicle, largest ``|value| / limit`` (1.0 is at the limit).
+    jerk_ratio : tuple of 2 float or None
+        The same for jerk; ``None`` when the schedule does not limit jerk.
+    start_error, goal_error : float
+        Track distance of the schedule's first and last positions from the route's, metres.
+    regions_match : bool
+        Whether the sampled region sequence equals the route's.
+    """
+
+    passed: bool
+    failures: tuple[str, ...]
+    pieces: int
+    min_separation: float
+    separation_margin: float
+    velocity_ratio: tuple[float, float]
+    acceleration_ratio: tuple[float, float]
+    jerk_ratio: tuple[float, float] | None
+    start_error: float
+    goal_error: float
+    regions_match: bool
+
+    @classmethod
+    def failed(cls, failures: tuple[str, ...], *, pieces: int = 0) -> VerificationReport:
+        """The report of a motion that could not be checked further (its figures are NaN)."""
+        nan = float("nan")
+        return cls(
+            passed=False,
+            failures=tuple(failures),
+            pieces=pieces,
+            min_separation=nan,
+            separation_margin=nan,
+            velocity_ratio=(nan, nan),
+            acceleration_ratio=(nan, nan),
+            jerk_ratio=None,
+            start_error=nan,
+            goal_error=nan,
+            regions_match=False,
+        )
+
+    def raise_if_failed(self) -> None:
+        """Raise VerificationError listing the failures, if any."""
+        if not self.passed:
+            raise VerificationError("schedule failed verification: " + "; ".join(self.failures))
+
+    def summary(self) -> dict:
+        """JSON-ready worst margins."""
+        return {
+            "verified": self.passed,
+            "failures": list(self.failures),
+            "pieces": self.pieces,
+            "min_separation_m": self.min_separation,
+            "separation_margin_m": self.separation_margin,
+            "velocity_ratio": list(self.velocity_ratio),
+            "acceleration_ratio": list(self.acceleration_ratio),
+            "jerk_ratio": None if self.jerk_ratio is None else list(self.jerk_ratio),
+            "start_error_m": self.start_error,
+            "goal_error_m": self.goal_error,
+            "regions_match": self.regions_match,
+        }
