@@ -7,7 +7,7 @@ Build as CI does (``tests/test_docs.py``)::
 ``-n`` (nitpicky) makes every reference that names no documented object a warning and ``-W`` makes
 warnings errors. Two rules of this file decide what a reference in a docstring may name (see
 :func:`resolve_elsewhere`): an object of trajgen that the API reference documents under another
-name (a re-export, e.g. ``trajgen.verify.certify`` is documented as ``trajgen.certify``) links
+name (a re-export, e.g. ``trajgen.verification.certify`` is documented as ``trajgen.certify``) links
 there; an object that exists but has no page here (the standard library, numpy, a private helper of
 trajgen) is shown as code without a link. A name that does not exist still fails the build.
 """

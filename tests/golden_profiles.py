@@ -28,7 +28,7 @@ from trajgen import Exact, Toppra, certify, load_scenario, make_schedule
 from trajgen.closed_loop import run_simulation
 from trajgen.export.csv import CsvOptions, Units, profile_chunks, render_profile
 from trajgen.export.plc import plc_tables
-from trajgen.verify import VerifiedSchedule
+from trajgen.verification import VerifiedSchedule
 
 GOLDEN = REPO / "tests" / "data" / "golden"
 NAMES = ("agv1", "agv2")

@@ -15,7 +15,7 @@ import numpy as np
 from topology import Region, reduce_regions
 from topology.indexed import JUNCTION_INDEX, region_keys, track_distance
 from trajgen.model.schedule import Schedule, ScheduleState
-from trajgen.verify import POSITION_TOLERANCE, RELATIVE_TOLERANCE, REST_TOLERANCE, TRACK_END_TOLERANCE
+from trajgen.verification import POSITION_TOLERANCE, RELATIVE_TOLERANCE, REST_TOLERANCE, TRACK_END_TOLERANCE
 
 
 @dataclass(frozen=True)

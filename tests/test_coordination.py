@@ -29,7 +29,7 @@ from trajgen.model.coordination import (
     stopping_distances,
 )
 from trajgen.online.goals import plan_for_execution
-from trajgen.verify.braking_rule import BRAKING_RULE_TOLERANCE, braking_rule_failures
+from trajgen.verification.braking_rule import BRAKING_RULE_TOLERANCE, braking_rule_failures
 
 SWAP = REPO / "examples" / "swap.toml"
 CROSSING = REPO / "examples" / "crossing.toml"

@@ -4,7 +4,7 @@ For each method on the swap and the crossing, every float array reachable from
 the schedule (:func:`tests.corruption.float_arrays`) gets, in turn, a NaN, +inf,
 -inf, two adjacent entries swapped, and one entry moved by 1e-3 of its value, at a
 seeded place, with nothing recomputed. Each corrupted schedule must either fail
-:func:`trajgen.verify.certify` with a :class:`VerificationError` that names the
+:func:`trajgen.verification.certify` with a :class:`VerificationError` that names the
 array, or export the very same CSV bytes as the original.
 """
 

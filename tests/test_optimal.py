@@ -125,7 +125,8 @@ def test_nlp_is_built_once_per_shape_and_reused():
 def test_forced_solver_failure_falls_back_to_exact_and_logs(caplog):
     route = route_of(UNEQUAL, ("A:12", "B:8"), ("B:8", "A:12"))
     with caplog.at_level(logging.WARNING, logger="trajgen.methods.optimal"):
-        schedule = optimal_schedule(route, LIMITS, max_iterations=1)
+        # a budget a loaded machine cannot spend on building the problems: the solvers fail first
+        schedule = optimal_schedule(route, LIMITS, max_iterations=1, time_budget=60.0)
     exact = exact_schedule(route, LIMITS)
     assert schedule.fallback_reason is FallbackReason.SOLVER_FAILED
     assert "did not converge" in schedule.notes[0]

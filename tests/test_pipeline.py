@@ -124,7 +124,7 @@ def test_cli_empty_folder_name_exits_2(tmp_path, capsys, monkeypatch):
 
 
 def test_a_run_verifies_each_schedule_once_and_commits_every_file(tmp_path, caplog):
-    with caplog.at_level(logging.DEBUG, logger="trajgen.verify"):
+    with caplog.at_level(logging.DEBUG, logger="trajgen.verification"):
         result = run(
             default_scenario(), outputs=Outputs(csv_dir=tmp_path / "csv", plot_dir=tmp_path / "plots")
         )

@@ -193,3 +193,62 @@ def test_tests_use_no_private_names_and_no_benchmark_module(path):
         elif isinstance(node, ast.Attribute) and _private(node.attr) and node.attr not in defined:
             problems.append(f"line {node.lineno}: uses .{node.attr}")
     assert problems == []
+
+
+#: The flow of the house, from the planner to the command line: a module imports only from its own
+#: layer or the ones before it.
+FLOW = (
+    ("topology",),
+    ("limits",),
+    ("trajgen.errors", "trajgen.lazy", "trajgen.progress"),
+    ("trajgen.scenario",),
+    ("trajgen.model",),
+    ("trajgen.verification",),
+    ("trajgen.methods",),
+    ("trajgen.export",),
+    ("trajgen.online",),
+    ("trajgen.plots",),
+    ("trajgen.pipeline", "trajgen.closed_loop"),
+    ("trajgen.cli",),
+    ("trajgen", "trajgen.__main__"),
+)
+
+
+def _layer(module: str) -> int:
+    """The place of ``module`` in :data:`FLOW` (the longest prefix that names a layer)."""
+    best, length = None, -1
+    for rank, names in enumerate(FLOW):
+        for name in names:
+            if (module == name or module.startswith(name + ".")) and len(name) > length:
+                best, length = rank, len(name)
+    assert best is not None, f"{module} is in no layer of the flow"
+    return best
+
+
+def test_no_module_imports_one_later_in_the_flow():
+    later = sorted(
+        f"{module} imports {target}"
+        for module in MODULES
+        for target in _imports(module)
+        if _layer(target) > _layer(module)
+    )
+    assert later == []
+
+
+def test_the_layer_check_sees_an_import_against_the_flow():
+    assert _layer("trajgen.model.schedule") < _layer("trajgen.verification.certify") < _layer("trajgen.cli")
+    assert _layer("trajgen.__main__") == _layer("trajgen") == len(FLOW) - 1
+
+
+MAX_MODULE_LINES = 600
+
+
+@pytest.mark.parametrize("module", sorted(MODULES), ids=sorted(MODULES))
+def test_no_module_is_over_600_lines(module):
+    lines = MODULES[module].read_text(encoding="utf-8").count("\n")
+    assert lines <= MAX_MODULE_LINES, f"{module}: {lines} lines"
+
+
+def test_at_most_eight_modules_at_the_root_of_trajgen():
+    root = sorted(path.name for path in (REPO / "trajgen").glob("*.py"))
+    assert len(root) <= 8, root

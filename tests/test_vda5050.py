@@ -1025,12 +1025,12 @@ def test_an_output_path_that_is_a_file_exits_2_before_computing(tmp_path, capsys
 
 
 def test_an_internal_failure_exits_1_and_writes_nothing(tmp_path, capsys, monkeypatch):
-    import trajgen.cli.vda5050
+    import trajgen.export.vda5050
 
     def broken(*args, **kwargs):
         raise RuntimeError("renderer broke")
 
-    monkeypatch.setattr(trajgen.cli.vda5050, "order_files", broken)
+    monkeypatch.setattr(trajgen.export.vda5050, "order_files", broken)
     out = tmp_path / "orders"
     assert main(["export-vda5050", str(SWAP), "--out", str(out), "--method", "exact"]) == EXIT_FAILURE
     assert "internal failure: RuntimeError: renderer broke" in capsys.readouterr().err

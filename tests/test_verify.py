@@ -41,7 +41,7 @@ def test_verification_cost_grows_with_pieces_not_with_duration():
 
 def test_each_schedule_is_verified_once(caplog):
     schedule = Exact().schedule(route_of(*SWAP), LIMITS)
-    with caplog.at_level(logging.DEBUG, logger="trajgen.verify"):
+    with caplog.at_level(logging.DEBUG, logger="trajgen.verification"):
         first = verify(schedule)
         second = verify(schedule)
         certified = certify(schedule)

@@ -28,9 +28,8 @@ from trajgen.methods import METHODS, make_schedule
 from trajgen.model.analysis import lower_bound
 from trajgen.model.schedule import TimingMethod
 from trajgen.model.summary import route_summary
-from trajgen.plots import render_configuration, render_coordination, render_separation, render_speed
 from trajgen.scenario import Scenario
-from trajgen.verify import VerifiedSchedule, certify
+from trajgen.verification import VerifiedSchedule, certify
 
 __all__ = ["PLOT_NAMES", "Outputs", "RunResult", "run"]
 
@@ -221,6 +220,8 @@ def run(
         paths = profile_paths(scenario.names, outputs.csv_dir)
         files.update(zip(paths, profile_chunk_pair(verified, outputs.csv), strict=True))
     if outputs.plot_dir is not None:
+        from trajgen.plots import render_configuration, render_coordination, render_separation, render_speed
+
         compared, notes = _comparison(route, scenario, chosen, verified)
         speed, separation, coordination, configuration = (outputs.plot_dir / name for name in PLOT_NAMES)
         files[speed] = render_speed(verified, names=scenario.names)

@@ -6,8 +6,6 @@ import sys
 from collections.abc import Iterable, Iterator
 from typing import TypeVar
 
-from tqdm import tqdm
-
 __all__ = ["progress"]
 
 Item = TypeVar("Item")
@@ -30,6 +28,9 @@ def progress(items: Iterable[Item], *, total: int | None = None, description: st
     [0, 1, 2]
     """
     shown = sys.stderr is not None and sys.stderr.isatty()
-    yield from tqdm(
-        items, total=total, desc=description or None, disable=not shown, file=sys.stderr, leave=False
-    )
+    if not shown:
+        yield from items
+        return
+    from tqdm import tqdm  # a bar only on a terminal: batch runs and the command line start without it
+
+    yield from tqdm(items, total=total, desc=description or None, file=sys.stderr, leave=False)

@@ -4,7 +4,24 @@ Exit status: 0 on success, 2 on bad input (message on stderr, nothing
 written), 1 on an internal failure (nothing written).
 """
 
-from trajgen.cli.main import build_parser, command_parsers, main
-from trajgen.cli.options import EXIT_BAD_INPUT, EXIT_FAILURE, EXIT_OK
+from typing import TYPE_CHECKING
+
+from trajgen.lazy import lazy_attributes
+
+if TYPE_CHECKING:
+    from trajgen.cli.main import build_parser, command_parsers, main
+    from trajgen.cli.options import EXIT_BAD_INPUT, EXIT_FAILURE, EXIT_OK
+
+#: ``import trajgen.cli`` loads nothing more: the parser and each command's modules load when used.
+_SOURCES = {
+    "EXIT_BAD_INPUT": "trajgen.cli.options",
+    "EXIT_FAILURE": "trajgen.cli.options",
+    "EXIT_OK": "trajgen.cli.options",
+    "build_parser": "trajgen.cli.main",
+    "command_parsers": "trajgen.cli.main",
+    "main": "trajgen.cli.main",
+}
 
 __all__ = ["EXIT_BAD_INPUT", "EXIT_FAILURE", "EXIT_OK", "build_parser", "command_parsers", "main"]
+
+__getattr__, __dir__ = lazy_attributes(__name__, globals(), _SOURCES)

@@ -8,8 +8,7 @@ from pathlib import Path
 
 from trajgen.cli.options import EXIT_OK, add_method, method_from, scenario_from
 from trajgen.errors import OutputError
-from trajgen.export import check_output_paths, commit_files
-from trajgen.pipeline import run
+from trajgen.export.atomic import check_output_paths, commit_files
 from trajgen.plots.animation import (
     DEFAULT_FPS,
     DEFAULT_MAX_FRAMES,
@@ -19,7 +18,6 @@ from trajgen.plots.animation import (
     MAX_FRAMES_LIMIT,
     playback,
 )
-from trajgen.plots.animation_drawing import render_animation
 
 __all__ = ["gif_path", "register"]
 
@@ -44,6 +42,9 @@ def gif_path(text: str) -> Path:
 def _command_animate(args: argparse.Namespace) -> int:
     path = gif_path(args.out)
     playback(0.0, fps=args.fps, max_frames=args.max_frames)  # bad options are refused before computing
+    from trajgen.pipeline import run
+    from trajgen.plots.animation_drawing import render_animation
+
     scenario = scenario_from(args.scenario)
     verified = run(scenario, method=method_from(args)).verified
     gif = render_animation(verified, names=scenario.names, fps=args.fps, max_frames=args.max_frames)

@@ -6,7 +6,6 @@ import argparse
 import json
 
 from trajgen.cli.options import EXIT_FAILURE, EXIT_OK, add_dialect_options, scenario_from
-from trajgen.export.check import check_profiles
 
 __all__ = ["SHOWN_FAILURES", "register"]
 
@@ -15,6 +14,8 @@ SHOWN_FAILURES = 10
 
 
 def _command_check(args: argparse.Namespace) -> int:
+    from trajgen.export.check import check_profiles
+
     scenario = scenario_from(args.scenario)
     verdict = check_profiles(
         scenario, args.csv, dialect=args.dialect, jerk=not args.ignore_jerk, max_points=args.max_points

@@ -14,13 +14,14 @@ from trajgen.cli.options import (
     csv_dialect,
     scenario_from,
 )
-from trajgen.closed_loop import format_simulation, run_simulation
-from trajgen.export import CsvOptions
 
 __all__ = ["register"]
 
 
 def _command_simulate(args: argparse.Namespace) -> int:
+    from trajgen.closed_loop import format_simulation, run_simulation  # the executor and its Ruckig
+    from trajgen.export.csv import CsvOptions
+
     scenario = scenario_from(args.scenario)
     result, files = run_simulation(
         scenario,

@@ -9,9 +9,8 @@ from datetime import UTC, datetime
 from topology.validation import short_repr
 from trajgen.cli.options import EXIT_OK, add_method, method_from, scenario_from
 from trajgen.errors import OptionError
-from trajgen.export import check_output_paths, commit_files
-from trajgen.export.vda5050 import MANIFEST_NAME, Vda5050Options, order_files, order_paths
-from trajgen.pipeline import run
+from trajgen.export.atomic import check_output_paths, commit_files
+from trajgen.export.vda5050_options import MANIFEST_NAME, Vda5050Options
 
 __all__ = ["parse_start_time", "register"]
 
@@ -87,6 +86,9 @@ def _format(summary: dict) -> str:
 
 
 def _command_export(args: argparse.Namespace) -> int:
+    from trajgen.export.vda5050 import order_files, order_paths
+    from trajgen.pipeline import run
+
     scenario = scenario_from(args.scenario)
     method = method_from(args)
     names = scenario.names

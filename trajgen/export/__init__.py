@@ -1,21 +1,55 @@
 """Outputs for controllers: CSV profiles, VDA 5050 orders, and the atomic commit of all files of a run."""
 
-from trajgen.export.atomic import check_output_paths, commit_files
-from trajgen.export.csv import (
-    DEFAULT_MAX_ROWS,
-    HEADER_NAMES,
-    CsvOptions,
-    Units,
-    check_row_limit,
-    format_block,
-    format_rows,
-    profile_chunk_pair,
-    profile_chunks,
-    profile_paths,
-    render_profile,
-    write_profiles,
-)
-from trajgen.export.vda5050 import Vda5050Options, plan_orders, render_manifest, render_orders, write_orders
+from typing import TYPE_CHECKING
+
+from trajgen.lazy import lazy_attributes
+
+if TYPE_CHECKING:
+    from trajgen.export.atomic import check_output_paths, commit_files
+    from trajgen.export.csv import (
+        DEFAULT_MAX_ROWS,
+        HEADER_NAMES,
+        CsvOptions,
+        Units,
+        check_row_limit,
+        format_block,
+        format_rows,
+        profile_chunk_pair,
+        profile_chunks,
+        profile_paths,
+        render_profile,
+        write_profiles,
+    )
+    from trajgen.export.vda5050 import (
+        Vda5050Options,
+        plan_orders,
+        render_manifest,
+        render_orders,
+        write_orders,
+    )
+
+#: Where each name lives: importing one exporter does not import the others.
+_SOURCES = {
+    "CsvOptions": "trajgen.export.csv",
+    "DEFAULT_MAX_ROWS": "trajgen.export.csv",
+    "HEADER_NAMES": "trajgen.export.csv",
+    "Units": "trajgen.export.csv",
+    "Vda5050Options": "trajgen.export.vda5050",
+    "check_output_paths": "trajgen.export.atomic",
+    "check_row_limit": "trajgen.export.csv",
+    "commit_files": "trajgen.export.atomic",
+    "format_block": "trajgen.export.csv",
+    "format_rows": "trajgen.export.csv",
+    "plan_orders": "trajgen.export.vda5050",
+    "profile_chunk_pair": "trajgen.export.csv",
+    "profile_chunks": "trajgen.export.csv",
+    "profile_paths": "trajgen.export.csv",
+    "render_manifest": "trajgen.export.vda5050",
+    "render_orders": "trajgen.export.vda5050",
+    "render_profile": "trajgen.export.csv",
+    "write_orders": "trajgen.export.vda5050",
+    "write_profiles": "trajgen.export.csv",
+}
 
 __all__ = [
     "DEFAULT_MAX_ROWS",
@@ -38,3 +72,6 @@ __all__ = [
     "write_orders",
     "write_profiles",
 ]
+
+
+__getattr__, __dir__ = lazy_attributes(__name__, globals(), _SOURCES)

@@ -1,6 +1,6 @@
 """CSV speed profiles for AGV PLCs, one file per vehicle (the ``generic`` format).
 
-Renderers return bytes and take only a :class:`~trajgen.verify.VerifiedSchedule`;
+Renderers return bytes and take only a :class:`~trajgen.verification.VerifiedSchedule`;
 :func:`write_profiles` commits both files together
 (:func:`~trajgen.export.atomic.commit_files`). Numbers are formatted with numpy
 (:mod:`trajgen.export.numbers`), a block of :data:`ROWS_PER_CHUNK` rows at a time.
@@ -22,7 +22,7 @@ from trajgen.export.atomic import commit_files
 from trajgen.export.numbers import format_number_rows
 from trajgen.model.schedule import Schedule, ScheduleState, check_period, sample_block, sample_rows
 from trajgen.scenario.naming import check_vehicle_names
-from trajgen.verify import VerifiedSchedule, require_verified
+from trajgen.verification import VerifiedSchedule, require_verified
 
 __all__ = [
     "DEFAULT_MAX_ROWS",
@@ -344,7 +344,7 @@ def write_profiles(
     Parameters
     ----------
     verified : VerifiedSchedule
-        From :func:`trajgen.verify.certify`.
+        From :func:`trajgen.verification.certify`.
     names : sequence of 2 str
         Vehicle names, used as file names.
     directory : path

@@ -19,7 +19,7 @@ from trajgen.export.resample import Resampled, resample
 from trajgen.export.table_check import TableCheck, check_tables
 from trajgen.export.tables import Interpolation, limit_ratios, slowdown
 from trajgen.scenario.naming import check_vehicle_names
-from trajgen.verify import VerifiedSchedule, require_verified
+from trajgen.verification import VerifiedSchedule, require_verified
 
 __all__ = ["PlcTables", "check_dialect_method", "plc_tables", "table_paths"]
 

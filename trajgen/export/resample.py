@@ -24,7 +24,7 @@ from trajgen.errors import InputError, OutputLimitError
 from trajgen.export.tables import Interpolation, ProfileTable, divided_differences, limit_ratios, slowdown
 from trajgen.model.pieces import schedule_pieces
 from trajgen.model.schedule import Schedule
-from trajgen.verify import VerifiedSchedule, require_verified
+from trajgen.verification import VerifiedSchedule, require_verified
 
 __all__ = ["POSITION_SCALE", "VELOCITY_SCALE", "Resampled", "resample"]
 

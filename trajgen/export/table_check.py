@@ -2,7 +2,7 @@
 
 :class:`TableMotion` turns the two vehicles' :class:`~trajgen.export.tables.ProfileTable` into a
 :class:`~trajgen.model.schedule.Schedule` along the route, so the independent verifier
-(:mod:`trajgen.verify`) checks the separation, the track, the start and goal and the homotopy class
+(:mod:`trajgen.verification`) checks the separation, the track, the start and goal and the homotopy class
 of exactly what the controllers will drive, in closed form between the points too;
 :func:`check_tables` adds the limits from divided differences and returns a :class:`TableCheck`.
 """
@@ -30,7 +30,7 @@ from trajgen.export.tables import (
 from trajgen.model.paths import VehiclePath
 from trajgen.model.profiles import PiecewiseCubic
 from trajgen.model.schedule import AxisMap, CubicKinematics, Schedule, Section, TimingMethod
-from trajgen.verify import VerificationReport, verify
+from trajgen.verification import VerificationReport, verify
 
 __all__ = ["TableCheck", "TableMotion", "check_tables", "junction_crossings", "leg_visits"]
 

@@ -18,14 +18,13 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.interpolate import CubicHermiteSpline, CubicSpline
 
 from limits import Limits
 from topology import Option
 from trajgen.errors import InputError
 from trajgen.model.profiles import PiecewiseCubic
 from trajgen.model.values import ArrayValue, readonly
-from trajgen.verify import RELATIVE_TOLERANCE
+from trajgen.verification import RELATIVE_TOLERANCE
 
 __all__ = [
     "CROSSING_TOLERANCE",
@@ -184,6 +183,8 @@ class ProfileTable(ArrayValue):
         if self.interpolation is Interpolation.VELOCITY:
             initial = np.stack([self.positions()[:-1], values[:-1], np.diff(values) / h], axis=1)
             return PiecewiseCubic(times, initial, np.zeros(h.size))
+        from scipy.interpolate import CubicHermiteSpline, CubicSpline  # only the spline tables need it
+
         if self.interpolation is Interpolation.HERMITE:
             spline = CubicHermiteSpline(times, values, self.velocities)
         else:

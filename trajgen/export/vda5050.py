@@ -33,11 +33,11 @@ from trajgen.export.vda5050_messages import (
     render_manifest,
     render_orders,
 )
-from trajgen.export.vda5050_options import MAX_FIRST_HEADER_ID, Vda5050Options
+from trajgen.export.vda5050_options import MANIFEST_NAME, MAX_FIRST_HEADER_ID, Vda5050Options
 from trajgen.export.vda5050_path import HOLD_MARGIN, NODE_TOLERANCE, NodeKind, OrderPath, PathEdge, PathNode
 from trajgen.export.vda5050_release import OrderPlan, Release, plan_orders
 from trajgen.scenario.naming import check_vehicle_names
-from trajgen.verify import VerifiedSchedule, require_verified
+from trajgen.verification import VerifiedSchedule, require_verified
 
 __all__ = [
     "HOLD_MARGIN",
@@ -62,9 +62,6 @@ __all__ = [
     "render_orders",
     "write_orders",
 ]
-
-#: Name of the index file written beside the vehicles' folders.
-MANIFEST_NAME = "manifest.json"
 
 
 def order_paths(names: Sequence[str], directory: str | Path) -> tuple[Path, Path, Path]:
@@ -113,7 +110,7 @@ def write_orders(
     Parameters
     ----------
     verified : VerifiedSchedule
-        From :func:`trajgen.verify.certify`.
+        From :func:`trajgen.verification.certify`.
     names : sequence of 2 str
         Vehicle names (their folders).
     directory : path

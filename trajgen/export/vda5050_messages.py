@@ -22,7 +22,7 @@ from trajgen.export.vda5050_path import NodeKind, OrderPath, PathEdge, PathNode
 from trajgen.export.vda5050_release import OrderPlan, Release, plan_orders
 from trajgen.model.schedule import Schedule
 from trajgen.scenario.naming import check_vehicle_names
-from trajgen.verify import VerifiedSchedule, require_verified
+from trajgen.verification import VerifiedSchedule, require_verified
 
 __all__ = ["VDA5050_VERSION", "OrderMessage", "edge_id", "node_id", "render_manifest", "render_orders"]
 

@@ -14,7 +14,17 @@ from datetime import UTC, datetime
 from topology.validation import short_repr
 from trajgen.errors import OptionError
 
-__all__ = ["FIRST_YEAR", "LAST_YEAR", "MAX_FIRST_HEADER_ID", "SERIAL_NUMBER", "Vda5050Options"]
+__all__ = [
+    "FIRST_YEAR",
+    "LAST_YEAR",
+    "MANIFEST_NAME",
+    "MAX_FIRST_HEADER_ID",
+    "SERIAL_NUMBER",
+    "Vda5050Options",
+]
+
+#: Name of the index file written beside the vehicles' folders.
+MANIFEST_NAME = "manifest.json"
 
 #: The characters VDA 5050 allows in a serial number (it is part of the MQTT topic).
 SERIAL_NUMBER = re.compile(r"[A-Za-z0-9_.:-]+")

@@ -38,7 +38,7 @@ from topology import JUNCTION_INDEX
 from trajgen.errors import ScheduleError
 from trajgen.export.vda5050_path import OrderPath, vehicle_path
 from trajgen.model.pieces import schedule_pieces
-from trajgen.verify import POSITION_TOLERANCE, VerifiedSchedule, require_verified
+from trajgen.verification import POSITION_TOLERANCE, VerifiedSchedule, require_verified
 
 __all__ = ["OrderPlan", "Release", "plan_orders"]
 
@@ -254,7 +254,7 @@ def plan_orders(verified: VerifiedSchedule) -> OrderPlan:
     Parameters
     ----------
     verified : VerifiedSchedule
-        From :func:`trajgen.verify.certify`.
+        From :func:`trajgen.verification.certify`.
 
     Returns
     -------

@@ -41,7 +41,7 @@ METHODS = MethodRegistry((Exact, Toppra, Optimal), default=Optimal.name)
 def make_schedule(route: Route, limits: Limits, *, method: TimingMethod | str | None = None) -> Schedule:
     """Time-parameterize ``route`` with ``method`` (an object with options, a name, or the default).
 
-    The result is not yet verified: see :func:`trajgen.verify.certify`.
+    The result is not yet verified: see :func:`trajgen.verification.certify`.
 
     Raises
     ------

@@ -83,7 +83,7 @@ class MethodRegistry:
         )
 
     def schedule(self, route: Route, limits: Limits, *, method: TimingMethod | str | None = None) -> Schedule:
-        """Time-parameterize ``route`` with ``method`` (unverified; see :func:`trajgen.verify.certify`).
+        """Time-parameterize ``route`` with ``method`` (unverified; see :func:`trajgen.verification.certify`).
 
         Raises
         ------

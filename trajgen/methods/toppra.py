@@ -45,7 +45,7 @@ from trajgen.model.schedule import (
     check_request,
 )
 from trajgen.model.values import ArrayValue, readonly
-from trajgen.verify import verify
+from trajgen.verification import verify
 
 __all__ = ["HEADROOM", "BlendedPath", "Toppra", "ToppraKinematics"]
 

@@ -128,11 +128,11 @@ class TimingMethod(abc.ABC):
 
     @abc.abstractmethod
     def schedule(self, route: Route, limits: Limits) -> Schedule:
-        """Time-parameterize ``route`` under ``limits`` (unverified: see :func:`trajgen.verify.certify`)."""
+        """Time-parameterize ``route`` under ``limits`` (unverified: see :func:`trajgen.certify`)."""
 
     @property
     def plans_for_execution(self) -> bool:
-        """Whether its schedules obey the braking rule (:mod:`trajgen.verify.braking_rule`): verify checks it.
+        """Whether its schedules obey the braking rule (:mod:`~trajgen.verification.braking_rule`).
 
         ``exact`` and ``toppra`` plans always do; ``optimal`` ones with ``braking_rule=True``.
         """

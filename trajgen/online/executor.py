@@ -48,8 +48,8 @@ from trajgen.online.goals import goal_refusal, plan_from_rest
 from trajgen.online.messages import Command, Event, GoalDecision, Mode, Setpoint, VehicleState, checked_state
 from trajgen.online.motion import AT_REST, PlanPlayer, VehicleMotion
 from trajgen.online.safety import SafetyGuard
-from trajgen.verify import VerifiedSchedule, require_verified
-from trajgen.verify.braking_rule import BRAKING_RULE_TOLERANCE
+from trajgen.verification import VerifiedSchedule, require_verified
+from trajgen.verification.braking_rule import BRAKING_RULE_TOLERANCE
 
 __all__ = ["PERIOD_RANGE", "Command", "Event", "Executor", "GoalDecision", "Mode", "Setpoint", "VehicleState"]
 

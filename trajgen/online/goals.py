@@ -15,7 +15,7 @@ from limits import Limits
 from topology import Configuration, StarGraph, plan
 from trajgen.methods import METHODS, make_schedule
 from trajgen.model.schedule import TimingMethod
-from trajgen.verify import VerifiedSchedule, certify
+from trajgen.verification import VerifiedSchedule, certify
 
 __all__ = ["execution_margin", "goal_refusal", "plan_for_execution", "plan_from_rest"]
 

@@ -22,7 +22,7 @@ from trajgen.errors import ScheduleError
 from trajgen.model.paths import VehiclePath
 from trajgen.model.pieces import schedule_pieces
 from trajgen.online.braking import PathState
-from trajgen.verify import VerifiedSchedule
+from trajgen.verification import VerifiedSchedule
 
 __all__ = ["AT_REST", "PlanPlayer", "VehicleMotion", "ruckig_jerk", "travel_state"]
 

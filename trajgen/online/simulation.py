@@ -36,7 +36,7 @@ from trajgen.online.messages import Command, Event, Mode, VehicleState
 from trajgen.online.plant import Plant
 from trajgen.online.trace import PLOT_SAMPLES, Decimated, Trace
 from trajgen.scenario import Scenario
-from trajgen.verify import VerifiedSchedule
+from trajgen.verification import VerifiedSchedule
 
 __all__ = ["PLOT_SAMPLES", "SimulationResult", "Trace", "parse_faults", "simulate"]
 

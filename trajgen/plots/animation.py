@@ -25,7 +25,7 @@ from topology.validation import short_repr
 from trajgen.errors import OptionError
 from trajgen.model.values import ArrayValue, frozen
 from trajgen.plots.gif import GIF_DELAY_UNIT_MS
-from trajgen.verify import VerifiedSchedule, require_verified
+from trajgen.verification import VerifiedSchedule, require_verified
 
 __all__ = [
     "DEFAULT_FPS",

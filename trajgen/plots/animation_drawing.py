@@ -48,7 +48,7 @@ from trajgen.plots.figure import frame_painter, new_figure
 from trajgen.plots.gif import gif_bytes
 from trajgen.plots.speed import VEHICLE_COLOURS
 from trajgen.progress import progress
-from trajgen.verify import VerifiedSchedule, require_verified
+from trajgen.verification import VerifiedSchedule, require_verified
 
 __all__ = ["render_animation"]
 

@@ -51,7 +51,7 @@ from topology.indexed import IndexedConfiguration, region_key
 from trajgen.errors import InputError
 from trajgen.model.values import ArrayValue, readonly
 from trajgen.plots.speed import plot_period
-from trajgen.verify import VerifiedSchedule, require_verified
+from trajgen.verification import VerifiedSchedule, require_verified
 
 __all__ = [
     "FLAP_SIZE",

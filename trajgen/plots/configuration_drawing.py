@@ -18,7 +18,7 @@ from trajgen.model.summary import class_label
 from trajgen.plots.configuration import ConfigurationLayout, rotate, route_samples, schedule_samples
 from trajgen.plots.figure import new_figure, png_bytes
 from trajgen.plots.retract_graph import configuration_subject, render_retract_graph
-from trajgen.verify import VerifiedSchedule
+from trajgen.verification import VerifiedSchedule
 
 __all__ = ["render_configuration"]
 

@@ -13,7 +13,7 @@ from trajgen.model.analysis import travelled
 from trajgen.model.schedule import Schedule
 from trajgen.plots.figure import new_figure, png_bytes
 from trajgen.plots.speed import plot_period
-from trajgen.verify import VerifiedSchedule, require_verified
+from trajgen.verification import VerifiedSchedule, require_verified
 
 __all__ = ["METHOD_COLOURS", "render_coordination"]
 

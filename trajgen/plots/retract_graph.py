@@ -46,7 +46,7 @@ from trajgen.model.summary import class_label
 from trajgen.model.values import ArrayValue, readonly
 from trajgen.plots.figure import new_figure, png_bytes
 from trajgen.plots.speed import VEHICLE_COLOURS, plot_period
-from trajgen.verify import VerifiedSchedule, require_verified
+from trajgen.verification import VerifiedSchedule, require_verified
 
 __all__ = [
     "BOW",

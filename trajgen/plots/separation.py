@@ -8,7 +8,7 @@ from topology.indexed import track_distance
 from trajgen.model.summary import class_label
 from trajgen.plots.figure import new_figure, png_bytes
 from trajgen.plots.speed import plot_period
-from trajgen.verify import VerifiedSchedule, require_verified
+from trajgen.verification import VerifiedSchedule, require_verified
 
 __all__ = ["render_separation"]
 

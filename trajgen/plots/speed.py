@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from trajgen.model.summary import class_label
 from trajgen.plots.figure import new_figure, png_bytes
-from trajgen.verify import VerifiedSchedule, require_verified
+from trajgen.verification import VerifiedSchedule, require_verified
 
 __all__ = ["MAX_PLOT_POINTS", "PLOT_PERIOD", "VEHICLE_COLOURS", "plot_period", "render_speed"]
 

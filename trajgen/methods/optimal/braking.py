@@ -1,6 +1,6 @@
 """The braking rule as constraints of the optimal-control NLP, phase by phase in leg coordinates.
 
-A plan meant for execution obeys the braking rule (:mod:`trajgen.verify.braking_rule`):
+A plan meant for execution obeys the braking rule (:mod:`trajgen.verification.braking_rule`):
 at every instant each vehicle that follows at a conflict can still come to
 rest, under its service braking, short of every position at which it would
 meet a position where its leader could still come to rest (from the leader's

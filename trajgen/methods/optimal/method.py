@@ -28,7 +28,7 @@ from trajgen.methods.optimal.transcription import ParameterLayout
 from trajgen.model.analysis import class_lower_bound
 from trajgen.model.schedule import FallbackReason, Schedule, TimingMethod, check_request
 from trajgen.model.summary import class_name
-from trajgen.verify import verify
+from trajgen.verification import verify
 
 __all__ = ["DEFAULT_NODES", "DEFAULT_REFINEMENT_TOLERANCE", "Optimal"]
 
@@ -100,8 +100,8 @@ class Optimal(TimingMethod):
         has no wall-time limit; its result is not used).
         If no class was solved by then, the ``exact`` schedule is returned, flagged ``time-budget``.
     braking_rule : bool, optional
-        State the braking rule (:mod:`trajgen.verify.braking_rule`) in the problem (default ``False``), so
-        that the plan can be executed by the order-keeping :class:`~trajgen.online.Executor`
+        State the braking rule (:mod:`trajgen.verification.braking_rule`) in the problem (default
+        ``False``), so that the plan can be executed by the order-keeping :class:`~trajgen.online.Executor`
         without holds; verify then checks it. Slower (seconds per solve), and fatrop may stall on
         it (the time budget's watchdog then abandons the call); the executor's
         :func:`~trajgen.online.plan_for_execution` turns it on.

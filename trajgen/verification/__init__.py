@@ -4,7 +4,7 @@
 schedule into a :class:`VerifiedSchedule`, the only kind that exporters and plots accept.
 """
 
-from trajgen.verify.certify import (
+from trajgen.verification.certify import (
     CONTINUITY_TOLERANCE,
     POSITION_TOLERANCE,
     RELATIVE_TOLERANCE,

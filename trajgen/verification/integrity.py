@@ -9,7 +9,7 @@ A failure names the array by its path from the schedule, for example
 ``sections[2].kinematics.vehicles[0].times[4] is nan``.
 
 The motion itself (limits, separation, continuity, start and goal, homotopy
-class) is checked afterwards by :mod:`trajgen.verify`, whose failures name
+class) is checked afterwards by :mod:`trajgen.verification`, whose failures name
 the arrays of the interval where they occur.
 """
 

@@ -16,7 +16,7 @@ from topology.indexed import JUNCTION_INDEX, track_distance
 from trajgen.model import polynomials
 from trajgen.model.pieces import Pieces, motion_arrays
 from trajgen.model.schedule import Schedule
-from trajgen.verify.report import (
+from trajgen.verification.report import (
     CONTINUITY_TOLERANCE,
     POSITION_TOLERANCE,
     RELATIVE_TOLERANCE,

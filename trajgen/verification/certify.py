@@ -19,11 +19,11 @@ number of pieces, not with the duration. It checks:
   pieces tile ``[0, duration]``;
 - the start and the goal are the route's, to 1e-9 m, at rest (1e-6 m/s);
 - the sequence of regions visited (the homotopy class) is the route's;
-- the braking rule (:mod:`trajgen.verify.braking_rule`): each vehicle that follows at a
+- the braking rule (:mod:`trajgen.verification.braking_rule`): each vehicle that follows at a
   conflict can always stop short of its frontier, so what is planned is what
   the online executor plays;
 - every number is finite, every knot sequence increases, and every array
-  derived from others agrees with them (:mod:`trajgen.verify.integrity`).
+  derived from others agrees with them (:mod:`trajgen.verification.integrity`).
 
 A failure names the arrays where it occurs, by their paths from the schedule
 (``sections[2].kinematics.vehicles[0].{times,initial,jerk} interval 4``).
@@ -52,9 +52,9 @@ from trajgen.errors import InputError, UnverifiedScheduleError, VerificationErro
 from trajgen.model import polynomials
 from trajgen.model.pieces import Pieces, UncheckableKinematicsError, schedule_pieces
 from trajgen.model.schedule import Schedule
-from trajgen.verify.braking_rule import BRAKING_RULE_TOLERANCE, braking_rule_failures
-from trajgen.verify.integrity import array_failures
-from trajgen.verify.piecewise import (
+from trajgen.verification.braking_rule import BRAKING_RULE_TOLERANCE, braking_rule_failures
+from trajgen.verification.integrity import array_failures
+from trajgen.verification.piecewise import (
     allowance,
     check_maps,
     check_parked,
@@ -64,7 +64,7 @@ from trajgen.verify.piecewise import (
     check_piece_track,
     piece_arrays,
 )
-from trajgen.verify.report import (
+from trajgen.verification.report import (
     CONTINUITY_TOLERANCE,
     POSITION_TOLERANCE,
     RELATIVE_TOLERANCE,
