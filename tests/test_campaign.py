@@ -11,20 +11,15 @@ from __future__ import annotations
 
 import pytest
 
-from trajgen import METHODS, Optimal, SolverCache, certify, make_schedule
+from trajgen import Exact, FallbackReason, Optimal, SolverCache, Toppra, certify, make_schedule
 from trajgen.scenario.sampling import campaign_scenarios
 
 SCENARIOS = campaign_scenarios(300, seed=9)
-CHUNK = 10
-#: ``exact`` and ``toppra`` are timed on the scenarios whose index is a multiple of this ...
+#: ``exact`` and ``toppra`` are timed on the scenarios whose index is a multiple of this, one test each
+#: (the longest schedules take seconds to verify) ...
 EVERY = 10
 #: ... and ``optimal`` on those whose index is a multiple of this.
 OPTIMAL_EVERY = 60
-
-
-@pytest.fixture(scope="module")
-def methods():
-    return [cls() if cls is not Optimal else Optimal(cache=SolverCache(maxsize=128)) for cls in METHODS]
 
 
 def test_the_campaign_spans_the_whole_range():
@@ -35,19 +30,27 @@ def test_the_campaign_spans_the_whole_range():
     assert sum(s.goal == s.start.swapped() for s in SCENARIOS) >= 70
 
 
-@pytest.mark.parametrize("chunk", range(len(SCENARIOS) // (CHUNK * EVERY)), ids=lambda k: f"chunk-{k}")
-def test_every_schedule_of_every_method_verifies(methods, chunk, record_property):
-    fallbacks = dict.fromkeys((m.name for m in methods), 0)
-    for index in range(CHUNK * EVERY * chunk, CHUNK * EVERY * (chunk + 1), EVERY):
-        scenario = SCENARIOS[index]
-        route = scenario.plan()
-        for method in methods:
-            if method.name == "optimal" and index % OPTIMAL_EVERY:
-                continue
-            schedule = make_schedule(route, scenario.limits, method=method)
-            certify(schedule)  # raises VerificationError, naming every failure, if one does not verify
-            fallbacks[method.name] += schedule.fallback_reason is not None
-    record_property("fallbacks", fallbacks)
-    assert fallbacks["exact"] == 0
-    assert fallbacks["toppra"] <= 2
-    assert fallbacks["optimal"] <= 1  # flagged and verified; the campaign's count is in the benchmark
+@pytest.mark.parametrize("index", range(0, len(SCENARIOS), EVERY), ids=lambda k: f"scenario-{k}")
+@pytest.mark.parametrize("method", [Exact(), Toppra()], ids=["exact", "toppra"])
+def test_every_exact_and_toppra_schedule_verifies(method, index):
+    scenario = SCENARIOS[index]
+    schedule = make_schedule(scenario.plan(), scenario.limits, method=method)
+    certify(schedule)  # raises VerificationError, naming every failure, if one does not verify
+    # neither falls back on these seeded scenarios (toppra may, flagged and verified, on others)
+    assert schedule.fallback_reason is None
+
+
+@pytest.fixture(scope="module")
+def optimal():
+    return Optimal(cache=SolverCache(maxsize=128))
+
+
+@pytest.mark.parametrize("index", range(0, len(SCENARIOS), OPTIMAL_EVERY), ids=lambda k: f"scenario-{k}")
+def test_the_optimal_schedule_verifies_and_is_no_slower_than_exact(optimal, index):
+    scenario = SCENARIOS[index]
+    route = scenario.plan()
+    schedule = certify(make_schedule(route, scenario.limits, method=optimal)).schedule
+    # solved, or (on a machine too loaded for the budget) flagged and verified; a solver failure on
+    # these seeded scenarios would be a regression
+    assert schedule.fallback_reason in (None, FallbackReason.TIME_BUDGET)
+    assert schedule.duration <= Exact().schedule(route, scenario.limits).duration * (1 + 1e-9)
