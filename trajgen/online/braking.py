@@ -10,8 +10,7 @@ at every instant the two tubes stay at least the required track distance
 apart: time is cut into intervals, and on each the range a vehicle can
 cover is widened by the most a motion of bounded acceleration can leave the
 chord between its ends (``a * dt**2 / 8``), so nothing between the instants
-is missed. Intervals that are not clear are halved, down to a 64th of
-the braking horizon. That covers a leader stopping short in front of a follower (the
+is missed. That covers a leader stopping short in front of a follower (the
 follower's service braking against the leader's emergency braking) and two
 vehicles closing on each other (both at service braking).
 """
@@ -28,8 +27,8 @@ from trajgen.model.paths import VehiclePath, set_distance
 
 __all__ = ["BrakingCheck", "PathState", "ServiceBraking", "emergency_position"]
 
-#: The shortest interval the check halves down to is the horizon over this.
-_FINEST = 64
+#: Time intervals tried in turn: a coarse pass is enough while the vehicles are far apart.
+_REFINEMENTS = (1, 6, 40)
 #: Below these a vehicle stands still (m/s, m/s²): it moves less than a micrometre while it brakes.
 _STILL_VELOCITY = 1e-7
 _STILL_ACCELERATION = 1e-6
@@ -149,52 +148,37 @@ class BrakingCheck:
             else 0.0
             for pad, c, m in zip(self._pad_acceleration, commanded, measured, strict=True)
         ]
-        return self._intervals_clear(paths, trajectories, durations, ends, measured, required, horizon, pads)
+        for count in _REFINEMENTS:
+            if self._intervals_clear(
+                paths, trajectories, durations, ends, measured, required, horizon, count, pads
+            ):
+                return True
+        return False
 
-    def _bounds(self, trajectories, durations, ends, measured, t):
-        """Each vehicle's travel range at ``t``: between its emergency and its service braking."""
-        bounds = []
-        for vehicle in (0, 1):
-            if t >= durations[vehicle]:
-                upper = ends[vehicle]
-            else:
-                (upper,), _, _ = trajectories[vehicle].at_time(t)
-            lower = emergency_position(measured[vehicle], self._emergency[vehicle], t)
-            bounds.append((min(lower, upper), max(lower, upper)))
-        return bounds
-
-    def _intervals_clear(self, paths, trajectories, durations, ends, measured, required, horizon, pads):
-        """Whether every interval of ``[0, horizon]`` is clear, halving the ones that are not.
-
-        Depth first: a real conflict fails after a handful of evaluations, and the intervals far
-        from any conflict stay long. An interval is given up below ``horizon / _FINEST``.
-        """
+    def _intervals_clear(
+        self, paths, trajectories, durations, ends, measured, required, horizon, count, pads
+    ):
+        step = horizon / count
+        previous = None
         lengths = self._lengths
-        finest = horizon / _FINEST
-        evaluate = self._bounds
-        pending = [
-            (
-                0.0,
-                horizon,
-                evaluate(trajectories, durations, ends, measured, 0.0),
-                evaluate(trajectories, durations, ends, measured, horizon),
-            )
-        ]
-        while pending:
-            start, end, first, last = pending.pop()
-            step = end - start
-            sets = []
+        for k in range(count + 1):
+            t = k * step
+            bounds = []
             for vehicle in (0, 1):
-                pad = pads[vehicle] * step * step / 8.0
-                low = min(first[vehicle][0], last[vehicle][0]) - pad
-                high = max(first[vehicle][1], last[vehicle][1]) + pad
-                sets.append(paths[vehicle].sweep(low, high, lengths))
-            if set_distance(sets[0], sets[1]) >= required:
-                continue
-            if step <= finest:
-                return False
-            middle = 0.5 * (start + end)
-            between = evaluate(trajectories, durations, ends, measured, middle)
-            pending.append((middle, end, between, last))
-            pending.append((start, middle, first, between))
+                if t >= durations[vehicle]:
+                    upper = ends[vehicle]
+                else:
+                    (upper,), _, _ = trajectories[vehicle].at_time(t)
+                lower = emergency_position(measured[vehicle], self._emergency[vehicle], t)
+                bounds.append((min(lower, upper), max(lower, upper)))
+            if previous is not None:
+                sets = []
+                for vehicle in (0, 1):
+                    pad = pads[vehicle] * step * step / 8.0
+                    low = min(previous[vehicle][0], bounds[vehicle][0]) - pad
+                    high = max(previous[vehicle][1], bounds[vehicle][1]) + pad
+                    sets.append(paths[vehicle].sweep(low, high, lengths))
+                if set_distance(sets[0], sets[1]) < required:
+                    return False
+            previous = bounds
         return True
