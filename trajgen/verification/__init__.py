@@ -4,17 +4,14 @@
 schedule into a :class:`VerifiedSchedule`, the only kind that exporters and plots accept.
 """
 
-from trajgen.verification.certify import (
+from trajgen.verification.certify import VerifiedSchedule, certify, require_verified, verify
+from trajgen.verification.report import (
     CONTINUITY_TOLERANCE,
     POSITION_TOLERANCE,
     RELATIVE_TOLERANCE,
     REST_TOLERANCE,
     TRACK_END_TOLERANCE,
     VerificationReport,
-    VerifiedSchedule,
-    certify,
-    require_verified,
-    verify,
 )
 
 __all__ = [

@@ -65,26 +65,13 @@ from trajgen.verification.piecewise import (
     piece_arrays,
 )
 from trajgen.verification.report import (
-    CONTINUITY_TOLERANCE,
     POSITION_TOLERANCE,
-    RELATIVE_TOLERANCE,
     REST_TOLERANCE,
     TRACK_END_TOLERANCE,
     VerificationReport,
 )
 
-__all__ = [
-    "CONTINUITY_TOLERANCE",
-    "POSITION_TOLERANCE",
-    "RELATIVE_TOLERANCE",
-    "REST_TOLERANCE",
-    "TRACK_END_TOLERANCE",
-    "VerificationReport",
-    "VerifiedSchedule",
-    "certify",
-    "require_verified",
-    "verify",
-]
+__all__ = ["VerifiedSchedule", "certify", "require_verified", "verify"]
 
 logger = logging.getLogger(__name__)
 
