@@ -8,6 +8,7 @@ import io
 import json
 import re
 
+import numpy as np
 import pytest
 
 import trajgen.closed_loop
@@ -283,3 +284,19 @@ def test_render_simulation_refuses_bad_arguments(stopped_run, result, min_separa
     result = stopped_run.result if result is None else result
     with pytest.raises(InputError, match=match):
         render_simulation(result, names=("agv1", "agv2"), min_separation=min_separation)
+
+
+def test_the_plot_data_hold_each_vehicles_frontier_and_no_vehicle_passes_it(stopped_run):
+    """What the plot draws as each vehicle's frontier: finite where a conflict binds, never overrun."""
+    plot = stopped_run.result.plot
+    t, travel, frontier = plot["t"], plot["travel"], plot["frontier"]
+    assert frontier.shape == travel.shape == (2, t.size)
+    bound = np.isfinite(frontier)
+    assert bound.any(axis=1).all()  # on the swap each vehicle follows at some conflict
+    assert np.all(travel[bound] <= frontier[bound] + 1e-6)
+    # agv1's stop (8 s to 11 s) holds agv2 back: its frontier stops advancing while agv1 stands
+    standing = (t >= 8.5) & (t <= 11.0) & bound[1]
+    assert standing.any()
+    assert np.ptp(frontier[1, standing]) < 1e-6
+    # and the frontier moves on once agv1 drives again
+    assert np.nanmax(np.where(bound[1] & (t > 11.5), frontier[1], np.nan)) > frontier[1, standing][0] + 0.1
