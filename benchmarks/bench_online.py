@@ -42,7 +42,10 @@ def run_case(args: tuple[int, int, str | None, bool]) -> dict:
     verified = plan_for_execution(scenario, method=method)
     margin = execution_margin(scenario, 0.05)
     specs = campaign_faults(scenario, verified.schedule.duration, seed=1000 + k, margin=margin)
-    result, _ = simulate(scenario, parse_faults(scenario, specs), verified=verified)
+    try:
+        result, _ = simulate(scenario, parse_faults(scenario, specs), verified=verified)
+    except Exception as error:  # a crash is a failed scenario, reported with the others
+        return {"k": k, "specs": specs, "method": verified.schedule.method.name, "error": repr(error)}
     row = {"k": k, "specs": specs, "method": verified.schedule.method.name, **result.summary()}
     if fault_free:
         clean, _ = simulate(scenario, (), verified=verified)
@@ -171,6 +174,8 @@ def main() -> None:
         done = progress(pool.imap_unordered(run_case, cases), total=len(cases), description="campaign")
         rows = sorted(done, key=lambda r: r["k"])
     wall = time.perf_counter() - started
+    crashed = [r for r in rows if "error" in r]
+    rows = [r for r in rows if "error" not in r]
     failed = [r for r in rows if not r["reached_goal"] or r["violations"] or r["emergency_brakes"]]
     lost = [r["time_lost_s"] for r in rows if r["reached_goal"]]
     relative = [r["time_lost_s"] / r["planned_s"] for r in rows if r["reached_goal"] and r["planned_s"] > 0]
@@ -179,7 +184,8 @@ def main() -> None:
         f"campaign: {args.count} scenarios (seed {args.seed}, plans by {', '.join(methods)}), "
         f"1-3 faults each, {wall:.0f} s wall"
     )
-    print(f"  goals reached: {sum(r['reached_goal'] for r in rows)}/{len(rows)}")
+    print(f"  crashed (an exception in the run): {len(crashed)}")
+    print(f"  goals reached: {sum(r['reached_goal'] for r in rows)}/{len(rows) + len(crashed)}")
     print(f"  deadlocks (goals never reached): {sum(not r['reached_goal'] for r in rows)}")
     print(f"  separation violations: {sum(r['separation_violations'] for r in rows)} cycles")
     print(f"  limit violations: {sum(r['limit_violations'] for r in rows)} cycles")
@@ -207,6 +213,8 @@ def main() -> None:
             f"holds {sum(c['holds'] for c in clean)}, "
             f"emergency brakes {sum(c['emergency_brakes'] for c in clean)}"
         )
+    for r in crashed:
+        print(f"  CRASHED scenario {r['k']}: {', '.join(r['specs'])}: {r['error']}")
     for r in failed:
         print(
             f"  FAILED scenario {r['k']}: {', '.join(r['specs'])}: reached {r['reached_goal']}, "

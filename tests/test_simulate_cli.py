@@ -17,7 +17,8 @@ from trajgen.cli import EXIT_BAD_INPUT, EXIT_FAILURE, EXIT_OK, main
 from trajgen.closed_loop import format_simulation, run_simulation
 from trajgen.errors import InputError
 from trajgen.online.faults import FaultError
-from trajgen.online.simulation import simulate
+from trajgen.online.goals import plan_for_execution
+from trajgen.online.simulation import parse_faults, simulate
 from trajgen.plots import render_simulation
 from trajgen.scenario import load_scenario
 
@@ -286,9 +287,13 @@ def test_render_simulation_refuses_bad_arguments(stopped_run, result, min_separa
         render_simulation(result, names=("agv1", "agv2"), min_separation=min_separation)
 
 
-def test_the_plot_data_hold_each_vehicles_frontier_and_no_vehicle_passes_it(stopped_run):
+@pytest.mark.parametrize("method", ["exact", "toppra"])
+def test_the_plot_data_hold_each_vehicles_frontier_and_no_vehicle_passes_it(method):
     """What the plot draws as each vehicle's frontier: finite where a conflict binds, never overrun."""
-    plot = stopped_run.result.plot
+    scenario = load_scenario(SWAP)
+    verified = plan_for_execution(scenario, method=method)
+    result, _ = simulate(scenario, parse_faults(scenario, ["stop:agv1@8+3"]), verified=verified)
+    plot = result.plot
     t, travel, frontier = plot["t"], plot["travel"], plot["frontier"]
     assert frontier.shape == travel.shape == (2, t.size)
     bound = np.isfinite(frontier)

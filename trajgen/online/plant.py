@@ -167,7 +167,8 @@ class Plant:
                     setpoint.jerk,
                     setpoint.branch,
                 )
-            body.branch = branch
+            if branch != JUNCTION_INDEX:  # a path that never moves, parked at the junction, names no leg
+                body.branch = branch
             slow = self._active(FaultKind.SLOW, v, t)
             cap = slow.value if slow is not None else math.inf  # a throttled drive's top speed
             wanted = axis - body.axis
