@@ -19,13 +19,15 @@ from ruckig import ControlInterface, InputParameter, Ruckig, Trajectory
 
 from limits import ILLUSTRATIVE_LIMITS, Limits, VehicleLimits
 from tests.conftest import REPO
-from topology import Configuration, Position, StarGraph, YGraph
+from topology import JUNCTION_INDEX, Configuration, Position, StarGraph, YGraph
 from topology.indexed import separation as indexed_separation
 from trajgen import Optimal, certify, default_scenario, load_scenario, make_schedule
 from trajgen.errors import InputError, UnverifiedScheduleError
 from trajgen.online import BrakingCheck, Executor, Mode, PathState, VehiclePath, VehicleState
 from trajgen.online.braking import emergency_position
 from trajgen.online.goals import execution_margin, plan_for_execution
+from trajgen.online.messages import Command, Setpoint, checked_state
+from trajgen.online.plant import Plant
 from trajgen.online.simulation import parse_faults, simulate
 from trajgen.scenario import Scenario
 from trajgen.scenario.sampling import campaign_faults, online_campaign, random_scenarios
@@ -621,3 +623,24 @@ def test_the_margin_shrinks_where_the_track_has_no_room():
     result, _ = simulate(scenario, (), method="exact")
     assert result.reached_goal
     assert result.violations == 0
+
+
+def test_a_setpoint_naming_no_next_leg_leaves_the_plants_vehicle_on_a_leg(plans):
+    """A parked path at the junction names no next leg: the plant keeps its vehicle on a leg.
+
+    Seed 12 of the campaign: a re-planned path that never moves, parked at the junction, named the
+    junction as the leg it takes next. A drive correction past the junction then put the simulated
+    vehicle on leg -1 at s = 0.023 m, which the executor refused as off the track.
+    """
+    scenario, verified = plans["swap", "exact"]
+    plant = Plant(Executor(verified, min_separation=scenario.limits.min_separation), (), 0.01)
+    body = plant.bodies[0]
+    body.s, body.v, body.a = 0.0, 0.0, 0.0  # parked exactly at the junction on its leg
+    across = body.axis - body.orientation * 0.02  # 2 cm on, through the junction
+    parked = Setpoint(across, 0.0, 0.0, 0.0, JUNCTION_INDEX, 0.0, JUNCTION_INDEX)
+    other = plant.bodies[1]
+    still = Setpoint(other.axis, 0.0, 0.0, 0.0, other.leg, other.s, other.branch)
+    plant.advance(Command(0.01, (parked, still), Mode.FOLLOWING), 0.0)
+    state = plant.measure()[0]
+    assert state.leg >= 0 or state.s == 0.0, state
+    checked_state(state, 1, scenario.track)  # what the executor reads: a place on the track
