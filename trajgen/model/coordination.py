@@ -306,8 +306,7 @@ class CoordinationDiagram:
         rows = []
         for conflict in self._by_follower[follower]:
             leader = conflict.leader
-            for polygon in conflict.polygons:
-                reach = max(vertex[leader] for vertex in polygon)
+            for polygon, reach in zip(conflict.polygons, conflict._reaches, strict=True):
                 for k, a in enumerate(polygon):
                     b = polygon[(k + 1) % len(polygon)]
                     rows.append((a[leader], a[1 - leader], b[leader], b[1 - leader], reach))
