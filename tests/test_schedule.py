@@ -9,7 +9,7 @@ import pytest
 
 from limits import Limits, VehicleLimits
 from tests.helpers import LIMITS, MIXED, route_of, too_close
-from topology import YGraph
+from topology import Configuration, Position, YGraph, plan
 from trajgen import METHODS, Exact, Schedule, Toppra, certify, make_schedule, verify
 from trajgen.errors import OptionError, VerificationError
 from trajgen.methods.toppra import ToppraKinematics
@@ -260,3 +260,26 @@ def test_a_toppra_section_it_cannot_time_keeps_its_stops(monkeypatch):
     assert any("TOPPRA failed on a section" in note for note in schedule.notes)
     assert schedule.duration == pytest.approx(exact_schedule(route, LIMITS, jerk=False).duration)
     assert verify(schedule).passed
+
+
+def test_a_round_off_first_move_neither_sets_nor_reverses_the_axis():
+    """A planner's 2e-14 m first move is no move: the axis grows in the direction of the real first one.
+
+    Seed 12 of the online campaign, scenario 742: re-planned from where the vehicles stood, the
+    route began with vehicle 1 moving 2.1e-14 m outward, then 7.96 m inward. Read as its first move,
+    the sliver made the axis run backwards over the real one, and the executor, whose paths ignore
+    such slivers, drove the vehicle away from its path.
+    """
+    lengths = (22.207407464799427, 27.615988714746972, 0.5943996977234312)
+    graph = YGraph(dict(zip("ABC", lengths, strict=True)))
+    start = Configuration(Position("A", 7.955232103637798), Position("C", 0.5943996977234296))
+    goal = Configuration(Position("B", 27.615988714746972), Position("C", 0.5943))
+    route = plan(graph, start, goal, min_separation=0.3730053062408387)
+    first, second = route.indexed_waypoints[:2]
+    assert 0.0 < second[1] - first[1] < 1e-12  # the sliver is there
+    axes = route_axes(route).axes
+    assert np.all(np.diff(axes, axis=0) >= 0.0), axes  # each vehicle one way: its axis never runs back
+    assert axes[-1, 0] == pytest.approx(7.955232103637798 + 27.615988714746972, abs=1e-9)
+    assert axes[-1, 1] == pytest.approx(0.5943996977234296 - 0.5943, abs=1e-9)
+    schedule = certify(make_schedule(route, Limits(LIMITS.vehicles, 0.3730053062408387))).schedule
+    assert schedule.state(0.5).velocity[0, 0] > 0.0  # the plan's first real move is its axis's + direction

@@ -15,6 +15,7 @@ import numpy as np
 
 from limits import Limits
 from topology import JUNCTION_INDEX, Route
+from trajgen.model.paths import MOVE_RESOLUTION
 from trajgen.model.profiles import PiecewiseCubic, scurve_phases, trapezoid_phases
 from trajgen.model.schedule import AxisMap
 from trajgen.model.values import ArrayValue, readonly
@@ -75,6 +76,12 @@ def route_axes(route: Route) -> RouteAxes:
                 axes[k + 1, vehicle] = axes[k, vehicle]
                 continue
             direction = 1 if step > 0 else -1
+            if abs(step) <= MOVE_RESOLUTION:
+                # round-off of the planner (a few 1e-14 m): no move of its own, so it neither sets the
+                # axis's positive direction nor reverses it (as VehiclePath ignores it too)
+                axes[k + 1, vehicle] = axes[k, vehicle] + sign * abs(step)
+                outward[k, vehicle] = direction * sign
+                continue
             if started:
                 through_junction = heading == -1 and direction == 1 and leg != heading_leg
                 if direction != heading and not through_junction:

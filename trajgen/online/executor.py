@@ -460,8 +460,10 @@ class Executor:
                 self.rejected_goals += 1
                 self._log("goal-refused", f"no plan from {start} to {goal}: {error}")
             else:
-                axes = [self._paths[v].axis(self._command[v].p) for v in (0, 1)]
-                orientation = [self._orientation(v) for v in (0, 1)]
+                # where each vehicle stands (the new plan starts there), not where it was told to be:
+                # a drive at rest short of its setpoint would carry the offset into the new axis
+                axes = [self._paths[v].axis(along[v].p) for v in (0, 1)]
+                orientation = [self._orientation(v, along[v].p) for v in (0, 1)]
                 self.replans += 1
                 self._load(verified, axis_start=axes, orientation=orientation)
                 route = verified.schedule.route
@@ -582,12 +584,16 @@ class Executor:
             return Position(None, 0.0)
         return Position(self.graph.names[state.leg], min(state.s, self.graph.lengths[state.leg]))
 
-    def _orientation(self, v: int) -> tuple[int, int] | None:
-        """``(leg, ds / d axis)`` of ``v`` where it stands on its path (``None`` if its path is empty)."""
+    def _orientation(self, v: int, p: float) -> tuple[int, int] | None:
+        """``(leg, ds / d axis)`` of ``v`` at travel ``p`` of its path (``None`` at the junction, unmoved).
+
+        A path that never moves keeps the convention of :class:`~trajgen.model.paths.VehiclePath`: its
+        axis grows away from the junction.
+        """
         path = self._paths[v]
         if not path.legs:
-            return None
-        p = self._command[v].p
+            leg = path.home[0]
+            return None if leg == JUNCTION_INDEX else (leg, 1)
         return path.legs[path.segment(p)], path.outward(p) * path.heading(p)
 
     def _log(self, kind: str, detail: str) -> None:

@@ -45,6 +45,9 @@ class Body:
         The end of a leg (and the junction, when the branch is the same leg) stops the vehicle: it
         does not get further, and neither does its axis; it is then at rest.
         """
+        if self.s <= 0.0 and d_axis != 0.0 and self.branch != JUNCTION_INDEX:
+            # at the junction every move leaves it, onto the branch: the axis sign there is a convention
+            self.leg, self.orientation = self.branch, (1 if d_axis > 0.0 else -1)
         s = self.s + self.orientation * d_axis
         blocked = 0.0
         if s < 0.0:
