@@ -29,8 +29,8 @@ __all__ = ["BrakingCheck", "PathState", "ServiceBraking", "emergency_position"]
 
 #: Time intervals tried in turn: a coarse pass is enough while the vehicles are far apart.
 _REFINEMENTS = (1, 6, 40)
-#: How often the finest pass may halve an interval that is not clear (down to 1/640 of the horizon).
-_HALVINGS = 4
+#: How often the finest pass may halve an interval that is not clear (down to 1/10,240 of the horizon).
+_HALVINGS = 8
 #: Below these a vehicle stands still (m/s, m/s²): it moves less than a micrometre while it brakes.
 _STILL_VELOCITY = 1e-7
 _STILL_ACCELERATION = 1e-6
@@ -174,9 +174,11 @@ class BrakingCheck:
     ) -> bool:
         """Whether ``count`` equal intervals of ``[0, horizon]`` are clear.
 
-        On the finest pass an interval that is not clear is halved, down to :data:`_HALVINGS` times:
-        tubes that pass within a few millimetres of the separation are told apart from a real conflict
-        at the cost of a few more evaluations, only where they are close.
+        On the finest pass an interval that is not clear is halved, up to :data:`_HALVINGS` times: an
+        interval's sweep is pessimistic by about the distance both vehicles drive over it, so tubes that
+        pass within a millimetre of the separation are told apart from a real conflict, with a few
+        more evaluations only where they are close. Where the tubes meet at an instant, the conflict
+        is real and the check ends there.
         """
         lengths = self._lengths
         halvings = _HALVINGS if count == _REFINEMENTS[-1] else 0
@@ -200,6 +202,9 @@ class BrakingCheck:
                     return False
                 middle = 0.5 * (start + end)
                 between = self._bounds(trajectories, durations, ends, measured, middle)
+                at_middle = [paths[v].sweep(between[v][0], between[v][1], lengths) for v in (0, 1)]
+                if set_distance(at_middle[0], at_middle[1]) < required:
+                    return False  # not the intervals' pessimism: the tubes meet at that instant
                 pending.append((middle, end, between, last, left - 1))
                 pending.append((start, middle, first, between, left - 1))
             previous = bounds
