@@ -216,3 +216,55 @@ def test_verify_refuses_a_plan_that_breaks_the_rule_naming_when_and_where(optima
     )
     with pytest.raises(VerificationError, match=r"vehicle [12] cannot stop short of its frontier at t=\d"):
         certify(relabelled)
+
+
+#: Campaign scenario 20 (seed 9): 3.8 km, 367 m and a shortest leg of 111 m that is the separation; a
+#: slow, soft vehicle (0.23 m/s, 0.079 m/s³) waits for hours while the other drives kilometres.
+LONG_WAIT = (
+    (366.97565449866704, 111.01040734381074, 3817.274258034254),
+    ("C:2714", "C:3529.01"),
+    Limits(
+        (
+            VehicleLimits(
+                max_velocity=1.0314118746610161, max_acceleration=0.23799801114673097, max_jerk=3.4597
+            ),
+            VehicleLimits(
+                max_velocity=0.22880728599774738, max_acceleration=0.3091416882898401, max_jerk=0.079
+            ),
+        ),
+        111.01040734381074,
+    ),
+)
+
+
+def test_the_rule_check_costs_about_the_same_on_a_schedule_a_hundred_times_longer(monkeypatch):
+    """Long rests and cruises are certified at once: the cost grows with the pieces, not the duration.
+
+    The check halves a step where the margin is thinner than what the follower's stop point can
+    gain over it. Bounded from the limits alone, a vehicle waiting for hours could gain metres: the
+    kilometre version of campaign scenario 20 (39,870 s) took 786,000 margins (12 s), 24 times the
+    metre version's. Resting or cruising through a step, a vehicle gains its speed times the step.
+    """
+    counted = []
+    frontiers = CoordinationDiagram.frontiers
+
+    def counting(self, follower, earliest):
+        counted.append(np.size(earliest))
+        return frontiers(self, follower, earliest)
+
+    monkeypatch.setattr(CoordinationDiagram, "frontiers", counting)
+    legs, (first, second), limits = LONG_WAIT
+    costs, durations = [], []
+    for scale in (0.01, 1.0):
+        track = YGraph(dict(zip("ABC", (length * scale for length in legs), strict=True)))
+        places = [f"{p[0]}:{float(p[2:]) * scale:.6f}" for p in (first, second)]
+        separation = limits.min_separation * scale
+        route = plan(track, conf(*places), conf(*reversed(places)), min_separation=separation)
+        schedule = Exact().schedule(route, Limits(limits.vehicles, separation))
+        counted.clear()
+        assert braking_rule_failures(schedule) == []
+        costs.append(sum(counted))
+        durations.append(schedule.duration)
+    assert durations[1] > 90.0 * durations[0]
+    assert costs[1] < 5.0 * costs[0], costs
+    assert costs[1] < 30_000, costs

@@ -15,7 +15,10 @@ back while the leader brakes no harder than its emergency deceleration), so a
 margin at an instant larger than what ``r_j`` can gain in the next ``h``
 seconds (:func:`stop_point_rate`, from the state and the limits) covers them;
 the check samples each piece and halves the step where the margin is thin.
-Its cost grows with the pieces and the thin stretches, not with the duration.
+Through a step where the follower rests or cruises (acceleration and jerk 0
+at both ends, within one piece), ``r_j`` moves at its speed, not at what the
+limits would allow: hours of waiting cost no more than seconds. Its cost grows
+with the pieces and the thin stretches, not with the duration.
 """
 
 from __future__ import annotations
@@ -142,6 +145,12 @@ def braking_rule_failures(
         """
         state = schedule.state(t)
         k = np.clip(np.searchsorted(times, t, side="right") - 1, 0, times.size - 2)
+        # a vehicle resting or cruising through the whole step (acceleration and jerk 0 at both ends of
+        # a stretch within one piece, whose jerk is at most linear) moves its stop point at its speed
+        after = schedule.state(t + step)
+        same_cell = np.searchsorted(times, t + step, side="left") - 1 <= k
+        steady = same_cell & (state.acceleration == 0.0) & (state.jerk == 0.0)
+        steady &= (after.acceleration == 0.0) & (after.jerk == 0.0)
         moved = state.axis - axis_at[:, k]
         p = travel[:, k] + np.abs(moved)
         direction = np.where(moved != 0.0, np.sign(moved), np.sign(state.velocity))
@@ -154,7 +163,8 @@ def braking_rule_failures(
                 speed[j], acceleration, vehicles[j], jerk_limited=schedule.jerk_limited
             )
             out[j] = diagram.frontiers(j, earliest[1 - j]) - stop
-            fall[j] = stop_point_rate(vehicles[j], speed[j], acceleration, step, schedule.jerk_limited) * step
+            rate = stop_point_rate(vehicles[j], speed[j], acceleration, step, schedule.jerk_limited)
+            fall[j] = np.where(steady[j], speed[j], rate) * step
         return out, fall
 
     worst: list[BrakingRuleFailure | None] = [None, None]
