@@ -24,6 +24,7 @@ from trajgen.errors import InputError, OutputLimitError
 from trajgen.export.tables import Interpolation, ProfileTable, divided_differences, limit_ratios, slowdown
 from trajgen.model.pieces import schedule_pieces
 from trajgen.model.schedule import Schedule
+from trajgen.model.values import sorted_unique
 from trajgen.verification import VerifiedSchedule, require_verified
 
 __all__ = ["POSITION_SCALE", "VELOCITY_SCALE", "Resampled", "resample"]
@@ -98,10 +99,10 @@ def _reference_times(schedule: Schedule, decimals: int, points: int) -> tuple[np
     boundaries = np.concatenate([[0.0, duration], pieces.start, pieces.start + pieces.length])
     fractions = np.linspace(0.0, 1.0, SAMPLES_PER_PIECE + 1)
     grid = (pieces.start[:, None] + pieces.length[:, None] * fractions[None, :]).ravel()
-    boundaries = np.unique(np.clip(np.round(boundaries, decimals), 0.0, duration))
+    boundaries = sorted_unique(np.clip(np.round(boundaries, decimals), 0.0, duration))
     boundaries = _spread(boundaries)
     even = np.linspace(0.0, duration, 4 * points + 1)
-    grid = np.unique(
+    grid = sorted_unique(
         np.concatenate([np.clip(np.round(np.r_[grid, even], decimals), 0.0, duration), boundaries])
     )
     return _spread(grid), boundaries
@@ -197,7 +198,7 @@ def _closest_approaches(grid: np.ndarray, state, separation: float) -> np.ndarra
     # and a little before and after: where the vehicles run close together, a table is held to
     # the schedule on both sides of the closest instant, not only at it
     around = (minima[:, None] + np.array([-APPROACH_SPAN, 0.0, APPROACH_SPAN])[None, :]).ravel()
-    return np.unique(grid[np.clip(np.searchsorted(grid, around), 0, grid.size - 1)])
+    return sorted_unique(grid[np.clip(np.searchsorted(grid, around), 0, grid.size - 1)])
 
 
 def _equidistributed(grid: np.ndarray, density: np.ndarray, required: np.ndarray, count: int) -> np.ndarray:
@@ -222,7 +223,7 @@ def _equidistributed(grid: np.ndarray, density: np.ndarray, required: np.ndarray
         targets = mass[required[k]] + shares[k] * np.arange(1, n + 1) / (n + 1)
         inside = np.clip(np.searchsorted(mass, targets), required[k] + 1, required[k + 1] - 1)
         chosen.append(inside[inside < required[k + 1]])
-    return np.unique(np.concatenate(chosen))
+    return sorted_unique(np.concatenate(chosen))
 
 
 def _points(
@@ -255,7 +256,7 @@ def _points(
         # a spline with knots at every jerk switch is the schedule itself; more knots would only
         # let the values' round-off through (it grows as the cube of a short step)
         return boundaries, np.searchsorted(boundaries, required)
-    chosen = np.unique(np.searchsorted(grid, required))
+    chosen = sorted_unique(np.searchsorted(grid, required))
     anchors = chosen.copy()
     axis, velocity = state.axis[vehicle], state.velocity[vehicle]
     if interpolation is not Interpolation.CUBIC:
@@ -287,7 +288,7 @@ def _points(
             break
         room = max_points - chosen.size
         take = candidates[np.argsort(-worst[candidates])][: max(1, min(room, chosen.size // 2 + 1))]
-        chosen = np.unique(np.concatenate([chosen, where[take]]))
+        chosen = sorted_unique(np.concatenate([chosen, where[take]]))
     return grid[chosen], np.searchsorted(chosen, anchors)
 
 

@@ -30,6 +30,7 @@ from trajgen.export.tables import (
 from trajgen.model.paths import VehiclePath
 from trajgen.model.profiles import PiecewiseCubic
 from trajgen.model.schedule import AxisMap, CubicKinematics, Schedule, Section, TimingMethod
+from trajgen.model.values import sorted_unique
 from trajgen.verification import VerificationReport, verify
 
 __all__ = ["TableCheck", "TableMotion", "check_tables", "junction_crossings", "leg_visits"]
@@ -69,7 +70,7 @@ def junction_crossings(motion: PiecewiseCubic, junction: float) -> list[float]:
     for h in roots:
         inside = np.isfinite(h) & (h > 0.0) & (h < length)
         candidates.append(begin[inside] + h[inside])
-    times = np.unique(np.concatenate(candidates))
+    times = sorted_unique(np.concatenate(candidates))
     gap = motion.evaluate(times)[0] - junction
     sign = np.where(np.abs(gap) <= CROSSING_TOLERANCE, 0.0, np.sign(gap))
     nonzero = np.nonzero(sign)[0]

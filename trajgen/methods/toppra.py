@@ -44,7 +44,7 @@ from trajgen.model.schedule import (
     TimingMethod,
     check_request,
 )
-from trajgen.model.values import ArrayValue, readonly
+from trajgen.model.values import ArrayValue, readonly, sorted_unique
 from trajgen.verification import verify
 
 __all__ = ["HEADROOM", "BlendedPath", "Toppra", "ToppraKinematics"]
@@ -332,7 +332,7 @@ def _toppra_section(path: BlendedPath, limits: Limits, grid_points: int) -> Topp
     acceleration = toppra.constraint.JointAccelerationConstraint(
         np.column_stack([-a, a]), discretization_scheme=toppra.constraint.DiscretizationType.Interpolation
     )
-    grid = np.unique(np.concatenate([np.linspace(0.0, path.length, grid_points), path.breakpoints]))
+    grid = sorted_unique(np.concatenate([np.linspace(0.0, path.length, grid_points), path.breakpoints]))
     instance = toppra.algorithm.TOPPRA(
         [velocity, acceleration], path, gridpoints=grid, parametrizer="ParametrizeConstAccel"
     )

@@ -27,6 +27,7 @@ import numpy as np
 from limits import VehicleLimits
 from trajgen.model.paths import VehiclePath
 from trajgen.model.pieces import Pieces, schedule_pieces
+from trajgen.model.values import sorted_unique
 
 __all__ = [
     "Conflict",
@@ -477,7 +478,7 @@ def schedule_times(schedule, pieces: Pieces | None = None) -> np.ndarray:
                     & (roots.real < pieces.length[rows, None])
                 )
                 times.append((pieces.start[rows, None] + roots.real)[real])
-    return np.unique(np.clip(np.concatenate(times), 0.0, schedule.duration))
+    return sorted_unique(np.clip(np.concatenate(times), 0.0, schedule.duration))
 
 
 def schedule_waypoints(schedule, times: np.ndarray | None = None) -> list[tuple[int, float, int, float]]:

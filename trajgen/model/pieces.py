@@ -16,7 +16,7 @@ import numpy as np
 from topology import JUNCTION_INDEX
 from trajgen.model.polynomials import evaluate, root_in
 from trajgen.model.schedule import AxisMap, CubicKinematics, Schedule, Section
-from trajgen.model.values import ArrayValue, readonly
+from trajgen.model.values import ArrayValue, readonly, sorted_unique
 
 __all__ = ["DEGREE", "Pieces", "UncheckableKinematicsError", "motion_arrays", "schedule_pieces", "shift"]
 
@@ -102,7 +102,7 @@ def shift(c: np.ndarray, delta: np.ndarray) -> np.ndarray:
 def _cubic_section(kinematics: CubicKinematics) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Breakpoints (m + 1,), axis polynomials (2, m, DEGREE + 1), knot intervals (2, m): a cubic section."""
     duration = kinematics.duration
-    times = np.unique(
+    times = sorted_unique(
         np.concatenate([np.clip(p.times, 0.0, duration) for p in kinematics.vehicles] + [[0.0]])
     )
     times = np.append(times[times < duration], duration) if duration > 0 else np.array([0.0, 0.0])
@@ -205,7 +205,7 @@ def _split_at_map_boundaries(
     for vehicle, axis_map in enumerate(maps):
         if axis_map.legs.size < 2:
             continue
-        bounds = np.unique(np.concatenate([axis_map.axis_start, axis_map.axis_end]))[1:-1]
+        bounds = sorted_unique(np.concatenate([axis_map.axis_start, axis_map.axis_end]))[1:-1]
         h = np.diff(times)
         for value in bounds:
             c = axis[vehicle].copy()

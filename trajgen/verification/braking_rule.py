@@ -32,6 +32,7 @@ from limits import VehicleLimits
 from trajgen.model.coordination import CoordinationDiagram, plan_paths, stopping_distances
 from trajgen.model.pieces import Pieces
 from trajgen.model.schedule import Schedule
+from trajgen.model.values import sorted_unique
 
 __all__ = ["BRAKING_RULE_TOLERANCE", "BrakingRuleFailure", "braking_rule_failures", "stop_point_rate"]
 
@@ -168,7 +169,7 @@ def braking_rule_failures(
         return out, fall
 
     worst: list[BrakingRuleFailure | None] = [None, None]
-    grid = np.unique(np.concatenate([times, np.linspace(0.0, schedule.duration, 64)]))
+    grid = sorted_unique(np.concatenate([times, np.linspace(0.0, schedule.duration, 64)]))
     starts, ends = grid[:-1], grid[1:]
     evaluations = 0
     while starts.size:
