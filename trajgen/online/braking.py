@@ -29,7 +29,7 @@ __all__ = ["BrakingCheck", "PathState", "ServiceBraking", "emergency_position"]
 
 #: Time intervals tried in turn: a coarse pass is enough while the vehicles are far apart.
 _REFINEMENTS = (1, 6, 40)
-#: How often the finest pass may halve an interval that is not clear (down to 1/10,240 of the horizon).
+#: How often the finest pass may halve an interval that is not clear, for a hold (to 1/10,240 of the horizon).
 _HALVINGS = 8
 #: Below these a vehicle stands still (m/s, m/s²): it moves less than a micrometre while it brakes.
 _STILL_VELOCITY = 1e-7
@@ -120,6 +120,8 @@ class BrakingCheck:
         commanded: tuple[PathState, PathState],
         measured: tuple[PathState, PathState],
         required: float,
+        *,
+        refine: bool = False,
     ) -> bool:
         """Whether the braking tubes stay at least ``required`` metres apart until both are at rest.
 
@@ -132,6 +134,10 @@ class BrakingCheck:
             The measured states (emergency braking starts there).
         required : float
             Track distance to keep, metres.
+        refine : bool, optional
+            Halve the finest pass's unclear intervals (:meth:`_intervals_clear`): for a hold, which
+            must not be refused for the intervals' pessimism. New motion is certified without, and
+            that pessimism is the room a later hold has.
         """
         trajectories = [braking.plan(state) for braking, state in zip(self._braking, commanded, strict=True)]
         durations = [t.duration for t in trajectories]
@@ -151,8 +157,9 @@ class BrakingCheck:
             for pad, c, m in zip(self._pad_acceleration, commanded, measured, strict=True)
         ]
         for count in _REFINEMENTS:
+            halvings = _HALVINGS if refine and count == _REFINEMENTS[-1] else 0
             if self._intervals_clear(
-                paths, trajectories, durations, ends, measured, required, horizon, count, pads
+                paths, trajectories, durations, ends, measured, required, horizon, count, pads, halvings
             ):
                 return True
         return False
@@ -170,18 +177,17 @@ class BrakingCheck:
         return bounds
 
     def _intervals_clear(
-        self, paths, trajectories, durations, ends, measured, required, horizon, count, pads
+        self, paths, trajectories, durations, ends, measured, required, horizon, count, pads, halvings
     ) -> bool:
         """Whether ``count`` equal intervals of ``[0, horizon]`` are clear.
 
-        On the finest pass an interval that is not clear is halved, up to :data:`_HALVINGS` times: an
+        An interval that is not clear is halved, up to ``halvings`` times: an
         interval's sweep is pessimistic by about the distance both vehicles drive over it, so tubes that
         pass within a millimetre of the separation are told apart from a real conflict, with a few
         more evaluations only where they are close. Where the tubes meet at an instant, the conflict
         is real and the check ends there.
         """
         lengths = self._lengths
-        halvings = _HALVINGS if count == _REFINEMENTS[-1] else 0
         step = horizon / count
         previous = self._bounds(trajectories, durations, ends, measured, 0.0)
         for k in range(1, count + 1):

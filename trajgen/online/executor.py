@@ -363,7 +363,7 @@ class Executor:
                 trial = list(states)
                 for v in order:
                     trial[v] = self._motions[v].brake(self._command[v], self.period)[0]
-                if self._guard.certifies(self._paths, (trial[0], trial[1]), along, required):
+                if self._guard.certifies(self._paths, (trial[0], trial[1]), along, required, hold=True):
                     certified = True
                     for v in order:
                         holding[v] = True

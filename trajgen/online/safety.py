@@ -67,8 +67,14 @@ class SafetyGuard:
         commanded: tuple[PathState, PathState],
         measured: tuple[PathState, PathState],
         required: float,
+        *,
+        hold: bool = False,
     ) -> bool:
         """Whether braking from ``commanded`` (service) and ``measured`` (emergency) keeps ``required``.
+
+        ``hold``: the setpoints hold vehicles (they brake as the last cycle certified), checked to the
+        millimetre; new motion is certified with the check's coarser intervals, whose pessimism keeps
+        room for the holds that may follow (:meth:`~trajgen.online.braking.BrakingCheck.clearance`).
 
         Vehicles far apart are certified at once: the track distance changes by at most the
         distance each vehicle drives, and none drives farther than its service stop from its
@@ -86,4 +92,4 @@ class SafetyGuard:
         gap = indexed_separation((first[0], first[1], second[0], second[1]))
         if gap - travel >= required:
             return True
-        return self._check.clearance(paths, commanded, measured, required)
+        return self._check.clearance(paths, commanded, measured, required, refine=hold)
