@@ -77,7 +77,7 @@ class _Palette:
         self.table = self.colours.astype(np.uint8).tobytes() + b"\0" * (3 * (256 - len(packed)))
 
     def indices(self, packed: np.ndarray) -> np.ndarray:
-        """Palette index of each pixel, shape (height, width) of packed colours (:func:`_pack`), uint8."""
+        """Palette index of each pixel, uint8, of the shape of ``packed`` (colours of :func:`_pack`)."""
         flat = packed.ravel()
         position = np.minimum(np.searchsorted(self.sorted, flat), len(self.sorted) - 1)
         found = self.sorted[position] == flat
@@ -159,7 +159,10 @@ def gif_bytes(
             else:  # nothing changed: one transparent pixel carries the delay
                 top, bottom, left, right = 0, 1, 0, 1
             window = (slice(top, bottom), slice(left, right))
-            part = np.where(changed[window], palette.indices(packed[window]), _TRANSPARENT).astype(np.uint8)
+            moved = changed[window]
+            # only the changed pixels are looked up: a clock and a bar span the frame, but change little
+            part = np.full(moved.shape, _TRANSPARENT, dtype=np.uint8)
+            part[moved] = palette.indices(packed[window][moved])
         from PIL import Image
 
         image = Image.frombytes("P", (part.shape[1], part.shape[0]), np.ascontiguousarray(part).tobytes())
