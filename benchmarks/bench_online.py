@@ -4,8 +4,10 @@
    simulated plant and the bookkeeping are not timed), over the first ``--timed`` campaign scenarios
    run one at a time in this process: median, 99th percentile, worst, in microseconds. The cycles
    that re-plan for a new goal (planner, timing method, verifier), and those during which Python's
-   garbage collector ran, are left out and reported apart. Beside them, the machine's own jitter: a
-   fixed loop of the median's duration, timed as often.
+   garbage collector ran, are left out and reported apart. Each timed scenario runs ``--repeats``
+   times (default 3): a run is deterministic, so each cycle's fastest time is its own cost, without
+   the spikes of the machine. Beside them, the machine's own jitter: a fixed loop of the median's
+   duration, timed as often.
 2. The campaign: ``--count`` seeded random scenarios (:func:`trajgen.scenario.sampling.online_campaign`),
    each with 1-3 random faults (:func:`trajgen.scenario.sampling.campaign_faults`: stops, slow drives, lags,
    position jumps within the margin, new goals), simulated closed loop: goals reached, deadlocks
@@ -15,7 +17,7 @@
 3. With ``--fault-free``, each scenario also runs without faults: the makespan against the plan.
 
 Run: ``python benchmarks/bench_online.py [--count 200] [--seed 11] [--timed 20] [--workers 2]
-[--method NAME] [--fault-free]``.
+[--method NAME] [--repeats 3] [--fault-free]``.
 """
 
 from __future__ import annotations
@@ -23,6 +25,7 @@ from __future__ import annotations
 import argparse
 import gc
 import logging
+import math
 import multiprocessing
 import statistics
 import time
@@ -53,19 +56,27 @@ def run_case(args: tuple[int, int, str | None, bool]) -> dict:
     return row
 
 
-def timed_cycles(count: int, seed: int, method: str | None) -> tuple[list[float], list[float], list[float]]:
+def timed_cycles(
+    count: int, seed: int, method: str | None, repeats: int = 1
+) -> tuple[list[float], list[float], list[float], list[float]]:
     """Wall time of every executor step (µs) that does not plan, and of those that do (ms).
 
     A step plans when both vehicles have come to rest for a new goal: it re-plans, or refuses the goal
     if no plan keeps the separation from there. Steps during which Python's cyclic garbage collector
     ran are returned apart (µs): the collector's pause belongs to the host process, which a control
     loop tunes (``gc.freeze()`` after loading, collections between runs), not to the executor.
+
+    Each scenario runs ``repeats`` times: a run is deterministic, so its n-th step does the same work
+    every time, and the smallest of its times is that step's own cost, without the machine's
+    spikes (returned fourth, µs; with one repeat, the same as the first).
     """
     logging.disable(logging.WARNING)
     cycles: list[float] = []
     collected: list[float] = []
     replans: list[float] = []
+    own: list[float] = []
     collections = [0]
+    steps: list[tuple[str, float]] = []
 
     def count_collections(phase: str, _info: dict) -> None:
         if phase == "start":
@@ -80,22 +91,33 @@ def timed_cycles(count: int, seed: int, method: str | None) -> tuple[list[float]
         command = original(self, first, second)
         elapsed = time.perf_counter_ns() - start
         if self.replans + self.rejected_goals > before:
-            replans.append(elapsed / 1e6)
+            steps.append(("plan", elapsed / 1e6))
         elif collections[0] > runs:
-            collected.append(elapsed / 1e3)
+            steps.append(("collected", elapsed / 1e3))
         else:
-            cycles.append(elapsed / 1e3)
+            steps.append(("cycle", elapsed / 1e3))
         return command
 
     Executor.step = step
     gc.callbacks.append(count_collections)
     try:
         for k in progress(range(count), description="timed scenarios"):
-            run_case((k, seed, method, False))
+            runs = []
+            for _ in range(max(1, repeats)):
+                steps.clear()
+                run_case((k, seed, method, False))
+                runs.append(list(steps))
+            for kind, elapsed in runs[0]:
+                {"plan": replans, "collected": collected, "cycle": cycles}[kind].append(elapsed)
+            if len({len(run) for run in runs}) == 1:  # deterministic, as it should be: step by step
+                for column in zip(*runs, strict=True):
+                    timed = [elapsed for kind, elapsed in column if kind == "cycle"]
+                    if timed:
+                        own.append(min(timed))
     finally:
         Executor.step = original
         gc.callbacks.remove(count_collections)
-    return cycles, collected, replans
+    return cycles, collected, replans, own
 
 
 def machine_jitter(count: int, target_us: float) -> list[float]:
@@ -112,10 +134,13 @@ def machine_jitter(count: int, target_us: float) -> list[float]:
         return total
 
     n = 100
-    while True:  # calibrate n to the target duration
-        start = time.perf_counter_ns()
-        work(n)
-        if (time.perf_counter_ns() - start) / 1e3 >= target_us or n > 10**7:
+    while True:  # calibrate n to the target duration (the fastest of a few tries: no spike decides)
+        fastest = math.inf
+        for _ in range(5):
+            start = time.perf_counter_ns()
+            work(n)
+            fastest = min(fastest, (time.perf_counter_ns() - start) / 1e3)
+        if fastest >= target_us or n > 10**7:
             break
         n *= 2
     times = []
@@ -138,17 +163,26 @@ def main() -> None:
     parser.add_argument("--timed", type=int, default=20)
     parser.add_argument("--workers", type=int, default=2)
     parser.add_argument("--method", default=None, help="timing method of the plans (default: the registry's)")
+    parser.add_argument(
+        "--repeats", type=int, default=3, help="runs of each timed scenario (each cycle's fastest is its own)"
+    )
     parser.add_argument("--fault-free", action="store_true", help="also run each scenario without faults")
     args = parser.parse_args()
 
     if args.timed:
-        cycles, collected, replans = timed_cycles(args.timed, args.seed, args.method)
+        cycles, collected, replans, own = timed_cycles(args.timed, args.seed, args.method, args.repeats)
         print(f"executor cycle (both vehicles), {len(cycles)} cycles of {args.timed} scenarios:")
         print(
             f"  median {statistics.median(cycles):.1f} us, p99 {percentile(cycles, 0.99):.1f} us, "
             f"p99.9 {percentile(cycles, 0.999):.1f} us, "
             f"worst {max(cycles):.1f} us"
         )
+        if args.repeats > 1 and own:
+            print(
+                f"  each cycle's own cost (its fastest of {args.repeats} identical runs, {len(own)} cycles): "
+                f"median {statistics.median(own):.1f} us, p99 {percentile(own, 0.99):.1f} us, "
+                f"p99.9 {percentile(own, 0.999):.1f} us, worst {max(own):.1f} us"
+            )
         jitter = machine_jitter(len(cycles), statistics.median(cycles))
         print(
             f"the machine's own jitter: a fixed loop of about the median, {len(jitter)} times: "

@@ -460,8 +460,7 @@ class Executor:
                 self.rejected_goals += 1
                 self._log("goal-refused", f"no plan from {start} to {goal}: {error}")
             else:
-                # where each vehicle stands (the new plan starts there), not where it was told to be:
-                # a drive at rest short of its setpoint would carry the offset into the new axis
+                # where each vehicle stands (the plan starts there), not its setpoint: no offset carried on
                 axes = [self._paths[v].axis(along[v].p) for v in (0, 1)]
                 orientation = [self._orientation(v, along[v].p) for v in (0, 1)]
                 self.replans += 1
@@ -585,10 +584,9 @@ class Executor:
         return Position(self.graph.names[state.leg], min(state.s, self.graph.lengths[state.leg]))
 
     def _orientation(self, v: int, p: float) -> tuple[int, int] | None:
-        """``(leg, ds / d axis)`` of ``v`` at travel ``p`` of its path (``None`` at the junction, unmoved).
+        """``(leg, ds / d axis)`` of ``v`` at travel ``p`` (``None`` at the junction, unmoved).
 
-        A path that never moves keeps the convention of :class:`~trajgen.model.paths.VehiclePath`: its
-        axis grows away from the junction.
+        An unmoved path's axis grows away from the junction (:class:`~trajgen.model.paths.VehiclePath`).
         """
         path = self._paths[v]
         if not path.legs:
