@@ -2,9 +2,13 @@
 
 from __future__ import annotations
 
+import functools
+
 from limits import Limits, VehicleLimits
+from tests.conftest import REPO
 from topology import Configuration, Position, YGraph, plan
-from trajgen import Schedule
+from trajgen import Optimal, Schedule, load_scenario
+from trajgen.online.goals import plan_for_execution
 
 SLOW = VehicleLimits(max_velocity=0.7, max_acceleration=0.35, max_jerk=0.6)
 AGV = VehicleLimits(max_velocity=1.0, max_acceleration=0.5, max_jerk=1.0)
@@ -25,3 +29,15 @@ def too_close(schedule: Schedule, separation: float = 10.5) -> Schedule:
     """The same motion relabelled with a minimum separation it does not keep (a broken schedule)."""
     limits = Limits(schedule.limits.vehicles, min_separation=separation)
     return Schedule(schedule.route, limits, schedule.method, schedule.sections, schedule.jerk_limited)
+
+
+@functools.cache
+def execution_plan(name: str, method: str):
+    """``(scenario, plan_for_execution(scenario))`` of ``examples/NAME.toml``, once per test process.
+
+    ``optimal`` with a budget that a loaded machine cannot cut short (a fallback would be another
+    plan). Several modules test the same plans; solved once, each worker shares them.
+    """
+    scenario = load_scenario(REPO / "examples" / f"{name}.toml")
+    chosen = Optimal(time_budget=60.0) if method == "optimal" else method
+    return scenario, plan_for_execution(scenario, method=chosen)

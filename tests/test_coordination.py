@@ -18,9 +18,9 @@ from ruckig import ControlInterface, InputParameter, Ruckig, Trajectory
 
 from limits import Limits, VehicleLimits
 from tests.conftest import REPO
-from tests.helpers import conf
+from tests.helpers import conf, execution_plan
 from topology import YGraph, plan
-from trajgen import Exact, Optimal, Toppra, certify, load_scenario, verify
+from trajgen import Exact, Optimal, certify, load_scenario, verify
 from trajgen.model.coordination import (
     CoordinationDiagram,
     earliest_rest,
@@ -28,7 +28,6 @@ from trajgen.model.coordination import (
     stopping_distance,
     stopping_distances,
 )
-from trajgen.online.goals import plan_for_execution
 from trajgen.verification.braking_rule import BRAKING_RULE_TOLERANCE, braking_rule_failures
 
 SWAP = REPO / "examples" / "swap.toml"
@@ -167,13 +166,10 @@ def test_a_plan_without_clearance_runs_between_two_conflicts_that_touch_at_a_poi
 # -- the braking rule --------------------------------------------------------------------------
 
 
-@pytest.mark.parametrize(
-    "method", [Exact(), Toppra(), Optimal(time_budget=60.0)], ids=["exact", "toppra", "optimal"]
-)
-@pytest.mark.parametrize("path", [SWAP, CROSSING], ids=["swap", "crossing"])
-def test_every_methods_plan_for_execution_obeys_the_braking_rule(path, method):
-    scenario = load_scenario(path)
-    verified = plan_for_execution(scenario, method=method)
+@pytest.mark.parametrize("method", ["exact", "toppra", "optimal"])
+@pytest.mark.parametrize("name", ["swap", "crossing"])
+def test_every_methods_plan_for_execution_obeys_the_braking_rule(name, method):
+    _, verified = execution_plan(name, method)
     assert verified.schedule.fallback_reason is None, verified.schedule.notes
     assert braking_rule_failures(verified.schedule) == []
 

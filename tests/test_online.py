@@ -19,9 +19,10 @@ from ruckig import ControlInterface, InputParameter, Ruckig, Trajectory
 
 from limits import ILLUSTRATIVE_LIMITS, Limits, VehicleLimits
 from tests.conftest import REPO
+from tests.helpers import execution_plan
 from topology import JUNCTION_INDEX, Configuration, Position, StarGraph, YGraph
 from topology.indexed import separation as indexed_separation
-from trajgen import Optimal, certify, default_scenario, load_scenario, make_schedule
+from trajgen import certify, default_scenario, load_scenario, make_schedule
 from trajgen.errors import InputError, UnverifiedScheduleError
 from trajgen.online import BrakingCheck, Executor, Mode, PathState, VehiclePath, VehicleState
 from trajgen.online.braking import emergency_position
@@ -46,10 +47,8 @@ def _quiet():
 
 @pytest.fixture(scope="module")
 def swap():
-    # the default method, with a budget that a loaded machine cannot cut short (a fallback would be
-    # another plan)
-    scenario = default_scenario()
-    return scenario, plan_for_execution(scenario, method=Optimal(time_budget=60.0))
+    # the default method (the built-in scenario is examples/swap.toml)
+    return execution_plan("swap", "optimal")
 
 
 # -- paths and coordination --------------------------------------------------------------------
@@ -300,13 +299,11 @@ def stop_bound(scenario, duration: float) -> float:
 @pytest.fixture(scope="module")
 def plans():
     """The plan for execution of each method on the swap and the crossing, computed once."""
-    out = {}
-    for name, path in (("swap", SWAP), ("crossing", CROSSING)):
-        scenario = load_scenario(path)
-        for method in ("exact", "toppra", "optimal"):
-            chosen = Optimal(time_budget=60.0) if method == "optimal" else method
-            out[name, method] = (scenario, plan_for_execution(scenario, method=chosen))
-    return out
+    return {
+        (name, method): execution_plan(name, method)
+        for name in ("swap", "crossing")
+        for method in ("exact", "toppra", "optimal")
+    }
 
 
 @pytest.mark.parametrize("method", ["exact", "toppra", "optimal"])
