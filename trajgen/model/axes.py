@@ -76,18 +76,15 @@ def route_axes(route: Route) -> RouteAxes:
                 axes[k + 1, vehicle] = axes[k, vehicle]
                 continue
             direction = 1 if step > 0 else -1
-            if abs(step) <= MOVE_RESOLUTION:
-                # round-off of the planner (a few 1e-14 m): no move of its own, so it neither sets the
-                # axis's positive direction nor reverses it (as VehiclePath ignores it too)
-                axes[k + 1, vehicle] = axes[k, vehicle] + sign * abs(step)
-                outward[k, vehicle] = direction * sign
-                continue
-            if started:
-                through_junction = heading == -1 and direction == 1 and leg != heading_leg
-                if direction != heading and not through_junction:
-                    sign = -sign  # the vehicle reverses
-            started = True
-            heading, heading_leg = direction, leg
+            # round-off of the planner (a few 1e-14 m) is no move of its own: it neither sets the axis's
+            # positive direction nor reverses it (VehiclePath ignores it too)
+            if abs(step) > MOVE_RESOLUTION:
+                if started:
+                    through_junction = heading == -1 and direction == 1 and leg != heading_leg
+                    if direction != heading and not through_junction:
+                        sign = -sign  # the vehicle reverses
+                started = True
+                heading, heading_leg = direction, leg
             # axis moves by sign * |step|; ds/daxis = direction * sign
             axes[k + 1, vehicle] = axes[k, vehicle] + sign * abs(step)
             outward[k, vehicle] = direction * sign
