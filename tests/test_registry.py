@@ -25,7 +25,7 @@ from trajgen import (
     run,
 )
 from trajgen.errors import InputError, OptionError
-from trajgen.methods import MethodRegistry
+from trajgen.methods import MethodRegistry, MethodSource
 from trajgen.methods.optimal.phases import NO_SWITCH, NlpShape, PhaseKind
 
 SWAP = ((10.0, 10.0, 10.0), ("A:10", "B:10"), ("B:10", "A:10"))
@@ -109,6 +109,41 @@ def test_a_new_method_plugs_into_dispatch_verification_and_the_pipeline(tmp_path
     result = run(default_scenario(), method=Cautious(), outputs=Outputs(csv_dir=tmp_path))
     assert result.summary()["method"] == "cautious"
     assert result.summary()["notes"] == ["cautious"]
+
+
+@pytest.mark.parametrize(
+    ("source", "match"),
+    [
+        pytest.param(
+            MethodSource("exact", "something else", "trajgen.methods.exact", "Exact"),
+            r"trajgen\.methods\.exact\.Exact is named 'exact' \('the route exactly.*registered as 'exact' "
+            r"\('something else'\)",
+            id="summary-drifted",
+        ),
+        pytest.param(
+            MethodSource(
+                "fast",
+                "the route exactly, one straight piece at a time, jerk-limited S-curves",
+                "trajgen.methods.exact",
+                "Exact",
+            ),
+            r"is named 'exact' .*registered as 'fast'",
+            id="name-drifted",
+        ),
+    ],
+)
+def test_a_registered_source_whose_class_has_drifted_is_refused_when_loaded(source, match):
+    registry = MethodRegistry((source,), default=source.name)
+    assert registry.names == (source.name,)  # naming needs no import
+    with pytest.raises(RuntimeError, match=match):
+        registry.create()
+
+
+def test_the_built_in_sources_name_and_summarize_their_classes():
+    assert [(cls.name, cls.summary) for cls in METHODS] == [
+        (name, line.split(": ", 1)[1].removesuffix(" (default)"))
+        for name, line in zip(METHODS.names, METHODS.help().splitlines(), strict=True)
+    ]
 
 
 def test_a_registry_refuses_duplicates_and_an_unknown_default():

@@ -52,6 +52,46 @@ def test_an_exact_schedule_on_the_command_line_loads_no_solver_spline_plot_or_ru
     assert not loaded & set(HEAVY), sorted(loaded & set(HEAVY))
     # nor NumPy's masked arrays (numpy.unique pulls them in on its first call)
     assert "numpy.ma" not in modules
+    # nor the methods it does not use: the optimal method's NLP code and TOPPRA's wrapper
+    unused = sorted(
+        name
+        for name in modules
+        if name.startswith(("trajgen.methods.optimal.", "trajgen.methods.toppra"))
+        and name != "trajgen.methods.optimal.choice"
+    )
+    assert not unused, unused
+    # nor the other commands' code: plots, VDA 5050, the closed loop, profile checking
+    others = sorted(
+        name
+        for name in modules
+        if name.startswith(
+            ("trajgen.plots", "trajgen.online", "trajgen.closed_loop", "trajgen.export.vda5050")
+        )
+        or name in ("trajgen.cli.animate", "trajgen.cli.check", "trajgen.cli.simulate", "trajgen.cli.vda5050")
+    )
+    assert not others, others
+
+
+def test_the_help_lists_every_command_with_its_summary():
+    from trajgen.cli.main import COMMANDS, build_parser
+
+    text = build_parser().format_help()
+    assert all(
+        name in text and " ".join(summary.split()[:4]) in text for name, (summary, _) in COMMANDS.items()
+    )
+
+
+def test_a_method_is_imported_when_it_is_first_created_not_when_it_is_named():
+    code = (
+        "from trajgen.methods import METHODS\n"
+        "assert METHODS.names == ('exact', 'toppra', 'optimal') and 'optimal:' in METHODS.help()\n"
+        "import sys\n"
+        "assert 'trajgen.methods.optimal.method' not in sys.modules\n"
+        "METHODS.create('optimal')\n"
+    )
+    modules = _modules_after(code, full=True)
+    assert "trajgen.methods.optimal.method" in modules
+    assert "trajgen.methods.toppra" not in modules
 
 
 def test_the_check_sees_a_heavy_import():

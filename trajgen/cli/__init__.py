@@ -10,13 +10,13 @@ from trajgen.lazy import lazy_attributes
 
 if TYPE_CHECKING:
     from trajgen.cli.main import build_parser, command_parsers, main
-    from trajgen.cli.options import EXIT_BAD_INPUT, EXIT_FAILURE, EXIT_OK
+    from trajgen.cli.parser import EXIT_BAD_INPUT, EXIT_FAILURE, EXIT_OK
 
 #: ``import trajgen.cli`` loads nothing more: the parser and each command's modules load when used.
 _SOURCES = {
-    "EXIT_BAD_INPUT": "trajgen.cli.options",
-    "EXIT_FAILURE": "trajgen.cli.options",
-    "EXIT_OK": "trajgen.cli.options",
+    "EXIT_BAD_INPUT": "trajgen.cli.parser",
+    "EXIT_FAILURE": "trajgen.cli.parser",
+    "EXIT_OK": "trajgen.cli.parser",
     "build_parser": "trajgen.cli.main",
     "command_parsers": "trajgen.cli.main",
     "main": "trajgen.cli.main",

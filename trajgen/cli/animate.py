@@ -6,7 +6,8 @@ import argparse
 import os
 from pathlib import Path
 
-from trajgen.cli.options import EXIT_OK, add_method, method_from, scenario_from
+from trajgen.cli.options import add_method, method_from, scenario_from
+from trajgen.cli.parser import EXIT_OK
 from trajgen.errors import OutputError
 from trajgen.export.atomic import check_output_paths, commit_files
 from trajgen.plots.animation import (
@@ -63,7 +64,6 @@ def register(commands) -> None:
     """Add ``animate`` to the sub-commands."""
     animate = commands.add_parser(
         "animate",
-        help="write an animated GIF of a scenario's verified schedule on the track",
         formatter_class=argparse.RawTextHelpFormatter,
     )
     animate.add_argument("scenario", help="scenario TOML file")

@@ -5,7 +5,8 @@ from __future__ import annotations
 import argparse
 import json
 
-from trajgen.cli.options import EXIT_FAILURE, EXIT_OK, add_dialect_options, scenario_from
+from trajgen.cli.options import add_dialect_options, scenario_from
+from trajgen.cli.parser import EXIT_FAILURE, EXIT_OK
 
 __all__ = ["SHOWN_FAILURES", "register"]
 
@@ -45,7 +46,6 @@ def register(commands) -> None:
     """Add ``check`` to the sub-commands."""
     check = commands.add_parser(
         "check",
-        help="verify profile files against a scenario (exit 1 on violations, 2 if unreadable)",
         formatter_class=argparse.RawTextHelpFormatter,
     )
     check.add_argument("scenario", help="scenario TOML file")

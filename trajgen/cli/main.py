@@ -9,21 +9,46 @@ trace and plot are written: they are the evidence).
 from __future__ import annotations
 
 import argparse
+import importlib
 import logging
 import os
 import sys
 from collections.abc import Sequence
 
-from trajgen.cli import animate, check, schedule, simulate, vda5050
-from trajgen.cli.options import EXIT_BAD_INPUT, EXIT_FAILURE, CommandParser
+from trajgen.cli.parser import EXIT_BAD_INPUT, EXIT_FAILURE, CommandParser
 from trajgen.errors import InputError
 
-__all__ = ["COMMAND_MODULES", "Commands", "build_parser", "command_parsers", "console_main", "main"]
+__all__ = ["COMMANDS", "Commands", "build_parser", "command_parsers", "console_main", "main"]
 
 logger = logging.getLogger(__name__)
 
-#: The modules whose ``register(commands)`` adds the sub-commands, in help order.
-COMMAND_MODULES = (schedule, check, simulate, vda5050, animate)
+#: Every sub-command, in help order: its one-line help and the module whose ``register(commands)``
+#: adds its parser. A run imports only its own command's module: ``trajgen schedule`` loads no
+#: plotting, VDA 5050 or closed-loop code.
+COMMANDS: dict[str, tuple[str, str]] = {
+    "demo": (
+        "run a built-in scenario end to end (the swap on a Y, or a 4-way crossing)",
+        "trajgen.cli.schedule",
+    ),
+    "plan": ("print the planner's route for a scenario file", "trajgen.cli.schedule"),
+    "schedule": ("schedule, verify and export a scenario", "trajgen.cli.schedule"),
+    "check": (
+        "verify profile files against a scenario (exit 1 on violations, 2 if unreadable)",
+        "trajgen.cli.check",
+    ),
+    "simulate": (
+        "run a scenario in closed loop under faults (exit 1 if it misses the goal or has violations)",
+        "trajgen.cli.simulate",
+    ),
+    "export-vda5050": (
+        "write VDA 5050 2.1.0 orders and order updates of a scenario's verified schedule",
+        "trajgen.cli.vda5050",
+    ),
+    "animate": (
+        "write an animated GIF of a scenario's verified schedule on the track",
+        "trajgen.cli.animate",
+    ),
+}
 
 
 class Commands:
@@ -43,28 +68,43 @@ class Commands:
         self.parsers: dict[str, tuple[str, argparse.ArgumentParser]] = {}
 
     def add_parser(
-        self, name: str, *, help: str, formatter_class: type = argparse.HelpFormatter
+        self, name: str, *, formatter_class: type = argparse.HelpFormatter
     ) -> argparse.ArgumentParser:
-        """Add the sub-command ``name`` and return its parser."""
-        parser = self._action.add_parser(name, help=help, formatter_class=formatter_class)
-        self.parsers[name] = (help, parser)
+        """Add the sub-command ``name`` (one of :data:`COMMANDS`, with its help) and return its parser."""
+        summary = COMMANDS[name][0]
+        parser = self._action.add_parser(name, help=summary, formatter_class=formatter_class)
+        self.parsers[name] = (summary, parser)
         return parser
 
 
-def _build() -> tuple[argparse.ArgumentParser, Commands]:
+def _chosen(argv: Sequence[str]) -> str | None:
+    """The sub-command ``argv`` names (its first word that is not an option), if it is one."""
+    word = next((arg for arg in argv if not arg.startswith("-")), None)
+    return word if word in COMMANDS else None
+
+
+def _build(command: str | None = None) -> tuple[argparse.ArgumentParser, Commands]:
+    """The parser: every sub-command in full, or only ``command`` in full and the others by name."""
     parser = CommandParser(
         prog="trajgen",
         description="Collision-free schedules for two AGVs on a junction of 3 to 8 legs (a Y, a crossing).",
     )
     parser.add_argument("-v", "--verbose", action="store_true", help="log progress to stderr")
     commands = Commands(parser.add_subparsers(dest="command", required=True, parser_class=CommandParser))
-    for module in COMMAND_MODULES:
-        module.register(commands)
+    registered: set[str] = set()
+    for name, (_, module) in COMMANDS.items():
+        if command is not None and module != COMMANDS[command][1]:
+            commands.add_parser(name)  # listed in --help; its options are never parsed in this run
+        elif module not in registered:
+            registered.add(module)
+            importlib.import_module(module).register(commands)
+    order = list(COMMANDS)
+    commands.parsers = dict(sorted(commands.parsers.items(), key=lambda item: order.index(item[0])))
     return parser, commands
 
 
 def build_parser() -> argparse.ArgumentParser:
-    """The argument parser of the ``trajgen`` command."""
+    """The argument parser of the ``trajgen`` command, every sub-command in full."""
     return _build()[0]
 
 
@@ -92,7 +132,8 @@ def console_main() -> int:
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the command line; returns the exit status."""
     try:
-        args = build_parser().parse_args(argv)
+        argv = sys.argv[1:] if argv is None else list(argv)
+        args = _build(_chosen(argv))[0].parse_args(argv)
         logging.basicConfig(level=logging.INFO if args.verbose else logging.WARNING, format="%(message)s")
         return args.run(args)
     except InputError as error:

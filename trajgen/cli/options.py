@@ -11,18 +11,15 @@ from __future__ import annotations
 import argparse
 import dataclasses
 
-from trajgen.errors import InputError, OptionError
+from trajgen.errors import OptionError
 from trajgen.export import DEFAULT_MAX_ROWS, CsvOptions, Units
 from trajgen.export.dialects import DIALECTS
-from trajgen.methods import METHODS, HomotopyChoice, Optimal
+from trajgen.methods import METHODS
+from trajgen.methods.optimal.choice import HomotopyChoice
 from trajgen.model.schedule import TimingMethod
 from trajgen.scenario import Scenario, default_scenario, load_scenario
 
 __all__ = [
-    "EXIT_BAD_INPUT",
-    "EXIT_FAILURE",
-    "EXIT_OK",
-    "CommandParser",
     "add_csv_options",
     "add_dialect_options",
     "add_method",
@@ -31,18 +28,6 @@ __all__ = [
     "method_from",
     "scenario_from",
 ]
-
-EXIT_OK = 0
-EXIT_FAILURE = 1
-EXIT_BAD_INPUT = 2
-
-
-class CommandParser(argparse.ArgumentParser):
-    """argparse that reports usage errors as bad input (exit 2) through our path."""
-
-    def error(self, message: str):
-        """Raise InputError with the usage message (argparse would exit)."""
-        raise InputError(f"{self.prog}: {message}")
 
 
 def scenario_from(path: str | None) -> Scenario:
@@ -125,7 +110,7 @@ def method_from(args: argparse.Namespace) -> TimingMethod:
     if getattr(args, "homotopy", None) is None:
         return method
     choice = HomotopyChoice.lookup(args.homotopy)
-    if not isinstance(method, Optimal):
+    if not any(field.name == "homotopy" for field in dataclasses.fields(method)):
         raise OptionError(
             f"--homotopy {args.homotopy!r} applies to the method 'optimal' only, "
             f"got --method {method.name!r} "

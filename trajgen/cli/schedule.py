@@ -5,14 +5,8 @@ from __future__ import annotations
 import argparse
 import json
 
-from trajgen.cli.options import (
-    EXIT_OK,
-    add_csv_options,
-    add_method,
-    csv_options,
-    method_from,
-    scenario_from,
-)
+from trajgen.cli.options import add_csv_options, add_method, csv_options, method_from, scenario_from
+from trajgen.cli.parser import EXIT_OK
 from trajgen.model.summary import format_route, format_run, route_summary
 from trajgen.pipeline import Outputs, run
 from trajgen.scenario import BuiltinScenario, builtin_scenario
@@ -57,7 +51,6 @@ def register(commands) -> None:
     """Add ``demo``, ``plan`` and ``schedule`` to the sub-commands."""
     demo = commands.add_parser(
         "demo",
-        help="run a built-in scenario end to end (the swap on a Y, or a 4-way crossing)",
         formatter_class=argparse.RawTextHelpFormatter,
     )
     demo.add_argument(
@@ -72,14 +65,13 @@ def register(commands) -> None:
     add_method(demo)
     demo.set_defaults(run=_command_demo)
 
-    plan_parser = commands.add_parser("plan", help="print the planner's route for a scenario file")
+    plan_parser = commands.add_parser("plan")
     plan_parser.add_argument("scenario", help="scenario TOML file")
     plan_parser.add_argument("--json", action="store_true", help="print a machine-readable summary")
     plan_parser.set_defaults(run=_command_plan)
 
     schedule = commands.add_parser(
         "schedule",
-        help="schedule, verify and export a scenario",
         formatter_class=argparse.RawTextHelpFormatter,
     )
     schedule.add_argument("scenario", help="scenario TOML file")

@@ -6,14 +6,8 @@ import argparse
 import json
 import sys
 
-from trajgen.cli.options import (
-    EXIT_FAILURE,
-    EXIT_OK,
-    add_csv_options,
-    add_method,
-    csv_dialect,
-    scenario_from,
-)
+from trajgen.cli.options import add_csv_options, add_method, csv_dialect, scenario_from
+from trajgen.cli.parser import EXIT_FAILURE, EXIT_OK
 
 __all__ = ["register"]
 
@@ -53,7 +47,6 @@ def register(commands) -> None:
     """Add ``simulate`` to the sub-commands."""
     simulate = commands.add_parser(
         "simulate",
-        help="run a scenario in closed loop under faults (exit 1 if it misses the goal or has violations)",
         formatter_class=argparse.RawTextHelpFormatter,
     )
     simulate.add_argument("scenario", help="scenario TOML file")

@@ -7,7 +7,8 @@ import json
 from datetime import UTC, datetime
 
 from topology.validation import short_repr
-from trajgen.cli.options import EXIT_OK, add_method, method_from, scenario_from
+from trajgen.cli.options import add_method, method_from, scenario_from
+from trajgen.cli.parser import EXIT_OK
 from trajgen.errors import OptionError
 from trajgen.export.atomic import check_output_paths, commit_files
 from trajgen.export.vda5050_options import MANIFEST_NAME, Vda5050Options
@@ -127,7 +128,6 @@ def register(commands) -> None:
     """Add ``export-vda5050`` to the sub-commands."""
     export = commands.add_parser(
         "export-vda5050",
-        help="write VDA 5050 2.1.0 orders and order updates of a scenario's verified schedule",
         formatter_class=argparse.RawTextHelpFormatter,
     )
     export.add_argument("scenario", help="scenario TOML file")

@@ -21,7 +21,6 @@ import json
 import os
 import shutil
 import tempfile
-import uuid
 from collections.abc import Iterable, Mapping, Sequence
 from pathlib import Path
 
@@ -165,7 +164,7 @@ def _keep_previous(path: Path) -> Path | None:
     """A hidden copy of what ``path`` is now (a hard link where possible; a link stays a link)."""
     if not os.path.lexists(path):
         return None
-    backup = path.with_name(f".{path.name}.{uuid.uuid4().hex}{_BAK_SUFFIX}")
+    backup = path.with_name(f".{path.name}.{os.urandom(16).hex()}{_BAK_SUFFIX}")
     try:
         os.link(path, backup, follow_symlinks=False)
     except OSError:
@@ -355,7 +354,7 @@ def recover_folder(folder: str | Path) -> None:
 def _replace_all(staged: list[tuple[str, Path]]) -> None:
     """Rename every staged file onto its target, journalled; on failure put every target back as it was."""
     backups = [(path, _keep_previous(path)) for _, path in staged]
-    key = uuid.uuid4().hex
+    key = os.urandom(16).hex()
     by_folder: dict[str, list[tuple[Path, Path | None]]] = {}
     for path, backup in backups:
         by_folder.setdefault(os.path.realpath(path.parent), []).append((path, backup))

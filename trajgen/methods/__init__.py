@@ -2,7 +2,9 @@
 
 Adding a method: write its class (a frozen dataclass implementing
 ``TimingMethod``) and list it in :data:`METHODS` below; the dispatcher, the
-command line, the plots and the benchmarks read the registry.
+command line, the plots and the benchmarks read the registry. Each method is
+imported when first used, so naming the methods (``trajgen --help``) or using
+``exact`` loads neither the optimal method's NLP code nor TOPPRA.
 
 Examples
 --------
@@ -13,13 +15,18 @@ True
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 from limits import Limits
 from topology import Route
-from trajgen.methods.exact import Exact
-from trajgen.methods.optimal import ClassComparison, HomotopyChoice, Optimal, OptimalInfo, SolverCache
-from trajgen.methods.registry import MethodRegistry
-from trajgen.methods.toppra import Toppra
+from trajgen.lazy import lazy_attributes
+from trajgen.methods.registry import MethodRegistry, MethodSource
 from trajgen.model.schedule import Schedule, TimingMethod
+
+if TYPE_CHECKING:  # imported when first used
+    from trajgen.methods.exact import Exact
+    from trajgen.methods.optimal import ClassComparison, HomotopyChoice, Optimal, OptimalInfo, SolverCache
+    from trajgen.methods.toppra import Toppra
 
 __all__ = [
     "METHODS",
@@ -27,6 +34,7 @@ __all__ = [
     "Exact",
     "HomotopyChoice",
     "MethodRegistry",
+    "MethodSource",
     "Optimal",
     "OptimalInfo",
     "SolverCache",
@@ -34,8 +42,41 @@ __all__ = [
     "make_schedule",
 ]
 
+_SOURCES = {
+    "ClassComparison": "trajgen.methods.optimal",
+    "Exact": "trajgen.methods.exact",
+    "HomotopyChoice": "trajgen.methods.optimal.choice",
+    "Optimal": "trajgen.methods.optimal",
+    "OptimalInfo": "trajgen.methods.optimal",
+    "SolverCache": "trajgen.methods.optimal",
+    "Toppra": "trajgen.methods.toppra",
+}
+__getattr__, __dir__ = lazy_attributes(__name__, globals(), _SOURCES)
+
 #: Every timing method, in display order; ``optimal`` is the default.
-METHODS = MethodRegistry((Exact, Toppra, Optimal), default=Optimal.name)
+METHODS = MethodRegistry(
+    (
+        MethodSource(
+            "exact",
+            "the route exactly, one straight piece at a time, jerk-limited S-curves",
+            "trajgen.methods.exact",
+            "Exact",
+        ),
+        MethodSource(
+            "toppra",
+            "rounded corners where safe, TOPPRA velocity/acceleration timing (jerk not limited)",
+            "trajgen.methods.toppra",
+            "Toppra",
+        ),
+        MethodSource(
+            "optimal",
+            "time-optimal jerk-limited schedule, faster of the two shortest homotopy classes (CasADi)",
+            "trajgen.methods.optimal",
+            "Optimal",
+        ),
+    ),
+    default="optimal",
+)
 
 
 def make_schedule(route: Route, limits: Limits, *, method: TimingMethod | str | None = None) -> Schedule:

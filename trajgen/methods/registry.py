@@ -2,14 +2,57 @@
 
 from __future__ import annotations
 
+import importlib
 from collections.abc import Iterator, Sequence
+from dataclasses import dataclass
 
 from limits import Limits
 from topology import Route
 from trajgen.errors import OptionError
 from trajgen.model.schedule import Schedule, TimingMethod
 
-__all__ = ["MethodRegistry"]
+__all__ = ["MethodRegistry", "MethodSource"]
+
+
+@dataclass(frozen=True, slots=True)
+class MethodSource:
+    """A timing method registered by where it lives, imported when first created or listed.
+
+    A command that only names the methods (``--help``) or uses one of them then loads none of
+    the others' dependencies (the optimal method's NLP code, TOPPRA).
+
+    Attributes
+    ----------
+    name : str
+        The method's name, as its class's ``name``.
+    summary : str
+        One line for help texts, as its class's ``summary``.
+    module : str
+        Dotted name of the module that defines the class.
+    class_name : str
+        The class's name in that module.
+    """
+
+    name: str
+    summary: str
+    module: str
+    class_name: str
+
+    def load(self) -> type[TimingMethod]:
+        """The class, imported; its ``name`` and ``summary`` must be the registered ones.
+
+        Raises
+        ------
+        RuntimeError
+            The class's ``name`` or ``summary`` differs from the registered one.
+        """
+        method = getattr(importlib.import_module(self.module), self.class_name)
+        if (method.name, method.summary) != (self.name, self.summary):
+            raise RuntimeError(
+                f"timing method {self.module}.{self.class_name} is named {method.name!r} "
+                f"({method.summary!r}), registered as {self.name!r} ({self.summary!r})"
+            )
+        return method
 
 
 class MethodRegistry:
@@ -17,8 +60,9 @@ class MethodRegistry:
 
     Parameters
     ----------
-    methods : sequence of TimingMethod subclasses
-        Each must be constructible without arguments (its default options).
+    methods : sequence of TimingMethod subclasses or MethodSource
+        Each class must be constructible without arguments (its default options); a
+        :class:`MethodSource` is imported when the method is first created or iterated over.
     default : str
         Name of the method used when none is given.
 
@@ -31,16 +75,17 @@ class MethodRegistry:
     Exact(jerk=True)
     """
 
-    __slots__ = ("_by_name", "default")
+    __slots__ = ("_by_name", "_summaries", "default")
 
-    def __init__(self, methods: Sequence[type[TimingMethod]], *, default: str) -> None:
-        self._by_name: dict[str, type[TimingMethod]] = {}
+    def __init__(self, methods: Sequence[type[TimingMethod] | MethodSource], *, default: str) -> None:
+        self._by_name: dict[str, type[TimingMethod] | MethodSource] = {}
         for method in methods:
             if method.name in self._by_name:
                 raise ValueError(f"timing method name {method.name!r} is registered twice")
             self._by_name[method.name] = method
         if default not in self._by_name:
             raise ValueError(f"default method {default!r} is not among {list(self._by_name)!r}")
+        self._summaries = {name: method.summary for name, method in self._by_name.items()}
         #: Name of the default method.
         self.default = default
 
@@ -50,10 +95,16 @@ class MethodRegistry:
         return tuple(self._by_name)
 
     def __iter__(self) -> Iterator[type[TimingMethod]]:
-        return iter(self._by_name.values())
+        return (self._load(name) for name in self._by_name)
 
     def __len__(self) -> int:
         return len(self._by_name)
+
+    def _load(self, name: str) -> type[TimingMethod]:
+        method = self._by_name[name]
+        if isinstance(method, MethodSource):
+            method = self._by_name[name] = method.load()
+        return method
 
     def lookup(self, name: object) -> type[TimingMethod]:
         """The method class named ``name`` (case-insensitive).
@@ -67,7 +118,7 @@ class MethodRegistry:
         if key not in self._by_name:
             text = repr(name) if len(repr(name)) <= 40 else repr(name)[:37] + "..."
             raise OptionError(f"method {text} is unknown: expected one of {list(self._by_name)!r}")
-        return self._by_name[key]
+        return self._load(key)
 
     def create(self, method: TimingMethod | str | None = None) -> TimingMethod:
         """A method object: ``method`` itself, the named method with default options, or the default."""
@@ -78,8 +129,8 @@ class MethodRegistry:
     def help(self) -> str:
         """One line per method for help texts: ``name: summary``."""
         return "\n".join(
-            f"{name}: {cls.summary}" + (" (default)" if name == self.default else "")
-            for name, cls in self._by_name.items()
+            f"{name}: {summary}" + (" (default)" if name == self.default else "")
+            for name, summary in self._summaries.items()
         )
 
     def schedule(self, route: Route, limits: Limits, *, method: TimingMethod | str | None = None) -> Schedule:

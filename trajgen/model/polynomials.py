@@ -64,12 +64,21 @@ def root_in(c: np.ndarray, low: np.ndarray, high: np.ndarray) -> np.ndarray:
     bracketed = np.isfinite(f_low) & np.isfinite(f_high) & (np.sign(f_low) * np.sign(f_high) <= 0.0)
     a, b = np.where(bracketed, low, np.nan), np.where(bracketed, high, np.nan)
     rising = f_high >= f_low
+    # in place on preallocated arrays: the loop runs 64 times per call, on every verification
+    columns = [np.ascontiguousarray(c[:, power]) for power in range(c.shape[1] - 1, -1, -1)]
+    middle, value, below = np.empty_like(a), np.empty_like(a), np.empty(a.shape, dtype=bool)
     for _ in range(_BISECTIONS):
-        middle = 0.5 * (a + b)
-        value = evaluate(c, middle)
-        below = (value < 0.0) == rising
-        a = np.where(below, middle, a)
-        b = np.where(below, b, middle)
+        np.add(a, b, out=middle)
+        middle *= 0.5
+        value[...] = columns[0]
+        for column in columns[1:]:
+            value *= middle
+            value += column
+        np.less(value, 0.0, out=below)
+        np.equal(below, rising, out=below)
+        np.copyto(a, middle, where=below)
+        np.logical_not(below, out=below)
+        np.copyto(b, middle, where=below)
     return 0.5 * (a + b)
 
 

@@ -16,9 +16,15 @@ schedule), :mod:`~.mesh` (mesh refinement), :mod:`~.classes` (classes solved sid
 :mod:`~.info` (diagnostics), :mod:`~.method` (the :class:`Optimal` method object).
 """
 
-from trajgen.methods.optimal.info import ClassComparison, HomotopyChoice, OptimalInfo, Source
-from trajgen.methods.optimal.method import DEFAULT_NODES, DEFAULT_REFINEMENT_TOLERANCE, Optimal
-from trajgen.methods.optimal.solve import Outcome, Solver, SolverAttempt, SolverCache
+from typing import TYPE_CHECKING
+
+from trajgen.lazy import lazy_attributes
+
+if TYPE_CHECKING:  # imported when first used: the option enum alone loads no NLP code
+    from trajgen.methods.optimal.choice import HomotopyChoice
+    from trajgen.methods.optimal.info import ClassComparison, OptimalInfo, Source
+    from trajgen.methods.optimal.method import DEFAULT_NODES, DEFAULT_REFINEMENT_TOLERANCE, Optimal
+    from trajgen.methods.optimal.solve import Outcome, Solver, SolverAttempt, SolverCache
 
 __all__ = [
     "DEFAULT_NODES",
@@ -33,3 +39,18 @@ __all__ = [
     "SolverCache",
     "Source",
 ]
+
+_SOURCES = {
+    "DEFAULT_NODES": "trajgen.methods.optimal.method",
+    "DEFAULT_REFINEMENT_TOLERANCE": "trajgen.methods.optimal.method",
+    "ClassComparison": "trajgen.methods.optimal.info",
+    "HomotopyChoice": "trajgen.methods.optimal.choice",
+    "Optimal": "trajgen.methods.optimal.method",
+    "OptimalInfo": "trajgen.methods.optimal.info",
+    "Outcome": "trajgen.methods.optimal.solve",
+    "Solver": "trajgen.methods.optimal.solve",
+    "SolverAttempt": "trajgen.methods.optimal.solve",
+    "SolverCache": "trajgen.methods.optimal.solve",
+    "Source": "trajgen.methods.optimal.info",
+}
+__getattr__, __dir__ = lazy_attributes(__name__, globals(), _SOURCES)

@@ -1,15 +1,15 @@
-"""Diagnostics and options of ``optimal``: where its motion comes from, which classes it considered."""
+"""Diagnostics of ``optimal``: where its motion comes from, which classes it considered."""
 
 from __future__ import annotations
 
 import enum
 from dataclasses import dataclass
 
-from topology import Homotopy, Option, WayRound
+from topology import Homotopy, WayRound
 from trajgen.methods.optimal.solve import Solver, SolverAttempt
 from trajgen.model.schedule import FallbackReason, MethodInfo
 
-__all__ = ["ClassComparison", "HomotopyChoice", "OptimalInfo", "Source"]
+__all__ = ["ClassComparison", "OptimalInfo", "Source"]
 
 
 class Source(enum.Enum):
@@ -17,15 +17,6 @@ class Source(enum.Enum):
 
     NLP = "nlp"  #: the solver's solution
     EXACT = "exact"  #: the exact schedule, faster than the discretized optimum (or a fallback)
-
-
-class HomotopyChoice(Option):
-    """Which homotopy classes ``optimal`` solves."""
-
-    #: the route's class and the other (the other way round a Y's boundary circle; the
-    #: second-shortest route on ``G_k`` for more legs); the faster wins
-    FASTEST = "fastest"
-    PAPER = "paper"  #: the route's class only (the paper's instruction, for a route from ``plan``)
 
 
 @dataclass(frozen=True, slots=True)

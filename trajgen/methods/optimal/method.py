@@ -17,10 +17,11 @@ from limits import Limits
 from topology import Homotopy, OptionError, Route, plan
 from trajgen.errors import InputError, SolverError
 from trajgen.methods.exact import Exact
+from trajgen.methods.optimal.choice import HomotopyChoice
 from trajgen.methods.optimal.classes import ClassRace, ClassSolve
 from trajgen.methods.optimal.decode import unpack
 from trajgen.methods.optimal.guess import assemble, initial_guess
-from trajgen.methods.optimal.info import ClassComparison, HomotopyChoice, OptimalInfo, Source
+from trajgen.methods.optimal.info import ClassComparison, OptimalInfo, Source
 from trajgen.methods.optimal.mesh import refine
 from trajgen.methods.optimal.phases import NlpShape, default_fractions, route_phases
 from trajgen.methods.optimal.solve import SolverCache, solve
