@@ -83,49 +83,54 @@ def test_the_command_line_page_has_the_help_of_every_command(built):
         assert f"usage: trajgen {name}" in text
 
 
-_TINY_INDEX = """# Tiny
+#: Pages with one defect each, built together: the build must fail and name every defect.
+_DEFECTS = [
+    pytest.param("See [a page](missing.md).\n", "missing.md", id="link-to-a-missing-page"),
+    pytest.param("See [a heading](clean.md#no-such-heading).\n", "no-such-heading", id="missing-heading"),
+    pytest.param("See {py:func}`trajgen.no_such_function`.\n", "no_such_function", id="missing-object"),
+    pytest.param("See {py:class}`topology.Routes`.\n", "topology.Routes", id="misspelt-class"),
+]
 
-```{toctree}
-page
-```
-"""
 
-
-@pytest.mark.parametrize(
-    ("page", "defect"),
-    [
-        pytest.param("See [the other page](page.md).\n", None, id="no-defect-passes"),
-        pytest.param("See [a page](missing.md).\n", "missing.md", id="link-to-a-missing-page"),
-        pytest.param("See [a heading](page.md#no-such-heading).\n", "no-such-heading", id="missing-heading"),
-        pytest.param("See {py:func}`trajgen.no_such_function`.\n", "no_such_function", id="missing-object"),
-        pytest.param("See {py:class}`topology.Routes`.\n", "topology.Routes", id="misspelt-class"),
-    ],
-)
-def test_a_broken_reference_fails_the_build(tmp_path, page, defect):
-    source = tmp_path / "docs"
+def _tiny_site(root: Path, pages: dict[str, str], *, orphans: tuple[str, ...] = ()) -> Path:
+    """A docs folder with our ``conf.py``, an index listing ``pages`` and pages outside every toctree."""
+    source = root / "docs"
     source.mkdir()
     shutil.copy(DOCS / "conf.py", source / "conf.py")
-    (source / "index.md").write_text(_TINY_INDEX, encoding="utf-8")
-    (source / "page.md").write_text(f"# Page\n\n## A heading\n\n{page}", encoding="utf-8")
-    result = _sphinx(source, tmp_path / "html")
+    listed = "\n".join(pages)
+    (source / "index.md").write_text(f"# Tiny\n\n```{{toctree}}\n{listed}\n```\n", encoding="utf-8")
+    for name, body in pages.items():
+        (source / f"{name}.md").write_text(f"# {name.title()}\n\n## A heading\n\n{body}", encoding="utf-8")
+    for name in orphans:
+        (source / f"{name}.md").write_text(f"# {name.title()}\n", encoding="utf-8")
+    return source
+
+
+@pytest.fixture(scope="module")
+def defective(tmp_path_factory) -> str:
+    """The output of one build of a site with every defect of :data:`_DEFECTS` and an orphan page."""
+    root = tmp_path_factory.mktemp("defects")
+    pages = {"clean": "Nothing wrong here.\n"}
+    pages |= {f"defect{k}": param.values[0] for k, param in enumerate(_DEFECTS)}
+    result = _sphinx(_tiny_site(root, pages, orphans=("orphan",)), root / "html")
     output = result.stdout + result.stderr
-    if defect is None:
-        assert result.returncode == 0, output
-    else:
-        assert result.returncode != 0, output
-        assert defect in output
+    assert result.returncode != 0, output
+    return output
 
 
-def test_a_page_outside_every_toctree_fails_the_build(tmp_path):
-    source = tmp_path / "docs"
-    source.mkdir()
-    shutil.copy(DOCS / "conf.py", source / "conf.py")
-    (source / "index.md").write_text(_TINY_INDEX, encoding="utf-8")
-    (source / "page.md").write_text("# Page\n", encoding="utf-8")
-    (source / "orphan.md").write_text("# Orphan\n", encoding="utf-8")
-    result = _sphinx(source, tmp_path / "html")
-    assert result.returncode != 0
-    assert "orphan" in result.stdout + result.stderr
+def test_a_site_without_defects_builds(tmp_path):
+    pages = {"clean": "See [the other page](other.md) and [its heading](other.md#a-heading).\n"}
+    result = _sphinx(_tiny_site(tmp_path, pages | {"other": "Text.\n"}), tmp_path / "html")
+    assert result.returncode == 0, result.stdout + result.stderr
+
+
+@pytest.mark.parametrize(("page", "defect"), _DEFECTS)
+def test_a_broken_reference_fails_the_build_naming_it(defective, page, defect):
+    assert defect in defective, defective
+
+
+def test_a_page_outside_every_toctree_fails_the_build(defective):
+    assert "orphan" in defective, defective
 
 
 def _python_blocks(page: Path) -> list[str]:
