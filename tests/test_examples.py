@@ -1,9 +1,15 @@
-"""Every numbered example runs headless and finishes cleanly."""
+"""Every numbered example runs headless and finishes cleanly.
+
+The examples run in the test process (as ``python examples/NN_name.py`` would run them, with
+``__name__ == "__main__"``): a worker imports NumPy, CasADi and matplotlib once for all of them
+and shares the solver cache. One example also runs as its own process, exactly as a user starts it.
+"""
 
 from __future__ import annotations
 
 import os
 import re
+import runpy
 import subprocess
 import sys
 
@@ -37,17 +43,31 @@ FIGURES = {
 }
 
 
+def _check_figure(script, stdout: str) -> None:
+    pattern, expected, tolerance = FIGURES[script.stem]
+    found = re.search(pattern, stdout)
+    assert found, f"{script.name} should print {pattern!r}:\n{stdout}"
+    assert float(found.group(1)) == pytest.approx(expected, abs=tolerance)
+
+
 @pytest.mark.parametrize("script", EXAMPLES, ids=[p.stem for p in EXAMPLES])
-def test_example_runs(script, tmp_path):
+def test_example_runs(script, tmp_path, monkeypatch, capsys):
+    monkeypatch.setenv("MPLBACKEND", "Agg")
+    monkeypatch.setenv("TRAJGEN_EXAMPLE_OUTPUT", str(tmp_path))
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.setattr(sys, "argv", [str(script)])
+    runpy.run_path(str(script), run_name="__main__")
+    _check_figure(script, capsys.readouterr().out)
+
+
+def test_an_example_runs_as_its_own_process_as_a_user_starts_it(tmp_path):
+    script = REPO / "examples" / "01_plan_a_swap.py"
     env = {**os.environ, "MPLBACKEND": "Agg", "TRAJGEN_EXAMPLE_OUTPUT": str(tmp_path)}
     result = subprocess.run(
         [sys.executable, str(script)], cwd=tmp_path, env=env, capture_output=True, text=True, timeout=600
     )
     assert result.returncode == 0, result.stderr
-    pattern, expected, tolerance = FIGURES[script.stem]
-    found = re.search(pattern, result.stdout)
-    assert found, f"{script.name} should print {pattern!r}:\n{result.stdout}"
-    assert float(found.group(1)) == pytest.approx(expected, abs=tolerance)
+    _check_figure(script, result.stdout)
 
 
 def test_every_example_has_its_figure():
