@@ -237,13 +237,30 @@ def braking_positions(state: PathState, limits: VehicleLimits, times: np.ndarray
     return np.array([trajectory.at_time(min(t, trajectory.duration))[0][0] for t in times])
 
 
+def _legs_and_s(path: VehiclePath, travel: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``VehiclePath.locate`` of many travels at once: leg (-1 at the junction) and ``s``."""
+    starts, s_from, s_to = (np.array(a) for a in (path.starts, path.s_from, path.s_to))
+    k = np.maximum(np.searchsorted(starts, travel, side="right") - 1, 0)
+    local = np.clip(travel - starts[k], 0.0, np.abs(s_to[k] - s_from[k]))
+    s = s_from[k] + np.where(s_to[k] > s_from[k], local, -local)
+    return np.where(s > 0.0, np.array(path.legs)[k], -1), s
+
+
 def track_distance(paths, first: np.ndarray, second: np.ndarray) -> np.ndarray:
-    out = []
-    for p, q in zip(first, second, strict=True):
-        leg1, s1 = paths[0].locate(p)
-        leg2, s2 = paths[1].locate(q)
-        out.append(indexed_separation((leg1, s1, leg2, s2)))
-    return np.array(out)
+    """Track distance at each pair of travels: ``|s1 - s2|`` on one leg, else ``s1 + s2``."""
+    (leg1, s1), (leg2, s2) = _legs_and_s(paths[0], first), _legs_and_s(paths[1], second)
+    return np.where((leg1 == leg2) & (leg1 >= 0), np.abs(s1 - s2), s1 + s2)
+
+
+def test_the_vectorized_track_distance_agrees_with_the_planners():
+    route = default_scenario().plan()
+    paths = tuple(VehiclePath.from_route(route, v) for v in (0, 1))
+    rng = np.random.default_rng(5)
+    one, two = rng.uniform(-1.0, paths[0].length + 1.0, 500), rng.uniform(-1.0, paths[1].length + 1.0, 500)
+    expected = [
+        indexed_separation((*paths[0].locate(p), *paths[1].locate(q))) for p, q in zip(one, two, strict=True)
+    ]
+    assert track_distance(paths, one, two) == pytest.approx(expected, abs=1e-12)
 
 
 @pytest.mark.parametrize("refine", [False, True], ids=["new-motion", "hold"])
