@@ -7,7 +7,7 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from trajgen.model.polynomials import evaluate, extrema
+from trajgen.model.polynomials import evaluate, extrema, root_in
 
 coefficient = st.floats(-10.0, 10.0, allow_nan=False)
 
@@ -51,3 +51,38 @@ def test_non_finite_coefficients_give_nan():
     low, _, high, _ = extrema(np.array([[1.0, np.nan, 0.0]]), np.array([1.0]))
     assert np.isnan(low[0])
     assert np.isnan(high[0])
+
+
+@pytest.mark.parametrize(
+    "kind",
+    ["random-quartics", "double-roots", "triple-roots", "tiny-and-huge-scales"],
+)
+def test_a_root_found_has_a_sign_change_within_a_few_units_of_round_off(kind):
+    """Seeded: every bracketed root is a true root to round-off, whatever the method takes to find it."""
+    rng = np.random.default_rng(11)
+    n = 400
+    if kind == "random-quartics":
+        c = rng.normal(size=(n, 5))
+    elif kind == "double-roots":  # (t - r)^2 (t - q)
+        r, q = rng.uniform(0.0, 2.0, n), rng.uniform(-1.0, 3.0, n)
+        c = np.column_stack([-r * r * q, r * r + 2.0 * r * q, -(2.0 * r + q), np.ones(n)])
+    elif kind == "triple-roots":  # (t - r)^3
+        r = rng.uniform(0.0, 2.0, n)
+        c = np.column_stack([-(r**3), 3.0 * r * r, -3.0 * r, np.ones(n)])
+    else:
+        c = rng.normal(size=(n, 4)) * 10.0 ** rng.integers(-12, 6, size=(n, 1))
+    low, high = np.zeros(n), rng.uniform(0.01, 3.0, n)
+    roots = root_in(c, low, high)
+    f_low, f_high = evaluate(c, low), evaluate(c, high)
+    bracketed = np.sign(f_low) * np.sign(f_high) <= 0.0
+    assert np.array_equal(np.isnan(roots), ~bracketed)
+    assert bracketed.sum() > n // 4  # the property is exercised
+    r = roots[bracketed]
+    assert np.all((r >= low[bracketed]) & (r <= high[bracketed]))
+    # the sign changes (or the value vanishes) within 16 units of round-off of the bracket's end
+    delta = 16.0 * np.finfo(float).eps * high[bracketed]
+    cb = c[bracketed]
+    before = evaluate(cb, np.maximum(r - delta, low[bracketed]))
+    after = evaluate(cb, np.minimum(r + delta, high[bracketed]))
+    at = evaluate(cb, r)
+    assert np.all((np.sign(before) * np.sign(after) <= 0.0) | (at == 0.0))

@@ -3,9 +3,10 @@
 Coefficients are in increasing powers, one row per polynomial: ``c[:, 0] +
 c[:, 1] t + ... + c[:, d] t^d`` on ``0 <= t <= h``, ``d <= 4``. The extrema
 are exact up to round-off: the critical points are the roots of the
-derivative, found by bisection on intervals where the derivative is monotone
-(split at the roots of the second derivative, in closed form), so no extremum
-is missed however close two of them are.
+derivative, found by safeguarded Newton steps (bisection where Newton's point
+leaves the bracket) on intervals where the derivative is monotone (split at
+the roots of the second derivative, in closed form), so no extremum is missed
+however close two of them are.
 """
 
 from __future__ import annotations
@@ -14,8 +15,10 @@ import numpy as np
 
 __all__ = ["derivative", "evaluate", "extrema", "root_in"]
 
-#: Bisection steps: 2**-64 of an interval, below the resolution of a double for any interval here.
+#: Most steps of the root search: 64 bisections shrink any bracket here below a double's resolution.
 _BISECTIONS = 64
+#: Where the root search stops, relative to the bracket's larger end: a few units of round-off.
+_ROOT_RESOLUTION = 4.0 * np.finfo(float).eps
 
 
 def evaluate(c: np.ndarray, t: np.ndarray) -> np.ndarray:
@@ -54,32 +57,63 @@ def _quadratic_roots(c: np.ndarray) -> np.ndarray:
     return out
 
 
+def _horner(columns: list[np.ndarray], x: np.ndarray, out: np.ndarray) -> np.ndarray:
+    """Values at ``x`` of the polynomials whose coefficient columns, highest power first, are ``columns``."""
+    out[...] = columns[0]
+    for column in columns[1:]:
+        out *= x
+        out += column
+    return out
+
+
 def root_in(c: np.ndarray, low: np.ndarray, high: np.ndarray) -> np.ndarray:
     """A root of each polynomial between ``low`` and ``high`` where the values there differ in sign, else NaN.
 
-    Bisection: the root found is within round-off of a true root when the
-    polynomial is monotone on the bracket.
+    Safeguarded Newton: each step keeps a bracket on which the sign changes, takes Newton's point
+    where it lies inside the bracket and at least halves the step before, else bisects. A row is
+    done when its value is 0, its Newton step or its bracket is below
+    :data:`_ROOT_RESOLUTION` of ``max(|low|, |high|)``: then the root found is within a few
+    times that of a true root (within the step's size times the root's multiplicity, at most 4).
+    Most rows take 5 to 10 steps; none more than :data:`_BISECTIONS`.
     """
     f_low, f_high = evaluate(c, low), evaluate(c, high)
     bracketed = np.isfinite(f_low) & np.isfinite(f_high) & (np.sign(f_low) * np.sign(f_high) <= 0.0)
     a, b = np.where(bracketed, low, np.nan), np.where(bracketed, high, np.nan)
     rising = f_high >= f_low
-    # in place on preallocated arrays: the loop runs 64 times per call, on every verification
-    columns = [np.ascontiguousarray(c[:, power]) for power in range(c.shape[1] - 1, -1, -1)]
-    middle, value, below = np.empty_like(a), np.empty_like(a), np.empty(a.shape, dtype=bool)
-    for _ in range(_BISECTIONS):
-        np.add(a, b, out=middle)
-        middle *= 0.5
-        value[...] = columns[0]
-        for column in columns[1:]:
-            value *= middle
-            value += column
-        np.less(value, 0.0, out=below)
-        np.equal(below, rising, out=below)
-        np.copyto(a, middle, where=below)
-        np.logical_not(below, out=below)
-        np.copyto(b, middle, where=below)
-    return 0.5 * (a + b)
+    degree = c.shape[1] - 1
+    columns = [np.ascontiguousarray(c[:, power]) for power in range(degree, -1, -1)]
+    slopes = [c[:, power] * power for power in range(degree, 0, -1)] or [np.zeros(c.shape[0])]
+    resolution = _ROOT_RESOLUTION * np.maximum(np.abs(low), np.abs(high))
+    x = 0.5 * (a + b)
+    width = b - a  # the step before: Newton's point must at least halve it
+    value, slope, newton, step = (np.empty_like(a) for _ in range(4))
+    above, accept = np.empty(a.shape, dtype=bool), np.empty(a.shape, dtype=bool)
+    active = bracketed.copy()
+    # in place on preallocated arrays: every verification runs this on every piece
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+        for _ in range(_BISECTIONS):
+            _horner(columns, x, value)
+            _horner(slopes, x, slope)
+            np.less(value, 0.0, out=above)
+            np.equal(above, rising, out=above)  # the root lies above x
+            np.copyto(a, x, where=above)
+            np.logical_not(above, out=above)
+            np.copyto(b, x, where=above)
+            np.divide(value, slope, out=newton)
+            np.abs(newton, out=step)
+            np.subtract(x, newton, out=newton)
+            active &= ~((value == 0.0) | (step <= resolution) | (b - a <= resolution))
+            if not active.any():
+                break
+            np.less_equal(step, 0.5 * width, out=accept)
+            accept &= newton > a
+            accept &= newton < b
+            middle = 0.5 * (a + b)
+            np.multiply(b - a, 0.5, out=width)
+            np.copyto(width, step, where=accept)
+            np.copyto(middle, newton, where=accept)
+            np.copyto(x, middle, where=active)
+    return np.where(bracketed, x, np.nan)
 
 
 def _critical_points(c: np.ndarray, h: np.ndarray) -> np.ndarray:
