@@ -182,3 +182,75 @@ def test_csv_options_of_the_wrong_type_are_an_option_error(tmp_path):
     )
     with pytest.raises(OptionError, match="CSV options must be CsvOptions, got str"):
         write_profiles(verified, ("a", "b"), tmp_path, options="x")  # type: ignore[arg-type]
+
+
+# -- destinations that take no file: refused before anything is computed, naming the user's path -------
+
+
+@pytest.fixture
+def nothing_scheduled(monkeypatch):
+    """Fail the test if a schedule is computed."""
+    import trajgen.pipeline
+
+    def refuse(*args, **kwargs):
+        raise AssertionError("a schedule was computed although the output cannot be written")
+
+    monkeypatch.setattr(trajgen.pipeline, "make_schedule", refuse)
+
+
+@pytest.fixture
+def immutable_folder(tmp_path):
+    """A folder with the immutable attribute (``chattr +i``), where the platform allows it."""
+    import shutil
+    import subprocess
+
+    folder = tmp_path / "locked"
+    folder.mkdir()
+    if shutil.which("chattr") is None:
+        pytest.skip("no chattr here")
+    if subprocess.run(["chattr", "+i", str(folder)], capture_output=True).returncode != 0:
+        pytest.skip("this file system or user cannot make a folder immutable")
+    yield folder
+    subprocess.run(["chattr", "-i", str(folder)], capture_output=True, check=True)
+
+
+@pytest.mark.usefixtures("nothing_scheduled")
+@pytest.mark.parametrize("option", ["--csv", "--plot"])
+def test_a_destination_under_proc_exits_2_before_solving_naming_it(capsys, option):
+    # /proc takes no new file, not even from root
+    assert main(["schedule", str(SWAP_FILE), option, "/proc/trajgen-out"]) == EXIT_BAD_INPUT
+    err = capsys.readouterr().err
+    assert "cannot write '/proc/trajgen-out/" in err
+    assert "folder '/proc' takes no new file" in err
+    assert "trajgen-tmp" not in err
+    assert "trajgen-probe" not in err
+
+
+@pytest.mark.usefixtures("nothing_scheduled")
+def test_an_immutable_folder_exits_2_before_solving_naming_the_file_asked_for(immutable_folder, capsys):
+    argv = ["schedule", str(SWAP_FILE), "--csv", str(immutable_folder / "out"), "--method", "exact"]
+    assert main(argv) == EXIT_BAD_INPUT
+    err = capsys.readouterr().err
+    assert f"cannot write '{immutable_folder / 'out' / 'agv1.csv'}'" in err
+    assert "trajgen-tmp" not in err
+    assert list(immutable_folder.iterdir()) == []
+
+
+def test_a_folder_locked_during_the_commit_is_reported_by_the_path_asked_for(immutable_folder):
+    """The last line of defence: the commit's own error names the file, not its hidden temporary."""
+    import subprocess
+
+    from trajgen.errors import OutputError
+    from trajgen.export import commit_files
+
+    subprocess.run(["chattr", "-i", str(immutable_folder)], check=True)
+
+    def content():
+        yield b"first row\n"
+        subprocess.run(["chattr", "+i", str(immutable_folder)], check=True)  # locked mid-commit
+        yield b"second row\n"
+
+    target = immutable_folder / "profile.csv"
+    with pytest.raises(OutputError, match=rf"cannot write '{target}': Operation not permitted"):
+        commit_files({target: content()})
+    assert not target.exists()

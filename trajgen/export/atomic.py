@@ -18,6 +18,7 @@ from __future__ import annotations
 import contextlib
 import fcntl
 import json
+import logging
 import os
 import shutil
 import tempfile
@@ -25,6 +26,8 @@ from collections.abc import Iterable, Mapping, Sequence
 from pathlib import Path
 
 from trajgen.errors import OutputError
+
+logger = logging.getLogger(__name__)
 
 __all__ = ["JOURNAL_NAME", "check_output_paths", "commit_files", "recover_folder"]
 
@@ -40,18 +43,63 @@ def _short(path: Path) -> str:
 
 
 def check_output_paths(paths) -> tuple[Path, ...]:
-    """Check that each path can become a file: not a folder, below folders (existing or to be made).
+    """Check that each path can become a file, before anything is computed for it.
+
+    Each path must not be a folder and must lie below folders (existing or to be made); and each
+    folder must take new files: a probe file is created and removed at once in the folder, or in
+    its nearest existing ancestor for a folder the commit will make (a read-only or immutable
+    folder, ``/proc``, a full quota are refused here, not after a solve).
 
     Raises
     ------
     OutputError
-        A target is a folder, a parent is a file, or a path is empty or given twice.
+        A target is a folder, a parent is a file, a path is empty or given twice, or a folder
+        takes no new file (naming the path asked for and the reason).
     """
     try:
-        return _check_output_paths(paths)
+        checked = _check_output_paths(paths)
     except OSError as error:  # a name the file system refuses (too long, ...)
         where = _short(Path(error.filename)) if error.filename else "an output path"
         raise OutputError(f"cannot use output path {where!r}: {error.strerror or error}") from None
+    probed: set[str] = set()
+    for path in checked:
+        folder = next((p for p in path.parents if p.exists()), Path("."))
+        if str(folder) not in probed:
+            _probe(folder, path)
+            probed.add(str(folder))
+    return checked
+
+
+def _asked_for(filename: str | os.PathLike, paths: Sequence[Path]) -> Path:
+    """The path asked for that ``filename`` stands for.
+
+    A hidden temporary or backup names its file; the commit's journal in a folder, the first file
+    asked for in that folder.
+    """
+    name = Path(filename)
+    for path in paths:
+        hidden = name.parent == path.parent and name.name.startswith(f".{path.name}.")
+        if name == path or (hidden and name.name.endswith((_TMP_SUFFIX, _BAK_SUFFIX))):
+            return path
+    for path in paths:
+        if name.parent == path.parent and name.name.startswith(JOURNAL_NAME):
+            return path
+    return name
+
+
+def _probe(folder: Path, path: Path) -> None:
+    """Create and remove a hidden file in ``folder``, which is to hold ``path`` (or its folders)."""
+    try:
+        # the commits' temporary suffix: a probe a crash left behind goes with the next commit's recovery
+        handle, probe = tempfile.mkstemp(prefix=".trajgen-probe.", suffix=_TMP_SUFFIX, dir=folder)
+        os.close(handle)
+        with contextlib.suppress(FileNotFoundError):  # a concurrent commit's recovery took it already
+            os.unlink(probe)
+    except OSError as error:
+        raise OutputError(
+            f"cannot write {_short(path)!r}: folder {_short(folder)!r} takes no new file "
+            f"({error.strerror or error}); expected a writable folder"
+        ) from None
 
 
 def _check_output_paths(paths) -> tuple[Path, ...]:
@@ -429,13 +477,17 @@ def commit_files(contents: Mapping[Path | str, bytes | Iterable[bytes]]) -> tupl
                 for folder in locks.folders:
                     _sync_folder(Path(folder))
         except OSError as error:
-            where = _short(Path(error.filename)) if error.filename else "the output folder"
+            where = _short(_asked_for(error.filename, paths)) if error.filename else "the output folder"
             raise OutputError(f"cannot write {where!r}: {error.strerror or error}") from error
     finally:
         if not succeeded:
             for temporary, _ in staged:
-                with contextlib.suppress(FileNotFoundError):
+                try:
                     os.unlink(temporary)
+                except FileNotFoundError:
+                    pass
+                except OSError as error:  # a folder turned read-only: the next commit's recovery removes it
+                    logger.warning("could not remove the temporary file %s: %s", temporary, error.strerror)
             for folder in reversed(created):
                 with contextlib.suppress(OSError):
                     folder.rmdir()
