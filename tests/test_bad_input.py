@@ -254,3 +254,19 @@ def test_a_folder_locked_during_the_commit_is_reported_by_the_path_asked_for(imm
     with pytest.raises(OutputError, match=rf"cannot write '{target}': Operation not permitted"):
         commit_files({target: content()})
     assert not target.exists()
+
+
+@pytest.mark.parametrize(
+    ("argv", "message"),
+    [
+        pytest.param(["--dialect", "siemens"], "dialect 'siemens' is unknown", id="dialect"),
+        pytest.param(["--homotopy", "both"], "homotopy choice 'both' is unknown", id="homotopy-choice"),
+        pytest.param(["--units", "inch"], "argument --units: invalid choice: 'inch'", id="units"),
+    ],
+)
+def test_an_unknown_option_value_is_named_in_words(capsys, argv, message):
+    assert main(["schedule", str(SWAP_FILE), *argv]) == EXIT_BAD_INPUT
+    err = capsys.readouterr().err
+    assert message in err
+    assert "dialectname" not in err
+    assert "homotopychoice" not in err

@@ -210,7 +210,7 @@ def test_cli_reports_the_class_and_keeps_the_papers_on_request(
     [
         pytest.param(
             ["--homotopy", "both"],
-            r"homotopychoice 'both' is unknown: expected one of \['fastest', 'paper'\]",
+            r"homotopy choice 'both' is unknown: expected one of \['fastest', 'paper'\]",
             id="unknown",
         ),
         pytest.param(

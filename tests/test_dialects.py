@@ -205,14 +205,30 @@ def test_the_summary_reports_points_and_errors(tmp_path, capsys):
             ["--dialect", "siemens-xy", "--max-points", "20000"],
             r"max points 20,000 is more than dialect 'siemens-xy'",
         ),
-        (["--dialect", "fanuc"], r"dialectname 'fanuc' is unknown"),
+        (["--dialect", "fanuc"], r"dialect 'fanuc' is unknown"),
         (["--dialect", "twincat-cam", "--max-points", "1"], r"max points must be an integer >= 2, got 1"),
         (["--max-points", "50"], r"max points 50 applies to table dialects"),
         (["--dialect", "logix-time-cam", "--method", "toppra"], r"needs a jerk-limited schedule"),
-        (["--dialect", "twincat-cam", "--units", "m"], r"--units set the generic CSV: dialect 'twincat-cam'"),
-        (["--dialect", "siemens-xy", "--delimiter", ","], r"--delimiter set the generic CSV"),
+        (
+            ["--dialect", "twincat-cam", "--units", "m"],
+            r"--units applies to the generic CSV only: dialect 'twincat-cam'",
+        ),
+        (["--dialect", "siemens-xy", "--delimiter", ","], r"--delimiter applies to the generic CSV only"),
+        (
+            ["--dialect", "siemens-xy", "--delimiter", ",", "--units", "mm"],
+            r"--delimiter, --units apply to the generic CSV only",
+        ),
     ],
-    ids=["siemens-limit", "unknown", "one-point", "generic-points", "cubic-toppra", "units", "delimiter"],
+    ids=[
+        "siemens-limit",
+        "unknown",
+        "one-point",
+        "generic-points",
+        "cubic-toppra",
+        "units",
+        "delimiter",
+        "two-options",
+    ],
 )
 def test_bad_dialect_options_exit_2_and_write_nothing(tmp_path, capsys, args, match):
     out = tmp_path / "out"
@@ -316,7 +332,7 @@ def test_tables_along_the_wrong_class_fail(swap):
 
 
 def test_option_errors():
-    with pytest.raises(OptionError, match=r"dialectname 'nope' is unknown"):
+    with pytest.raises(OptionError, match=r"dialect 'nope' is unknown"):
         DIALECTS.lookup("nope")
 
 

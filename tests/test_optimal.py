@@ -227,7 +227,7 @@ def test_make_schedule_dispatches_optimal():
         ),
         pytest.param(
             {"homotopy": "both"},
-            r"homotopychoice 'both' is unknown: expected one of \['fastest', 'paper'\]",
+            r"homotopy choice 'both' is unknown: expected one of \['fastest', 'paper'\]",
             id="homotopy",
         ),
     ],

@@ -220,3 +220,25 @@ def test_cli_help_lists_one_line_per_method(capsys):
         assert any(line.strip().startswith(f"{cls.name}: {cls.summary}") for line in out.splitlines()), (
             cls.name
         )
+
+
+def test_a_schedule_longer_than_a_day_is_run_with_a_warning_and_a_note(tmp_path, caplog):
+    from trajgen import load_scenario
+    from trajgen.pipeline import LONG_SCHEDULE_S
+
+    text = (REPO / "examples" / "swap.toml").read_text(encoding="utf-8")
+    slow = text.replace("A = 10.0, B = 10.0, C = 10.0", "A = 100000.0, B = 100000.0, C = 100000.0")
+    slow = slow.replace('"A:10.0"', '"A:100000.0"').replace('"B:10.0"', '"B:100000.0"')
+    slow = slow.replace("max_velocity = 1.0", "max_velocity = 0.001")
+    path = tmp_path / "slow.toml"
+    path.write_text(slow, encoding="utf-8")
+    with caplog.at_level(logging.WARNING, logger="trajgen.pipeline"):
+        result = run(load_scenario(path), method="exact")
+    duration = result.verified.schedule.duration
+    assert duration > 600_000_000.0
+    assert duration > LONG_SCHEDULE_S == 86_400.0
+    (note,) = [n for n in result.summary()["notes"] if "more than 86,400 s" in n]
+    assert "check the scenario's units" in note
+    assert note in caplog.text
+    # a schedule of an hour is not warned about
+    assert not [n for n in run(load_scenario(REPO / "examples" / "swap.toml"), method="exact").notes]

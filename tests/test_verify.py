@@ -143,3 +143,23 @@ def test_a_schedule_that_does_not_limit_jerk_reports_no_jerk_ratio():
     assert report.jerk_ratio is None
     assert report.summary()["jerk_ratio"] is None
     assert report == verify(Toppra().schedule(route_of(*SWAP), LIMITS))
+
+
+def test_a_verified_schedule_and_its_report_print_as_one_short_line():
+    from trajgen import Exact, VerificationReport, certify, default_scenario, make_schedule
+
+    scenario = default_scenario()
+    verified = certify(make_schedule(scenario.plan(), scenario.limits, method=Exact()))
+    for value in (verified, verified.schedule, verified.report):
+        text = repr(value)
+        assert "\n" not in text
+        assert len(text) <= 240, text
+        assert "array" not in text
+    assert repr(verified) == (
+        "<VerifiedSchedule: exact, 67.500 s in 3 section(s), jerk-limited, counterclockwise; "
+        "passed, 24 pieces, closest approach 10.0000 m, worst ratio to the limits 1.000000>"
+    )
+    failed = VerificationReport.failed(tuple(f"failure {k}: " + "x" * 300 for k in range(5)))
+    assert repr(failed).startswith("<VerificationReport: FAILED, failure 0: xxx")
+    assert repr(failed).endswith("... and 4 more>")
+    assert len(repr(failed)) <= 200

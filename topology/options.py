@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import enum
+import re
 
 from topology.errors import OptionError
 
@@ -10,7 +11,12 @@ __all__ = ["Option"]
 
 
 class Option(enum.StrEnum):
-    """Base of the package's string options; the quantity's name is the class name, lower case."""
+    """Base of the package's string options; messages name the quantity by :meth:`label`."""
+
+    @classmethod
+    def label(cls) -> str:
+        """The quantity's name in messages: the class name in words (``HomotopyChoice``: homotopy choice)."""
+        return re.sub(r"(?<!^)(?=[A-Z])", " ", cls.__name__).lower()
 
     @classmethod
     def lookup(cls, name: object):
@@ -25,5 +31,5 @@ class Option(enum.StrEnum):
             return cls(str(name).lower())
         except ValueError:
             raise OptionError(
-                f"{cls.__name__.lower()} {name!r} is unknown: expected one of {[m.value for m in cls]!r}"
+                f"{cls.label()} {name!r} is unknown: expected one of {[m.value for m in cls]!r}"
             ) from None

@@ -31,9 +31,12 @@ from trajgen.model.summary import route_summary
 from trajgen.scenario import Scenario
 from trajgen.verification import VerifiedSchedule, certify
 
-__all__ = ["PLOT_NAMES", "Outputs", "RunResult", "run"]
+__all__ = ["LONG_SCHEDULE_S", "PLOT_NAMES", "Outputs", "RunResult", "run"]
 
 logger = logging.getLogger(__name__)
+
+#: A schedule longer than this (seconds, one day) gets a warning and a note: usually a unit slip.
+LONG_SCHEDULE_S = 86_400.0
 
 #: The files written into the plot folder.
 PLOT_NAMES = ("speed.png", "separation.png", "coordination.png", "configuration.png")
@@ -209,6 +212,14 @@ def run(
     verified = certify(make_schedule(route, scenario.limits, method=chosen))
     files: dict[Path, object] = {}
     notes: list[str] = []
+    duration = verified.schedule.duration
+    if duration > LONG_SCHEDULE_S:
+        note = (
+            f"the schedule takes {duration:,.0f} s ({duration / 86_400.0:,.1f} days), more than "
+            f"{LONG_SCHEDULE_S:,.0f} s: check the scenario's units (metres, m/s, m/s^2, m/s^3)"
+        )
+        logger.warning("%s", note)
+        notes.append(note)
     tables = None
     if tabled:  # resampled to the dialect's points and verified as its controllers interpolate them
         tables = plc_tables(verified, outputs.dialect, max_points=outputs.max_points)
@@ -222,7 +233,8 @@ def run(
     if outputs.plot_dir is not None:
         from trajgen.plots import render_configuration, render_coordination, render_separation, render_speed
 
-        compared, notes = _comparison(route, scenario, chosen, verified)
+        compared, plot_notes = _comparison(route, scenario, chosen, verified)
+        notes += plot_notes
         speed, separation, coordination, configuration = (outputs.plot_dir / name for name in PLOT_NAMES)
         files[speed] = render_speed(verified, names=scenario.names)
         files[separation] = render_separation(verified)

@@ -74,7 +74,8 @@ def csv_options(args: argparse.Namespace) -> CsvOptions:
     if given and DIALECTS.lookup(dialect).point_limit is not None:
         options = ", ".join("--" + name.replace("_", "-") for name in given)
         raise OptionError(
-            f"{options} set the generic CSV: dialect {dialect!r} writes its own fixed format "
+            f"{options} {'applies' if len(given) == 1 else 'apply'} to the generic CSV only: "
+            f"dialect {dialect!r} writes its own fixed format "
             "(see docs/formats/); expected them only with --dialect generic"
         )
     return CsvOptions(

@@ -51,6 +51,11 @@ GENERIC_COLUMNS = ("t", "axis", "v", "a", "j", "leg", "s", "x", "y")
 class DialectName(Option):
     """Name of a profile file dialect (``--dialect``)."""
 
+    @classmethod
+    def label(cls) -> str:
+        """``dialect``, as the option is called."""
+        return "dialect"
+
     GENERIC = "generic"
     TWINCAT_CAM = "twincat-cam"
     CODESYS_XY = "codesys-xy"

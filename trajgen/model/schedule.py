@@ -371,6 +371,15 @@ class Schedule:
             return self.continuity
         return 2 if self.jerk_limited else 1
 
+    def __repr__(self) -> str:
+        """One line: method, makespan, sections, jerk, class (the arrays stay out of it)."""
+        jerk = "jerk-limited" if self.jerk_limited else "jerk not limited"
+        fallback = "" if self.fallback_reason is None else f", fell back ({self.fallback_reason.value})"
+        return (
+            f"<Schedule: {self.method.name}, {self.duration:.3f} s in {len(self.sections)} section(s), "
+            f"{jerk}, {self.route.way_round.value}{fallback}>"
+        )
+
     @property
     def duration(self) -> float:
         """Makespan: time until both vehicles are at rest at the goal, seconds."""

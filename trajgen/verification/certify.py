@@ -99,6 +99,12 @@ class VerifiedSchedule:
     schedule: Schedule
     report: VerificationReport
 
+    def __repr__(self) -> str:
+        """One line: the schedule and the verifier's verdict."""
+        schedule = repr(self.schedule).removeprefix("<Schedule: ").removesuffix(">")
+        report = repr(self.report).removeprefix("<VerificationReport: ").removesuffix(">")
+        return f"<VerifiedSchedule: {schedule}; {report}>"
+
     def __post_init__(self) -> None:
         if not isinstance(self.schedule, Schedule) or not isinstance(self.report, VerificationReport):
             raise UnverifiedScheduleError("a VerifiedSchedule holds a Schedule and its VerificationReport")

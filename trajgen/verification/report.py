@@ -66,6 +66,20 @@ class VerificationReport:
     goal_error: float
     regions_match: bool
 
+    def __repr__(self) -> str:
+        """One line: the verdict, the closest approach and the worst ratios, or the first failure."""
+        if not self.passed:
+            first = self.failures[0] if self.failures else "no reason given"
+            first = first if len(first) <= 120 else first[:117] + "..."
+            more = f" and {len(self.failures) - 1} more" if len(self.failures) > 1 else ""
+            return f"<VerificationReport: FAILED, {first}{more}>"
+        ratios = [max(self.velocity_ratio), max(self.acceleration_ratio)]
+        ratios += [] if self.jerk_ratio is None else [max(self.jerk_ratio)]
+        return (
+            f"<VerificationReport: passed, {self.pieces} pieces, "
+            f"closest approach {self.min_separation:.4f} m, worst ratio to the limits {max(ratios):.6f}>"
+        )
+
     @classmethod
     def failed(cls, failures: tuple[str, ...], *, pieces: int = 0) -> VerificationReport:
         """The report of a motion that could not be checked further (its figures are NaN)."""
