@@ -8,6 +8,7 @@ the ``homotopy`` option in Python and on the command line.
 from __future__ import annotations
 
 import json
+import logging
 import re
 
 import pytest
@@ -266,3 +267,22 @@ def test_a_refinement_that_raises_keeps_the_passes_solved_before(monkeypatch, ca
     assert "pass 1 of 1" in schedule.notes[0]
     assert verify(schedule).passed
     assert any("keeping its earlier passes" in r.message for r in caplog.records)
+
+
+def test_a_fallback_summary_marks_no_failed_class_chosen_and_gives_the_reasons_once(capsys, caplog):
+    from trajgen import Optimal, default_scenario, run
+    from trajgen.model.summary import format_run
+
+    with caplog.at_level(logging.WARNING):
+        result = run(default_scenario(), method=Optimal(max_iterations=1, time_budget=60.0))
+    text = format_run(result.summary())
+    assert result.summary()["fallback_reason"] == "solver-failed"
+    class_lines = [line for line in text.splitlines() if line.startswith("class ")]
+    assert len(class_lines) == 2
+    assert all("failed (solver-failed)" in line for line in class_lines)
+    assert not any("<- chosen" in line for line in class_lines)
+    assert "(the exact fallback keeps this class)" in class_lines[0]
+    # every solver attempt is listed once: in the note, not again in the log
+    detail = "ipopt-polish did not converge"
+    assert (text + caplog.text).count(detail) == text.count(detail) == 2  # two classes, one line
+    assert "fell back to exact (solver-failed)" in caplog.text

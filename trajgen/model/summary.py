@@ -119,6 +119,15 @@ def _route_class_text(route: dict) -> str:
     return _class_text(route["way_round"] if circle else route["class"], route["paper_class"], circle)
 
 
+def _chosen_mark(comparison: dict, *, fallback: bool) -> str:
+    """`` <- chosen`` for the class whose solution was returned; nothing for a class that failed."""
+    if not comparison["chosen"]:
+        return ""
+    if comparison["failure"] is not None or fallback:
+        return " (the exact fallback keeps this class)"
+    return " <- chosen"
+
+
 def format_run(summary: dict) -> str:
     """Human-readable lines of a run's JSON summary (:meth:`trajgen.pipeline.RunResult.summary`)."""
     margins = summary["worst_margins"]
@@ -139,7 +148,7 @@ def format_run(summary: dict) -> str:
             f"class {c.get('class', c['way_round'])} ({c['homotopy']}): "
             + _class_makespan(c)
             + f", lower bound {c['lower_bound_s']:.3f} s"
-            + (" <- chosen" if c["chosen"] else "")
+            + _chosen_mark(c, fallback=summary["fallback_reason"] is not None)
             for c in summary["solver"].get("classes", ())
         ]
     lines += [f"note: {note}" for note in summary["notes"]]

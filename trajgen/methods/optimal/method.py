@@ -503,7 +503,9 @@ def _parameters(route: Route, limits: Limits, phases, fractions: np.ndarray) -> 
 
 
 def _fallback(exact: Schedule, reason: FallbackReason, detail: str, info: OptimalInfo) -> Schedule:
-    logger.warning("optimal schedule fell back to exact (%s): %s", reason.value, detail)
+    # the detail (every solver attempt) is the schedule's note, printed with the summary: not twice
+    logger.warning("optimal schedule fell back to exact (%s): see the schedule's notes", reason.value)
+    logger.debug("optimal fallback: %s", detail)
     return dataclasses.replace(
         exact, notes=(f"fallback to exact ({reason.value}): {detail}",), fallback_reason=reason, info=info
     )
