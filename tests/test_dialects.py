@@ -463,3 +463,25 @@ def test_the_generic_files_of_every_method_pass_the_checker(tmp_path, method):
     assert main(["schedule", SWAP, "--csv", str(out), "--method", method]) == EXIT_OK
     jerk = [] if method == "exact" else ["--ignore-jerk"]
     assert main(["check", SWAP, "--csv", str(out), *jerk]) == EXIT_OK
+
+
+@pytest.mark.parametrize("name", ["twincat-cam", "siemens-xy", "velocity-profile"])
+def test_checking_a_dialects_file_without_the_flag_names_the_dialects_it_reads_as(exported, name, capsys):
+    assert main(["check", SWAP, "--csv", str(exported / name)]) == EXIT_BAD_INPUT
+    err = capsys.readouterr().err
+    assert "is not trajgen's" in err
+    assert "pass --dialect" in err
+    assert repr(name) in err  # the dialect that wrote it is among those named
+    # and with the flag the same files pass
+    assert main(["check", SWAP, "--csv", str(exported / name), "--dialect", name]) == EXIT_OK
+
+
+def test_a_file_no_dialect_reads_gets_the_generic_message_alone(tmp_path, capsys):
+    folder = tmp_path / "junk"
+    folder.mkdir()
+    for vehicle in ("agv1", "agv2"):
+        (folder / f"{vehicle}.csv").write_text("hello;world\nnot;numbers\n", encoding="utf-8")
+    assert main(["check", SWAP, "--csv", str(folder)]) == EXIT_BAD_INPUT
+    err = capsys.readouterr().err
+    assert "is not trajgen's" in err
+    assert "pass --dialect" not in err

@@ -23,7 +23,7 @@ from topology import Homotopy, Route, plan
 from topology.indexed import track_distance
 from trajgen.errors import OptionError, ProfileFileError
 from trajgen.export.csv import profile_paths
-from trajgen.export.dialects import DIALECTS, Dialect, TableDialect
+from trajgen.export.dialects import DIALECTS, Dialect, DialectName, TableDialect
 from trajgen.export.plc import table_paths
 from trajgen.export.table_check import TableCheck, check_tables
 from trajgen.export.tables import ProfileTable
@@ -179,6 +179,31 @@ def _generic_columns(parsed, vehicle: int, check: TableCheck, scenario: Scenario
     return failures
 
 
+def _read(dialect: Dialect, text, source: str):
+    """``dialect.read``; a file the generic reader refuses names the dialects that do read it."""
+    try:
+        return dialect.read(text, source=source)
+    except ProfileFileError as error:
+        if dialect.name is not DialectName.GENERIC:
+            raise
+        readers = []
+        for other in DIALECTS:
+            named_like = not isinstance(other, TableDialect) or other.suffix == ".csv"
+            if other.name is DialectName.GENERIC or not named_like:
+                continue
+            with contextlib.suppress(ProfileFileError, ValueError):
+                other.read(text, source=source)
+                readers.append(other.name.value)
+        if not readers:
+            raise
+        if len(readers) == 1:
+            hint = f"it reads as dialect {readers[0]!r}: pass --dialect {readers[0]}"
+        else:  # these formats share a layout: only the writer knows which it meant
+            listed = ", ".join(repr(name) for name in readers)
+            hint = f"it reads as each of the dialects {listed}: pass --dialect with the one that wrote it"
+        raise ProfileFileError(f"{error}; {hint} (in Python: dialect=...)") from None
+
+
 def check_profiles(
     scenario: Scenario,
     directory: str | Path,
@@ -214,7 +239,7 @@ def check_profiles(
     limit = dialect.check_points(max_points) if isinstance(dialect, TableDialect) else None
     files = profile_files(scenario, directory, dialect)
     parsed = [
-        dialect.read(read_bounded(path, f"profile file {file_label(path)}", PROFILE_FILE), source=str(path))
+        _read(dialect, read_bounded(path, f"profile file {file_label(path)}", PROFILE_FILE), str(path))
         for path in files
     ]
     tables = (parsed[0].table, parsed[1].table)
