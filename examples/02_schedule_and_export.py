@@ -18,7 +18,11 @@ from trajgen import CsvOptions, Exact, Outputs, Toppra, load_scenario, make_sche
 
 here = Path(__file__).resolve().parent
 scenario = load_scenario(here / "swap.toml")
-output = Path(os.environ.get("TRAJGEN_EXAMPLE_OUTPUT") or tempfile.mkdtemp(prefix="trajgen-example-"))
+# The files go to $TRAJGEN_EXAMPLE_OUTPUT if it is set (and stay there), else to a temporary
+# folder that is removed when the script ends.
+kept = os.environ.get("TRAJGEN_EXAMPLE_OUTPUT")
+scratch = None if kept else tempfile.TemporaryDirectory(prefix="trajgen-example-")
+output = Path(kept or scratch.name).resolve()
 
 route = scenario.plan()
 print(
@@ -46,3 +50,6 @@ for path in result.files:
 # The first rows of agv2's profile: t, signed axis, v, a, j, leg (1-based), s, x, y.
 print(*(output / "csv" / "agv2.csv").read_text().splitlines()[:3], sep="\n")
 print(f"exact makespan: {result.verified.schedule.duration:.2f} s")
+if scratch is not None:
+    print(f"(the files in {output} are removed now: set TRAJGEN_EXAMPLE_OUTPUT=DIR to keep them)")
+    scratch.cleanup()

@@ -20,7 +20,11 @@ from trajgen.plots import render_coordination, render_speed
 
 here = Path(__file__).resolve().parent
 scenario = load_scenario(here / "swap.toml")
-output = Path(os.environ.get("TRAJGEN_EXAMPLE_OUTPUT") or tempfile.mkdtemp(prefix="trajgen-example-"))
+# The files go to $TRAJGEN_EXAMPLE_OUTPUT if it is set (and stay there), else to a temporary
+# folder that is removed when the script ends.
+kept = os.environ.get("TRAJGEN_EXAMPLE_OUTPUT")
+scratch = None if kept else tempfile.TemporaryDirectory(prefix="trajgen-example-")
+output = Path(kept or scratch.name).resolve()
 
 route = scenario.plan()
 print("homotopy class:", " -> ".join(str(region) for region in route.regions))
@@ -57,3 +61,6 @@ files = commit_files(
 )
 for path in files:
     print(f"wrote {path}")
+if scratch is not None:
+    print(f"(the files in {output} are removed now: set TRAJGEN_EXAMPLE_OUTPUT=DIR to keep them)")
+    scratch.cleanup()

@@ -28,7 +28,11 @@ from trajgen.plots import render_simulation
 
 here = Path(__file__).resolve().parent
 scenario = load_scenario(here / "swap.toml")
-output = Path(os.environ.get("TRAJGEN_EXAMPLE_OUTPUT") or tempfile.mkdtemp(prefix="trajgen-example-"))
+# The files go to $TRAJGEN_EXAMPLE_OUTPUT if it is set (and stay there), else to a temporary
+# folder that is removed when the script ends.
+kept = os.environ.get("TRAJGEN_EXAMPLE_OUTPUT")
+scratch = None if kept else tempfile.TemporaryDirectory(prefix="trajgen-example-")
+output = Path(kept or scratch.name).resolve()
 
 # The plan the executor plays: the optimal swap, planned with room for the executor's margins.
 plan = plan_for_execution(scenario)
@@ -69,3 +73,6 @@ commit_files(
     {path: render_simulation(result, names=scenario.names, min_separation=scenario.limits.min_separation)}
 )
 print(f"wrote {path}")
+if scratch is not None:
+    print(f"(the files in {output} are removed now: set TRAJGEN_EXAMPLE_OUTPUT=DIR to keep them)")
+    scratch.cleanup()

@@ -18,7 +18,11 @@ from trajgen.export.check import check_profiles
 
 here = Path(__file__).resolve().parent
 scenario = load_scenario(here / "swap.toml")
-output = Path(os.environ.get("TRAJGEN_EXAMPLE_OUTPUT") or tempfile.mkdtemp(prefix="trajgen-example-"))
+# The files go to $TRAJGEN_EXAMPLE_OUTPUT if it is set (and stay there), else to a temporary
+# folder that is removed when the script ends.
+kept = os.environ.get("TRAJGEN_EXAMPLE_OUTPUT")
+scratch = None if kept else tempfile.TemporaryDirectory(prefix="trajgen-example-")
+output = Path(kept or scratch.name).resolve()
 folder = output / "siemens"
 
 # Schedule (optimal), resample for the TO_Cam, verify the tables as written, commit both files.
@@ -43,3 +47,6 @@ print(f"edited: passed {edited.passed}")
 for failure in edited.failures:
     print(f"  {failure}")
 print(f"violations after moving one point by 1 cm: {len(edited.failures)}")
+if scratch is not None:
+    print(f"(the files in {output} are removed now: set TRAJGEN_EXAMPLE_OUTPUT=DIR to keep them)")
+    scratch.cleanup()

@@ -26,7 +26,11 @@ from trajgen import load_scenario, run
 from trajgen.export.vda5050 import Vda5050Options, write_orders
 
 here = Path(__file__).resolve().parent
-output = Path(os.environ.get("TRAJGEN_EXAMPLE_OUTPUT") or tempfile.mkdtemp(prefix="trajgen-example-"))
+# The files go to $TRAJGEN_EXAMPLE_OUTPUT if it is set (and stay there), else to a temporary
+# folder that is removed when the script ends.
+kept = os.environ.get("TRAJGEN_EXAMPLE_OUTPUT")
+scratch = None if kept else tempfile.TemporaryDirectory(prefix="trajgen-example-")
+output = Path(kept or scratch.name).resolve()
 
 # 1. The AGV maker's factsheet (VDA 5050 2.1.0) gives speedMax, accelerationMax and
 #    decelerationMax. trajgen's limits are symmetric, so it takes the smaller of the two
@@ -90,7 +94,7 @@ options = Vda5050Options(
 )
 files = write_orders(result.verified, scenario.names, output / "vda5050", options=options)
 for path in files:
-    print(f"wrote {path.relative_to(output)}")
+    print(f"wrote {path}")
 
 # 4. agv1's first order: released to the hold node 1.5 m (the separation) before the junction,
 #    the junction and beyond it still horizon, because agv2 goes through first.
@@ -113,3 +117,6 @@ print(
 )
 update = next(e for e in manifest["messages"] if e["vehicle"] == "agv1" and e["order_update_id"] == 1)
 print(f"agv1 may pass the junction at t = {update['send_at_s']:.3f} s")
+if scratch is not None:
+    print(f"(the files in {output} are removed now: set TRAJGEN_EXAMPLE_OUTPUT=DIR to keep them)")
+    scratch.cleanup()

@@ -30,7 +30,11 @@ from trajgen.plots.animation import frame_geometry, playback
 
 here = Path(__file__).resolve().parent
 scenario = load_scenario(here / "swap.toml")
-output = Path(os.environ.get("TRAJGEN_EXAMPLE_OUTPUT") or tempfile.mkdtemp(prefix="trajgen-example-"))
+# The files go to $TRAJGEN_EXAMPLE_OUTPUT if it is set (and stay there), else to a temporary
+# folder that is removed when the script ends.
+kept = os.environ.get("TRAJGEN_EXAMPLE_OUTPUT")
+scratch = None if kept else tempfile.TemporaryDirectory(prefix="trajgen-example-")
+output = Path(kept or scratch.name).resolve()
 
 # 1. The schedule to show: the optimal swap, certified (plots accept nothing else).
 route = scenario.plan()
@@ -64,3 +68,6 @@ files = {
 }
 for path in commit_files(files):
     print(f"wrote {path} ({path.stat().st_size:,} bytes)")
+if scratch is not None:
+    print(f"(the files in {output} are removed now: set TRAJGEN_EXAMPLE_OUTPUT=DIR to keep them)")
+    scratch.cleanup()

@@ -57,17 +57,31 @@ def test_example_runs(script, tmp_path, monkeypatch, capsys):
     monkeypatch.chdir(tmp_path)
     monkeypatch.setattr(sys, "argv", [str(script)])
     runpy.run_path(str(script), run_name="__main__")
-    _check_figure(script, capsys.readouterr().out)
+    out = capsys.readouterr().out
+    _check_figure(script, out)
+    for line in out.splitlines():  # what it wrote, named by absolute paths, is kept in the folder given
+        if line.startswith("wrote "):
+            path = line.removeprefix("wrote ").split(" (")[0]
+            assert os.path.isabs(path), line
+            assert os.path.exists(path), line
 
 
 def test_an_example_runs_as_its_own_process_as_a_user_starts_it(tmp_path):
-    script = REPO / "examples" / "01_plan_a_swap.py"
-    env = {**os.environ, "MPLBACKEND": "Agg", "TRAJGEN_EXAMPLE_OUTPUT": str(tmp_path)}
+    """As a user runs it, without TRAJGEN_EXAMPLE_OUTPUT: absolute paths, and nothing left behind."""
+    script = REPO / "examples" / "08_vda5050_export.py"
+    env = {k: v for k, v in os.environ.items() if k != "TRAJGEN_EXAMPLE_OUTPUT"}
+    env |= {"MPLBACKEND": "Agg", "TMPDIR": str(tmp_path)}
     result = subprocess.run(
         [sys.executable, str(script)], cwd=tmp_path, env=env, capture_output=True, text=True, timeout=600
     )
     assert result.returncode == 0, result.stderr
     _check_figure(script, result.stdout)
+    written = [
+        line.removeprefix("wrote ") for line in result.stdout.splitlines() if line.startswith("wrote ")
+    ]
+    assert written
+    assert all(os.path.isabs(path) and path.startswith(str(tmp_path)) for path in written), written
+    assert list(tmp_path.iterdir()) == []  # its temporary folder is gone
 
 
 def test_every_example_has_its_figure():
