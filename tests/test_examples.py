@@ -29,7 +29,7 @@ FIGURES = {
     "04_online_stop_in_the_junction": (r"closest approach ([0-9.]+) m", 1.550, 0.003),
     # equal vehicles: the paper's class; both move at once, the waiting one parks only as deep as needed
     "05_unequal_legs": (r"optimal / exact = ([0-9.]+)", 0.364, 0.005),
-    # the README's figures: 37.46 s in the paper's class, 33.84 s in the other
+    # docs/timing.md: 37.45 s in the paper's class, 33.83 s in the other (tests/test_docs_figures.py)
     "06_two_different_vehicles": (r"time saved by the other class: ([0-9.]+) s", 3.62, 0.05),
     # a point moved by 1 cm breaks the velocity (closed form), acceleration and jerk (divided
     # differences), and makes a velocity step no drive follows within 1 mm
