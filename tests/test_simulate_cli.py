@@ -305,3 +305,60 @@ def test_the_plot_data_hold_each_vehicles_frontier_and_no_vehicle_passes_it(meth
     assert np.ptp(frontier[1, standing]) < 1e-6
     # and the frontier moves on once agv1 drives again
     assert np.nanmax(np.where(bound[1] & (t > 11.5), frontier[1], np.nan)) > frontier[1, standing][0] + 0.1
+
+
+def test_a_fault_due_after_the_run_ended_is_reported_as_never_applied(capsys):
+    argv = ["simulate", SWAP, "--method", "exact", "--fault", "stop:agv1@500+3", "--json"]
+    assert main(argv) == EXIT_OK
+    summary = json.loads(capsys.readouterr().out)
+    # the run ends when both vehicles are at their goals: the plan's 67.5 s, not the fault's 503 s
+    assert summary["makespan_s"] == pytest.approx(67.5, abs=0.011)
+    assert summary["time_lost_s"] == pytest.approx(0.0, abs=0.011)
+    assert summary["cycles"] <= 6752
+    assert summary["unapplied_faults"] == ["stop:agv1@500+3"]
+    assert main(argv[:-1]) == EXIT_OK
+    assert "fault: stop:agv1@500+3 (never applied: the run ended at 67.5" in capsys.readouterr().out
+
+
+def test_events_name_the_vehicles_by_their_names(capsys):
+    assert main(["simulate", SWAP, "--method", "exact", "--fault", "stop:agv1@20+5", "--json"]) == EXIT_OK
+    summary = json.loads(capsys.readouterr().out)
+    details = " ".join(event["detail"] for event in summary["events"])
+    assert "agv1 is off its setpoints" in details
+    assert "vehicle 1" not in details
+    assert "vehicle 2" not in details
+    assert summary["unapplied_faults"] == []
+
+
+def test_a_run_of_repeated_events_prints_as_one_line_with_its_count():
+    from trajgen.closed_loop import format_simulation
+
+    events = [
+        {"t_s": 10.0 + 0.01 * k, "kind": "retime", "detail": "agv2 holds: the braking check"}
+        for k in range(784)
+    ]
+    events.append({"t_s": 30.0, "kind": "done", "detail": "both vehicles at their goals"})
+    summary = {
+        "reached_goal": True,
+        "makespan_s": 30.0,
+        "planned_s": 27.5,
+        "time_lost_s": 2.5,
+        "min_separation_m": 1.6,
+        "certified_separation_m": 1.6,
+        "velocity_ratio": 1.0,
+        "acceleration_ratio": 1.0,
+        "jerk_ratio": 1.0,
+        "replans": 0,
+        "rejected_goals": 0,
+        "violations": 0,
+        "separation_violations": 0,
+        "limit_violations": 0,
+        "cycles": 3000,
+        "faults": [],
+        "events": events,
+    }
+    lines = [line for line in format_simulation(summary, min_separation=1.5).splitlines() if "event" in line]
+    assert lines == [
+        "event     10.000 s  retime: agv2 holds: the braking check (x784, until 17.830 s)",
+        "event     30.000 s  done: both vehicles at their goals",
+    ]

@@ -19,7 +19,7 @@ from trajgen.errors import InputError
 from trajgen.export import CsvOptions, check_output_paths, commit_files, profile_paths
 from trajgen.methods import METHODS
 from trajgen.model.schedule import TimingMethod
-from trajgen.online.executor import PERIOD_RANGE
+from trajgen.online.messages import PERIOD_RANGE
 from trajgen.online.simulation import SimulationResult, parse_faults, simulate
 from trajgen.plots import render_simulation
 from trajgen.scenario import Scenario
@@ -164,6 +164,25 @@ def run_simulation(
     return result, tuple(written)
 
 
+def _event_lines(events: list[dict]) -> list[str]:
+    """One line per event; a run of events of one kind and text is one line with its count and span."""
+    lines: list[str] = []
+    k = 0
+    while k < len(events):
+        first, last = events[k], k
+        while last + 1 < len(events) and (events[last + 1]["kind"], events[last + 1]["detail"]) == (
+            first["kind"],
+            first["detail"],
+        ):
+            last += 1
+        line = f"event {first['t_s']:10.3f} s  {first['kind']}: {first['detail']}"
+        if last > k:
+            line += f" (x{last - k + 1}, until {events[last]['t_s']:.3f} s)"
+        lines.append(line)
+        k = last + 1
+    return lines
+
+
 def format_simulation(summary: dict, *, min_separation: float) -> str:
     """Human-readable lines of a simulation's summary (:meth:`SimulationResult.summary`).
 
@@ -186,7 +205,12 @@ def format_simulation(summary: dict, *, min_separation: float) -> str:
         f"violations: {summary['violations']} (separation {summary['separation_violations']}, "
         f"limits {summary['limit_violations']}) in {summary['cycles']} cycles",
     ]
-    lines += [f"fault: {spec}" for spec in summary["faults"]]
-    lines += [f"event {e['t_s']:10.3f} s  {e['kind']}: {e['detail']}" for e in summary["events"]]
+    unapplied = set(summary.get("unapplied_faults", ()))
+    lines += [
+        f"fault: {spec}"
+        + (f" (never applied: the run ended at {summary['makespan_s']:.3f} s)" if spec in unapplied else "")
+        for spec in summary["faults"]
+    ]
+    lines += _event_lines(summary["events"])
     lines += [f"wrote {path}" for path in summary.get("files", ())]
     return "\n".join(lines)

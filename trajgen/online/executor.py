@@ -41,11 +41,22 @@ from trajgen.model.coordination import (
     stopping_distance,
 )
 from trajgen.model.paths import VehiclePath
-from trajgen.model.schedule import check_period
 from trajgen.model.summary import class_name
 from trajgen.online.braking import PathState
 from trajgen.online.goals import goal_refusal, plan_from_rest
-from trajgen.online.messages import Command, Event, GoalDecision, Mode, Setpoint, VehicleState, checked_state
+from trajgen.online.messages import (
+    PERIOD_RANGE,
+    Command,
+    Event,
+    GoalDecision,
+    Mode,
+    Setpoint,
+    VehicleState,
+    checked_names,
+    checked_number,
+    checked_period,
+    checked_state,
+)
 from trajgen.online.motion import AT_REST, PlanPlayer, VehicleMotion
 from trajgen.online.safety import SafetyGuard
 from trajgen.verification import VerifiedSchedule, require_verified
@@ -55,16 +66,8 @@ __all__ = ["PERIOD_RANGE", "Command", "Event", "Executor", "GoalDecision", "Mode
 
 logger = logging.getLogger(__name__)
 
-#: Shortest and longest control period, seconds.
-PERIOD_RANGE = (0.002, 0.1)
 #: A vehicle within this travel of a point is at it, metres.
 _AT = 1e-6
-
-
-def _finite_positive(value: object, name: str) -> float:
-    if not (isinstance(value, (int, float)) and math.isfinite(value) and value > 0.0):
-        raise InputError(f"{name} must be a finite number > 0, got {value!r}")
-    return float(value)
 
 
 class Executor:
@@ -87,6 +90,8 @@ class Executor:
     latency : float, optional
         How late a drive may follow its setpoints, seconds: a vehicle within the tolerances of any
         setpoint of that window is on them.
+    names : pair of str, optional
+        The vehicles' names, as the events call them (default "vehicle 1", "vehicle 2").
     """
 
     def __init__(
@@ -99,24 +104,16 @@ class Executor:
         velocity_tolerance: float = 0.05,
         position_margin: float = 0.05,
         latency: float = 0.2,
+        names: tuple[str, str] = ("vehicle 1", "vehicle 2"),
     ) -> None:
         verified = require_verified(verified, "Executor")
+        self.names = checked_names(names)
         schedule = verified.schedule
-        period = check_period(period)
-        if not PERIOD_RANGE[0] <= period <= PERIOD_RANGE[1]:
-            raise InputError(
-                f"control period must be {PERIOD_RANGE[0]:g} to {PERIOD_RANGE[1]:g} s, got {period!r}"
-            )
-        self.position_tolerance = _finite_positive(position_tolerance, "position_tolerance (m)")
-        self.velocity_tolerance = _finite_positive(velocity_tolerance, "velocity_tolerance (m/s)")
-        self.latency = _finite_positive(latency, "latency (s)")
-        if not (
-            isinstance(position_margin, (int, float))
-            and math.isfinite(position_margin)
-            and position_margin >= 0
-        ):
-            raise InputError(f"position_margin (m) must be a finite number >= 0, got {position_margin!r}")
-        self.position_margin = float(position_margin)
+        period = checked_period(period)
+        self.position_tolerance = checked_number(position_tolerance, "position_tolerance (m)")
+        self.velocity_tolerance = checked_number(velocity_tolerance, "velocity_tolerance (m/s)")
+        self.latency = checked_number(latency, "latency (s)")
+        self.position_margin = checked_number(position_margin, "position_margin (m)", zero=True)
         if min_separation is None:
             min_separation = schedule.limits.min_separation
         if not (
@@ -240,15 +237,15 @@ class Executor:
         try:
             position = self.graph.check(position)
         except InputError as error:
-            return self._refuse(f"goal {position} of vehicle {vehicle + 1}: {error}")
+            return self._refuse(f"goal {position} of {self.names[vehicle]}: {error}")
         goal = list(self._next_goal or self._goal)
         goal[vehicle] = position
         candidate = Configuration(*goal)
         reason = goal_refusal(self.graph, candidate, self.limits.min_separation + 2.0 * self.position_margin)
         if reason is not None:
-            return self._refuse(f"vehicle {vehicle + 1}: {reason}")
+            return self._refuse(f"{self.names[vehicle]}: {reason}")
         self._next_goal = candidate
-        self._log("goal-accepted", f"new goal {position} for vehicle {vehicle + 1}: both stop, then re-plan")
+        self._log("goal-accepted", f"new goal {position} for {self.names[vehicle]}: both stop, then re-plan")
         return GoalDecision(True)
 
     def request_speed_limit(self, vehicle: int, speed: float) -> None:
@@ -262,7 +259,7 @@ class Executor:
             )
         self._motions[vehicle].set_speed_limit(float(speed))
         self._leave_plan(vehicle, f"speed limit {speed:g} m/s")
-        self._log("speed-limit", f"vehicle {vehicle + 1} held to {speed:g} m/s")
+        self._log("speed-limit", f"{self.names[vehicle]} held to {speed:g} m/s")
 
     # -- the cycle -------------------------------------------------------------------------------
     def step(self, first: VehicleState, second: VehicleState) -> Command:
@@ -283,7 +280,7 @@ class Executor:
             return self._emergency_stop(measured, "a vehicle is off its path beyond the margins")
         for v in (0, 1):
             if self._departed(v, along[v]):
-                self._leave_plan(v, f"vehicle {v + 1} is off its setpoints", rebase=along[v])
+                self._leave_plan(v, f"{self.names[v]} is off its setpoints", rebase=along[v])
         if self._next_goal is not None:
             return self._stop_for_goal(measured, along)
         earliest = [
@@ -315,7 +312,7 @@ class Executor:
                 jerk_limited=self.schedule.jerk_limited,
             ):
                 return state, heading * jerk, axis
-            self._leave_plan(v, f"vehicle {v + 1} meets its frontier at {frontier:.3f} m")
+            self._leave_plan(v, f"{self.names[v]} meets its frontier at {frontier:.3f} m")
         limit = min(frontier, path.length)
         command = self._command[v]
         motion = self._motions[v]
@@ -368,7 +365,7 @@ class Executor:
                     for v in order:
                         holding[v] = True
                         proposals[v] = (*self._motions[v].brake(self._command[v], self.period), None)
-                        self._leave_plan(v, f"vehicle {v + 1} holds: the braking check")
+                        self._leave_plan(v, f"{self.names[v]} holds: the braking check")
                     self.holds += 1
                     break
         if not certified:

@@ -12,8 +12,21 @@ from dataclasses import dataclass
 from topology import JUNCTION_INDEX, StarGraph
 from topology.options import Option
 from trajgen.errors import InputError
+from trajgen.model.schedule import check_period
 
-__all__ = ["Command", "Event", "GoalDecision", "Mode", "Setpoint", "VehicleState", "checked_state"]
+__all__ = [
+    "PERIOD_RANGE",
+    "Command",
+    "Event",
+    "GoalDecision",
+    "Mode",
+    "Setpoint",
+    "VehicleState",
+    "checked_names",
+    "checked_number",
+    "checked_period",
+    "checked_state",
+]
 
 
 class Mode(Option):
@@ -132,6 +145,47 @@ class GoalDecision:
 
     accepted: bool
     reason: str = ""
+
+
+#: Shortest and longest control period, seconds.
+PERIOD_RANGE = (0.002, 0.1)
+
+
+def checked_period(period: object) -> float:
+    """A control period within :data:`PERIOD_RANGE`, seconds.
+
+    Raises
+    ------
+    InputError
+        Not a finite number, or outside the range (naming both).
+    """
+    period = check_period(period)
+    if not PERIOD_RANGE[0] <= period <= PERIOD_RANGE[1]:
+        raise InputError(
+            f"control period must be {PERIOD_RANGE[0]:g} to {PERIOD_RANGE[1]:g} s, got {period!r}"
+        )
+    return period
+
+
+def checked_number(value: object, name: str, *, zero: bool = False) -> float:
+    """``value`` as a float if it is a finite number > 0 (``zero``: >= 0), else InputError naming ``name``."""
+    finite = isinstance(value, (int, float)) and math.isfinite(value)
+    if not (finite and (value > 0.0 or (zero and value == 0))):
+        raise InputError(f"{name} must be a finite number {'>=' if zero else '>'} 0, got {value!r}")
+    return float(value)
+
+
+def checked_names(names: object) -> tuple[str, str]:
+    """The two vehicles' names as events call them: two non-empty strings.
+
+    Raises
+    ------
+    InputError
+        Naming the value given.
+    """
+    if not (isinstance(names, tuple) and len(names) == 2 and all(isinstance(n, str) and n for n in names)):
+        raise InputError(f"names must be two non-empty strings, got {names!r}")
+    return names
 
 
 def checked_state(state: object, number: int, graph: StarGraph) -> VehicleState:

@@ -90,6 +90,8 @@ class SimulationResult:
         The undisturbed plan.
     position_margin : float
         The margin the executor's conflicts kept beyond the separation, metres.
+    unapplied_faults : tuple of Fault
+        The faults that never applied: due after the run had ended (both vehicles at their goals).
     """
 
     reached_goal: bool
@@ -113,6 +115,7 @@ class SimulationResult:
     plot: dict = field(repr=False)
     schedule: VerifiedSchedule = field(repr=False)
     position_margin: float = 0.0
+    unapplied_faults: tuple[Fault, ...] = ()
 
     @property
     def violations(self) -> int:
@@ -140,6 +143,7 @@ class SimulationResult:
             "limit_violations": self.limit_violations,
             "cycles": self.cycles,
             "faults": [fault.spec for fault in self.faults],
+            "unapplied_faults": [fault.spec for fault in self.unapplied_faults],
             "events": [{"t_s": round(e.time, 6), "kind": e.kind, "detail": e.detail} for e in self.events],
         }
 
@@ -264,7 +268,11 @@ def simulate(
     if verified is None:
         verified = plan_for_execution(scenario, method=method, position_margin=position_margin)
     executor = Executor(
-        verified, period=period, position_margin=margin, min_separation=scenario.limits.min_separation
+        verified,
+        period=period,
+        position_margin=margin,
+        min_separation=scenario.limits.min_separation,
+        names=scenario.names,
     )
     plant = Plant(executor, faults, period)
     jerk_limited = verified.schedule.jerk_limited
@@ -272,7 +280,6 @@ def simulate(
     planned = verified.schedule.duration
     horizon = _time_limit(planned, faults, limits, scenario.track)
     pending = sorted((f for f in faults if f.kind in (FaultKind.JUMP, FaultKind.GOAL)), key=lambda f: f.time)
-    settle = max((f.time + (f.value if f.kind is FaultKind.STOP else 0.0) for f in faults), default=0.0)
     spool = Trace(scenario.track, trace) if trace is not None else None
     plot = Decimated(PLOT_SAMPLES)
     worst = [0.0, 0.0, 0.0]
@@ -332,12 +339,8 @@ def simulate(
             if spool is not None:
                 spool.add(t, bodies)
             plot.add((t, bodies[0].v, bodies[1].v, now, *executor.travel, *command.frontiers))
-            done = (
-                command.mode is Mode.DONE
-                and not pending
-                and t >= settle
-                and all(abs(b.v) <= _AT_REST for b in bodies)
-            )
+            # both at their goals: the run ends, also before a stop or slow-down that would come later
+            done = command.mode is Mode.DONE and not pending and all(abs(b.v) <= _AT_REST for b in bodies)
             if done:
                 makespan = t
                 break
@@ -355,6 +358,9 @@ def simulate(
     }
     reached = makespan is not None
     makespan = makespan if reached else t
+    unapplied = tuple(f for f in faults if f.time > makespan + 1e-9)
+    for fault in unapplied:
+        logger.info("fault %s never applied: the run ended at %.3f s", fault.spec, makespan)
     result = SimulationResult(
         reached_goal=reached,
         makespan_s=makespan,
@@ -377,5 +383,6 @@ def simulate(
         plot=samples,
         schedule=verified,
         position_margin=margin,
+        unapplied_faults=unapplied,
     )
     return result, spool
