@@ -14,7 +14,8 @@ from tests.conftest import REPO
 from tests.helpers import LIMITS, MIXED, route_of
 from trajgen import Exact, Optimal, Toppra, certify, default_scenario, make_schedule, run
 from trajgen.cli import EXIT_BAD_INPUT, EXIT_FAILURE, EXIT_OK, main
-from trajgen.errors import OptionError, OutputLimitError, ProfileFileError, VerificationError
+from trajgen.errors import InputError, OptionError, OutputLimitError, ProfileFileError, VerificationError
+from trajgen.export import CsvOptions, write_profiles
 from trajgen.export.check import check_profiles
 from trajgen.export.dialects import DIALECTS, TableDialect
 from trajgen.export.plc import plc_tables
@@ -485,3 +486,37 @@ def test_a_file_no_dialect_reads_gets_the_generic_message_alone(tmp_path, capsys
     err = capsys.readouterr().err
     assert "is not trajgen's" in err
     assert "pass --dialect" not in err
+
+
+def test_write_tables_writes_a_dialects_files_verified_both_or_neither(swap, tmp_path):
+    from trajgen.export import plc_tables, write_tables
+
+    written = write_tables(swap, ("agv1", "agv2"), tmp_path / "out", dialect="siemens-xy")
+    assert [p.name for p in written] == ["agv1.csv", "agv2.csv"]
+    assert tuple(p.read_bytes() for p in written) == plc_tables(swap, "siemens-xy").contents
+    assert main(["check", SWAP, "--csv", str(tmp_path / "out"), "--dialect", "siemens-xy"]) == EXIT_OK
+    with pytest.raises(OptionError, match="dialect 'generic' is sampled, not resampled: write it with"):
+        write_tables(swap, ("agv1", "agv2"), tmp_path / "generic", dialect="generic")
+    assert not (tmp_path / "generic").exists()
+
+
+@pytest.mark.parametrize(
+    ("call", "remedy"),
+    [
+        pytest.param(
+            lambda swap, folder: write_profiles(swap, ("a", "b"), folder, options=CsvOptions(max_rows=10)),
+            "CsvOptions(max_rows=...) or --max-rows",
+            id="rows",
+        ),
+        pytest.param(
+            lambda swap, folder: plc_tables(swap, "siemens-xy", max_points=3),
+            "max_points=... or --max-points",
+            id="points",
+        ),
+    ],
+)
+def test_an_api_error_names_the_apis_remedy_and_the_flag(swap, tmp_path, call, remedy):
+    with pytest.raises((InputError, VerificationError)) as raised:
+        call(swap, tmp_path / "out")
+    assert remedy in str(raised.value)
+    assert not (tmp_path / "out").exists()

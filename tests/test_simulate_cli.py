@@ -362,3 +362,15 @@ def test_a_run_of_repeated_events_prints_as_one_line_with_its_count():
         "event     10.000 s  retime: agv2 holds: the braking check (x784, until 17.830 s)",
         "event     30.000 s  done: both vehicles at their goals",
     ]
+
+
+def test_run_simulation_returns_a_named_result_with_its_files(tmp_path):
+    from trajgen import Exact
+    from trajgen.closed_loop import SimulationRun
+
+    run = run_simulation(load_scenario(SWAP), ["stop:agv1@8+3"], method=Exact(), plot_dir=tmp_path)
+    assert isinstance(run, SimulationRun)
+    assert run.result.reached_goal
+    assert run.files == (tmp_path / "simulation.png",)
+    assert run.summary()["files"] == [str(tmp_path / "simulation.png")]
+    assert run.summary()["makespan_s"] == round(run.result.makespan_s, 6)

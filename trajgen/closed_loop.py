@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
+from dataclasses import dataclass
 from pathlib import Path
 
 from topology.validation import finite_real, short_repr
@@ -24,7 +25,7 @@ from trajgen.online.simulation import SimulationResult, parse_faults, simulate
 from trajgen.plots import render_simulation
 from trajgen.scenario import Scenario
 
-__all__ = ["SIMULATION_PLOT_NAME", "format_simulation", "run_simulation", "simulation_paths"]
+__all__ = ["SIMULATION_PLOT_NAME", "SimulationRun", "format_simulation", "run_simulation", "simulation_paths"]
 
 #: The file written into the plot folder.
 SIMULATION_PLOT_NAME = "simulation.png"
@@ -83,6 +84,26 @@ def _check_settings(period: object, position_margin: object) -> tuple[float, flo
     return period, float(position_margin)
 
 
+@dataclass(frozen=True, slots=True)
+class SimulationRun:
+    """What :func:`run_simulation` did and wrote.
+
+    Attributes
+    ----------
+    result : SimulationResult
+        The closed-loop run: goal reached, makespan, separation, violations, events.
+    files : tuple of Path
+        Every file written (the trace and the plot, committed together).
+    """
+
+    result: SimulationResult
+    files: tuple[Path, ...]
+
+    def summary(self) -> dict:
+        """The JSON-ready summary ``trajgen simulate --json`` prints: the result's and ``files``."""
+        return {**self.result.summary(), "files": [str(path) for path in self.files]}
+
+
 def run_simulation(
     scenario: Scenario,
     specs: Sequence[str] = (),
@@ -93,7 +114,7 @@ def run_simulation(
     trace_dir: str | Path | None = None,
     plot_dir: str | Path | None = None,
     csv_options: CsvOptions | None = None,
-) -> tuple[SimulationResult, tuple[Path, ...]]:
+) -> SimulationRun:
     """Simulate ``scenario`` under the faults ``specs`` and commit its trace and plot.
 
     Parameters
@@ -117,9 +138,9 @@ def run_simulation(
 
     Returns
     -------
-    SimulationResult, tuple of Path
-        What the run did, and every file written (committed together). A run that missed its goal
-        or had violations still writes its files.
+    SimulationRun
+        What the run did (``.result``) and every file written (``.files``, committed together). A
+        run that missed its goal or had violations still writes its files.
 
     Raises
     ------
@@ -161,7 +182,7 @@ def run_simulation(
     finally:
         if trace is not None:
             trace.close()
-    return result, tuple(written)
+    return SimulationRun(result, tuple(written))
 
 
 def _event_lines(events: list[dict]) -> list[str]:

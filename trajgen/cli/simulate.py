@@ -17,7 +17,7 @@ def _command_simulate(args: argparse.Namespace) -> int:
     from trajgen.export.csv import CsvOptions
 
     scenario = scenario_from(args.scenario)
-    result, files = run_simulation(
+    run = run_simulation(
         scenario,
         args.fault,
         period=args.period,
@@ -27,7 +27,7 @@ def _command_simulate(args: argparse.Namespace) -> int:
         plot_dir=args.plot,
         csv_options=CsvOptions(**csv_dialect(args)),
     )
-    summary = {**result.summary(), "files": [str(path) for path in files]}
+    result, summary = run.result, run.summary()
     if args.json:
         print(json.dumps(summary, indent=2))
     else:

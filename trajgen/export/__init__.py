@@ -20,6 +20,8 @@ if TYPE_CHECKING:
         render_profile,
         write_profiles,
     )
+    from trajgen.export.dialects import DIALECTS, Dialect, DialectName, TableDialect
+    from trajgen.export.plc import PlcTables, plc_tables, table_paths, write_tables
     from trajgen.export.vda5050 import (
         Vda5050Options,
         plan_orders,
@@ -30,6 +32,14 @@ if TYPE_CHECKING:
 
 #: Where each name lives: importing one exporter does not import the others.
 _SOURCES = {
+    "DIALECTS": "trajgen.export.dialects",
+    "Dialect": "trajgen.export.dialects",
+    "DialectName": "trajgen.export.dialects",
+    "PlcTables": "trajgen.export.plc",
+    "TableDialect": "trajgen.export.dialects",
+    "plc_tables": "trajgen.export.plc",
+    "table_paths": "trajgen.export.plc",
+    "write_tables": "trajgen.export.plc",
     "CsvOptions": "trajgen.export.csv",
     "DEFAULT_MAX_ROWS": "trajgen.export.csv",
     "HEADER_NAMES": "trajgen.export.csv",
@@ -53,8 +63,13 @@ _SOURCES = {
 
 __all__ = [
     "DEFAULT_MAX_ROWS",
+    "DIALECTS",
     "HEADER_NAMES",
     "CsvOptions",
+    "Dialect",
+    "DialectName",
+    "PlcTables",
+    "TableDialect",
     "Units",
     "Vda5050Options",
     "check_output_paths",
@@ -63,14 +78,17 @@ __all__ = [
     "format_block",
     "format_rows",
     "plan_orders",
+    "plc_tables",
     "profile_chunk_pair",
     "profile_chunks",
     "profile_paths",
     "render_manifest",
     "render_orders",
     "render_profile",
+    "table_paths",
     "write_orders",
     "write_profiles",
+    "write_tables",
 ]
 
 

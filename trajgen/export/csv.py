@@ -43,6 +43,10 @@ __all__ = [
 
 #: Most rows of one CSV profile unless ``CsvOptions.max_rows`` says otherwise (a day at 10 ms: 8.64 million).
 DEFAULT_MAX_ROWS = 10_000_000
+#: What a profile over the row limit can change, in Python and on the command line.
+_ROW_LIMIT_REMEDY = (
+    "(raise CsvOptions(max_rows=...) or --max-rows, or sample less often: sample_period, --sample-period)"
+)
 #: Rows sampled (once for both vehicles' files: :func:`profile_chunk_pair`) and formatted at a time while
 #: streaming a profile; memory is bounded by this many rows whatever the duration.
 ROWS_PER_CHUNK = 20_000
@@ -209,13 +213,13 @@ def check_row_limit(duration: float, options: CsvOptions, *, lower_bound: bool =
         raise OutputLimitError(
             f"a CSV profile of this {'scenario' if lower_bound else 'schedule'} has {what}{rows:,.0f} rows "
             f"({duration:.6g} s every {options.sample_period:g} s): expected at most max_rows "
-            f"{options.max_rows:,} (raise --max-rows, or a longer --sample-period)"
+            f"{options.max_rows:,} {_ROW_LIMIT_REMEDY}"
         )
     rows = profile_rows(duration, options)
     if rows > options.max_rows:  # the last row at the goal, after the grid
         raise OutputLimitError(
             f"a CSV profile of this schedule has {rows:,} rows: "
-            f"expected at most max_rows {options.max_rows:,} (raise --max-rows, or a longer --sample-period)"
+            f"expected at most max_rows {options.max_rows:,} {_ROW_LIMIT_REMEDY}"
         )
     return rows
 

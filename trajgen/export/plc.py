@@ -14,6 +14,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from trajgen.errors import OptionError, VerificationError
+from trajgen.export.atomic import check_output_paths, commit_files
 from trajgen.export.dialects import DIALECTS, TableDialect
 from trajgen.export.resample import Resampled, resample
 from trajgen.export.table_check import TableCheck, check_tables
@@ -21,7 +22,7 @@ from trajgen.export.tables import Interpolation, limit_ratios, slowdown
 from trajgen.scenario.naming import check_vehicle_names
 from trajgen.verification import VerifiedSchedule, require_verified
 
-__all__ = ["PlcTables", "check_dialect_method", "plc_tables", "table_paths"]
+__all__ = ["PlcTables", "check_dialect_method", "plc_tables", "table_paths", "write_tables"]
 
 logger = logging.getLogger(__name__)
 
@@ -134,7 +135,7 @@ def plc_tables(
     if not check.passed:
         raise VerificationError(
             f"the {dialect.name.value} tables ({points} points) fail as their controllers interpolate "
-            f"them: {'; '.join(check.failures[:3])} (more points may help: --max-points)"
+            f"them: {'; '.join(check.failures[:3])} (more points may help: max_points=... or --max-points)"
         )
     logger.info(
         "%s tables: %s points, position error %.3g m, verified",
@@ -143,3 +144,63 @@ def plc_tables(
         max(resampled.position_error),
     )
     return PlcTables(dialect, points, resampled, check, contents)
+
+
+def write_tables(
+    verified: VerifiedSchedule,
+    names: Sequence[str],
+    directory: str | Path,
+    *,
+    dialect: TableDialect | str,
+    max_points: int | None = None,
+) -> tuple[Path, Path]:
+    """Write both vehicles' tables in a PLC ``dialect`` into ``directory``, both or neither.
+
+    The tables are those of :func:`plc_tables` (verified as their controllers interpolate them);
+    the output paths are checked before anything is computed.
+
+    Parameters
+    ----------
+    verified : VerifiedSchedule
+        From :func:`trajgen.verification.certify`.
+    names : sequence of 2 str
+        Vehicle names, used as file names (``<name><suffix>``: ``.txt`` for ``codesys-xy``).
+    directory : path
+        Created if missing.
+    dialect : TableDialect or str
+        A table dialect (:data:`~trajgen.export.dialects.DIALECTS`, not ``generic``: for it see
+        :func:`~trajgen.export.csv.write_profiles`).
+    max_points : int, optional
+        Points per table (default: the dialect's limit).
+
+    Returns
+    -------
+    (Path, Path)
+        The two files written.
+
+    Raises
+    ------
+    InputError
+        Bad names, dialect, points or output folder; nothing written.
+    VerificationError
+        The tables fail as interpolated; nothing written.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> from trajgen import Exact, certify, default_scenario, make_schedule
+    >>> scenario = default_scenario()
+    >>> verified = certify(make_schedule(scenario.plan(), scenario.limits, method=Exact()))
+    >>> with tempfile.TemporaryDirectory() as folder:
+    ...     [p.name for p in write_tables(verified, scenario.names, folder, dialect="codesys-xy")]
+    ['agv1.txt', 'agv2.txt']
+    """
+    chosen = DIALECTS.lookup(dialect)
+    if not isinstance(chosen, TableDialect):
+        raise OptionError(
+            f"dialect {chosen.name.value!r} is sampled, not resampled: write it with write_profiles"
+        )
+    paths = check_output_paths(table_paths(chosen, names, directory))
+    tables = plc_tables(verified, chosen, max_points=max_points)
+    first, second = commit_files(dict(zip(paths, tables.contents, strict=True)))
+    return first, second

@@ -248,7 +248,8 @@ def _points(
     if required.size > max_points:
         raise OutputLimitError(
             f"vehicle {vehicle + 1}'s table needs at least {required.size} points (start, goal and every "
-            f"start, stop and reversal): expected at most max_points {max_points} (raise --max-points)"
+            f"start, stop and reversal): expected at most max_points {max_points} "
+            "(raise max_points=... or --max-points)"
         )
     if required.size + critical.size <= max_points // 2:  # where the vehicles come closest
         required = np.union1d(required, critical)
