@@ -149,3 +149,8 @@ def test_the_python_of_a_page_runs_and_prints_what_it_says(page, tmp_path, monke
         else:  # a script: it runs
             exec(compile(block, name, "exec"), {})  # our own documentation's example
     assert runner.summarize(verbose=False).failed == 0
+
+
+def test_every_page_has_a_python_example_that_the_suite_runs():
+    without = [page.relative_to(DOCS).as_posix() for page in PAGES if not _python_blocks(page)]
+    assert without == [], f"pages without a ```python example: {without}"

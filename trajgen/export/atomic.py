@@ -440,7 +440,7 @@ def commit_files(contents: Mapping[Path | str, bytes | Iterable[bytes]]) -> tupl
 
     Parameters
     ----------
-    contents : mapping of path to bytes or iterable of bytes
+    contents : dict of path to bytes or iterable of bytes
         Every file of the run and its content, whole or as chunks streamed to
         disk one at a time (memory stays bounded), a chunk of each file in
         turn. Missing folders are made.

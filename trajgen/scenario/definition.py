@@ -139,8 +139,24 @@ class Scenario:
     names : tuple of 2 str
         Vehicle names (file names of their CSV profiles).
     start, goal : Configuration
-    source : str
-        Where it came from (file path or ``<built-in swap.toml>``).
+    source : str, optional
+        Where it came from (file path, ``<built-in swap.toml>``; default ``<python>``).
+
+    Examples
+    --------
+    >>> from limits import Limits, VehicleLimits
+    >>> from topology import Configuration, Position, YGraph
+    >>> agv = VehicleLimits(max_velocity=1.0, max_acceleration=0.5, max_jerk=1.0)
+    >>> start = Configuration(Position("A", 10.0), Position("B", 10.0))
+    >>> scenario = Scenario(
+    ...     track=YGraph({"A": 10.0, "B": 10.0, "C": 10.0}),
+    ...     limits=Limits(vehicles=(agv, agv), min_separation=1.5),
+    ...     names=("agv1", "agv2"),
+    ...     start=start,
+    ...     goal=start.swapped(),
+    ... )
+    >>> scenario.names, scenario.source, len(scenario.plan().waypoints)
+    (('agv1', 'agv2'), '<python>', 7)
     """
 
     track: StarGraph
@@ -148,7 +164,7 @@ class Scenario:
     names: tuple[str, str]
     start: Configuration
     goal: Configuration
-    source: str
+    source: str = "<python>"
 
     def __post_init__(self) -> None:
         if not isinstance(self.track, StarGraph):
