@@ -514,3 +514,73 @@ def test_the_default_frame_cap_is_documented():
     assert DEFAULT_MAX_FRAMES == 300
     assert math.isclose(playback(29.9).speedup, 1.0)
     assert playback(30.0).speedup == 2.0
+
+
+# -- the coordination and speed plots explain themselves --------------------------------------------------
+
+
+@pytest.fixture(scope="module")
+def swap_by_method():
+    """The demo swap by every method, verified (optimal parks shallower: other paths, another panel)."""
+    from trajgen.methods import METHODS
+
+    scenario = default_scenario()
+    route = scenario.plan()
+    return {cls.name: certify(make_schedule(route, scenario.limits, method=cls())) for cls in METHODS}
+
+
+def test_the_coordination_plot_draws_the_too_close_region_as_the_diagrams_exact_polygons(swap_by_method):
+    from matplotlib.patches import Polygon
+
+    from trajgen.model.coordination import CoordinationDiagram, plan_paths
+    from trajgen.plots.coordination import coordination_figure
+
+    exact = swap_by_method["exact"].schedule
+    figure = coordination_figure({"exact": swap_by_method["exact"]})
+    (axis,) = figure.axes
+    drawn = sorted(
+        tuple(map(tuple, np.round(p.get_xy()[:-1], 9))) for p in axis.patches if isinstance(p, Polygon)
+    )
+    paths, times, _ = plan_paths(exact)
+    diagram = CoordinationDiagram(paths, exact.limits.min_separation, exact, times)
+    expected = sorted(
+        tuple(tuple(np.round(v, 9)) for v in polygon) for c in diagram.conflicts for polygon in c.polygons
+    )
+    assert drawn == expected
+    assert len(drawn) >= 2  # not a raster: one patch per convex piece of each conflict
+    assert not axis.collections  # no contour mesh
+
+
+def test_a_curve_along_the_frame_stays_inside_it(swap_by_method):
+    from trajgen.plots.coordination import coordination_figure
+
+    (axis,) = coordination_figure({"exact": swap_by_method["exact"]}).axes
+    (curve,) = axis.get_lines()
+    x, y = curve.get_xdata(), curve.get_ydata()
+    (x0, x1), (y0, y1) = axis.get_xlim(), axis.get_ylim()
+    # exact waits at 0 and ends at the full travel: both must lie inside the frame, not on it
+    assert x0 < x.min()
+    assert x.max() < x1
+    assert y0 < y.min()
+    assert y.max() < y1
+    assert curve.get_zorder() > 2
+
+
+def test_two_panels_say_why_each_has_its_own_axes(swap_by_method):
+    from trajgen.plots.coordination import coordination_figure
+
+    figure = coordination_figure(swap_by_method)
+    assert len(figure.axes) == 2
+    why = figure._suptitle.get_text()
+    assert "different paths" in why
+    assert "homotopy class" in why
+    assert all("class " in axis.get_title() for axis in figure.axes)
+    one = coordination_figure({"exact": swap_by_method["exact"]})
+    assert one._suptitle is None
+
+
+def test_the_speed_plot_says_what_a_negative_velocity_means(swap_by_method):
+    from trajgen.plots.speed import speed_figure
+
+    title = speed_figure(swap_by_method["optimal"], names=("agv1", "agv2")).axes[0].get_title()
+    assert "v < 0 is backing out of a side leg" in title

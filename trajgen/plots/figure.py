@@ -23,11 +23,11 @@ def new_figure(*, figsize: tuple[float, float]):
     return Figure(figsize=figsize)
 
 
-def polygon_patch(vertices, *, facecolor, alpha: float, edgecolor):
-    """A closed matplotlib polygon patch through ``vertices`` (array of shape (n, 2))."""
+def polygon_patch(vertices, *, facecolor, alpha: float, edgecolor, label: str | None = None):
+    """A closed polygon patch through ``vertices`` (array of shape (n, 2)), labelled for a legend."""
     from matplotlib.patches import Polygon
 
-    return Polygon(vertices, closed=True, facecolor=facecolor, alpha=alpha, edgecolor=edgecolor)
+    return Polygon(vertices, closed=True, facecolor=facecolor, alpha=alpha, edgecolor=edgecolor, label=label)
 
 
 def png_bytes(figure) -> bytes:

@@ -6,7 +6,7 @@ from trajgen.model.summary import class_label
 from trajgen.plots.figure import new_figure, png_bytes
 from trajgen.verification import VerifiedSchedule, require_verified
 
-__all__ = ["MAX_PLOT_POINTS", "PLOT_PERIOD", "VEHICLE_COLOURS", "plot_period", "render_speed"]
+__all__ = ["MAX_PLOT_POINTS", "PLOT_PERIOD", "VEHICLE_COLOURS", "plot_period", "render_speed", "speed_figure"]
 
 #: Sample period of the plotted curves, seconds (longer for long schedules: see :func:`plot_period`).
 PLOT_PERIOD = 0.01
@@ -26,12 +26,21 @@ VEHICLE_COLOURS = ("tab:blue", "tab:orange")
 def render_speed(verified: VerifiedSchedule, *, names: tuple[str, str] = ("vehicle 1", "vehicle 2")) -> bytes:
     """``v``, ``a``, ``j`` over time for both vehicles with their limit lines, as PNG bytes.
 
+    Each is along the vehicle's own axis, which grows in the direction of its first move: a
+    negative ``v`` is a vehicle moving against it, backing out of a side leg it entered to make
+    room (the figure says so).
+
     Parameters
     ----------
     verified : VerifiedSchedule
     names : pair of str
         Legend labels.
     """
+    return png_bytes(speed_figure(verified, names=names))
+
+
+def speed_figure(verified: VerifiedSchedule, *, names: tuple[str, str] = ("vehicle 1", "vehicle 2")):
+    """The figure of :func:`render_speed`, a matplotlib Figure."""
     schedule = require_verified(verified, "render_speed").schedule
     state = schedule.sample(plot_period(schedule.duration))
     figure = new_figure(figsize=(10.5, 7.5))
@@ -64,9 +73,10 @@ def render_speed(verified: VerifiedSchedule, *, names: tuple[str, str] = ("vehic
         axes[2].set_title("jerk not limited by this method (steps in a)", fontsize=9)
     axes[0].set_title(
         f"{schedule.method.name} schedule, {schedule.duration:.2f} s, class {class_label(schedule.route)}"
-        "\n(dashed: the limits)",
+        "\n(dashed: the limits; along each vehicle's axis, which grows in its first move: "
+        "v < 0 is backing out of a side leg)",
         fontsize=10,
     )
     axes[-1].set_xlabel("t [s]")
     figure.tight_layout()
-    return png_bytes(figure)
+    return figure
