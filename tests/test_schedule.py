@@ -283,3 +283,26 @@ def test_a_round_off_first_move_neither_sets_nor_reverses_the_axis():
     assert axes[-1, 1] == pytest.approx(0.5943996977234296 - 0.5943, abs=1e-9)
     schedule = certify(make_schedule(route, Limits(LIMITS.vehicles, 0.3730053062408387))).schedule
     assert schedule.state(0.5).velocity[0, 0] > 0.0  # the plan's first real move is its axis's + direction
+
+
+def test_the_csv_leg_column_is_the_states_leg_plus_one_and_leg_names_read_both(tmp_path):
+    """One convention, documented where the value appears: CSV 1-based with 0 at the junction."""
+    from topology import JUNCTION_NAME
+    from trajgen import certify, default_scenario, write_profiles
+
+    scenario = default_scenario()
+    verified = certify(make_schedule(scenario.plan(), scenario.limits, method="exact"))
+    first, _ = write_profiles(verified, scenario.names, tmp_path)
+    rows = [line.split(";") for line in first.read_text().splitlines()[1:]]
+    t = np.array([float(row[0]) for row in rows])
+    column = np.array([int(row[5]) for row in rows])
+    state = verified.schedule.state(t)
+    np.testing.assert_array_equal(column, state.leg[0] + 1)
+    names = state.leg_names(scenario.track)
+    assert set(names[0]) == {"A", "B", JUNCTION_NAME}  # agv1 drives A -> O -> (C) -> O -> B
+    assert all(
+        names[0][k] == (JUNCTION_NAME if c == 0 else scenario.track.names[c - 1])
+        for k, c in enumerate(column)
+    )
+    with pytest.raises(ValueError, match="read-only"):
+        names[0, 0] = "C"

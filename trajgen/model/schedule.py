@@ -18,7 +18,7 @@ from typing import ClassVar
 import numpy as np
 
 from limits import Limits
-from topology import JUNCTION_INDEX, Configuration, Position, Route
+from topology import JUNCTION_INDEX, JUNCTION_NAME, Configuration, Position, Route, StarGraph
 from topology.validation import finite_real
 from trajgen.errors import InputError
 from trajgen.model.profiles import PiecewiseCubic
@@ -289,7 +289,10 @@ class ScheduleState(ArrayValue):
     axis, velocity, acceleration, jerk : ndarray, shape (2, n)
         Per vehicle: signed axis (m), its velocity (m/s), acceleration (m/s²), jerk (m/s³).
     leg : ndarray of int, shape (2, n)
-        Leg index (0, 1, 2 in the track's order) or ``JUNCTION_INDEX`` at the junction.
+        Leg index counted from 0 in the track's order (``graph.names[leg]``), or
+        ``JUNCTION_INDEX`` (-1) at the junction. The generic CSV's ``leg`` column is this plus
+        one (1 for the first leg, 0 at the junction); :meth:`leg_names` gives the names, which
+        need no convention.
     s : ndarray, shape (2, n)
         Distance from the junction, metres.
     """
@@ -305,6 +308,21 @@ class ScheduleState(ArrayValue):
     def __post_init__(self) -> None:
         for name in ("t", "axis", "velocity", "acceleration", "jerk", "leg", "s"):
             object.__setattr__(self, name, frozen(np.asarray(getattr(self, name))))
+
+    def leg_names(self, graph: StarGraph) -> np.ndarray:
+        """Each vehicle's leg by its name in ``graph`` (``"O"`` at the junction), shape (2, n), read-only.
+
+        Examples
+        --------
+        >>> from trajgen import default_scenario, make_schedule
+        >>> scenario = default_scenario()
+        >>> schedule = make_schedule(scenario.plan(), scenario.limits, method="exact")
+        >>> state = schedule.state([0.0, schedule.duration])
+        >>> state.leg_names(scenario.track).tolist(), state.leg.tolist()
+        ([['A', 'B'], ['B', 'A']], [[0, 1], [1, 0]])
+        """
+        names = np.array([*graph.names, JUNCTION_NAME], dtype=object)
+        return frozen(names[np.where(self.leg == JUNCTION_INDEX, len(graph.names), self.leg)])
 
 
 @dataclass(frozen=True, slots=True, weakref_slot=True)
