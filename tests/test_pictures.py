@@ -571,12 +571,12 @@ def test_two_panels_say_why_each_has_its_own_axes(swap_by_method):
 
     figure = coordination_figure(swap_by_method)
     assert len(figure.axes) == 2
-    why = figure._suptitle.get_text()
+    why = figure.get_suptitle()
     assert "different paths" in why
     assert "homotopy class" in why
     assert all("class " in axis.get_title() for axis in figure.axes)
     one = coordination_figure({"exact": swap_by_method["exact"]})
-    assert one._suptitle is None
+    assert one.get_suptitle() == ""
 
 
 def test_the_speed_plot_says_what_a_negative_velocity_means(swap_by_method):
