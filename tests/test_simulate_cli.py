@@ -368,9 +368,9 @@ def test_run_simulation_returns_a_named_result_with_its_files(tmp_path):
     from trajgen import Exact
     from trajgen.closed_loop import SimulationRun
 
-    run = run_simulation(load_scenario(SWAP), ["stop:agv1@8+3"], method=Exact(), plot_dir=tmp_path)
+    run = run_simulation(load_scenario(SWAP), ["stop:agv1@8+3"], method=Exact(), trace_dir=tmp_path)
     assert isinstance(run, SimulationRun)
     assert run.result.reached_goal
-    assert run.files == (tmp_path / "simulation.png",)
-    assert run.summary()["files"] == [str(tmp_path / "simulation.png")]
+    assert run.files == (tmp_path / "agv1.csv", tmp_path / "agv2.csv")
+    assert run.summary()["files"] == [str(tmp_path / "agv1.csv"), str(tmp_path / "agv2.csv")]
     assert run.summary()["makespan_s"] == round(run.result.makespan_s, 6)
