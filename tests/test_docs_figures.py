@@ -5,13 +5,13 @@ When a change moves a figure, this test names the page and the figure it now pri
 
 from __future__ import annotations
 
+import runpy
+
 import numpy as np
 import pytest
 
-from limits import Limits, VehicleLimits
 from tests.conftest import REPO
-from topology import Configuration, Position, YGraph, plan
-from trajgen import Optimal, certify, default_scenario, make_schedule, run
+from trajgen import default_scenario, run
 from trajgen.export.dialects import DIALECTS, TableDialect
 from trajgen.export.plc import plc_tables
 
@@ -66,16 +66,12 @@ def test_each_dialects_page_quotes_its_figures(demo_tables, name):
     assert expected in _text(f"formats/{name}.md"), f"formats/{name}.md should say {expected!r}"
 
 
-def test_the_timing_page_quotes_the_mixed_swap_in_both_classes():
-    """Example 06's swap: legs 12/8/15 m, a fast vehicle and a slow one."""
-    track = YGraph({"A": 12.0, "B": 8.0, "C": 15.0})
-    start = Configuration(Position("A", 12.0), Position("B", 8.0))
-    fast = VehicleLimits(max_velocity=1.0, max_acceleration=0.5, max_jerk=1.0)
-    slow = VehicleLimits(max_velocity=0.7, max_acceleration=0.35, max_jerk=0.6)
-    limits = Limits(vehicles=(fast, slow), min_separation=1.5)
-    route = plan(track, start, start.swapped(), min_separation=1.5)
-    paper = make_schedule(route, limits, method=Optimal(homotopy="paper")).duration
-    fastest = certify(make_schedule(route, limits, method=Optimal())).schedule.duration
+def test_the_timing_page_quotes_example_06s_swap_in_both_classes(capsys):
+    """Example 06's swap (legs 12/8/15 m, a fast vehicle and a slow one), as the example computes it."""
+    example = runpy.run_path(str(REPO / "examples" / "06_two_different_vehicles.py"))
+    capsys.readouterr()
+    paper = example["in_paper_class"].schedule.duration
+    fastest = example["fastest"].schedule.duration
     text = _text("timing.md")
     assert f"it takes {fastest:.2f} s against {paper:.2f} s in the paper's class" in text
     assert f"{fastest:.2f} s (other class; {paper:.2f} s in the paper's)" in text

@@ -175,8 +175,8 @@ def write_tables(
 
     Returns
     -------
-    (Path, Path)
-        The two files written.
+    tuple of 2 Path
+        Vehicle 1's and vehicle 2's table, as committed.
 
     Raises
     ------
