@@ -10,6 +10,7 @@ missed its goal or had violations: they are the evidence.
 
 from __future__ import annotations
 
+import itertools
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -187,20 +188,11 @@ def run_simulation(
 
 def _event_lines(events: list[dict]) -> list[str]:
     """One line per event; a run of events of one kind and text is one line with its count and span."""
-    lines: list[str] = []
-    k = 0
-    while k < len(events):
-        first, last = events[k], k
-        while last + 1 < len(events) and (events[last + 1]["kind"], events[last + 1]["detail"]) == (
-            first["kind"],
-            first["detail"],
-        ):
-            last += 1
-        line = f"event {first['t_s']:10.3f} s  {first['kind']}: {first['detail']}"
-        if last > k:
-            line += f" (x{last - k + 1}, until {events[last]['t_s']:.3f} s)"
-        lines.append(line)
-        k = last + 1
+    lines = []
+    for (kind, detail), run in itertools.groupby(events, key=lambda e: (e["kind"], e["detail"])):
+        run = list(run)
+        line = f"event {run[0]['t_s']:10.3f} s  {kind}: {detail}"
+        lines.append(line + (f" (x{len(run)}, until {run[-1]['t_s']:.3f} s)" if len(run) > 1 else ""))
     return lines
 
 

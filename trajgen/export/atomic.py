@@ -77,14 +77,12 @@ def _asked_for(filename: str | os.PathLike, paths: Sequence[Path]) -> Path:
     asked for in that folder.
     """
     name = Path(filename)
-    for path in paths:
-        hidden = name.parent == path.parent and name.name.startswith(f".{path.name}.")
-        if name == path or (hidden and name.name.endswith((_TMP_SUFFIX, _BAK_SUFFIX))):
+    beside = [path for path in paths if path.parent == name.parent]
+    for path in beside:
+        hidden = name.name.startswith(f".{path.name}.") and name.name.endswith((_TMP_SUFFIX, _BAK_SUFFIX))
+        if name == path or hidden:
             return path
-    for path in paths:
-        if name.parent == path.parent and name.name.startswith(JOURNAL_NAME):
-            return path
-    return name
+    return beside[0] if beside and name.name.startswith(JOURNAL_NAME) else name
 
 
 def _probe(folder: Path, path: Path) -> None:
