@@ -303,7 +303,7 @@ class _StandInNlp:
         self.abandoned = False
         self._solver = _SleepySolver(seconds)
 
-    def solver(self, _which):
+    def solver(self, _which, *, ipopt_wall_time):
         return self._solver
 
 

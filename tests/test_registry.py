@@ -26,6 +26,7 @@ from trajgen import (
 )
 from trajgen.errors import InputError, OptionError
 from trajgen.methods import MethodRegistry, MethodSource
+from trajgen.methods.optimal.method import class_copies
 from trajgen.methods.optimal.phases import NO_SWITCH, NlpShape, PhaseKind
 
 SWAP = ((10.0, 10.0, 10.0), ("A:10", "B:10"), ("B:10", "A:10"))
@@ -212,3 +213,27 @@ def test_warm_up_builds_the_shape_ahead_of_the_first_query():
     assert method.warm_up(route) is True
     assert method.warm_up(route) is False
     assert method.schedule(route, LIMITS).info.built is False
+
+
+def test_classes_of_different_shapes_share_the_first_copy_and_only_a_shape_needed_twice_gets_a_second():
+    one, other = _shape(4), _shape(6)
+    assert [s.slot for s in class_copies([one, other])] == [0, 0]
+    assert [s.slot for s in class_copies([one, one])] == [0, 1]
+    assert [s.slot for s in class_copies([one, other, one])] == [0, 0, 1]
+    cache = SolverCache(maxsize=8)
+    method = Optimal(cache=cache)
+    route = route_of(*SWAP)
+    method.warm_up(route)
+    shapes = [method.shape(r) for r in method.class_routes(route)]
+    assert shapes[0] != shapes[1]
+    assert len(cache) == 2
+    assert all(shape in cache for shape in shapes)
+
+
+def test_a_new_time_budget_solves_on_the_nlp_already_built():
+    cache = SolverCache(maxsize=4)
+    route = route_of(*SWAP)
+    assert Optimal(cache=cache, time_budget=2.0).warm_up(route) is True
+    schedule = Optimal(cache=cache, time_budget=7.5).schedule(route, LIMITS)
+    assert schedule.info.built is False
+    assert len(cache) == 2

@@ -40,7 +40,7 @@ from trajgen.export.vda5050_path import OrderPath, vehicle_path
 from trajgen.model.pieces import schedule_pieces
 from trajgen.verification import POSITION_TOLERANCE, VerifiedSchedule, require_verified
 
-__all__ = ["OrderPlan", "Release", "plan_orders"]
+__all__ = ["BaseRelease", "OrderPlan", "Release", "plan_orders"]
 
 
 @dataclass(frozen=True, slots=True)
@@ -105,16 +105,32 @@ def _gap(first: tuple[int, float, float], second: tuple[int, float, float]) -> f
     return low_a + low_b
 
 
-class _Replay:
-    """Both paths replayed node by node in the schedule's order; a vehicle waits at its decision point.
+class BaseRelease:
+    """The release rule of both vehicles' bases: how far each may be released, from the nodes reached.
 
     The order of the track is a *node plan*: a sequence of moves, each taking one vehicle to its next
     node while the other stands at a node, every move keeping the separation, that follows the
     schedule's order of arrivals wherever the nodes allow it. A vehicle's edge is released once the
     other vehicle has reached the node the plan has it at during that move, and its track keeps the
-    separation from the other vehicle's claim; so the replay follows the plan (with more motion at
-    once where the claims allow it) and cannot deadlock. "Reached the node" is relaxed to "left every
-    edge the plan drives before, and that comes closer than the separation".
+    separation from the other vehicle's claim (the stretch from the last node it reached to its
+    decision point); so the vehicles follow the plan (with more motion at once where the claims allow
+    it) and cannot deadlock. "Reached the node" is relaxed to "left every edge the plan drives
+    before, and that comes closer than the separation".
+
+    Only the nodes reached move the releases on, never the time: whatever the timing of either
+    vehicle within its base, the claims stay apart. This is what the live master runs
+    (:mod:`trajgen.live`), on the nodes the vehicles report.
+
+    Parameters
+    ----------
+    paths : tuple of 2 OrderPath
+    separation : float
+        The minimum separation, metres.
+
+    Raises
+    ------
+    ScheduleError
+        No sequence of moves between the nodes keeps the separation.
     """
 
     def __init__(self, paths: tuple[OrderPath, OrderPath], separation: float) -> None:
@@ -123,23 +139,25 @@ class _Replay:
         self.threshold = max(separation - POSITION_TOLERANCE, POSITION_TOLERANCE)
         self.stretches = [[(e.leg, e.low, e.high) for e in path.edges] for path in paths]
         self.points = [[(n.leg, n.s, n.s) for n in path.nodes] for path in paths]
-        self.after = self.node_plan()
+        self.after = self._node_plan()
+        #: per vehicle, the last node it reached and the index of its decision point
         self.reached = [0, 0]
         self.released = [0, 0]
-        self.delay = [0.0, 0.0]
+        for vehicle in (0, 1):
+            self.released[vehicle] = self._extend(vehicle)
+
+    @property
+    def last(self) -> tuple[int, int]:
+        """Each vehicle's goal node index."""
+        return (len(self.points[0]) - 1, len(self.points[1]) - 1)
 
     def apart(self, first: tuple[int, float, float], second: tuple[int, float, float]) -> bool:
+        """Whether two stretches ``(leg, low, high)`` keep the separation."""
         return _gap(first, second) >= self.threshold
 
-    def node_plan(self) -> tuple[list[int], list[int]]:
-        """Per vehicle and edge, the node the other vehicle must have reached before the edge is released.
-
-        Raises
-        ------
-        ScheduleError
-            No sequence of moves between the nodes keeps the separation.
-        """
-        last = (len(self.points[0]) - 1, len(self.points[1]) - 1)
+    def _node_plan(self) -> tuple[list[int], list[int]]:
+        """Per vehicle and edge, the node the other vehicle must have reached before the edge is released."""
+        last = self.last
 
         def move(vehicle: int, k: int, other_node: int) -> bool:
             """Whether ``vehicle`` may drive its edge ``k`` while the other stands at ``other_node``."""
@@ -192,58 +210,96 @@ class _Replay:
         )
 
     def claim(self, vehicle: int) -> list[tuple[int, float, float]]:
+        """The track ``vehicle`` may be on: its last node reached and its base edges beyond it."""
         first, last = self.reached[vehicle], self.released[vehicle]
         return [self.points[vehicle][first], *self.stretches[vehicle][first:last]]
 
-    def allowed(self, vehicle: int, edge: int) -> bool:
+    def _allowed(self, vehicle: int, edge: int) -> bool:
         other = 1 - vehicle
         if self.reached[other] < self.after[vehicle][edge]:
             return False
         stretch = self.stretches[vehicle][edge]
         return all(self.apart(stretch, held) for held in self.claim(other))
 
-    def extend(self, vehicle: int) -> int:
+    def _extend(self, vehicle: int) -> int:
         edge = self.released[vehicle]
-        while edge < len(self.stretches[vehicle]) and self.allowed(vehicle, edge):
+        while edge < len(self.stretches[vehicle]) and self._allowed(vehicle, edge):
             edge += 1
         return edge
+
+    def reach(self, vehicle: int, node: int) -> list[tuple[int, int, int]]:
+        """Record that ``vehicle`` reached ``node``; the releases that follow, the other vehicle's first.
+
+        Parameters
+        ----------
+        vehicle : int
+            0 or 1.
+        node : int
+            Index of the node on its path, at most its decision point (a vehicle does not drive
+            past its base). A node at or before the last one reached changes nothing.
+
+        Returns
+        -------
+        list of (vehicle, previous decision point, new decision point)
+
+        Raises
+        ------
+        ValueError
+            ``node`` is past the vehicle's decision point.
+        """
+        if node > self.released[vehicle]:
+            raise ValueError(
+                f"vehicle {vehicle} node {node} is past its decision point {self.released[vehicle]}; "
+                "expected a node of its base"
+            )
+        if node <= self.reached[vehicle]:
+            return []
+        self.reached[vehicle] = node
+        releases = []
+        for each in (1 - vehicle, vehicle):
+            end = self._extend(each)
+            if end != self.released[each]:
+                releases.append((each, self.released[each], end))
+                self.released[each] = end
+        return releases
+
+
+class _Replay:
+    """Both paths replayed node by node in the schedule's order; a vehicle waits at its decision point."""
+
+    def __init__(self, paths: tuple[OrderPath, OrderPath], separation: float) -> None:
+        self.paths = paths
+        self.rule = BaseRelease(paths, separation)
+        self.delay = [0.0, 0.0]
 
     def time_of(self, vehicle: int, node: int) -> float:
         return self.paths[vehicle].nodes[node].arrival + self.delay[vehicle]
 
     def run(self) -> tuple[list[Release], float]:
-        releases: list[Release] = []
-        for vehicle in (0, 1):
-            self.released[vehicle] = self.extend(vehicle)
-            releases.append(Release(vehicle, 0, 0, self.released[vehicle], 0.0, None, 0.0, None))
+        rule = self.rule
+        releases = [Release(v, 0, 0, rule.released[v], 0.0, None, 0.0, None) for v in (0, 1)]
         counts = [1, 1]
-        last = [len(path.nodes) - 1 for path in self.paths]
-        while self.reached != last:
-            movable = [v for v in (0, 1) if self.reached[v] < self.released[v]]
+        last = list(rule.last)
+        while rule.reached != last:
+            movable = [v for v in (0, 1) if rule.reached[v] < rule.released[v]]
             if not movable:
                 raise ScheduleError(
                     "VDA 5050 orders: the releases deadlock at nodes "
-                    f"{self.reached[0]} and {self.reached[1]}: the schedule's order of the track "
+                    f"{rule.reached[0]} and {rule.reached[1]}: the schedule's order of the track "
                     "cannot be released node by node"
                 )
-            mover = min(movable, key=lambda v: (self.time_of(v, self.reached[v] + 1), v))
-            now = self.time_of(mover, self.reached[mover] + 1)
-            self.reached[mover] += 1
-            for vehicle in (1 - mover, mover):
-                end = self.extend(vehicle)
-                if end == self.released[vehicle]:
-                    continue
-                old = self.released[vehicle]
+            mover = min(movable, key=lambda v: (self.time_of(v, rule.reached[v] + 1), v))
+            now = self.time_of(mover, rule.reached[mover] + 1)
+            for vehicle, old, end in rule.reach(mover, rule.reached[mover] + 1):
                 needed = self.paths[vehicle].nodes[old].departure + self.delay[vehicle]
-                wait = max(0.0, now - needed) if self.reached[vehicle] == old else 0.0
+                wait = max(0.0, now - needed) if rule.reached[vehicle] == old else 0.0
                 self.delay[vehicle] += wait
                 releases.append(
                     Release(
-                        vehicle, counts[vehicle], old, end, now, needed, wait, (mover, self.reached[mover])
+                        vehicle, counts[vehicle], old, end, now, needed, wait, (mover, rule.reached[mover])
                     )
                 )
                 counts[vehicle] += 1
-                self.released[vehicle] = end
         finish = max(self.time_of(v, last[v]) for v in (0, 1))
         return releases, finish
 

@@ -72,6 +72,15 @@ def _positive_int(value: object, name: str, minimum: int = 1) -> None:
         raise InputError(f"optimal option {name} must be an integer >= {minimum}, got {value!r}")
 
 
+def class_copies(shapes: list[NlpShape]) -> list[NlpShape]:
+    """``shapes`` with a copy each where classes solved at once share a shape.
+
+    A compiled NLP runs one solve at a time, so a shape that two classes need gets a second
+    copy; a class whose shape no other class shares uses copy 0, which earlier solves built.
+    """
+    return [dataclasses.replace(shape, slot=shapes[:k].count(shape)) for k, shape in enumerate(shapes)]
+
+
 @dataclass(frozen=True, slots=True)
 class Optimal(TimingMethod):
     """The fastest jerk-limited schedule of the two shortest homotopy classes, verified; else ``exact``.
@@ -178,6 +187,11 @@ class Optimal(TimingMethod):
         """Always True."""
         return True
 
+    @property
+    def _ipopt_wall_time(self) -> float:
+        """Seconds one Ipopt run may take: half the budget (fatrop and the build take the rest)."""
+        return 0.5 * float(self.time_budget)
+
     def _cache(self) -> SolverCache:
         return self.cache if self.cache is not None else Optimal.shared_cache()
 
@@ -189,7 +203,6 @@ class Optimal(TimingMethod):
             segments=self.segments,
             max_iterations=self.max_iterations,
             fatrop_iterations=self.fatrop_iterations,
-            time_budget=float(self.time_budget),
             braking=self.braking_rule,
         )
 
@@ -206,11 +219,8 @@ class Optimal(TimingMethod):
         """Build the NLPs that ``route``'s classes need into the cache now; returns whether any was built."""
         if len(route.waypoints) == 1:
             return False
-        built = [
-            self._cache().get(dataclasses.replace(self.shape(r), slot=k))[1]
-            for k, r in enumerate(self.class_routes(route))
-        ]
-        return any(built)
+        shapes = class_copies([self.shape(r) for r in self.class_routes(route)])
+        return any([self._cache().get(shape)[1] for shape in shapes])
 
     def class_routes(self, route: Route) -> list[Route]:
         """The routes of the classes this method considers: ``route``'s own first, then the other.
@@ -252,6 +262,7 @@ class Optimal(TimingMethod):
         wanted = [k for k, bound in enumerate(bounds) if bound < fastest_exact.duration * (1.0 - 1e-9)]
         deadline = began + self.time_budget
         race = ClassRace(wanted)
+        shapes = dict(zip(wanted, class_copies([self.shape(routes[k]) for k in wanted]), strict=True))
         if len(wanted) > 1:
             with concurrent.futures.ThreadPoolExecutor(
                 len(wanted), thread_name_prefix="trajgen-class"
@@ -262,6 +273,7 @@ class Optimal(TimingMethod):
                         routes[k],
                         limits,
                         exacts[k],
+                        shapes[k],
                         slot=k,
                         deadline=deadline,
                         race=race,
@@ -273,7 +285,14 @@ class Optimal(TimingMethod):
         else:
             solved = {
                 k: self._solve_class(
-                    routes[k], limits, exacts[k], slot=k, deadline=deadline, race=race, bound=bounds[k]
+                    routes[k],
+                    limits,
+                    exacts[k],
+                    shapes[k],
+                    slot=k,
+                    deadline=deadline,
+                    race=race,
+                    bound=bounds[k],
                 )
                 for k in wanted
             }
@@ -380,6 +399,7 @@ class Optimal(TimingMethod):
         route: Route,
         limits: Limits,
         exact: Schedule,
+        shape: NlpShape,
         *,
         slot: int,
         deadline: float,
@@ -388,13 +408,12 @@ class Optimal(TimingMethod):
     ) -> ClassSolve:
         """Solve ``route``'s own class: the first grid, then refinement passes (unverified).
 
-        ``slot``: which compiled copy of the NLP to use (concurrent classes of one shape use two), and
-        this class's place in ``race``, through which a class that another beats by more than its
-        refinement could still gain stops refining; ``bound`` its lower bound, seconds.
+        ``shape``: the NLP to solve it on (its copy, see :func:`class_copies`); ``slot``: this class's
+        place in ``race``, through which a class that another beats by more than its refinement
+        could still gain stops refining; ``bound`` its lower bound, seconds.
         """
         began = time.perf_counter()
         phases = route_phases(route)
-        shape = dataclasses.replace(self.shape(route), slot=slot)
         outcome = ClassSolve(route, limits, phases, shape, built=False)
         try:
             building = time.perf_counter()
@@ -434,7 +453,10 @@ class Optimal(TimingMethod):
                 guess = assemble(states, shape, compiled.transcription.size)
             except SolverError:
                 return
-            result = solve(compiled, guess, _parameters(route, limits, phases, fractions), deadline=deadline)
+            parameters = _parameters(route, limits, phases, fractions)
+            result = solve(
+                compiled, guess, parameters, deadline=deadline, ipopt_wall_time=self._ipopt_wall_time
+            )
             outcome.attempts += result.attempts
             last_pass = time.perf_counter() - began
             if result.solution is None:
@@ -461,7 +483,7 @@ class Optimal(TimingMethod):
         except Exception as error:  # a malformed guess is a bug, but must not leak an unverified schedule
             outcome.failed(FallbackReason.SETUP_FAILED, f"{type(error).__name__}: {error}")
             return
-        result = solve(compiled, guess, parameters, deadline=deadline)
+        result = solve(compiled, guess, parameters, deadline=deadline, ipopt_wall_time=self._ipopt_wall_time)
         outcome.attempts += result.attempts
         if result.solution is None:
             late = time.perf_counter() > deadline

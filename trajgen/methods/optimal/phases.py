@@ -220,8 +220,6 @@ class NlpShape:
         Iteration limit of Ipopt.
     fatrop_iterations : int
         Iteration limit of fatrop.
-    time_budget : float
-        Wall time of the whole solve, seconds (each Ipopt attempt may take half of it).
     slot : int
         Which compiled copy: concurrent solves of one shape (two classes) use two copies.
     braking : bool
@@ -233,7 +231,6 @@ class NlpShape:
     segments: int
     max_iterations: int
     fatrop_iterations: int
-    time_budget: float = 2.0
     slot: int = 0
     braking: bool = True
 
@@ -246,7 +243,6 @@ class NlpShape:
         segments: int,
         max_iterations: int,
         fatrop_iterations: int,
-        time_budget: float = 2.0,
         braking: bool = True,
     ) -> NlpShape:
         """The shape of the problem for ``phases`` with these options.
@@ -266,7 +262,7 @@ class NlpShape:
         )
         if braking:
             nodes, segments = max(1, (nodes + 1) // 2), 2 * segments
-        return cls(kinds, nodes, segments, max_iterations, fatrop_iterations, time_budget, braking=braking)
+        return cls(kinds, nodes, segments, max_iterations, fatrop_iterations, braking=braking)
 
     @property
     def phase_count(self) -> int:

@@ -42,6 +42,8 @@ _WATCHDOG_CAP = 60.0
 _WATCHDOG_GRACE = 0.05
 #: Iteration limit of the warm-started polish: it converges in < 20 when it is near a solution.
 _POLISH_MAX_ITER = 60
+#: Seconds an Ipopt run may take by default: half the optimal method's default time budget.
+DEFAULT_IPOPT_WALL_TIME = 1.0
 
 
 class Solver(enum.Enum):
@@ -111,7 +113,7 @@ class CompiledNlp:
         #: abandoned call, so the cache builds the shape afresh rather than reuse it.
         self.abandoned = False
         nlp = self.transcription.nlp
-        self._solvers: dict[Solver, object] = {
+        self._solvers: dict[Solver | tuple[Solver, float], object] = {
             Solver.FATROP: ca.nlpsol(
                 "trajgen_optimal_fatrop",
                 "fatrop",
@@ -134,13 +136,18 @@ class CompiledNlp:
             )
         }
 
-    def solver(self, which: Solver):
-        """The CasADi solver ``which``, built on first use (call with the lock held)."""
-        if which not in self._solvers:
-            self._solvers[which] = self._ipopt(warm=which is Solver.IPOPT_POLISH)
-        return self._solvers[which]
+    def solver(self, which: Solver, *, ipopt_wall_time: float = DEFAULT_IPOPT_WALL_TIME):
+        """The CasADi solver ``which``, built on first use (call with the lock held).
 
-    def _ipopt(self, *, warm: bool):
+        ``ipopt_wall_time``: seconds after which an Ipopt run stops by itself (an Ipopt option, so
+        each value is a solver of its own; fatrop ignores it).
+        """
+        key = which if which is Solver.FATROP else (which, ipopt_wall_time)
+        if key not in self._solvers:
+            self._solvers[key] = self._ipopt(warm=which is Solver.IPOPT_POLISH, wall_time=ipopt_wall_time)
+        return self._solvers[key]
+
+    def _ipopt(self, *, warm: bool, wall_time: float):
         """Ipopt on the same NLP; ``warm``: polish a nearby iterate, starting from its multipliers."""
         import casadi as ca
 
@@ -155,7 +162,7 @@ class CompiledNlp:
             "ipopt.constr_viol_tol": 1e-10,
             "ipopt.mu_strategy": "monotone",
             "ipopt.mu_init": 1e-2,
-            "ipopt.max_wall_time": 0.5 * self.shape.time_budget,  # fatrop and the build take the rest
+            "ipopt.max_wall_time": wall_time,
         }
         if warm:
             options.update(
@@ -329,12 +336,17 @@ def _lowest_priority(thread: threading.Thread) -> None:
 
 
 def solve(
-    compiled: CompiledNlp, guess: np.ndarray, parameters: np.ndarray, *, deadline: float = float("inf")
+    compiled: CompiledNlp,
+    guess: np.ndarray,
+    parameters: np.ndarray,
+    *,
+    deadline: float = float("inf"),
+    ipopt_wall_time: float = DEFAULT_IPOPT_WALL_TIME,
 ) -> SolveResult:
     """Try fatrop, then the warm Ipopt polish of its last iterate, then Ipopt from ``guess``.
 
     No solver is started after ``deadline`` (a ``time.perf_counter()`` value);
-    each Ipopt run stops by itself after the shape's time budget.
+    each Ipopt run stops by itself after ``ipopt_wall_time`` seconds.
     """
     attempts: list[SolverAttempt] = []
     previous = None  # the last solver's finite result, to warm-start the polish
@@ -350,7 +362,7 @@ def solve(
                 start = {"x0": previous["x"], "lam_x0": previous["lam_x"], "lam_g0": previous["lam_g"]}
             else:
                 start = {"x0": guess}
-            solver = compiled.solver(which)
+            solver = compiled.solver(which, ipopt_wall_time=ipopt_wall_time)
             try:
                 if which is Solver.FATROP:
                     call = _call_with_watchdog(solver, start, parameters, bounds, compiled, deadline)
