@@ -207,6 +207,7 @@ FLOW = (
     ("trajgen.methods",),
     ("trajgen.export",),
     ("trajgen.online",),
+    ("trajgen.live",),
     ("trajgen.plots",),
     ("trajgen.pipeline", "trajgen.closed_loop"),
     ("trajgen.cli",),

@@ -26,6 +26,7 @@ from topology.errors import (
 __all__ = [
     "InputError",
     "LimitsError",
+    "LiveError",
     "OptionError",
     "OutputError",
     "OutputLimitError",
@@ -72,3 +73,7 @@ class VerificationError(ScheduleError):
 
 class SolverError(ScheduleError):
     """A numerical solver failed to deliver a usable result."""
+
+
+class LiveError(TrajgenError, RuntimeError):
+    """A live run over MQTT failed: the broker was unreachable, or the run did not end in time."""

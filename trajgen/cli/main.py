@@ -48,6 +48,11 @@ COMMANDS: dict[str, tuple[str, str]] = {
         "write an animated GIF of a scenario's verified schedule on the track",
         "trajgen.cli.animate",
     ),
+    "serve": (
+        "drive both vehicles over VDA 5050 on an MQTT broker, releasing base by the frontier",
+        "trajgen.cli.live",
+    ),
+    "vehicle": ("a simulated VDA 5050 vehicle on an MQTT broker", "trajgen.cli.live"),
 }
 
 

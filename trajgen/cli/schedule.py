@@ -37,6 +37,10 @@ def _command_schedule(args: argparse.Namespace) -> int:
 def _command_demo(args: argparse.Namespace) -> int:
     chosen = BuiltinScenario.lookup(args.scenario)
     scenario = builtin_scenario(chosen)
+    if args.live:
+        from trajgen.cli.live import live_demo  # the broker, the vehicles and the master
+
+        return live_demo(scenario, method=method_from(args), time_scale=args.time_scale, output=args.output)
     result = run(
         scenario, method=method_from(args), outputs=Outputs(csv_dir=args.output, plot_dir=args.output)
     )
@@ -62,6 +66,15 @@ def register(commands) -> None:
         + f"\n(default {BuiltinScenario.SWAP.value})",
     )
     demo.add_argument("--output", default="trajgen-demo", help="folder for CSV and plots (trajgen-demo)")
+    demo.add_argument(
+        "--live",
+        action="store_true",
+        help="drive it live instead: an MQTT broker, two simulated VDA 5050 vehicles and the\n"
+        "master in this process; writes live-run.jsonl and live-run.png",
+    )
+    demo.add_argument(
+        "--time-scale", type=float, default=4.0, metavar="K", help="with --live: K times real time (4)"
+    )
     add_method(demo)
     demo.set_defaults(run=_command_demo)
 

@@ -24,7 +24,15 @@ from trajgen.model.schedule import Schedule
 from trajgen.scenario.naming import check_vehicle_names
 from trajgen.verification import VerifiedSchedule, require_verified
 
-__all__ = ["VDA5050_VERSION", "OrderMessage", "edge_id", "node_id", "render_manifest", "render_orders"]
+__all__ = [
+    "VDA5050_VERSION",
+    "OrderMessage",
+    "edge_id",
+    "node_id",
+    "order_elements",
+    "render_manifest",
+    "render_orders",
+]
 
 #: The protocol version written into every message.
 VDA5050_VERSION = "2.1.0"
@@ -111,6 +119,40 @@ def _edge_json(graph: StarGraph, path: OrderPath, edge: PathEdge, released: bool
     return data
 
 
+def order_elements(
+    graph: StarGraph, path: OrderPath, *, first: int, decision_point: int, map_id: str
+) -> tuple[list[dict], list[dict]]:
+    """The ``nodes`` and ``edges`` of an order (update) of ``path``, as JSON documents.
+
+    Parameters
+    ----------
+    graph : StarGraph
+    path : OrderPath
+    first : int
+        Index of the first node sent: 0 for an order, the previous decision point for an update.
+    decision_point : int
+        Index of the last base node; the nodes and edges after it are the horizon.
+    map_id : str
+        ``nodePosition.mapId``.
+
+    Returns
+    -------
+    nodes, edges : list of dict
+        Node ``j`` has ``sequenceId`` ``2 j``, edge ``k`` ``2 k + 1``.
+    """
+    nodes = [
+        _node_json(graph, node, 2 * j, j <= decision_point, map_id)
+        for j, node in enumerate(path.nodes)
+        if j >= first
+    ]
+    edges = [
+        _edge_json(graph, path, edge, edge.index < decision_point)
+        for edge in path.edges
+        if edge.index >= first
+    ]
+    return nodes, edges
+
+
 @dataclass(frozen=True, slots=True)
 class OrderMessage:
     """One rendered message and when to send it.
@@ -185,16 +227,9 @@ def render_orders(
     for release in plan.releases:
         vehicle = release.vehicle
         path = plan.paths[vehicle]
-        nodes = [
-            _node_json(graph, node, 2 * j, j <= release.decision_point, options.map_id)
-            for j, node in enumerate(path.nodes)
-            if j >= release.first
-        ]
-        edges = [
-            _edge_json(graph, path, edge, edge.index < release.decision_point)
-            for edge in path.edges
-            if edge.index >= release.first
-        ]
+        nodes, edges = order_elements(
+            graph, path, first=release.first, decision_point=release.decision_point, map_id=options.map_id
+        )
         header_id = options.first_header_id + release.update
         timestamp = _timestamp(options.start_time, release.send_at)
         document = {

@@ -52,6 +52,7 @@ class NodeKind(Option):
     REVERSAL = "reversal"  #: the vehicle reverses
     STOP = "stop"  #: the vehicle stops, and goes on in the same direction
     HOLD = "hold"  #: the edge of the junction zone, the minimum separation from O
+    RELEASE = "release"  #: a node only for a finer release of the base (``spacing``)
 
 
 @dataclass(frozen=True, slots=True)
@@ -310,6 +311,24 @@ def _with_holds(schedule: Schedule, pieces: Pieces, vehicle: int, events: list[_
     return out
 
 
+def _with_spacing(
+    schedule: Schedule, pieces: Pieces, vehicle: int, events: list[_Event], spacing: float
+) -> list[_Event]:
+    """Insert release nodes so that no edge is longer than ``spacing`` metres."""
+    out = [events[0]]
+    for a, b in itertools.pairwise(events):
+        count = math.ceil(abs(b.s - a.s) / spacing - 1e-9)
+        leg = _edge_leg(a, b)
+        for k in range(1, count):
+            s = a.s + (b.s - a.s) * k / count
+            time = _crossing(pieces, vehicle, a.departure, b.arrival, leg, s)
+            if time is not None:
+                axis = float(schedule.state(time).axis[vehicle, 0])
+                out.append(_Event(leg, s, axis, time, time, {NodeKind.RELEASE}))
+        out.append(b)
+    return out
+
+
 def _max_speed(pieces: Pieces, vehicle: int, t0: float, t1: float) -> float:
     """Highest |velocity| of the vehicle in ``[t0, t1]``, m/s (closed form, piece by piece)."""
     mask = (pieces.start < t1) & (pieces.start + pieces.length > t0)
@@ -323,7 +342,9 @@ def _max_speed(pieces: Pieces, vehicle: int, t0: float, t1: float) -> float:
     return float(np.max(np.maximum(np.abs(v_low), np.abs(v_high))))
 
 
-def vehicle_path(schedule: Schedule, pieces: Pieces, vehicle: int) -> OrderPath:
+def vehicle_path(
+    schedule: Schedule, pieces: Pieces, vehicle: int, *, spacing: float | None = None
+) -> OrderPath:
     """The nodes and edges of ``vehicle``'s (0 or 1) VDA 5050 path (see the module's description).
 
     Parameters
@@ -334,6 +355,9 @@ def vehicle_path(schedule: Schedule, pieces: Pieces, vehicle: int) -> OrderPath:
         ``schedule_pieces(schedule)``.
     vehicle : int
         0 or 1.
+    spacing : float, optional
+        Longest edge, metres: longer ones get release nodes between (``None``: none). Base is
+        released node by node, so finer nodes let a vehicle follow the other more closely.
 
     Returns
     -------
@@ -343,6 +367,8 @@ def vehicle_path(schedule: Schedule, pieces: Pieces, vehicle: int) -> OrderPath:
     for event in events:
         _snap(schedule, vehicle, event)
     events = _with_holds(schedule, pieces, vehicle, _merged(events))
+    if spacing is not None:
+        events = _with_spacing(schedule, pieces, vehicle, events, spacing)
     for event in events:  # a stop is named only where nothing else names the node
         if len(event.kinds) > 1:
             event.kinds.discard(NodeKind.STOP)

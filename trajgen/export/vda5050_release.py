@@ -32,10 +32,12 @@ slower (:attr:`OrderPlan.planned_duration`).
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 from topology import JUNCTION_INDEX
-from trajgen.errors import ScheduleError
+from topology.validation import short_repr
+from trajgen.errors import InputError, ScheduleError
 from trajgen.export.vda5050_path import OrderPath, vehicle_path
 from trajgen.model.pieces import schedule_pieces
 from trajgen.verification import POSITION_TOLERANCE, VerifiedSchedule, require_verified
@@ -304,13 +306,16 @@ class _Replay:
         return releases, finish
 
 
-def plan_orders(verified: VerifiedSchedule) -> OrderPlan:
+def plan_orders(verified: VerifiedSchedule, *, spacing: float | None = None) -> OrderPlan:
     """Both vehicles' VDA 5050 paths and the releases of their bases (see the module's description).
 
     Parameters
     ----------
     verified : VerifiedSchedule
         From :func:`trajgen.verification.certify`.
+    spacing : float, optional
+        Longest edge, metres (``None``: the paths' own nodes only): release nodes between let
+        the base follow the other vehicle more closely.
 
     Returns
     -------
@@ -326,6 +331,9 @@ def plan_orders(verified: VerifiedSchedule) -> OrderPlan:
     """
     schedule = require_verified(verified, "plan_orders").schedule
     pieces = schedule_pieces(schedule)
-    paths = (vehicle_path(schedule, pieces, 0), vehicle_path(schedule, pieces, 1))
+    usable = isinstance(spacing, int | float) and not isinstance(spacing, bool) and math.isfinite(spacing)
+    if spacing is not None and not (usable and spacing > 0):
+        raise InputError(f"release spacing {short_repr(spacing)} m is not allowed: expected a number > 0")
+    paths = tuple(vehicle_path(schedule, pieces, v, spacing=spacing) for v in (0, 1))
     releases, finish = _Replay(paths, schedule.limits.min_separation).run()
     return OrderPlan(paths, tuple(releases), max(finish, schedule.duration))

@@ -12,6 +12,7 @@ if TYPE_CHECKING:
     from trajgen.plots.animation_drawing import render_animation
     from trajgen.plots.configuration_drawing import render_configuration
     from trajgen.plots.coordination import METHOD_COLOURS, render_coordination
+    from trajgen.plots.live_run import render_live_run
     from trajgen.plots.separation import render_separation
     from trajgen.plots.simulation import render_simulation
     from trajgen.plots.speed import render_speed
@@ -21,6 +22,7 @@ __all__ = [
     "render_animation",
     "render_configuration",
     "render_coordination",
+    "render_live_run",
     "render_separation",
     "render_simulation",
     "render_speed",
@@ -31,6 +33,7 @@ _SOURCES = {
     "render_animation": "trajgen.plots.animation_drawing",
     "render_configuration": "trajgen.plots.configuration_drawing",
     "render_coordination": "trajgen.plots.coordination",
+    "render_live_run": "trajgen.plots.live_run",
     "render_separation": "trajgen.plots.separation",
     "render_simulation": "trajgen.plots.simulation",
     "render_speed": "trajgen.plots.speed",

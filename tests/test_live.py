@@ -1,0 +1,511 @@
+"""Live runs over VDA 5050 on a real MQTT broker (amqtt in the test process; mosquitto when installed).
+
+Every run drives two simulated vehicles with the master on a broker, at a time scale that keeps each
+test under 20 s. Safety is checked on the vehicles' true positions (every control cycle), never on
+what they reported.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import subprocess
+import sys
+import threading
+import time
+
+import pytest
+
+from tests.helpers import REPO, execution_plan
+from tests.vda5050_reference import schema_errors
+from topology import Configuration, Position
+from trajgen.cli import main
+from trajgen.errors import InputError, LiveError
+from trajgen.export.vda5050_release import BaseRelease, plan_orders
+from trajgen.live.broker import EmbeddedBroker
+from trajgen.live.clock import RunClock
+from trajgen.live.master import LiveMaster, LiveOutcome
+from trajgen.live.mqtt import BrokerSettings, Topic, VehicleIdentity, make_client
+from trajgen.live.session import LiveDemo, identities, position_xy
+from trajgen.live.vehicle import SimulatedVehicle, StopFault
+
+#: Time scale of the runs whose makespan is checked (the broker then carries ~150 messages/s).
+STRICT_SCALE = 5.0
+#: Time scale and state rate of the runs that check behaviour under faults.
+FAST_SCALE, FAST_STATE_RATE = 10.0, 4.0
+
+
+class Tap:
+    """Every message on the broker, as a third client sees it: ``(wall time, topic, payload)``."""
+
+    def __init__(self, url: str) -> None:
+        self.messages: list[tuple[float, str, bytes]] = []
+        self._ready = threading.Event()
+        self._client = make_client(BrokerSettings.from_url(url), f"tap-{id(self):x}")
+        self._client.on_connect = lambda client, *_: (client.subscribe("uagv/#", qos=0), self._ready.set())
+        self._client.on_message = lambda client, userdata, m: self.messages.append(
+            (time.monotonic(), m.topic, bytes(m.payload))
+        )
+        settings = BrokerSettings.from_url(url)
+        self._client.connect(settings.host, settings.port)
+        self._client.loop_start()
+        assert self._ready.wait(5.0)
+        time.sleep(0.1)  # the subscription is in place
+
+    def close(self) -> None:
+        self._client.disconnect()
+        self._client.loop_stop()
+
+    def of(self, kind: str) -> list[dict]:
+        return [json.loads(p) for _, topic, p in self.messages if topic.endswith("/" + kind)]
+
+
+def _demo(name: str, method: str, *, scale: float, rate: float = 10.0, faults=((), ())) -> LiveDemo:
+    scenario, verified = execution_plan(name, method)
+    demo = LiveDemo(scenario, verified, method="exact", time_scale=scale, faults=faults)
+    demo.__enter__()
+    for vehicle in demo.vehicles:
+        vehicle.state_rate = rate
+    return demo
+
+
+def _separation(name: str) -> float:
+    return execution_plan(name, "exact")[0].limits.min_separation
+
+
+@pytest.mark.parametrize(
+    ("name", "method"), [("swap", "optimal"), ("crossing", "optimal")], ids=["swap", "crossing"]
+)
+def test_a_fault_free_run_is_safe_schema_valid_and_close_to_its_plan(name, method):
+    demo = _demo(name, method, scale=STRICT_SCALE)
+    tap = Tap(demo.broker.url)
+    try:
+        outcome = demo.run()
+    finally:
+        tap.close()
+        demo.__exit__()
+    run = outcome.run
+    assert run.outcome is LiveOutcome.GOALS_REACHED
+    assert outcome.closest >= _separation(name) - 1e-9
+    assert run.makespan <= run.planned * 1.05 + 1.0
+    assert run.ignored == 0
+    for kind, schema in (("order", "order"), ("state", "state"), ("connection", "connection")):
+        documents = tap.of(kind)
+        assert documents, kind
+        for document in documents:
+            assert schema_errors(document, schema) == [], (kind, document.get("headerId"))
+    updates = [d for d in tap.of("order") if d["orderUpdateId"] > 0]
+    assert updates  # the base was released in steps
+    for update in updates:  # stitched at the previous decision point: the first node is released
+        assert update["nodes"][0]["released"] is True
+    scenario = execution_plan(name, method)[0]
+    goals = (scenario.goal.first, scenario.goal.second)
+    for vehicle, goal in zip(outcome.vehicles, goals, strict=True):
+        assert math.dist((vehicle.snapshot.x, vehicle.snapshot.y), position_xy(scenario.track, goal)) < 1e-6
+
+
+def test_a_broker_restart_mid_run_is_survived_and_the_latest_orders_are_sent_again():
+    demo = _demo("swap", "exact", scale=FAST_SCALE, rate=FAST_STATE_RATE)
+    restarted = []
+
+    def restart(demo):
+        restarted.append(demo.clock.now())
+        demo.broker.restart(down_for=0.3)
+
+    try:
+        outcome = demo.run(at=[(12.0, restart)])
+    finally:
+        demo.__exit__()
+    assert outcome.run.outcome is LiveOutcome.GOALS_REACHED
+    assert outcome.closest >= _separation("swap") - 1e-9
+    records = list(outcome.log.records())
+    again = [r for r in records if r["event"] == "order" and r["resent"] and r["t"] > restarted[0]]
+    assert {r["vehicle"] for r in again} == {"agv1", "agv2"}
+
+
+def test_a_vehicle_that_drops_off_holds_the_other_at_its_released_base_until_it_is_back():
+    demo = _demo("crossing", "exact", scale=FAST_SCALE, rate=FAST_STATE_RATE)
+    try:
+        outcome = demo.run(
+            at=[
+                (3.0, lambda demo: demo.vehicles[0].drop_connection()),
+                (20.0, lambda demo: demo.vehicles[0].restore_connection()),
+            ]
+        )
+    finally:
+        demo.__exit__()
+    assert outcome.run.outcome is LiveOutcome.GOALS_REACHED
+    assert outcome.closest >= _separation("crossing") - 1e-9
+    records = list(outcome.log.records())
+    broken = next(r["t"] for r in records if r["event"] == "connection" and r["state"] == "CONNECTIONBROKEN")
+    back = next(
+        r["t"] for r in records if r["event"] == "connection" and r["state"] == "ONLINE" and r["t"] > broken
+    )
+    released = [r for r in records if r["event"] == "order" and not r["resent"] and broken < r["t"] < back]
+    assert released == []  # nothing released to either vehicle while agv1 was away
+    frontier = max(
+        r["frontier_m"] for r in records if r["event"] == "order" and r["vehicle"] == "agv2" and r["t"] < back
+    )
+    waiting = [
+        r for r in records if r["event"] == "state" and r["vehicle"] == "agv2" and broken < r["t"] < back
+    ]
+    assert waiting
+    assert max(r["along_m"] for r in waiting) <= frontier + 1e-6
+    assert not waiting[-1]["driving"]  # it stood at its released base
+
+
+def test_a_stop_fault_makes_the_other_wait_and_costs_at_most_the_online_bound():
+    scenario = execution_plan("crossing", "exact")[0]
+    demo = _demo("crossing", "exact", scale=FAST_SCALE, rate=FAST_STATE_RATE)
+    try:
+        free = demo.run().run
+    finally:
+        demo.__exit__()
+    duration = 6.0
+    demo = _demo(
+        "crossing", "exact", scale=FAST_SCALE, rate=FAST_STATE_RATE, faults=((StopFault(8.0, duration),), ())
+    )
+    try:
+        stopped = demo.run()
+    finally:
+        demo.__exit__()
+    assert stopped.run.outcome is LiveOutcome.GOALS_REACHED
+    assert stopped.closest >= scenario.limits.min_separation - 1e-9
+    slack = max(
+        v.max_velocity / v.max_acceleration + v.max_acceleration / v.max_jerk
+        for v in scenario.limits.vehicles
+    )
+    latency = 0.5  # seconds of the run: a state and an update through the broker, at this time scale
+    assert stopped.run.makespan <= free.makespan + duration + 3.0 * slack + 1.0 + latency
+
+
+def test_a_new_goal_mid_run_stops_both_at_their_bases_and_replans_from_there():
+    scenario = execution_plan("swap", "exact")[0]
+    goal = Configuration(Position("C", 8.0), Position("A", 10.0))
+    demo = _demo("swap", "exact", scale=FAST_SCALE, rate=FAST_STATE_RATE)
+    try:
+        outcome = demo.run(at=[(10.0, lambda demo: demo.master.request_goal(goal))])
+    finally:
+        demo.__exit__()
+    assert outcome.run.outcome is LiveOutcome.GOALS_REACHED
+    assert outcome.run.replans == 1
+    assert outcome.closest >= scenario.limits.min_separation - 1e-9
+    for vehicle, position in zip(outcome.vehicles, (goal.first, goal.second), strict=True):
+        assert (
+            math.dist((vehicle.snapshot.x, vehicle.snapshot.y), position_xy(scenario.track, position)) < 1e-6
+        )
+
+
+# -- the master alone, fed states by the test: what it takes and what it ignores ---------------------
+
+
+class FakeVehicles:
+    """A client that publishes states for both vehicles and reads the orders the master sends."""
+
+    def __init__(self, url: str, ids) -> None:
+        self.ids = ids
+        self.orders: list[dict] = []
+        self.header = 100
+        self._client = make_client(BrokerSettings.from_url(url), f"fake-{id(self):x}")
+        self._client.on_connect = lambda client, *_: [client.subscribe(i.topic(Topic.ORDER)) for i in ids]
+        self._client.on_message = lambda c, u, m: self.orders.append(json.loads(m.payload))
+        settings = BrokerSettings.from_url(url)
+        self._client.connect(settings.host, settings.port)
+        self._client.loop_start()
+
+    def publish(self, v: int, payload: bytes, topic: str | None = None) -> None:
+        self._client.publish(topic or self.ids[v].topic(Topic.STATE), payload).wait_for_publish(2.0)
+        time.sleep(0.15)
+
+    def send_order(self, v: int, payload: bytes) -> None:
+        self._client.publish(self.ids[v].topic(Topic.ORDER), payload).wait_for_publish(2.0)
+
+    def state(self, v: int, order: dict, node: int, *, header: int | None = None, **override) -> bytes:
+        self.header += 1
+        document = {
+            "headerId": self.header if header is None else header,
+            "timestamp": "2026-11-26T10:00:00.000Z",
+            "version": "2.1.0",
+            "manufacturer": self.ids[v].manufacturer,
+            "serialNumber": self.ids[v].serial_number,
+            "orderId": order["orderId"],
+            "orderUpdateId": order["orderUpdateId"],
+            "lastNodeId": order["nodes"][node]["nodeId"],
+            "lastNodeSequenceId": order["nodes"][node]["sequenceId"],
+            "nodeStates": [],
+            "edgeStates": [],
+            "driving": False,
+            "actionStates": [],
+            "batteryState": {"batteryCharge": 100.0, "charging": False},
+            "operatingMode": "AUTOMATIC",
+            "errors": [],
+            "safetyState": {"eStop": "NONE", "fieldViolation": False},
+        }
+        document.update(override)
+        return json.dumps(document).encode()
+
+    def close(self) -> None:
+        self._client.disconnect()
+        self._client.loop_stop()
+
+
+def _last_base(order: dict) -> int:
+    return max(k for k, node in enumerate(order["nodes"]) if node["released"])
+
+
+def _releasing_vehicle(verified, spacing: float) -> int:
+    """A vehicle whose arrival at its first decision point releases base (by the master's own rule)."""
+    plan = plan_orders(verified, spacing=spacing)
+    for v in (0, 1):
+        rule = BaseRelease(plan.paths, verified.schedule.limits.min_separation)
+        if rule.reach(v, rule.released[v]):
+            return v
+    raise AssertionError("no first arrival releases anything")
+
+
+UNTRUSTED = {
+    "malformed": lambda fake, v, order, node: b'{"headerId": "not a number"',
+    "foreign-manufacturer": lambda fake, v, order, node: fake.state(v, order, node, manufacturer="acme"),
+    "out-of-order": lambda fake, v, order, node: fake.state(v, order, node, header=1),
+    "not-its-node": lambda fake, v, order, node: fake.state(v, order, node, lastNodeId="B:7.25"),
+    "odd-sequence-id": lambda fake, v, order, node: fake.state(
+        v, order, node, lastNodeSequenceId=order["nodes"][node]["sequenceId"] + 1
+    ),
+}
+
+
+@pytest.mark.parametrize("kind", list(UNTRUSTED), ids=list(UNTRUSTED))
+def test_an_untrusted_state_is_logged_and_ignored_and_releases_nothing(kind):
+    scenario, verified = execution_plan("swap", "exact")
+    ids = identities(scenario.names)
+    with EmbeddedBroker() as broker:
+        fake = FakeVehicles(broker.url, ids)
+        master = LiveMaster(
+            verified, scenario.names, identities=ids, broker=BrokerSettings.from_url(broker.url)
+        )
+        master.start()
+        try:
+            deadline = time.monotonic() + 5.0
+            while len(fake.orders) < 2 and time.monotonic() < deadline:
+                time.sleep(0.02)
+            v = _releasing_vehicle(verified, master.spacing)
+            first = next(o for o in fake.orders if o["serialNumber"] == scenario.names[v])
+            sent = len(fake.orders)
+            node = _last_base(first)  # at its decision point: that releases base
+            fake.publish(v, fake.state(v, first, 0))  # genuine, at its start: releases nothing
+            assert len(fake.orders) == sent
+            fake.publish(v, UNTRUSTED[kind](fake, v, first, node))
+            assert len(fake.orders) == sent  # nothing released on its account
+            assert master.result().ignored == 1
+            fake.publish(v, fake.state(v, first, node))  # the genuine report does release
+            assert len(fake.orders) > sent
+        finally:
+            master.stop()
+            fake.close()
+    ignored = [r for r in master.log.records() if r["event"] == "ignored"]
+    assert len(ignored) == 1
+    assert ignored[0]["vehicle"] == scenario.names[v]
+
+
+def test_a_state_on_a_topic_of_no_vehicle_of_the_run_never_reaches_the_master():
+    scenario, verified = execution_plan("swap", "exact")
+    ids = identities(scenario.names)
+    with EmbeddedBroker() as broker:
+        fake = FakeVehicles(broker.url, ids)
+        master = LiveMaster(
+            verified, scenario.names, identities=ids, broker=BrokerSettings.from_url(broker.url)
+        )
+        master.start()
+        try:
+            time.sleep(0.5)
+            sent = len(fake.orders)
+            fake.publish(0, b"{}", topic=VehicleIdentity("acme", "agv9").topic(Topic.STATE))
+            assert len(fake.orders) == sent
+        finally:
+            master.stop()
+            fake.close()
+    assert master.result().ignored == 0  # not subscribed: it never arrives
+
+
+# -- the simulated vehicle ----------------------------------------------------------------------------
+
+
+def test_the_vehicle_takes_a_stitched_update_ignores_a_duplicate_and_refuses_one_that_does_not_continue():
+    scenario, verified = execution_plan("swap", "exact")
+    ids = identities(scenario.names)
+    with EmbeddedBroker() as broker:
+        settings = BrokerSettings.from_url(broker.url)
+        fake = FakeVehicles(broker.url, ids)
+        clock = RunClock(FAST_SCALE)
+        vehicle = SimulatedVehicle(
+            ids[0],
+            scenario.limits.vehicles[0],
+            position_xy(scenario.track, scenario.start.first),
+            broker=settings,
+            clock=clock,
+        ).start()
+        master = LiveMaster(verified, scenario.names, identities=ids, broker=settings, clock=clock)
+        try:
+            states = []
+            watcher = make_client(settings, "watcher")
+            watcher.on_connect = lambda client, *_: client.subscribe(ids[0].topic(Topic.STATE))
+            watcher.on_message = lambda c, u, m: states.append(json.loads(m.payload))
+            watcher.connect(settings.host, settings.port)
+            watcher.loop_start()
+            master.start()
+            time.sleep(1.5)
+            sent = next(o for o in fake.orders if o["serialNumber"] == "agv1")
+            taken = states[-1]
+            assert taken["orderUpdateId"] == 0
+            assert taken["errors"] == []
+            # an update that does not start at the decision point: refused, as VDA 5050's figure 8 says
+            document = json.loads(json.dumps(sent))
+            document["orderUpdateId"] = 7
+            document["headerId"] += 50
+            document["nodes"] = document["nodes"][1:]
+            document["edges"] = document["edges"][1:]
+            fake.send_order(0, json.dumps(document).encode())
+            time.sleep(0.5)
+            assert states[-1]["orderUpdateId"] == 0
+            assert [e["errorType"] for e in states[-1]["errors"]] == ["orderUpdateError"]
+            assert vehicle.rejections == 1
+            # the same order again: a duplicate, ignored without an error
+            fake.send_order(0, json.dumps(sent).encode())
+            time.sleep(0.5)
+            assert vehicle.rejections == 1
+            # it never drives past its base
+            base_end = _last_base(sent)
+            assert states[-1]["lastNodeSequenceId"] <= 2 * base_end
+            watcher.disconnect()
+            watcher.loop_stop()
+        finally:
+            master.stop()
+            vehicle.stop()
+            fake.close()
+
+
+# -- the command line ---------------------------------------------------------------------------------
+
+
+def test_serve_drives_two_vehicle_processes_and_commits_its_log_and_picture(tmp_path):
+    with EmbeddedBroker() as broker:
+        common = ["--broker", broker.url, "--time-scale", "10"]
+        vehicles = [
+            subprocess.Popen(
+                [
+                    sys.executable,
+                    "-m",
+                    "trajgen",
+                    "vehicle",
+                    str(REPO / "examples" / "swap.toml"),
+                    name,
+                    *common,
+                    "--state-rate",
+                    "4",
+                    "--exit-at-goal",
+                ],
+                stdout=subprocess.PIPE,
+                stderr=subprocess.PIPE,
+                text=True,
+            )
+            for name in ("agv1", "agv2")
+        ]
+        try:
+            status = main(
+                [
+                    "serve",
+                    str(REPO / "examples" / "swap.toml"),
+                    *common,
+                    "--method",
+                    "exact",
+                    "--log",
+                    str(tmp_path / "run.jsonl"),
+                    "--plot",
+                    str(tmp_path / "run.png"),
+                    "--timeout",
+                    "300",
+                ]
+            )
+        finally:
+            outputs = [p.communicate(timeout=20) for p in vehicles]
+    assert status == 0
+    assert all(p.returncode == 0 for p in vehicles), outputs
+    assert all("at its goal" in out for out, _ in outputs)
+    records = [json.loads(line) for line in (tmp_path / "run.jsonl").read_text().splitlines()]
+    assert records[-1]["event"] == "end"
+    assert records[-1]["outcome"] == "goals-reached"
+    assert (tmp_path / "run.png").read_bytes()[:4] == b"\x89PNG"
+
+
+def test_demo_live_runs_broker_vehicles_and_master_in_one_command(tmp_path, capsys):
+    status = main(["demo", "--live", "--method", "exact", "--time-scale", "10", "--output", str(tmp_path)])
+    out = capsys.readouterr().out
+    assert status == 0
+    assert "goals-reached" in out
+    assert (tmp_path / "live-run.png").read_bytes()[:4] == b"\x89PNG"
+    assert (tmp_path / "live-run.jsonl").stat().st_size > 0
+
+
+def test_serve_with_no_broker_listening_exits_1_naming_the_url(tmp_path, capsys):
+    status = main(
+        [
+            "serve",
+            str(REPO / "examples" / "swap.toml"),
+            "--broker",
+            "mqtt://127.0.0.1:1",
+            "--method",
+            "exact",
+            "--log",
+            str(tmp_path / "run.jsonl"),
+        ]
+    )
+    assert status == 1
+    assert "mqtt://127.0.0.1:1 cannot be reached" in capsys.readouterr().err
+    assert not (tmp_path / "run.jsonl").exists()
+
+
+@pytest.mark.parametrize(
+    ("call", "match"),
+    [
+        pytest.param(lambda: BrokerSettings.from_url("http://host:1883"), "scheme 'http'", id="scheme"),
+        pytest.param(lambda: BrokerSettings.from_url("mqtt://host:99999"), "bad port", id="port"),
+        pytest.param(lambda: BrokerSettings.from_url("mqtt://:1883"), "names no host", id="no-host"),
+        pytest.param(
+            lambda: BrokerSettings.from_url("mqtt://h:1", username="u", password_file="/nonexistent/pw"),
+            "password file '/nonexistent/pw' cannot be read",
+            id="password-file",
+        ),
+        pytest.param(lambda: RunClock(1000.0), "time scale 1000.0 is out of range", id="time-scale"),
+        pytest.param(lambda: StopFault.parse("halt@3"), "vehicle fault 'halt@3' cannot be read", id="fault"),
+        pytest.param(lambda: identities(("agv1", "agv1")), "expected two different ones", id="same-serials"),
+        pytest.param(lambda: VehicleIdentity("a/b", "agv1"), "not an MQTT topic level", id="slash-in-level"),
+    ],
+)
+def test_bad_live_input_is_refused_naming_the_value(call, match):
+    with pytest.raises(InputError, match=match):
+        call()
+
+
+@pytest.mark.parametrize(
+    ("arguments", "match"),
+    [
+        pytest.param(["--goal-at", "soon=A:3,B:3"], "--goal-at 'soon=A:3,B:3' cannot be read", id="goal-at"),
+        pytest.param(["--time-scale", "0"], "time scale 0.0 is out of range", id="time-scale"),
+        pytest.param(["--broker", "ftp://x"], "scheme 'ftp'", id="broker"),
+    ],
+)
+def test_bad_serve_arguments_exit_2_before_connecting(arguments, match, capsys, tmp_path):
+    argv = [
+        "serve",
+        str(REPO / "examples" / "swap.toml"),
+        "--broker",
+        "mqtt://127.0.0.1:1",
+        "--log",
+        str(tmp_path / "l"),
+    ]
+    assert main([*argv, *arguments]) == 2
+    assert match in capsys.readouterr().err
+
+
+def test_the_live_error_is_a_runtime_error():
+    assert issubclass(LiveError, RuntimeError)

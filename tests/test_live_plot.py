@@ -1,0 +1,252 @@
+"""The picture of a live run: progress under the released base per vehicle, the events, clear errors."""
+
+from __future__ import annotations
+
+import copy
+import io
+import math
+
+import numpy as np
+import pytest
+from matplotlib.colors import to_rgb
+from PIL import Image
+
+from trajgen.errors import InputError
+from trajgen.live.runlog import RunLog, read_run_log
+from trajgen.plots import render_live_run
+from trajgen.plots.speed import VEHICLE_COLOURS
+
+NAMES = ("agv1", "agv2")
+PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
+
+
+def synthetic_run() -> dict:
+    """Two vehicles, 300 states each, orders stepping the frontier, a connection loss, an end record."""
+    t = np.linspace(0.0, 30.0, 300)
+    states = {
+        "agv1": [(float(x), float(min(0.5 * x, 12.0)), bool(x < 24.0)) for x in t],
+        "agv2": [(float(x), float(0.3 * max(x - 4.0, 0.0)), bool(x > 4.0)) for x in t],
+    }
+    orders = {
+        "agv1": [(0.0, 4.0), (6.0, 8.0), (14.0, 12.0)],
+        "agv2": [(0.5, 2.0), (9.0, 5.0), (20.0, 7.8)],
+    }
+    events = [
+        (3.0, "connection", "agv1", "ONLINE"),
+        (10.0, "connection", "agv2", "CONNECTIONBROKEN"),
+        (13.5, "connection", "agv2", "ONLINE"),
+        (11.0, "ignored", "agv1", "stale header id"),
+        (15.0, "ignored", None, "unknown vehicle agv9"),
+        (18.0, "goal", "agv1", "node 7"),
+        (22.0, "replan", None, ""),
+    ]
+    end = {"t": 30.5, "event": "end", "outcome": "reached", "makespan_s": 29.8}
+    return {"states": states, "orders": orders, "events": events, "end": end}
+
+
+def decoded(png: bytes) -> Image.Image:
+    assert png.startswith(PNG_SIGNATURE)
+    image = Image.open(io.BytesIO(png))
+    assert image.format == "PNG"
+    image.load()  # decodes the pixels: a truncated or corrupt file fails here
+    return image
+
+
+def test_render_live_run_draws_a_png_of_a_sensible_size():
+    image = decoded(render_live_run(synthetic_run(), names=NAMES))
+    width, height = image.size
+    assert 800 <= width <= 2500
+    assert 500 <= height <= 2000
+    pixels = np.asarray(image.convert("RGB"), dtype=float) / 255.0
+    for colour in VEHICLE_COLOURS:  # each vehicle's curves are drawn in its colour
+        near = np.abs(pixels - np.array(to_rgb(colour))).max(axis=2) < 0.04
+        assert near.sum() > 500, colour
+
+
+def test_render_live_run_leaves_the_run_unchanged():
+    run = synthetic_run()
+    before = copy.deepcopy(run)
+    render_live_run(run, names=NAMES)
+    assert run == before
+
+
+def test_render_live_run_takes_a_run_without_orders_events_or_end():
+    run = synthetic_run()
+    run.update(orders={}, events=[], end=None)
+    decoded(render_live_run(run, names=NAMES))
+
+
+def test_render_live_run_takes_one_state_per_vehicle_and_states_out_of_order():
+    run = synthetic_run()
+    run["states"] = {"agv1": [(2.0, 1.0, True)], "agv2": [(5.0, 2.0, True), (1.0, 0.0, False)]}
+    run["events"].append((40.0, "connection", "agv1", "OFFLINE"))  # never back online: up to the end
+    decoded(render_live_run(run, names=NAMES))
+
+
+def test_render_live_run_draws_the_most_states_a_log_keeps():
+    t = np.linspace(0.0, 600.0, 8000)
+    run = synthetic_run()
+    run["states"] = {name: [(float(x), float(0.01 * x), True) for x in t] for name in NAMES}
+    decoded(render_live_run(run, names=NAMES))
+
+
+def test_render_live_run_of_a_run_log():
+    log = RunLog()
+    try:
+        log.write({"t": 0.0, "event": "plan", "method": "exact", "planned_s": 20.0, "nodes": [5, 4]})
+        for vehicle, name in enumerate(NAMES):
+            log.write(
+                {
+                    "t": 0.1 * vehicle,
+                    "event": "order",
+                    "vehicle": name,
+                    "update": 0,
+                    "first": 0,
+                    "decision_point": 2,
+                    "frontier_m": 3.0,
+                    "resent": False,
+                }
+            )
+            log.write({"t": 0.0, "event": "connection", "vehicle": name, "state": "ONLINE"})
+        for step in range(200):
+            t = 0.1 * step
+            for vehicle, name in enumerate(NAMES):
+                along = min(0.2 * t, 3.0) if t < 8.0 else min(0.2 * t, 6.0)
+                log.write(
+                    {
+                        "t": t,
+                        "event": "state",
+                        "vehicle": name,
+                        "x": along,
+                        "y": float(vehicle),
+                        "node": int(along),
+                        "along_m": along,
+                        "driving": along < 6.0,
+                    }
+                )
+            if step == 80:
+                for name in NAMES:
+                    log.write(
+                        {
+                            "t": t,
+                            "event": "order",
+                            "vehicle": name,
+                            "update": 1,
+                            "first": 2,
+                            "decision_point": 4,
+                            "frontier_m": 6.0,
+                            "resent": False,
+                        }
+                    )
+            if step == 50:
+                log.write({"t": t, "event": "connection", "vehicle": "agv2", "state": "CONNECTIONBROKEN"})
+            if step == 70:
+                log.write({"t": t, "event": "connection", "vehicle": "agv2", "state": "ONLINE"})
+            if step == 120:
+                log.write(
+                    {"t": t, "event": "ignored", "topic": "state", "vehicle": "agv1", "reason": "old header"}
+                )
+        log.write({"t": 20.0, "event": "end", "outcome": "reached", "makespan_s": 19.9})
+        run = read_run_log(log.records())
+    finally:
+        log.close()
+    assert len(run["states"]["agv1"]) == 200
+    assert run["orders"]["agv2"] == [(0.1, 3.0), (8.0, 6.0)]
+    assert (12.0, "ignored", "agv1", "old header") in [(round(e[0], 6), *e[1:]) for e in run["events"]]
+    decoded(render_live_run(run, names=NAMES))
+
+
+def _broken(change):
+    run = synthetic_run()
+    change(run)
+    return run
+
+
+BAD_NAMES = [
+    pytest.param("agv1", id="a-string"),
+    pytest.param(("agv1",), id="one-name"),
+    pytest.param(("agv1", "agv2", "agv3"), id="three-names"),
+    pytest.param(("agv1", 2), id="not-a-string"),
+    pytest.param(("agv1", ""), id="empty-name"),
+    pytest.param(("agv1", "agv1"), id="same-name-twice"),
+]
+
+
+@pytest.mark.parametrize("names", BAD_NAMES)
+def test_bad_names_are_refused(names):
+    with pytest.raises(InputError, match="names must be two different non-empty vehicle names"):
+        render_live_run(synthetic_run(), names=names)
+
+
+BAD_RUNS = [
+    pytest.param(["not", "a", "dict"], "must be the dict of read_run_log, got list", id="not-a-dict"),
+    pytest.param(
+        _broken(lambda run: run.pop("orders")), r"the run has no orders; expected", id="no-orders-key"
+    ),
+    pytest.param(
+        _broken(lambda run: run.update(states={})),
+        "the log has no state of agv1: expected at least one",
+        id="no-states-at-all",
+    ),
+    pytest.param(
+        _broken(lambda run: run["states"].update(agv2=[])),
+        "the log has no state of agv2: expected at least one",
+        id="no-state-of-one-vehicle",
+    ),
+    pytest.param(
+        _broken(lambda run: run["states"].update(agv9=[(0.0, 0.0, True)])),
+        "the log has states of agv9, not one of the vehicles",
+        id="a-stranger-vehicle",
+    ),
+    pytest.param(
+        _broken(lambda run: run["states"]["agv1"].append((31.0, math.nan, True))),
+        "the states of agv1 has a non-finite number: \\(31.0, nan, True\\)",
+        id="nan-along",
+    ),
+    pytest.param(
+        _broken(lambda run: run["orders"]["agv2"].append((math.inf, 9.0))),
+        "the orders of agv2 has a non-finite number",
+        id="infinite-order-time",
+    ),
+    pytest.param(
+        _broken(lambda run: run["states"]["agv1"].append((31.0, "far", True))),
+        "the states of agv1 must be tuples of 3 numbers",
+        id="text-for-a-number",
+    ),
+    pytest.param(
+        _broken(lambda run: run["orders"]["agv1"].append((31.0,))),
+        "the orders of agv1 must be tuples of 2 numbers",
+        id="short-order",
+    ),
+    pytest.param(
+        _broken(lambda run: run["events"].append((math.nan, "goal", "agv1", "x"))),
+        "an event's time must be a finite number",
+        id="nan-event-time",
+    ),
+    pytest.param(
+        _broken(lambda run: run["events"].append((1.0, "teleport", "agv1", ""))),
+        "an event's kind must be one of connection, ignored, goal, replan",
+        id="unknown-event-kind",
+    ),
+    pytest.param(
+        _broken(lambda run: run["events"].append((1.0, "goal"))),
+        r"an event must be \(t, kind, vehicle or None, detail\)",
+        id="short-event",
+    ),
+    pytest.param(
+        _broken(lambda run: run["end"].update(makespan_s=math.inf)),
+        "the end record's makespan_s must be a finite number, got inf",
+        id="infinite-makespan",
+    ),
+]
+
+
+@pytest.mark.parametrize(("run", "message"), BAD_RUNS)
+def test_bad_runs_are_refused_with_what_is_wrong(run, message):
+    with pytest.raises(InputError, match=message):
+        render_live_run(run, names=NAMES)
+
+
+def test_the_input_error_is_a_value_error():
+    with pytest.raises(ValueError, match="live run picture"):
+        render_live_run({"states": {}, "orders": {}, "events": [], "end": None}, names=NAMES)

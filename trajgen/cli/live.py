@@ -1,0 +1,268 @@
+"""``trajgen serve`` and ``trajgen vehicle``: drive vehicles over VDA 5050 on an MQTT broker.
+
+``serve`` plans and verifies a scenario, then drives both vehicles, releasing
+base by the frontier (:mod:`trajgen.live.master`); it commits its run log (and
+picture) when the run ends. ``vehicle`` is a simulated VDA 5050 vehicle
+(:mod:`trajgen.live.vehicle`). ``demo --live`` runs both, with a broker, in
+one process (:func:`live_demo`).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import re
+import signal
+import sys
+import threading
+from pathlib import Path
+
+from topology import Configuration, Position
+from topology.validation import short_repr
+from trajgen.cli.options import add_method, method_from, scenario_from
+from trajgen.cli.parser import EXIT_FAILURE, EXIT_OK
+from trajgen.errors import InputError
+
+__all__ = ["live_demo", "register"]
+
+_GOAL = re.compile(r"(?P<at>[^=]+)=(?P<first>[^,]+),(?P<second>.+)")
+
+
+def _goal(text: str) -> tuple[float, Configuration]:
+    """``T=LEG:S,LEG:S``: at T seconds of the run, a new goal for both vehicles."""
+    match = _GOAL.fullmatch(text.strip())
+    try:
+        at = float(match["at"]) if match else float("nan")
+    except ValueError:
+        at = float("nan")
+    if not match or not at >= 0.0 or at == float("inf"):
+        raise InputError(
+            f"--goal-at {short_repr(text)} cannot be read: expected T=LEG:S,LEG:S (T seconds of the run "
+            ">= 0, then both vehicles' new goals, e.g. 20=C:8,A:10)"
+        )
+    return at, Configuration(Position.parse(match["first"]), Position.parse(match["second"]))
+
+
+def _add_broker_options(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--broker", required=True, metavar="URL", help="mqtt://HOST:PORT (mqtts:// for TLS)")
+    parser.add_argument("--username", help="broker login")
+    parser.add_argument("--password-file", metavar="FILE", help="file whose first line is the password")
+    parser.add_argument("--tls", action="store_true", help="connect over TLS (as mqtts:// does)")
+    parser.add_argument("--cafile", metavar="FILE", help="certificate authority file for TLS")
+    parser.add_argument("--interface", default="uagv", help="VDA 5050 interface, first topic level (uagv)")
+    parser.add_argument("--version", default="v2", help="VDA 5050 major version, second topic level (v2)")
+    parser.add_argument("--manufacturer", default="unspecified", help="vehicles' manufacturer (unspecified)")
+    parser.add_argument(
+        "--time-scale",
+        type=float,
+        default=1.0,
+        metavar="K",
+        help="seconds of the run per wall-clock second (1); the same for the master and the vehicles",
+    )
+
+
+def _settings(args: argparse.Namespace):
+    from trajgen.live.mqtt import BrokerSettings
+
+    return BrokerSettings.from_url(
+        args.broker,
+        username=args.username,
+        password_file=args.password_file,
+        tls=args.tls,
+        cafile=args.cafile,
+    )
+
+
+def _identities(args: argparse.Namespace, scenario):
+    from trajgen.live.session import identities
+
+    serials = None
+    if args.serial_numbers is not None:
+        serials = tuple(part.strip() for part in args.serial_numbers.split(","))
+    return identities(
+        scenario.names,
+        manufacturer=args.manufacturer,
+        serial_numbers=serials,
+        interface=args.interface,
+        version=args.version,
+    )
+
+
+def _commit(log, log_path: str, plot_path: str | None, names) -> None:
+    """The run log and the picture, committed together."""
+    from trajgen.export.atomic import commit_files
+
+    contents = {Path(log_path): log.chunks()}
+    if plot_path is not None:
+        from trajgen.live.runlog import read_run_log
+        from trajgen.plots.live_run import render_live_run
+
+        contents[Path(plot_path)] = render_live_run(read_run_log(log.records()), names=tuple(names))
+    commit_files(contents)
+
+
+def _report(run, args: argparse.Namespace, *, closest: float | None = None) -> int:
+    summary = run.summary()
+    if closest is not None:
+        summary["closest_m"] = closest
+    if args.json:
+        print(json.dumps(summary, indent=2))
+    else:
+        latency = summary["release_latency_median_ms"]
+        print(
+            f"live run: {summary['outcome']} in {summary['makespan_s']:.3f} s of the run "
+            f"(plan {summary['planned_s']:.3f} s); {summary['orders']} orders and updates "
+            f"({summary['resent']} sent again), {summary['ignored']} messages ignored, "
+            f"{summary['replans']} re-plans"
+            + (f"; release latency {latency:.2f} ms median" if latency is not None else "")
+            + (f"; closest approach {closest:.3f} m" if closest is not None else "")
+        )
+    if summary["outcome"] != "goals-reached":
+        print("trajgen: the live run did not reach both goals in time", file=sys.stderr)
+        return EXIT_FAILURE
+    return EXIT_OK
+
+
+def _command_serve(args: argparse.Namespace) -> int:
+    from trajgen.export.atomic import check_output_paths
+    from trajgen.live.clock import RunClock
+    from trajgen.live.master import LiveMaster
+    from trajgen.live.session import live_plan
+
+    scenario = scenario_from(args.scenario)
+    goals = sorted((_goal(text) for text in args.goal_at), key=lambda goal: goal[0])
+    check_output_paths([args.log] + ([args.plot] if args.plot else []))
+    settings = _settings(args)
+    ids = _identities(args, scenario)
+    clock = RunClock(args.time_scale)
+    verified = live_plan(scenario, method=method_from(args))
+    master = LiveMaster(
+        verified,
+        scenario.names,
+        identities=ids,
+        broker=settings,
+        method=method_from(args),
+        clock=clock,
+        order_id=args.order_id,
+        map_id=args.map_id,
+    )
+    timeout = args.timeout if args.timeout is not None else 4.0 * verified.schedule.duration + 60.0
+    try:
+        master.start()
+        for at, goal in goals:
+            if master.wait(timeout=at - clock.now()):
+                break  # both at their goals before it was due: it is never applied
+            master.request_goal(goal)
+        master.wait(timeout=timeout - clock.now())
+    finally:
+        master.stop()
+    run = master.result()
+    _commit(master.log, args.log, args.plot, scenario.names)
+    master.log.close()
+    return _report(run, args)
+
+
+def _command_vehicle(args: argparse.Namespace) -> int:
+    from trajgen.live.clock import RunClock
+    from trajgen.live.session import position_xy
+    from trajgen.live.vehicle import SimulatedVehicle, StopFault
+
+    scenario = scenario_from(args.scenario)
+    if args.name not in scenario.names:
+        raise InputError(
+            f"vehicle {short_repr(args.name)} is not in the scenario: expected one of {list(scenario.names)}"
+        )
+    v = scenario.names.index(args.name)
+    faults = [StopFault.parse(text) for text in args.fault]
+    vehicle = SimulatedVehicle(
+        _identities(args, scenario)[v],
+        scenario.limits.vehicles[v],
+        position_xy(scenario.track, (scenario.start.first, scenario.start.second)[v]),
+        broker=_settings(args),
+        clock=RunClock(args.time_scale),
+        state_rate=args.state_rate,
+        faults=faults,
+        map_id=args.map_id,
+    )
+    stopped = threading.Event()
+    for signum in (signal.SIGINT, signal.SIGTERM):
+        signal.signal(signum, lambda *_: stopped.set())
+    vehicle.start()
+    try:
+        while not stopped.wait(0.1):
+            if args.exit_at_goal and vehicle.snapshot.finished:
+                break
+    finally:
+        vehicle.stop()
+    snapshot = vehicle.snapshot
+    print(
+        f"vehicle {args.name}: stopped at x={snapshot.x:.3f} m, y={snapshot.y:.3f} m after "
+        f"{snapshot.time:.3f} s of the run ({'at its goal' if snapshot.finished else 'not at a goal'})"
+    )
+    return EXIT_OK
+
+
+def live_demo(scenario, *, method, time_scale: float, output: str) -> int:
+    """``trajgen demo --live``: a broker, two simulated vehicles and the master in this process."""
+    from trajgen.export.atomic import check_output_paths
+    from trajgen.live.session import run_demo
+
+    log_path, plot_path = str(Path(output) / "live-run.jsonl"), str(Path(output) / "live-run.png")
+    check_output_paths([log_path, plot_path])
+    print(
+        f"Live demo: {scenario.source} over VDA 5050 on an MQTT broker in this process, "
+        f"{time_scale:g}x real time ..."
+    )
+    demo = run_demo(scenario, method=method, time_scale=time_scale)
+    _commit(demo.log, log_path, plot_path, scenario.names)
+    demo.log.close()
+    status = _report(demo.run, argparse.Namespace(json=False), closest=demo.closest)
+    print(f"Run log and picture: {log_path}, {plot_path}")
+    return status
+
+
+def register(commands) -> None:
+    """Add ``serve`` and ``vehicle`` to the sub-commands."""
+    serve = commands.add_parser("serve", formatter_class=argparse.RawTextHelpFormatter)
+    serve.add_argument("scenario", help="scenario TOML file")
+    _add_broker_options(serve)
+    serve.add_argument(
+        "--serial-numbers", metavar="A,B", help="both vehicles' serial numbers (default: their names)"
+    )
+    add_method(serve, what="timing method of the plan", homotopy=False)
+    serve.add_argument("--order-id", default="trajgen", help="orderId: <prefix>-<vehicle name> (trajgen)")
+    serve.add_argument("--map-id", default="trajgen", help="nodePosition.mapId (trajgen)")
+    serve.add_argument(
+        "--goal-at",
+        action="append",
+        default=[],
+        metavar="T=LEG:S,LEG:S",
+        help="at T s of the run, new goals for both vehicles (repeatable): both stop at\n"
+        "their released base, then are re-planned from there",
+    )
+    serve.add_argument("--timeout", type=float, help="seconds of the run before giving up (4x plan + 60)")
+    serve.add_argument("--log", default="trajgen-live.jsonl", help="JSON-lines run log (trajgen-live.jsonl)")
+    serve.add_argument("--plot", metavar="FILE", help="PNG picture of the run: progress, releases, events")
+    serve.add_argument("--json", action="store_true", help="print a machine-readable summary")
+    serve.set_defaults(run=_command_serve)
+
+    vehicle = commands.add_parser("vehicle", formatter_class=argparse.RawTextHelpFormatter)
+    vehicle.add_argument("scenario", help="scenario TOML file (the vehicle's limits and start)")
+    vehicle.add_argument("name", help="the vehicle's name in the scenario")
+    _add_broker_options(vehicle)
+    vehicle.add_argument("--serial-numbers", metavar="A,B", help="both vehicles' serial numbers (names)")
+    vehicle.add_argument("--map-id", default="trajgen", help="agvPosition.mapId (trajgen)")
+    vehicle.add_argument(
+        "--state-rate", type=float, default=10.0, metavar="HZ", help="states per second of the run (10)"
+    )
+    vehicle.add_argument(
+        "--fault",
+        action="append",
+        default=[],
+        metavar="stop@T+D",
+        help="stop at T s of the run for D s (repeatable)",
+    )
+    vehicle.add_argument(
+        "--exit-at-goal", action="store_true", help="end once at the goal of an order (else: until Ctrl-C)"
+    )
+    vehicle.set_defaults(run=_command_vehicle)

@@ -1,0 +1,1 @@
+"""Live: drive vehicles over VDA 5050 on an MQTT broker."""

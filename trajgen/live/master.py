@@ -1,0 +1,599 @@
+"""The live master: drives two VDA 5050 vehicles over MQTT, releasing base by the frontier.
+
+It sends each vehicle one order: its whole path, the base up to its current
+frontier (the last released node) and the rest as horizon. Then it follows the
+vehicles' states. When a vehicle reports a node reached, the release rule
+(:class:`~trajgen.export.vda5050_release.BaseRelease`) may let the base of
+either vehicle grow; each growth is an order update (same ``orderId``,
+``orderUpdateId`` + 1, stitched at the previous decision point).
+
+What keeps the vehicles apart is the released base, never the timing: a
+vehicle claims the track from the last node it reported to its decision point,
+the two claims never come closer than the minimum separation, and a claim only
+shrinks when its vehicle reports it has moved on. A late, lost or duplicated
+message therefore only delays a release; it never makes one unsafe. Messages
+that cannot be trusted (malformed, another vehicle's, older than one already
+taken, or naming a node the vehicle cannot have reached) are logged and
+ignored. While a vehicle is offline (its last will, or OFFLINE) nothing is
+released to either vehicle; when it is back, the latest order is sent again.
+After a broker restart the client reconnects and re-sends every vehicle's
+latest order (a vehicle ignores one it already has).
+
+A new goal: no more base is released; once both vehicles stand at their
+decision points, the planner plans from there and each vehicle gets an order
+update stitched where it stands, with the new path.
+"""
+
+from __future__ import annotations
+
+import enum
+import logging
+import threading
+import time
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from topology import JUNCTION_INDEX, Configuration, Position
+from trajgen.errors import InputError, LiveError
+from trajgen.export.vda5050_messages import VDA5050_VERSION, node_id, order_elements
+from trajgen.export.vda5050_release import BaseRelease, plan_orders
+from trajgen.live.clock import RunClock
+from trajgen.live.mqtt import BrokerSettings, Topic, VehicleIdentity, make_client
+from trajgen.live.runlog import RunLog
+from trajgen.online.goals import goal_refusal, plan_from_rest
+from trajgen.verification import VerifiedSchedule, require_verified
+
+__all__ = ["NODE_DEVIATION", "RELEASE_SPACING", "LiveMaster", "LiveOutcome", "LiveRun"]
+
+logger = logging.getLogger(__name__)
+
+#: ``allowedDeviationXY`` of every node sent: how close a vehicle must be to count as on it, metres.
+NODE_DEVIATION = 1e-3
+#: Longest edge of the paths sent by default, metres.
+RELEASE_SPACING = 0.25
+#: Wall seconds between two re-sends of one vehicle's latest order while its state lags behind it.
+_RESEND_INTERVAL_S = 0.25
+#: Slower than this (reported ``velocity``) a vehicle at its decision point stands, m/s.
+_AT_REST = 1e-6
+
+
+class LiveOutcome(enum.Enum):
+    """How a live run ended."""
+
+    GOALS_REACHED = "goals-reached"  #: both vehicles stand at their goals
+    TIMED_OUT = "timed-out"  #: the time limit passed first
+
+
+@dataclass(frozen=True, slots=True)
+class LiveRun:
+    """What a live run did.
+
+    Attributes
+    ----------
+    outcome : LiveOutcome
+    makespan : float
+        Seconds of the run from the first order to both vehicles at their goals (or to the time out).
+    planned : float
+        When the first plan's releases bring both vehicles to their goals, seconds
+        (:attr:`~trajgen.export.vda5050_release.OrderPlan.planned_duration`).
+    orders : int
+        Orders and order updates published, re-sends included.
+    resent : int
+        How many of them were re-sends (after a reconnection, or to a vehicle whose state lagged).
+    ignored : int
+        Messages logged and ignored.
+    replans : int
+        New goals taken.
+    release_latency : ndarray
+        Per release, wall seconds from taking the state that allowed it to publishing the update,
+        shape (releases,), read-only.
+    """
+
+    outcome: LiveOutcome
+    makespan: float
+    planned: float
+    orders: int
+    resent: int
+    ignored: int
+    replans: int
+    release_latency: np.ndarray
+
+    def summary(self) -> dict:
+        """A JSON-ready summary."""
+        latency = self.release_latency
+        return {
+            "outcome": self.outcome.value,
+            "makespan_s": self.makespan,
+            "planned_s": self.planned,
+            "orders": self.orders,
+            "resent": self.resent,
+            "ignored": self.ignored,
+            "replans": self.replans,
+            "releases": int(latency.size),
+            "release_latency_median_ms": float(np.median(latency) * 1e3) if latency.size else None,
+        }
+
+
+class _View:
+    """What the master knows of one vehicle."""
+
+    def __init__(self, name: str, identity: VehicleIdentity) -> None:
+        self.name = name
+        self.identity = identity
+        self.path = None  # OrderPath of the current plan
+        self.arcs: list[float] = []  # distance along the whole run at each node of the current path
+        self.offset = 0  # sequenceId of the current path's node 0
+        self.update = -1  # the latest orderUpdateId sent
+        self.message: bytes | None = None  # the latest order (update) sent
+        self.sent_at = -float("inf")  # wall time of the latest send
+        self.header = 0
+        self.state_header: int | None = None
+        self.node = 0  # last node reached (index on the current path)
+        self.driving = False
+        self.online: bool | None = None
+        self.errors: set[str] = set()
+        self.record: dict = {}
+        self.elements: list = []  # [(nodes, edges) in horizon, (nodes, edges) in base]
+
+
+class LiveMaster:
+    """Drive two VDA 5050 vehicles through a verified plan over an MQTT broker.
+
+    Parameters
+    ----------
+    verified : VerifiedSchedule
+        The plan (from :func:`~trajgen.verification.certify`); its route fixes both paths and the
+        order at every conflict.
+    names : sequence of 2 str
+        The vehicles' names (in the run log).
+    identities : tuple of 2 VehicleIdentity
+    broker : BrokerSettings
+    method : TimingMethod or str, optional
+        What times a new plan after a goal change (default: the registry's default).
+    clock : RunClock, optional
+        The run's clock (its time scale must be the vehicles').
+    order_id : str
+        ``orderId`` prefix: ``<order_id>-<vehicle name>`` (default ``"trajgen"``).
+    map_id : str
+        ``nodePosition.mapId`` (default ``"trajgen"``).
+    log : RunLog, optional
+        Where every event is logged (default: a new one, :attr:`log`).
+    spacing : float
+        Longest edge of the paths sent, metres (default :data:`RELEASE_SPACING`): the base is released
+        node by node, so finer nodes let a vehicle follow the other closely instead of braking early.
+    """
+
+    def __init__(
+        self,
+        verified: VerifiedSchedule,
+        names: Sequence[str],
+        *,
+        identities: tuple[VehicleIdentity, VehicleIdentity],
+        broker: BrokerSettings,
+        method=None,
+        clock: RunClock | None = None,
+        order_id: str = "trajgen",
+        map_id: str = "trajgen",
+        log: RunLog | None = None,
+        spacing: float = RELEASE_SPACING,
+    ) -> None:
+        verified = require_verified(verified, "LiveMaster")
+        self.spacing = spacing
+        if len(identities) != 2 or identities[0].topic("") == identities[1].topic(""):
+            raise InputError("live vehicles must have two different identities (one topic each)")
+        self.graph = verified.schedule.route.graph
+        self.limits = verified.schedule.limits
+        self.names = tuple(names)
+        self.method = method
+        self.broker = broker
+        self.clock = clock if clock is not None else RunClock()
+        self.order_id = order_id
+        self.map_id = map_id
+        self.log = log if log is not None else RunLog()
+        self._views = [_View(self.names[v], identities[v]) for v in (0, 1)]
+        self._topics = {}
+        for v, identity in enumerate(identities):
+            self._topics[identity.topic(Topic.STATE)] = (v, Topic.STATE)
+            self._topics[identity.topic(Topic.CONNECTION)] = (v, Topic.CONNECTION)
+        self._lock = threading.RLock()
+        self._done = threading.Event()
+        self._goal: Configuration | None = None
+        self._rule: BaseRelease | None = None
+        self._started_at: float | None = None
+        self._latencies: list[float] = []
+        self._counts = {"orders": 0, "resent": 0, "ignored": 0, "replans": 0}
+        self._planned = 0.0
+        self._end_time = 0.0
+        self._adopt(verified, first=True)
+        self._client = make_client(broker, f"trajgen-master-{identities[0].interface}-{id(self):x}")
+        self._client.on_connect = self._on_connect
+        self._client.on_message = self._on_message
+
+    # ----------------------------------------------------------------- plans and orders
+    def _adopt(self, verified: VerifiedSchedule, *, first: bool) -> None:
+        """Take a new plan: paths, release rule, and (after a goal change) the stitch offsets."""
+        plan = plan_orders(verified, spacing=self.spacing)
+        rule = BaseRelease(plan.paths, verified.schedule.limits.min_separation)
+        for v, view in enumerate(self._views):
+            if not first:
+                view.offset += 2 * view.node
+                start = view.arcs[view.node]
+            else:
+                start = 0.0
+            view.path = plan.paths[v]
+            view.arcs = [start]
+            for edge in view.path.edges:
+                view.arcs.append(view.arcs[-1] + edge.length)
+            view.node = 0
+            self._elements(v)
+        self._rule = rule
+        if first:
+            self._planned = plan.planned_duration
+        self.log.write(
+            {
+                "t": self.clock.now(),
+                "event": "plan",
+                "method": verified.schedule.method.name,
+                "planned_s": plan.planned_duration,
+                "nodes": [len(p.nodes) for p in plan.paths],
+            }
+        )
+
+    def _elements(self, v: int) -> None:
+        """Each node and edge of vehicle ``v``'s path as a validated model, in base and in horizon."""
+        from vda5050.model.order import Edge, Node
+
+        view = self._views[v]
+        last = len(view.path.nodes) - 1
+        forms = []
+        for released in (False, True):
+            nodes, edges = order_elements(
+                self.graph, view.path, first=0, decision_point=last if released else -1, map_id=self.map_id
+            )
+            for node in nodes:
+                node["sequenceId"] += view.offset
+                node["nodePosition"]["allowedDeviationXY"] = NODE_DEVIATION
+            for edge in edges:
+                edge["sequenceId"] += view.offset
+            forms.append(([Node.model_validate(n) for n in nodes], [Edge.model_validate(e) for e in edges]))
+        view.elements = forms
+
+    def _order(self, v: int, first: int, decision_point: int):
+        """The order (update) of vehicle ``v`` from node ``first``, its base up to ``decision_point``."""
+        from vda5050.model.order import Order
+
+        view = self._views[v]
+        (horizon_nodes, horizon_edges), (base_nodes, base_edges) = view.elements
+        nodes = [
+            base_nodes[j] if j <= decision_point else horizon_nodes[j] for j in range(first, len(base_nodes))
+        ]
+        edges = [
+            base_edges[k] if k < decision_point else horizon_edges[k] for k in range(first, len(base_edges))
+        ]
+        view.header += 1
+        # its nodes and edges were validated once per plan (_elements), its header is this master's
+        order = Order.model_construct(
+            header_id=view.header,
+            timestamp=self.clock.timestamp(),
+            version=VDA5050_VERSION,
+            manufacturer=view.identity.manufacturer,
+            serial_number=view.identity.serial_number,
+            order_id=f"{self.order_id}-{view.name}",
+            order_update_id=view.update + 1,
+            nodes=nodes,
+            edges=edges,
+        )
+        return order
+
+    def _publish(self, v: int, payload: bytes, *, resent: bool, record: dict) -> None:
+        view = self._views[v]
+        self._client.publish(view.identity.topic(Topic.ORDER), payload, qos=0)
+        logger.debug("master: published %s %s", view.name, record.get("update"))
+        view.sent_at = time.monotonic()
+        self._counts["orders"] += 1
+        self._counts["resent"] += resent
+        self.log.write(
+            {"t": self.clock.now(), "event": "order", "vehicle": view.name, "resent": resent, **record}
+        )
+
+    def _send(self, v: int, first: int, decision_point: int) -> None:
+        view = self._views[v]
+        order = self._order(v, first, decision_point)
+        view.update += 1
+        view.message = order.to_json().encode()
+        view.record = {
+            "update": view.update,
+            "first": first,
+            "decision_point": decision_point,
+            "frontier_m": view.arcs[decision_point],
+        }
+        self._publish(v, view.message, resent=False, record=view.record)
+
+    def _resend(self, v: int) -> None:
+        view = self._views[v]
+        if view.message is not None:
+            self._publish(v, view.message, resent=True, record=view.record)
+
+    # ----------------------------------------------------------------- MQTT
+    def _on_connect(self, client, userdata, flags, reason_code, properties) -> None:
+        if reason_code.is_failure:
+            logger.warning("master: broker refused the connection: %s", reason_code)
+            return
+        for topic in self._topics:
+            client.subscribe(topic, qos=1)
+        with self._lock:
+            if self._started_at is None:
+                self._started_at = self.clock.now()
+                for v in (0, 1):
+                    self._send(v, 0, self._rule.released[v])
+            else:  # reconnected (the broker restarted): the latest orders again
+                for v in (0, 1):
+                    self._resend(v)
+        logger.info("master: connected to %s", self.broker.url)
+
+    def _ignore(self, topic: str, reason: str, vehicle: str | None = None) -> None:
+        self._counts["ignored"] += 1
+        logger.warning("master: ignored a message on %s: %s", topic, reason)
+        self.log.write(
+            {"t": self.clock.now(), "event": "ignored", "topic": topic, "vehicle": vehicle, "reason": reason}
+        )
+
+    def _on_message(self, client, userdata, message) -> None:
+        taken = time.perf_counter()
+        where = self._topics.get(message.topic)
+        try:
+            with self._lock:
+                if where is None:
+                    self._ignore(message.topic, "not a topic of this run's vehicles")
+                elif where[1] == Topic.STATE:
+                    self._take_state(where[0], message.topic, bytes(message.payload), taken)
+                else:
+                    self._take_connection(where[0], message.topic, bytes(message.payload))
+        except Exception:  # a message must never stop the master: log it, keep the releases as they are
+            logger.exception("master: a message on %s raised; ignored", message.topic)
+
+    def _decode(self, v: int, topic: str, payload: bytes, model):
+        from vda5050.errors import MessageValidationError
+        from vda5050.serialization import decode
+
+        view = self._views[v]
+        try:
+            message = decode(payload, model)
+        except MessageValidationError as error:
+            self._ignore(topic, f"malformed: {str(error)[:120]}", view.name)
+            return None
+        identity = (message.manufacturer, message.serial_number)
+        if identity != (view.identity.manufacturer, view.identity.serial_number):
+            self._ignore(topic, f"from {identity[0]}/{identity[1]}, not {view.name}", view.name)
+            return None
+        return message
+
+    def _take_connection(self, v: int, topic: str, payload: bytes) -> None:
+        from vda5050.model.connection import Connection
+
+        message = self._decode(v, topic, payload, Connection)
+        if message is None:
+            return
+        view = self._views[v]
+        online = message.connection_state.value == "ONLINE"
+        if online == view.online:
+            return
+        view.online = online
+        self.log.write(
+            {
+                "t": self.clock.now(),
+                "event": "connection",
+                "vehicle": view.name,
+                "state": message.connection_state.value,
+            }
+        )
+        if online:
+            logger.info("master: %s is online", view.name)
+            view.state_header = None  # a vehicle that restarted counts its headers afresh
+            self._resend(v)
+            self._release()
+        else:
+            logger.warning("master: %s is %s: no base is released", view.name, message.connection_state.value)
+
+    def _take_state(self, v: int, topic: str, payload: bytes, taken: float) -> None:
+        from vda5050.model.state import State
+
+        state = self._decode(v, topic, payload, State)
+        if state is None:
+            return
+        view = self._views[v]
+        if view.state_header is not None and state.header_id <= view.state_header:
+            self._ignore(topic, f"headerId {state.header_id} is not after {view.state_header}", view.name)
+            return
+        expected = f"{self.order_id}-{view.name}"
+        if state.order_id != expected or state.order_update_id < view.update:
+            view.state_header = state.header_id
+            if time.monotonic() - view.sent_at >= _RESEND_INTERVAL_S:  # it lacks the latest order
+                logger.debug("master: %s has not the latest order: sent again", view.name)
+                self._resend(v)
+            return
+        j = (state.last_node_sequence_id - view.offset) // 2
+        if not (
+            0 <= j <= self._rule.released[v]
+            and (state.last_node_sequence_id - view.offset) % 2 == 0
+            and state.last_node_id == self._node_id(v, j)
+        ):
+            self._ignore(
+                topic,
+                f"last node {state.last_node_id!r} (sequenceId {state.last_node_sequence_id}) is not a node "
+                f"of {view.name}'s base",
+                view.name,
+            )
+            return
+        view.state_header = state.header_id
+        for error in state.errors:
+            if error.error_description not in view.errors:
+                view.errors.add(error.error_description)
+                logger.warning(
+                    "master: %s reports %s: %s", view.name, error.error_type, error.error_description
+                )
+        view.node = max(view.node, j)
+        view.driving = state.driving
+        self.log.write(
+            {
+                "t": self.clock.now(),
+                "event": "state",
+                "vehicle": view.name,
+                "x": state.agv_position.x if state.agv_position else None,
+                "y": state.agv_position.y if state.agv_position else None,
+                "node": view.node + view.offset // 2,
+                "along_m": view.arcs[j] + (state.distance_since_last_node or 0.0),
+                "driving": state.driving,
+            }
+        )
+        released = self._release()
+        if released:
+            self._latencies.append(time.perf_counter() - taken)
+        self._check_end()
+
+    def _node_id(self, v: int, j: int) -> str:
+        node = self._views[v].path.nodes[j]
+        return node_id(self.graph, node.leg, node.s)
+
+    def _release(self) -> int:
+        """Take the nodes reached into the rule and send the releases that follow; their count."""
+        if self._goal is not None:
+            self._maybe_replan()
+            return 0
+        if not all(view.online is not False for view in self._views):
+            return 0
+        count = 0
+        for v, view in enumerate(self._views):
+            if view.node > self._rule.reached[v]:
+                for vehicle, old, new in self._rule.reach(v, view.node):
+                    self._send(vehicle, old, new)
+                    count += 1
+        return count
+
+    def _check_end(self) -> None:
+        if self._goal is None and all(
+            view.node == len(view.path.nodes) - 1 and not view.driving for view in self._views
+        ):
+            if not self._done.is_set():
+                self._end_time = self.clock.now()
+            self._done.set()
+
+    # ----------------------------------------------------------------- goals
+    def request_goal(self, goal: Configuration) -> None:
+        """Ask for a new goal: both vehicles stop at their bases, then are re-planned from there.
+
+        Raises
+        ------
+        InputError
+            ``goal`` is not on the track, or leaves the vehicles closer than the separation.
+        """
+        if not isinstance(goal, Configuration):
+            raise InputError(f"live goal must be a Configuration, got {type(goal).__name__}")
+        goal = Configuration(self.graph.check(goal.first), self.graph.check(goal.second))
+        refusal = goal_refusal(self.graph, goal, self.limits.min_separation)
+        if refusal is not None:
+            raise InputError(refusal)
+        with self._lock:
+            self._goal = goal
+            self._done.clear()
+            self.log.write({"t": self.clock.now(), "event": "goal", "goal": str(goal)})
+            logger.info("master: new goal %s: holding both vehicles at their bases", goal)
+            self._maybe_replan()
+
+    def _maybe_replan(self) -> None:
+        views = self._views
+        if not all(
+            view.node == self._rule.released[v] and not view.driving and view.online is not False
+            for v, view in enumerate(views)
+        ):
+            return
+        here = [views[v].path.nodes[views[v].node] for v in (0, 1)]
+        start = Configuration(
+            *(
+                Position(None, 0.0) if n.leg == JUNCTION_INDEX else Position(self.graph.names[n.leg], n.s)
+                for n in here
+            )
+        )
+        goal, self._goal = self._goal, None
+        verified = plan_from_rest(self.graph, self.limits, start, goal, method=self.method, margin=0.0)
+        self._counts["replans"] += 1
+        self.log.write({"t": self.clock.now(), "event": "replan", "goal": str(goal)})
+        self._adopt(verified, first=False)
+        for v in (0, 1):
+            self._send(v, 0, self._rule.released[v])
+        self._check_end()
+
+    # ----------------------------------------------------------------- running
+    def run(self, *, timeout: float) -> LiveRun:
+        """Connect, drive both vehicles to their goals, disconnect.
+
+        Parameters
+        ----------
+        timeout : float
+            Seconds of the run after which it ends unfinished.
+
+        Returns
+        -------
+        LiveRun
+
+        Raises
+        ------
+        LiveError
+            The broker could not be reached.
+        """
+        self.start()
+        try:
+            self.wait(timeout=timeout)
+        finally:
+            self.stop()
+        return self.result()
+
+    def start(self) -> LiveMaster:
+        """Connect (in paho's thread); the orders go out once connected. Returns itself."""
+        try:
+            self._client.connect(self.broker.host, self.broker.port, keepalive=5)
+        except OSError as error:
+            raise LiveError(
+                f"broker {self.broker.url} cannot be reached ({error}): expected an MQTT broker "
+                "listening there"
+            ) from None
+        self._client.loop_start()
+        return self
+
+    def wait(self, *, timeout: float) -> bool:
+        """Wait until both vehicles stand at their goals or ``timeout`` seconds of the run pass."""
+        deadline = self.clock.now() + timeout
+        while not self._done.is_set():
+            left = deadline - self.clock.now()
+            if left <= 0.0:
+                return False
+            self._done.wait(min(self.clock.wall_seconds(left), 0.05))
+        return True
+
+    def stop(self) -> None:
+        """Disconnect."""
+        self._client.disconnect()
+        self._client.loop_stop()
+
+    def result(self) -> LiveRun:
+        """The run so far (see :class:`LiveRun`); logs its end."""
+        with self._lock:
+            now = self.clock.now()
+            began = self._started_at if self._started_at is not None else now
+            outcome = LiveOutcome.GOALS_REACHED if self._done.is_set() else LiveOutcome.TIMED_OUT
+            latency = np.array(self._latencies, dtype=float)
+            latency.flags.writeable = False
+            run = LiveRun(
+                outcome,
+                (self._end_time if self._done.is_set() else now) - began,
+                self._planned,
+                self._counts["orders"],
+                self._counts["resent"],
+                self._counts["ignored"],
+                self._counts["replans"],
+                latency,
+            )
+            self.log.write({"t": now, "event": "end", "outcome": outcome.value, "makespan_s": run.makespan})
+            return run

@@ -1,0 +1,259 @@
+"""A live run's parts from a scenario: the plan, the vehicles' identities and places, the demo.
+
+:func:`live_plan` plans and verifies the run; :func:`identities` names each
+vehicle on the broker (by default its scenario name as serial number);
+:func:`position_xy` and :func:`track_position` convert between the track and
+the map's x/y (the legs drawn at the scenario's angles), as the orders and
+states carry positions; :func:`run_demo` runs a broker, two simulated
+vehicles and the master in this process.
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+from topology import Position, StarGraph
+from trajgen.errors import InputError
+from trajgen.live.clock import RunClock
+from trajgen.live.master import RELEASE_SPACING, LiveMaster, LiveRun
+from trajgen.live.mqtt import DEFAULT_INTERFACE, DEFAULT_VERSION, BrokerSettings, VehicleIdentity
+from trajgen.live.runlog import RunLog
+from trajgen.live.vehicle import SimulatedVehicle, StopFault
+from trajgen.online.goals import plan_for_execution
+from trajgen.verification import VerifiedSchedule
+
+__all__ = [
+    "DEFAULT_MANUFACTURER",
+    "DemoRun",
+    "LiveDemo",
+    "closest_approach",
+    "identities",
+    "live_plan",
+    "position_xy",
+    "run_demo",
+    "track_position",
+]
+
+logger = logging.getLogger(__name__)
+
+#: ``manufacturer`` of both vehicles when none is given (as the VDA 5050 file export writes).
+DEFAULT_MANUFACTURER = "unspecified"
+
+
+def live_plan(scenario, *, method=None) -> VerifiedSchedule:
+    """The verified plan of ``scenario`` for a live run: the online executor's plan.
+
+    The same plan :func:`~trajgen.online.goals.plan_for_execution` gives (``optimal`` with the
+    braking rule in its problem, a position margin on the separation): what is planned is what
+    both the executor and the live master carry out.
+    """
+    return plan_for_execution(scenario, method=method)
+
+
+def identities(
+    names: Sequence[str],
+    *,
+    manufacturer: str = DEFAULT_MANUFACTURER,
+    serial_numbers: Sequence[str] | None = None,
+    interface: str = DEFAULT_INTERFACE,
+    version: str = DEFAULT_VERSION,
+) -> tuple[VehicleIdentity, VehicleIdentity]:
+    """Both vehicles' identities: ``serial_numbers`` default to the vehicle names.
+
+    Raises
+    ------
+    InputError
+        Not two serial numbers, two equal ones, or a level an MQTT topic cannot carry.
+    """
+    serials = tuple(names if serial_numbers is None else serial_numbers)
+    if len(serials) != 2 or serials[0] == serials[1]:
+        raise InputError(f"serial numbers {serials!r}: expected two different ones, one per vehicle")
+    return tuple(VehicleIdentity(manufacturer, serial, interface, version) for serial in serials)
+
+
+def position_xy(graph: StarGraph, position: Position) -> tuple[float, float]:
+    """Map x/y of a track position, metres (leg drawn at its angle from the junction at 0, 0)."""
+    if position.leg is None or position.s == 0.0:
+        return (0.0, 0.0)
+    angle = math.radians(graph.angles_deg[graph.index(position.leg)])
+    return (position.s * math.cos(angle), position.s * math.sin(angle))
+
+
+def track_position(graph: StarGraph, x: float, y: float) -> Position:
+    """The track position at map x/y (the nearest leg by angle; at the junction within 1 µm)."""
+    s = math.hypot(x, y)
+    if s < 1e-6:
+        return Position(None, 0.0)
+    angle = math.degrees(math.atan2(y, x))
+    leg = min(
+        range(len(graph.names)), key=lambda k: abs((graph.angles_deg[k] - angle + 180.0) % 360.0 - 180.0)
+    )
+    return Position(graph.names[leg], min(s, graph.lengths[leg]))
+
+
+@dataclass(frozen=True, slots=True)
+class DemoRun:
+    """What :func:`run_demo` did.
+
+    Attributes
+    ----------
+    run : LiveRun
+    log : RunLog
+        Its run log (the caller closes it).
+    closest : float
+        The smallest track distance between the vehicles' true positions, sampled every cycle, metres.
+    vehicles : tuple of 2 SimulatedVehicle
+        Stopped.
+    """
+
+    run: LiveRun
+    log: RunLog
+    closest: float
+    vehicles: tuple[SimulatedVehicle, SimulatedVehicle]
+
+
+class LiveDemo:
+    """A broker (unless one is given), two simulated vehicles and the master, in this process.
+
+    Parameters
+    ----------
+    scenario : Scenario
+    verified : VerifiedSchedule, optional
+        The plan (default: :func:`live_plan` of ``scenario`` with ``method``).
+    method : TimingMethod or str, optional
+    time_scale : float
+        Seconds of the run per wall-clock second.
+    faults : pair of sequences of StopFault
+        Per vehicle.
+    broker_url : str, optional
+        Use this broker instead of starting one.
+    spacing : float
+        Longest edge of the paths sent, metres.
+
+    Examples
+    --------
+    Use it as a context manager; :meth:`run` drives the vehicles, ``at`` lists what to do when.
+
+    >>> # with LiveDemo(scenario, time_scale=10) as demo:
+    >>> #     outcome = demo.run(at=[(12.0, lambda demo: demo.broker.restart())])
+    """
+
+    def __init__(
+        self,
+        scenario,
+        verified: VerifiedSchedule | None = None,
+        *,
+        method=None,
+        time_scale: float = 1.0,
+        faults: Sequence[Sequence[StopFault]] = ((), ()),
+        broker_url: str | None = None,
+        spacing: float = RELEASE_SPACING,
+    ) -> None:
+        self.scenario = scenario
+        self.verified = verified if verified is not None else live_plan(scenario, method=method)
+        self.method = method
+        self.clock = RunClock(time_scale)
+        self.faults = faults
+        self.broker_url = broker_url
+        self.spacing = spacing
+        self.broker = None
+        self.vehicles: tuple[SimulatedVehicle, ...] = ()
+        self.master: LiveMaster | None = None
+
+    def __enter__(self) -> LiveDemo:
+        from trajgen.live.broker import EmbeddedBroker
+
+        scenario = self.scenario
+        if self.broker_url is None:
+            self.broker = EmbeddedBroker().start()
+        url = self.broker_url if self.broker_url is not None else self.broker.url
+        settings = BrokerSettings.from_url(url)
+        ids = identities(scenario.names)
+        starts = (scenario.start.first, scenario.start.second)
+        self.vehicles = tuple(
+            SimulatedVehicle(
+                ids[v],
+                scenario.limits.vehicles[v],
+                position_xy(scenario.track, starts[v]),
+                broker=settings,
+                clock=self.clock,
+                faults=self.faults[v],
+                record=True,
+            )
+            for v in (0, 1)
+        )
+        self.master = LiveMaster(
+            self.verified,
+            scenario.names,
+            identities=ids,
+            broker=settings,
+            method=self.method,
+            clock=self.clock,
+            log=RunLog(),
+            spacing=self.spacing,
+        )
+        for vehicle in self.vehicles:
+            vehicle.start()
+        return self
+
+    def run(self, *, timeout: float | None = None, at: Sequence = ()) -> DemoRun:
+        """Drive both vehicles to their goals; ``at``: ``(seconds of the run, action(demo))`` pairs.
+
+        ``timeout``: seconds of the run (default: four times the plan plus a minute).
+        """
+        limit = timeout if timeout is not None else 4.0 * self.verified.schedule.duration + 60.0
+        master = self.master
+        master.start()
+        try:
+            for moment, action in sorted(at, key=lambda pair: pair[0]):
+                if master.wait(timeout=moment - self.clock.now()):
+                    break
+                action(self)
+            master.wait(timeout=limit - self.clock.now())
+        finally:
+            master.stop()
+        run = master.result()
+        for vehicle in self.vehicles:
+            vehicle.stop()
+        return DemoRun(run, master.log, closest_approach(self.scenario.track, self.vehicles), self.vehicles)
+
+    def __exit__(self, *exc) -> None:
+        for vehicle in self.vehicles:
+            vehicle.stop()
+        if self.broker is not None:
+            self.broker.stop()
+
+
+def run_demo(
+    scenario,
+    *,
+    method=None,
+    time_scale: float = 1.0,
+    faults: Sequence[Sequence[StopFault]] = ((), ()),
+    timeout: float | None = None,
+    broker_url: str | None = None,
+) -> DemoRun:
+    """Run ``scenario`` live in this process: a broker, two simulated vehicles and the master.
+
+    See :class:`LiveDemo` for the parameters; ``timeout`` in seconds of the run.
+    """
+    demo = LiveDemo(scenario, method=method, time_scale=time_scale, faults=faults, broker_url=broker_url)
+    with demo:
+        return demo.run(timeout=timeout)
+
+
+def closest_approach(graph: StarGraph, vehicles: Sequence[SimulatedVehicle]) -> float:
+    """The smallest track distance between two recorded vehicles at the cycles both recorded, metres."""
+    first, second = (vehicle.trace for vehicle in vehicles)
+    by_time = {round(s.time, 9): s for s in second}
+    closest = math.inf
+    for a in first:
+        b = by_time.get(round(a.time, 9))
+        if b is not None:
+            closest = min(
+                closest, graph.distance(track_position(graph, a.x, a.y), track_position(graph, b.x, b.y))
+            )
+    return closest

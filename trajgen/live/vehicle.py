@@ -1,0 +1,569 @@
+"""A simulated VDA 5050 vehicle: takes orders by the protocol's rules and drives its base with Ruckig.
+
+It accepts, ignores or rejects each order and order update by the decision
+chain of VDA 5050's figure 8 (vda5050-sdk's ``OrderAcceptancePolicy``); a
+rejection shows as an error in its state. It drives only on its base: Ruckig
+takes it, time-optimally under its own limits, to rest at its decision point
+(or at a reversal on the way), and re-plans every cycle as the base grows. It
+publishes ``state`` at a fixed rate and at once on every event (a node
+reached, an order taken or refused), and ``connection`` ONLINE, retained, with
+a last will of CONNECTIONBROKEN.
+
+Positions are the order's node positions (metres, the map's x/y), interpolated
+along each edge: the vehicle knows no more of the track than its orders say.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import itertools
+import logging
+import math
+import queue
+import re
+import threading
+import time
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+from limits import VehicleLimits
+from topology.validation import short_repr
+from trajgen.errors import InputError
+from trajgen.live.clock import RunClock
+from trajgen.live.mqtt import BrokerSettings, Topic, VehicleIdentity, make_client
+
+__all__ = ["SimulatedVehicle", "StopFault", "VehicleSnapshot"]
+
+logger = logging.getLogger(__name__)
+
+#: A node is reached within this of its position along the path, metres.
+NODE_TOLERANCE = 1e-6
+#: Slower than this is at rest, m/s.
+AT_REST = 1e-6
+#: Cosine below which the directions of two edges meeting at a node are opposite: a reversal.
+_REVERSAL_COSINE = -0.999
+#: How far ahead of its decision point the vehicle asks for more base (``newBaseRequest``), metres.
+_BASE_REQUEST_DISTANCE = 2.0
+#: Wall seconds the drive loop sleeps between its catch-ups.
+_LOOP_SLEEP_S = 0.004
+_FAULT = re.compile(r"stop@(?P<at>[^+]+)\+(?P<duration>.+)")
+
+
+@dataclass(frozen=True, slots=True)
+class StopFault:
+    """The vehicle stops at ``at`` (seconds of the run) and stands ``duration`` seconds.
+
+    It brakes as hard as its limits allow, then goes on.
+    """
+
+    at: float
+    duration: float
+
+    @classmethod
+    def parse(cls, text: str) -> StopFault:
+        """Read ``stop@T+D`` (seconds).
+
+        Raises
+        ------
+        InputError
+            Not of that form, or T, D negative or not finite.
+        """
+        match = _FAULT.fullmatch(text.strip()) if isinstance(text, str) else None
+        try:
+            at, duration = (float(match["at"]), float(match["duration"])) if match else (math.nan, math.nan)
+        except ValueError:
+            at = duration = math.nan
+        if not (math.isfinite(at) and math.isfinite(duration) and at >= 0.0 and duration >= 0.0):
+            raise InputError(
+                f"vehicle fault {short_repr(text)} cannot be read: expected stop@T+D with T, D seconds >= 0 "
+                "(e.g. stop@12+3)"
+            )
+        return cls(at, duration)
+
+    def active(self, t: float) -> bool:
+        """Whether the vehicle is held at run time ``t``."""
+        return self.at <= t < self.at + self.duration
+
+
+@dataclass(frozen=True, slots=True)
+class VehicleSnapshot:
+    """Where a simulated vehicle truly is (not what it reported).
+
+    Attributes
+    ----------
+    time : float
+        Seconds of the run.
+    x, y : float
+        Metres, map coordinates.
+    velocity : float
+        Along its path, m/s (>= 0).
+    last_node : int
+        How many nodes of its current order it has passed (0: at its first node).
+    finished : bool
+        At rest at the last node of an order with no horizon left.
+    """
+
+    time: float
+    x: float
+    y: float
+    velocity: float
+    last_node: int
+    finished: bool
+
+
+class _Path:
+    """The nodes and edges of the current order (merged with its updates), with arc lengths."""
+
+    def __init__(self, nodes: list, edges: list) -> None:
+        self.nodes: list = []
+        self.edges: list = []
+        self.arcs = [0.0]
+        self.extend(0, nodes, edges, first=True)
+
+    def extend(self, stitch: int, nodes: list, edges: list, *, first: bool = False) -> None:
+        """Replace everything after node ``stitch`` by ``nodes[1:]`` and ``edges`` (``first``: all)."""
+        self.nodes = list(nodes) if first else self.nodes[: stitch + 1] + list(nodes[1:])
+        self.edges = list(edges) if first else self.edges[:stitch] + list(edges)
+        self.arcs = self.arcs[: stitch + 1]
+        for a, b in itertools.pairwise(self.nodes[stitch:]):
+            pa, pb = a.node_position, b.node_position
+            self.arcs.append(self.arcs[-1] + math.hypot(pb.x - pa.x, pb.y - pa.y))
+
+    @property
+    def base_end(self) -> int:
+        """Index of the decision point (the last released node)."""
+        return max(k for k, node in enumerate(self.nodes) if node.released)
+
+    def reversal(self, k: int) -> bool:
+        """Whether the path turns back at node ``k``."""
+        if not 0 < k < len(self.nodes) - 1:
+            return False
+        incoming = self._direction(k - 1, k)
+        outgoing = self._direction(k, k + 1)
+        if incoming is None or outgoing is None:
+            return False
+        return incoming[0] * outgoing[0] + incoming[1] * outgoing[1] < _REVERSAL_COSINE
+
+    def _direction(self, a: int, b: int) -> tuple[float, float] | None:
+        # an edge of zero length (at the junction) has the direction of its neighbours
+        while a >= 0 and b < len(self.nodes):
+            pa, pb = self.nodes[a].node_position, self.nodes[b].node_position
+            length = math.hypot(pb.x - pa.x, pb.y - pa.y)
+            if length > NODE_TOLERANCE:
+                return ((pb.x - pa.x) / length, (pb.y - pa.y) / length)
+            a, b = (a - 1, b) if a > 0 else (a, b + 1)
+        return None
+
+    def point(self, p: float) -> tuple[float, float, float]:
+        """``(x, y, theta)`` at arc length ``p``."""
+        k = 0
+        while k + 1 < len(self.arcs) - 1 and self.arcs[k + 1] <= p:
+            k += 1
+        if len(self.nodes) == 1:
+            position = self.nodes[0].node_position
+            return position.x, position.y, 0.0
+        a, b = self.nodes[k].node_position, self.nodes[k + 1].node_position
+        length = self.arcs[k + 1] - self.arcs[k]
+        f = 0.0 if length <= 0.0 else min(max((p - self.arcs[k]) / length, 0.0), 1.0)
+        direction = self._direction(k, k + 1)
+        theta = math.atan2(direction[1], direction[0]) if direction is not None else 0.0
+        return a.x + f * (b.x - a.x), a.y + f * (b.y - a.y), theta
+
+
+class SimulatedVehicle:
+    """A VDA 5050 vehicle simulated in this process, on an MQTT broker.
+
+    Parameters
+    ----------
+    identity : VehicleIdentity
+    limits : VehicleLimits
+        Its own velocity, acceleration and jerk limits (SI).
+    start : (float, float)
+        Where it stands, metres (map x, y).
+    broker : BrokerSettings
+    clock : RunClock, optional
+        The run's clock (shared with others in the process to compare their times).
+    state_rate : float
+        ``state`` messages per second of the run, besides those on events (default 10).
+    period : float
+        Control cycle, seconds of the run (default 0.01).
+    faults : sequence of StopFault
+    map_id : str
+        ``agvPosition.mapId`` (default ``"trajgen"``).
+    record : bool
+        Keep a :class:`VehicleSnapshot` of every cycle (:attr:`trace`; for tests: it grows with the run).
+    """
+
+    def __init__(
+        self,
+        identity: VehicleIdentity,
+        limits: VehicleLimits,
+        start: tuple[float, float],
+        *,
+        broker: BrokerSettings,
+        clock: RunClock | None = None,
+        state_rate: float = 10.0,
+        period: float = 0.01,
+        faults: Sequence[StopFault] = (),
+        map_id: str = "trajgen",
+        record: bool = False,
+    ) -> None:
+        from ruckig import InputParameter, OutputParameter, Ruckig
+
+        if not isinstance(state_rate, int | float) or not 0.1 <= state_rate <= 100.0:
+            raise InputError(f"state rate {short_repr(state_rate)} Hz is out of range: expected 0.1 to 100")
+        if not isinstance(period, int | float) or not 0.001 <= period <= 0.1:
+            raise InputError(f"control period {short_repr(period)} s is out of range: expected 0.001 to 0.1")
+        self.identity = identity
+        self.limits = limits
+        self.clock = clock if clock is not None else RunClock()
+        self.state_rate = float(state_rate)
+        self.period = float(period)
+        self.faults = tuple(faults)
+        self.map_id = map_id
+        self.record = record
+        self._start = (float(start[0]), float(start[1]))
+        self._otg = Ruckig(1, self.period)
+        self._input = InputParameter(1)
+        self._output = OutputParameter(1)
+        self._input.max_velocity = [limits.max_velocity]
+        self._input.max_acceleration = [limits.max_acceleration]
+        self._input.max_jerk = [limits.max_jerk]
+        self._t = 0.0
+        self._p = self._v = self._a = 0.0
+        self._path: _Path | None = None
+        self._last = 0
+        self._order = None  # the accepted order, merged with its updates (vda5050 Order)
+        self._state = None  # the last state published (vda5050 State)
+        self._errors: list = []
+        self._headers = {Topic.STATE: 0, Topic.CONNECTION: 0}
+        self._inbox: queue.SimpleQueue[bytes] = queue.SimpleQueue()
+        self._event = True
+        self._next_state = 0.0
+        self._lock = threading.Lock()
+        self._snapshot = VehicleSnapshot(0.0, *self._start, 0.0, 0, False)
+        self._trace: list[VehicleSnapshot] = []
+        self._halt = threading.Event()
+        self._thread: threading.Thread | None = None
+        self._client = make_client(
+            broker,
+            f"trajgen-vehicle-{identity.manufacturer}-{identity.serial_number}",
+            will=(identity.topic(Topic.CONNECTION), self._connection_message("CONNECTIONBROKEN")),
+        )
+        self._client.on_connect = self._on_connect
+        self._client.on_message = self._on_message
+        self._broker = broker
+        self.rejections = 0
+
+    # ----------------------------------------------------------------- MQTT
+    def _connection_message(self, state: str) -> bytes:
+        from vda5050.model.connection import Connection
+
+        self._headers[Topic.CONNECTION] += 1
+        message = Connection(
+            header_id=self._headers[Topic.CONNECTION],
+            timestamp=self.clock.timestamp(),
+            version="2.1.0",
+            manufacturer=self.identity.manufacturer,
+            serial_number=self.identity.serial_number,
+            connection_state=state,
+        )
+        return message.to_json().encode()
+
+    def _on_connect(self, client, userdata, flags, reason_code, properties) -> None:
+        if reason_code.is_failure:
+            logger.warning(
+                "vehicle %s: broker refused the connection: %s", self.identity.serial_number, reason_code
+            )
+            return
+        client.subscribe(self.identity.topic(Topic.ORDER), qos=0)
+        client.publish(
+            self.identity.topic(Topic.CONNECTION), self._connection_message("ONLINE"), qos=1, retain=True
+        )
+        self._event = True  # a state at once: the master learns where the vehicle is
+        logger.info("vehicle %s: connected to %s", self.identity.serial_number, self._broker.url)
+
+    def _on_message(self, client, userdata, message) -> None:
+        self._inbox.put(bytes(message.payload))
+
+    def start(self) -> SimulatedVehicle:
+        """Connect and start driving (in threads of its own); returns itself."""
+        self._client.connect_async(self._broker.host, self._broker.port, keepalive=5)
+        self._client.loop_start()
+        self._thread = threading.Thread(
+            target=self._run, name=f"trajgen-vehicle-{self.identity.serial_number}", daemon=True
+        )
+        self._thread.start()
+        return self
+
+    def stop(self) -> None:
+        """Say OFFLINE, disconnect and stop driving."""
+        self._halt.set()
+        if self._thread is not None:
+            self._thread.join(5.0)
+        if self._client.is_connected():
+            info = self._client.publish(
+                self.identity.topic(Topic.CONNECTION), self._connection_message("OFFLINE"), qos=1, retain=True
+            )
+            info.wait_for_publish(1.0)
+        self._client.disconnect()
+        self._client.loop_stop()
+
+    def drop_connection(self) -> None:
+        """Lose the broker without a word (the broker sends the last will); it keeps driving its base."""
+        self._client.loop_stop()
+        sock = self._client.socket()
+        if sock is not None:
+            import socket
+
+            with contextlib.suppress(OSError):
+                sock.shutdown(socket.SHUT_RDWR)
+        logger.info("vehicle %s: connection dropped", self.identity.serial_number)
+
+    def restore_connection(self) -> None:
+        """Reconnect after :meth:`drop_connection`."""
+        self._client.reconnect()
+        self._client.loop_start()
+
+    def __enter__(self) -> SimulatedVehicle:
+        return self.start()
+
+    def __exit__(self, *exc) -> None:
+        self.stop()
+
+    # ----------------------------------------------------------------- readouts
+    @property
+    def snapshot(self) -> VehicleSnapshot:
+        """Where it truly is now."""
+        with self._lock:
+            return self._snapshot
+
+    @property
+    def trace(self) -> tuple[VehicleSnapshot, ...]:
+        """Every cycle's snapshot (with ``record=True``; empty otherwise)."""
+        with self._lock:
+            return tuple(self._trace)
+
+    # ----------------------------------------------------------------- orders
+    def _reject(self, error_type: str, detail: str, references: dict[str, str]) -> None:
+        from vda5050.model.common import Error
+
+        self.rejections += 1
+        self._errors.append(
+            Error(
+                error_type=error_type,
+                error_references=[{"reference_key": k, "reference_value": v} for k, v in references.items()],
+                error_description=detail,
+                error_level="WARNING",
+            )
+        )
+        logger.warning("vehicle %s: order refused (%s): %s", self.identity.serial_number, error_type, detail)
+
+    def _receive(self, payload: bytes) -> None:
+        from vda5050.domain.order.acceptance import AcceptanceDecision, OrderAcceptancePolicy
+        from vda5050.domain.sessions.vehicle_session import VehicleSession
+        from vda5050.errors import MessageValidationError
+        from vda5050.identity import VehicleKey
+        from vda5050.model.order import Order
+        from vda5050.serialization import decode
+
+        self._event = True
+        try:
+            order = decode(payload, Order)
+        except MessageValidationError as error:
+            self._reject("validationError", str(error)[:200], {"topic": Topic.ORDER})
+            return
+        references = {
+            "headerId": str(order.header_id),
+            "orderId": order.order_id,
+            "orderUpdateId": str(order.order_update_id),
+        }
+        if (order.manufacturer, order.serial_number) != (
+            self.identity.manufacturer,
+            self.identity.serial_number,
+        ):
+            self._reject("orderError", "the order names another vehicle", references)
+            return
+        if any(node.node_position is None for node in order.nodes):
+            self._reject(
+                "orderError", "a node has no nodePosition: this vehicle drives by positions", references
+            )
+            return
+        session = VehicleSession(
+            key=VehicleKey(self.identity.manufacturer, self.identity.serial_number),
+            order=self._order,
+            state=self._state,
+        )
+        result = OrderAcceptancePolicy().evaluate(order, session, available_map_ids={self.map_id})
+        if result.decision is AcceptanceDecision.IGNORE_DUPLICATE:
+            return
+        if not result.accepted:
+            self._reject(
+                result.error_type or "orderError", result.detail or result.decision.value, references
+            )
+            return
+        self._errors.clear()
+        if result.decision is AcceptanceDecision.ACCEPT_NEW:
+            self._path = _Path(list(order.nodes), list(order.edges))
+            self._order = order
+            self._last = 0
+            self._p = self._v = self._a = 0.0
+            x, y, _ = self._path.point(0.0)
+            self._start = (x, y)
+        else:
+            stitch = next(
+                k for k, node in enumerate(self._path.nodes) if node.sequence_id == order.nodes[0].sequence_id
+            )
+            self._path.extend(stitch, list(order.nodes), list(order.edges))
+            self._order = order.model_copy(update={"nodes": self._path.nodes, "edges": self._path.edges})
+        logger.debug(
+            "vehicle %s: took order %s update %d (base to node %d)",
+            self.identity.serial_number,
+            order.order_id,
+            order.order_update_id,
+            self._path.base_end,
+        )
+
+    # ----------------------------------------------------------------- driving
+    def _held(self, t: float) -> bool:
+        return any(fault.active(t) for fault in self.faults)
+
+    def _next_stop(self) -> float:
+        path = self._path
+        end = path.base_end
+        k = self._last + 1
+        while k < end and not path.reversal(k):
+            k += 1
+        return path.arcs[max(min(k, end), self._last)]
+
+    def _step(self) -> None:
+        from ruckig import ControlInterface, Result
+
+        self._t += self.period
+        path = self._path
+        if path is None:
+            return
+        inp = self._input
+        inp.current_position = [self._p]
+        inp.current_velocity = [self._v]
+        inp.current_acceleration = [self._a]
+        if self._held(self._t):
+            inp.control_interface = ControlInterface.Velocity
+            inp.target_velocity = [0.0]
+            inp.target_acceleration = [0.0]
+        else:
+            inp.control_interface = ControlInterface.Position
+            inp.target_position = [self._next_stop()]
+            inp.target_velocity = [0.0]
+            inp.target_acceleration = [0.0]
+        result = self._otg.update(inp, self._output)
+        if result not in (Result.Working, Result.Finished):
+            logger.error("vehicle %s: Ruckig failed (%s); braking", self.identity.serial_number, result)
+            self._v = max(0.0, self._v - self.limits.max_acceleration * self.period)
+            self._a = 0.0
+        else:
+            self._p, self._v, self._a = (
+                self._output.new_position[0],
+                self._output.new_velocity[0],
+                self._output.new_acceleration[0],
+            )
+        end = path.base_end
+        while self._last < end and self._p >= path.arcs[self._last + 1] - NODE_TOLERANCE:
+            self._last += 1
+            self._event = True
+
+    def _finished(self) -> bool:
+        path = self._path
+        return (
+            path is not None
+            and self._last == len(path.nodes) - 1
+            and all(node.released for node in path.nodes)
+            and abs(self._v) <= AT_REST
+        )
+
+    def _update_snapshot(self) -> None:
+        x, y, _ = self._path.point(self._p) if self._path is not None else (*self._start, 0.0)
+        snapshot = VehicleSnapshot(self._t, x, y, self._v, self._last, self._finished())
+        with self._lock:
+            self._snapshot = snapshot
+            if self.record:
+                self._trace.append(snapshot)
+
+    def _state_message(self) -> bytes:
+        from vda5050.model.state import State
+
+        path = self._path
+        self._headers[Topic.STATE] += 1
+        x, y, theta = path.point(self._p) if path is not None else (*self._start, 0.0)
+        nodes = path.nodes if path is not None else []
+        edges = path.edges if path is not None else []
+        last = nodes[self._last] if nodes else None
+        to_decision_point = path.arcs[path.base_end] - self._p if path is not None else 0.0
+        state = State(
+            header_id=self._headers[Topic.STATE],
+            timestamp=self.clock.timestamp(self._t),
+            version="2.1.0",
+            manufacturer=self.identity.manufacturer,
+            serial_number=self.identity.serial_number,
+            order_id=self._order.order_id if self._order is not None else "",
+            order_update_id=self._order.order_update_id if self._order is not None else 0,
+            last_node_id=last.node_id if last is not None else "",
+            last_node_sequence_id=last.sequence_id if last is not None else 0,
+            node_states=[
+                {"node_id": n.node_id, "sequence_id": n.sequence_id, "released": n.released}
+                for n in nodes[self._last + 1 :]
+            ],
+            edge_states=[
+                {"edge_id": e.edge_id, "sequence_id": e.sequence_id, "released": e.released}
+                for e in edges[self._last :]
+            ],
+            agv_position={
+                "position_initialized": True,
+                "x": x,
+                "y": y,
+                "theta": theta,
+                "map_id": self.map_id,
+            },
+            velocity={"vx": self._v * math.cos(theta), "vy": self._v * math.sin(theta), "omega": 0.0},
+            driving=abs(self._v) > AT_REST,
+            paused=self._held(self._t),
+            new_base_request=path is not None
+            and any(not n.released for n in nodes)
+            and to_decision_point < _BASE_REQUEST_DISTANCE,
+            distance_since_last_node=max(0.0, self._p - path.arcs[self._last]) if path is not None else 0.0,
+            action_states=[],
+            battery_state={"battery_charge": 100.0, "charging": False},
+            operating_mode="AUTOMATIC",
+            errors=list(self._errors),
+            safety_state={"e_stop": "NONE", "field_violation": False},
+        )
+        self._state = state
+        return state.to_json().encode()
+
+    def _publish_state(self) -> None:
+        if not self._client.is_connected():  # offline: the next state after reconnecting tells all
+            return
+        self._client.publish(self.identity.topic(Topic.STATE), self._state_message(), qos=0)
+        self._event = False
+        self._next_state = self._t + 1.0 / self.state_rate
+
+    def _run(self) -> None:
+        try:
+            while not self._halt.is_set():
+                now = self.clock.now()
+                while True:
+                    try:
+                        self._receive(self._inbox.get_nowait())
+                    except queue.Empty:
+                        break
+                while self._t + self.period <= now:
+                    self._step()
+                    self._update_snapshot()
+                    if self._event or self._t >= self._next_state:
+                        self._publish_state()
+                if self._event:
+                    self._publish_state()
+                time.sleep(_LOOP_SLEEP_S)
+        except Exception:  # a simulated vehicle that dies says so; the master sees it go silent
+            logger.exception("vehicle %s: stopped by an error", self.identity.serial_number)
+            raise
