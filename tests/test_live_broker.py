@@ -116,6 +116,10 @@ class Peer:
         sock = self.client.socket()
         if sock is not None:
             sock.close()
+        # no reference cycle through the callbacks: the client is freed at once, and closes its
+        # internal socket pair itself (freed by the garbage collector, the pair might go first)
+        self.client.on_connect = self.client.on_subscribe = None
+        self.client.on_disconnect = self.client.on_message = None
 
 
 @pytest.fixture(params=KINDS)

@@ -41,7 +41,7 @@ def test_importing_the_package_or_its_command_line_loads_no_heavy_library(code):
 def test_an_exact_schedule_on_the_command_line_loads_no_solver_spline_plot_or_ruckig():
     code = (
         "import contextlib, io\n"
-        "from trajgen.cli.main import main\n"
+        "from trajgen.cli.entry import main\n"
         "with contextlib.redirect_stdout(io.StringIO()) as out:\n"
         "    status = main(['schedule', 'examples/swap.toml', '--method', 'exact', '--json'])\n"
         "assert status == 0 and '\"duration_s\": 67.5' in out.getvalue(), out.getvalue()[:300]\n"
@@ -73,7 +73,7 @@ def test_an_exact_schedule_on_the_command_line_loads_no_solver_spline_plot_or_ru
 
 
 def test_the_help_lists_every_command_with_its_summary():
-    from trajgen.cli.main import COMMANDS, build_parser
+    from trajgen.cli.entry import COMMANDS, build_parser
 
     text = build_parser().format_help()
     assert all(

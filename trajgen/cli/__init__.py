@@ -9,7 +9,7 @@ from typing import TYPE_CHECKING
 from trajgen.lazy import lazy_attributes
 
 if TYPE_CHECKING:
-    from trajgen.cli.main import build_parser, command_parsers, main
+    from trajgen.cli.entry import build_parser, command_parsers, main
     from trajgen.cli.parser import EXIT_BAD_INPUT, EXIT_FAILURE, EXIT_OK
 
 #: ``import trajgen.cli`` loads nothing more: the parser and each command's modules load when used.
@@ -17,9 +17,9 @@ _SOURCES = {
     "EXIT_BAD_INPUT": "trajgen.cli.parser",
     "EXIT_FAILURE": "trajgen.cli.parser",
     "EXIT_OK": "trajgen.cli.parser",
-    "build_parser": "trajgen.cli.main",
-    "command_parsers": "trajgen.cli.main",
-    "main": "trajgen.cli.main",
+    "build_parser": "trajgen.cli.entry",
+    "command_parsers": "trajgen.cli.entry",
+    "main": "trajgen.cli.entry",
 }
 
 __all__ = ["EXIT_BAD_INPUT", "EXIT_FAILURE", "EXIT_OK", "build_parser", "command_parsers", "main"]

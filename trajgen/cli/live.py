@@ -202,10 +202,28 @@ def _command_vehicle(args: argparse.Namespace) -> int:
     return EXIT_OK
 
 
+def _show_progress(record: dict) -> None:
+    """One line per release, connection change, ignored message and re-plan of a live run."""
+    kind, t = record["event"], record["t"]
+    if kind == "order" and not record["resent"]:
+        what = "order" if record["update"] == 0 else f"update {record['update']}"
+        line = f"{record['vehicle']}: {what}, base to {record['frontier_m']:.2f} m along its path"
+    elif kind == "connection":
+        line = f"{record['vehicle']} is {record['state']}"
+    elif kind == "ignored":
+        line = f"ignored a message on {record['topic']}: {record['reason']}"
+    elif kind in ("goal", "replan"):
+        line = f"{kind}: {record['goal']}"
+    else:
+        return
+    print(f"{t:9.2f} s  {line}", flush=True)
+
+
 def live_demo(scenario, *, method, time_scale: float, output: str) -> int:
     """``trajgen demo --live``: a broker, two simulated vehicles and the master in this process."""
     from trajgen.export.atomic import check_output_paths
-    from trajgen.live.session import run_demo
+    from trajgen.live.runlog import RunLog
+    from trajgen.live.session import LiveDemo
 
     log_path, plot_path = str(Path(output) / "live-run.jsonl"), str(Path(output) / "live-run.png")
     check_output_paths([log_path, plot_path])
@@ -213,7 +231,9 @@ def live_demo(scenario, *, method, time_scale: float, output: str) -> int:
         f"Live demo: {scenario.source} over VDA 5050 on an MQTT broker in this process, "
         f"{time_scale:g}x real time ..."
     )
-    demo = run_demo(scenario, method=method, time_scale=time_scale)
+    demo = LiveDemo(scenario, method=method, time_scale=time_scale, log=RunLog(listener=_show_progress))
+    with demo:
+        demo = demo.run()
     _commit(demo.log, log_path, plot_path, scenario.names)
     demo.log.close()
     status = _report(demo.run, argparse.Namespace(json=False), closest=demo.closest)

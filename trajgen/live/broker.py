@@ -33,6 +33,7 @@ import subprocess
 import tempfile
 import threading
 import time
+import weakref
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any, Self
@@ -40,7 +41,7 @@ from typing import Any, Self
 from topology.validation import finite_real, short_repr
 from trajgen.errors import InputError, LiveError
 
-__all__ = ["HOST", "EmbeddedBroker", "MosquittoBroker", "mosquitto_available"]
+__all__ = ["HOST", "THREAD_NAME", "EmbeddedBroker", "MosquittoBroker", "mosquitto_available"]
 
 logger = logging.getLogger(__name__)
 
@@ -473,13 +474,24 @@ class EmbeddedBroker(_Broker):
     @staticmethod
     async def _close(broker: Any) -> None:
         """On the broker's loop: end every connection, then shut amqtt down (its listener, its tasks)."""
-        share = STOP_TIMEOUT_S / 3
+        share = STOP_TIMEOUT_S / 4  # three shares at most: within the stop's wait
         await broker.trajgen_end_connections(share)
         try:
             await asyncio.wait_for(broker.shutdown(), share)
         except Exception:
             logger.debug("amqtt's shutdown failed; the broker's loop ends regardless", exc_info=True)
         await broker.trajgen_end_connections(share)  # none, unless the shutdown failed
+
+
+def _end_process(process: subprocess.Popen[bytes]) -> None:
+    """Terminate ``process`` and wait for it (kill it after :data:`STOP_TIMEOUT_S` s)."""
+    if process.poll() is None:
+        process.terminate()
+        try:
+            process.wait(STOP_TIMEOUT_S)
+        except subprocess.TimeoutExpired:
+            process.kill()
+            process.wait()
 
 
 class MosquittoBroker(_Broker):
@@ -505,6 +517,7 @@ class MosquittoBroker(_Broker):
         super().__init__(port=port)
         self._process: subprocess.Popen[bytes] | None = None
         self._folder: tempfile.TemporaryDirectory[str] | None = None
+        self._finalizer: weakref.finalize | None = None
 
     @property
     def running(self) -> bool:
@@ -542,6 +555,8 @@ class MosquittoBroker(_Broker):
                 self._process = subprocess.Popen(
                     [executable, "-c", str(config)], stdin=subprocess.DEVNULL, stdout=log, stderr=log
                 )
+            # no mosquitto outlives this broker object or the interpreter, stopped or not
+            self._finalizer = weakref.finalize(self, _end_process, self._process)
             try:
                 self._wait_until_answering(deadline, lambda: self.running)
             except LiveError as error:
@@ -567,16 +582,12 @@ class MosquittoBroker(_Broker):
         Does nothing if the broker is not running.
         """
         with self._lock:
-            process, folder = self._process, self._folder
-            self._process = self._folder = None
+            process, folder, finalizer = self._process, self._folder, self._finalizer
+            self._process = self._folder = self._finalizer = None
+            if finalizer is not None:
+                finalizer.detach()
             if process is not None:
-                if process.poll() is None:
-                    process.terminate()
-                    try:
-                        process.wait(STOP_TIMEOUT_S)
-                    except subprocess.TimeoutExpired:
-                        process.kill()
-                        process.wait()
+                _end_process(process)
                 logger.info("mosquitto on %s stopped", self.url)
             if folder is not None:
                 folder.cleanup()

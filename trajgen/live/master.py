@@ -86,7 +86,7 @@ class LiveRun:
         Messages logged and ignored.
     replans : int
         New goals taken.
-    release_latency : ndarray
+    release_latency : numpy.ndarray
         Per release, wall seconds from taking the state that allowed it to publishing the update,
         shape (releases,), read-only.
     """
@@ -159,7 +159,7 @@ class LiveMaster:
     map_id : str
         ``nodePosition.mapId`` (default ``"trajgen"``).
     log : RunLog, optional
-        Where every event is logged (default: a new one, :attr:`log`).
+        Where every event is logged (default: a new one, its ``log``).
     spacing : float
         Longest edge of the paths sent, metres (default :data:`RELEASE_SPACING`): the base is released
         node by node, so finer nodes let a vehicle follow the other closely instead of braking early.

@@ -23,7 +23,7 @@ from __future__ import annotations
 import json
 import tempfile
 import threading
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from typing import IO
 
 __all__ = ["MAX_PLOTTED_STATES", "RunLog", "read_run_log"]
@@ -34,13 +34,21 @@ _CHUNK = 1 << 16
 
 
 class RunLog:
-    """A JSON-lines log written to a temporary file (thread-safe); :meth:`chunks` reads it back."""
+    """A JSON-lines log written to a temporary file (thread-safe); :meth:`chunks` reads it back.
 
-    def __init__(self) -> None:
+    Parameters
+    ----------
+    listener : callable, optional
+        Called with each record after it is written (in the writer's thread).
+    """
+
+    def __init__(self, *, listener: Callable[[dict], None] | None = None) -> None:
         # open for the log's life, closed by close()
         self._file: IO[bytes] = tempfile.TemporaryFile(prefix="trajgen-live-", suffix=".jsonl")  # noqa: SIM115
         self._lock = threading.Lock()
         self.lines = 0
+        #: called with each record once written (a command line's progress display)
+        self.listener = listener
 
     def write(self, record: dict) -> None:
         """Append one record (its values JSON numbers, text, booleans, lists or ``None``)."""
@@ -48,6 +56,8 @@ class RunLog:
         with self._lock:
             self._file.write(line.encode("utf-8"))
             self.lines += 1
+        if self.listener is not None:
+            self.listener(record)
 
     def chunks(self) -> Iterator[bytes]:
         """The log so far, in pieces of 64 KiB (for a streamed commit)."""

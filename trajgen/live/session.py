@@ -126,12 +126,20 @@ class LiveDemo:
     method : TimingMethod or str, optional
     time_scale : float
         Seconds of the run per wall-clock second.
-    faults : pair of sequences of StopFault
+    faults : tuple of 2 sequence of StopFault
         Per vehicle.
     broker_url : str, optional
         Use this broker instead of starting one.
     spacing : float
         Longest edge of the paths sent, metres.
+    state_rate : float
+        Each vehicle's state messages per second of the run, besides those on events.
+    period : float
+        The vehicles' control cycle, seconds of the run.
+    log : RunLog, optional
+        The master's run log (default: a new one).
+
+    The broker is mosquitto when it is installed, else amqtt, both on a free port of 127.0.0.1.
 
     Examples
     --------
@@ -151,8 +159,14 @@ class LiveDemo:
         faults: Sequence[Sequence[StopFault]] = ((), ()),
         broker_url: str | None = None,
         spacing: float = RELEASE_SPACING,
+        state_rate: float = 10.0,
+        period: float = 0.01,
+        log: RunLog | None = None,
     ) -> None:
         self.scenario = scenario
+        self.state_rate = state_rate
+        self.period = period
+        self.log = log if log is not None else RunLog()
         self.verified = verified if verified is not None else live_plan(scenario, method=method)
         self.method = method
         self.clock = RunClock(time_scale)
@@ -164,11 +178,11 @@ class LiveDemo:
         self.master: LiveMaster | None = None
 
     def __enter__(self) -> LiveDemo:
-        from trajgen.live.broker import EmbeddedBroker
+        from trajgen.live.broker import EmbeddedBroker, MosquittoBroker, mosquitto_available
 
         scenario = self.scenario
         if self.broker_url is None:
-            self.broker = EmbeddedBroker().start()
+            self.broker = (MosquittoBroker() if mosquitto_available() else EmbeddedBroker()).start()
         url = self.broker_url if self.broker_url is not None else self.broker.url
         settings = BrokerSettings.from_url(url)
         ids = identities(scenario.names)
@@ -181,6 +195,8 @@ class LiveDemo:
                 broker=settings,
                 clock=self.clock,
                 faults=self.faults[v],
+                state_rate=self.state_rate,
+                period=self.period,
                 record=True,
             )
             for v in (0, 1)
@@ -192,7 +208,7 @@ class LiveDemo:
             broker=settings,
             method=self.method,
             clock=self.clock,
-            log=RunLog(),
+            log=self.log,
             spacing=self.spacing,
         )
         for vehicle in self.vehicles:
@@ -200,19 +216,20 @@ class LiveDemo:
         return self
 
     def run(self, *, timeout: float | None = None, at: Sequence = ()) -> DemoRun:
-        """Drive both vehicles to their goals; ``at``: ``(seconds of the run, action(demo))`` pairs.
+        """Drive both vehicles to their goals; ``at``: ``(seconds after the start, action(demo))`` pairs.
 
         ``timeout``: seconds of the run (default: four times the plan plus a minute).
         """
         limit = timeout if timeout is not None else 4.0 * self.verified.schedule.duration + 60.0
         master = self.master
+        began = self.clock.now()
         master.start()
         try:
             for moment, action in sorted(at, key=lambda pair: pair[0]):
-                if master.wait(timeout=moment - self.clock.now()):
+                if master.wait(timeout=began + moment - self.clock.now()):
                     break
                 action(self)
-            master.wait(timeout=limit - self.clock.now())
+            master.wait(timeout=began + limit - self.clock.now())
         finally:
             master.stop()
         run = master.result()

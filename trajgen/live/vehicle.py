@@ -237,7 +237,7 @@ class SimulatedVehicle:
         self._state = None  # the last state published (vda5050 State)
         self._errors: list = []
         self._headers = {Topic.STATE: 0, Topic.CONNECTION: 0}
-        self._inbox: queue.SimpleQueue[bytes] = queue.SimpleQueue()
+        self._inbox: queue.SimpleQueue[tuple[float, bytes]] = queue.SimpleQueue()  # (arrival, payload)
         self._event = True
         self._next_state = 0.0
         self._lock = threading.Lock()
@@ -284,7 +284,10 @@ class SimulatedVehicle:
         logger.info("vehicle %s: connected to %s", self.identity.serial_number, self._broker.url)
 
     def _on_message(self, client, userdata, message) -> None:
-        self._inbox.put(bytes(message.payload))
+        if message.topic != self.identity.topic(Topic.ORDER):  # amqtt may replay others' retained messages
+            logger.debug("vehicle %s: ignored a message on %s", self.identity.serial_number, message.topic)
+            return
+        self._inbox.put((self.clock.now(), bytes(message.payload)))
 
     def start(self) -> SimulatedVehicle:
         """Connect and start driving (in threads of its own); returns itself."""
@@ -547,20 +550,28 @@ class SimulatedVehicle:
         self._event = False
         self._next_state = self._t + 1.0 / self.state_rate
 
+    def _advance(self, until: float) -> None:
+        """Drive cycle by cycle up to run time ``until`` with what it knows now."""
+        while self._t + self.period <= until:
+            self._step()
+            self._update_snapshot()
+            if self._event or self._t >= self._next_state:
+                self._publish_state()
+
     def _run(self) -> None:
         try:
             while not self._halt.is_set():
                 now = self.clock.now()
+                # a message takes effect when it arrived: a vehicle whose thread fell behind first
+                # drives to that moment without it (else it would act on news from its future)
                 while True:
                     try:
-                        self._receive(self._inbox.get_nowait())
+                        arrival, payload = self._inbox.get_nowait()
                     except queue.Empty:
                         break
-                while self._t + self.period <= now:
-                    self._step()
-                    self._update_snapshot()
-                    if self._event or self._t >= self._next_state:
-                        self._publish_state()
+                    self._advance(min(arrival, now))
+                    self._receive(payload)
+                self._advance(now)
                 if self._event:
                     self._publish_state()
                 time.sleep(_LOOP_SLEEP_S)
