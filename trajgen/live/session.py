@@ -118,6 +118,8 @@ class DemoRun:
 class LiveDemo:
     """A broker (unless one is given), two simulated vehicles and the master, in this process.
 
+    The broker is mosquitto when it is installed, else amqtt, on a free port of 127.0.0.1.
+
     Parameters
     ----------
     scenario : Scenario
@@ -138,8 +140,6 @@ class LiveDemo:
         The vehicles' control cycle, seconds of the run.
     log : RunLog, optional
         The master's run log (default: a new one).
-
-    The broker is mosquitto when it is installed, else amqtt, both on a free port of 127.0.0.1.
 
     Examples
     --------
