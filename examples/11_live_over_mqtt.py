@@ -2,10 +2,11 @@
 
 The master (trajgen's ``LiveMaster``) sends each vehicle its order with the base
 released only up to its frontier; as the vehicles report the nodes they reach,
-it releases more. Here the broker (amqtt) and both vehicles run in this process,
-ten times faster than real time. The vehicles never come closer than the
-minimum separation, whatever the timing of the messages: the released base,
-not the clock, keeps them apart.
+it releases more. Here the broker (amqtt, or mosquitto when installed) and both
+vehicles run in this process, twenty times faster than real time: a state a
+second and a node every metre keep a pure-Python broker at ease. The vehicles
+never come closer than the minimum separation, whatever the timing of the
+messages: the released base, not the clock, keeps them apart.
 
 Run: ``python examples/11_live_over_mqtt.py``.
 """
@@ -14,7 +15,7 @@ from trajgen import default_scenario
 from trajgen.live import LiveDemo
 
 scenario = default_scenario()  # the swap: agv1 at A:10, agv2 at B:10 exchange places
-with LiveDemo(scenario, method="exact", time_scale=10, state_rate=2) as demo:
+with LiveDemo(scenario, method="exact", time_scale=20, state_rate=1, spacing=1.0) as demo:
     outcome = demo.run()
 
 run = outcome.run

@@ -22,7 +22,7 @@ from topology import Configuration, Position
 from trajgen.cli import main
 from trajgen.errors import InputError, LiveError
 from trajgen.export.vda5050_release import BaseRelease, plan_orders
-from trajgen.live.broker import EmbeddedBroker
+from trajgen.live.broker import EmbeddedBroker, MosquittoBroker, mosquitto_available
 from trajgen.live.clock import RunClock
 from trajgen.live.master import LiveMaster, LiveOutcome
 from trajgen.live.mqtt import BrokerSettings, Topic, VehicleIdentity, make_client
@@ -34,6 +34,11 @@ STRICT_SCALE = 4.0
 #: Time scale, state rate (Hz of the run), control period (s) and node spacing (m) of the runs
 #: that check behaviour under faults: ~100 messages/s through amqtt.
 FAST = {"time_scale": 15.0, "state_rate": 2.0, "period": 0.02, "spacing": 0.5}
+
+
+def _broker():
+    """The broker of a test: mosquitto when it is installed, else amqtt in this process."""
+    return MosquittoBroker() if mosquitto_available() else EmbeddedBroker()
 
 
 class Tap:
@@ -71,10 +76,15 @@ def _separation(name: str) -> float:
     return execution_plan(name, "exact")[0].limits.min_separation
 
 
-@pytest.mark.parametrize(
-    ("name", "method"), [("swap", "optimal"), ("crossing", "optimal")], ids=["swap", "crossing"]
-)
-def test_a_fault_free_run_is_safe_schema_valid_and_close_to_its_plan(name, method):
+@pytest.fixture(params=["swap", "crossing"])
+def optimal_plan(request) -> tuple[str, str]:
+    """The scenario's optimal plan for execution, solved before the test (``(name, "optimal")``)."""
+    execution_plan(request.param, "optimal")
+    return request.param, "optimal"
+
+
+def test_a_fault_free_run_is_safe_schema_valid_and_close_to_its_plan(optimal_plan):
+    name, method = optimal_plan
     demo = _demo(name, method, time_scale=STRICT_SCALE, period=0.02)
     tap = Tap(demo.broker.url)
     try:
@@ -279,7 +289,7 @@ UNTRUSTED = {
 def test_an_untrusted_state_is_logged_and_ignored_and_releases_nothing(kind):
     scenario, verified = execution_plan("swap", "exact")
     ids = identities(scenario.names)
-    with EmbeddedBroker() as broker:
+    with _broker() as broker:
         fake = FakeVehicles(broker.url, ids)
         master = LiveMaster(
             verified, scenario.names, identities=ids, broker=BrokerSettings.from_url(broker.url)
@@ -311,7 +321,7 @@ def test_an_untrusted_state_is_logged_and_ignored_and_releases_nothing(kind):
 def test_a_state_on_a_topic_of_no_vehicle_of_the_run_never_reaches_the_master():
     scenario, verified = execution_plan("swap", "exact")
     ids = identities(scenario.names)
-    with EmbeddedBroker() as broker:
+    with _broker() as broker:
         fake = FakeVehicles(broker.url, ids)
         master = LiveMaster(
             verified, scenario.names, identities=ids, broker=BrokerSettings.from_url(broker.url)
@@ -344,7 +354,7 @@ def _until(condition, seconds: float = 10.0) -> bool:
 def test_the_vehicle_ignores_a_duplicate_order_and_refuses_an_update_that_does_not_continue_its_base():
     scenario, verified = execution_plan("swap", "exact")
     ids = identities(scenario.names)
-    with EmbeddedBroker() as broker:
+    with _broker() as broker:
         settings = BrokerSettings.from_url(broker.url)
         fake = FakeVehicles(broker.url, ids)
         clock = RunClock(FAST["time_scale"])
@@ -399,7 +409,7 @@ def test_the_vehicle_ignores_a_duplicate_order_and_refuses_an_update_that_does_n
 
 
 def test_serve_drives_two_vehicle_processes_and_commits_its_log_and_picture(tmp_path):
-    with EmbeddedBroker() as broker:
+    with _broker() as broker:
         common = ["--broker", broker.url, "--time-scale", "10"]
         vehicles = [
             subprocess.Popen(

@@ -160,7 +160,7 @@ class LiveDemo:
         broker_url: str | None = None,
         spacing: float = RELEASE_SPACING,
         state_rate: float = 10.0,
-        period: float = 0.01,
+        period: float = 0.02,
         log: RunLog | None = None,
     ) -> None:
         self.scenario = scenario

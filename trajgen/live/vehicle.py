@@ -186,7 +186,7 @@ class SimulatedVehicle:
     state_rate : float
         ``state`` messages per second of the run, besides those on events (default 10).
     period : float
-        Control cycle, seconds of the run (default 0.01).
+        Control cycle, seconds of the run (default 0.02).
     faults : sequence of StopFault
     map_id : str
         ``agvPosition.mapId`` (default ``"trajgen"``).
@@ -203,7 +203,7 @@ class SimulatedVehicle:
         broker: BrokerSettings,
         clock: RunClock | None = None,
         state_rate: float = 10.0,
-        period: float = 0.01,
+        period: float = 0.02,
         faults: Sequence[StopFault] = (),
         map_id: str = "trajgen",
         record: bool = False,
