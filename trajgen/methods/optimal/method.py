@@ -263,39 +263,20 @@ class Optimal(TimingMethod):
         deadline = began + self.time_budget
         race = ClassRace(wanted)
         shapes = dict(zip(wanted, class_copies([self.shape(routes[k]) for k in wanted]), strict=True))
+
+        def solve_class(k: int) -> ClassSolve:
+            return self._solve_class(
+                routes[k], limits, exacts[k], shapes[k], slot=k, deadline=deadline, race=race, bound=bounds[k]
+            )
+
         if len(wanted) > 1:
             with concurrent.futures.ThreadPoolExecutor(
                 len(wanted), thread_name_prefix="trajgen-class"
             ) as pool:
-                futures = {
-                    k: pool.submit(
-                        self._solve_class,
-                        routes[k],
-                        limits,
-                        exacts[k],
-                        shapes[k],
-                        slot=k,
-                        deadline=deadline,
-                        race=race,
-                        bound=bounds[k],
-                    )
-                    for k in wanted
-                }
+                futures = {k: pool.submit(solve_class, k) for k in wanted}
                 solved = {k: future.result() for k, future in futures.items()}
         else:
-            solved = {
-                k: self._solve_class(
-                    routes[k],
-                    limits,
-                    exacts[k],
-                    shapes[k],
-                    slot=k,
-                    deadline=deadline,
-                    race=race,
-                    bound=bounds[k],
-                )
-                for k in wanted
-            }
+            solved = {k: solve_class(k) for k in wanted}
         solve_time = time.perf_counter() - began
         attempts = tuple(a for k in wanted for a in solved[k].attempts)
         info = OptimalInfo(
