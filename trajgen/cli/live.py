@@ -219,7 +219,7 @@ def _show_progress(record: dict) -> None:
     print(f"{t:9.2f} s  {line}", flush=True)
 
 
-def live_demo(scenario, *, method, time_scale: float, output: str) -> int:
+def live_demo(scenario, *, method, time_scale: float, state_rate: float = 10.0, output: str) -> int:
     """``trajgen demo --live``: a broker, two simulated vehicles and the master in this process."""
     from trajgen.export.atomic import check_output_paths
     from trajgen.live.runlog import RunLog
@@ -231,7 +231,13 @@ def live_demo(scenario, *, method, time_scale: float, output: str) -> int:
         f"Live demo: {scenario.source} over VDA 5050 on an MQTT broker in this process, "
         f"{time_scale:g}x real time ..."
     )
-    demo = LiveDemo(scenario, method=method, time_scale=time_scale, log=RunLog(listener=_show_progress))
+    demo = LiveDemo(
+        scenario,
+        method=method,
+        time_scale=time_scale,
+        state_rate=state_rate,
+        log=RunLog(listener=_show_progress),
+    )
     with demo:
         demo = demo.run()
     _commit(demo.log, log_path, plot_path, scenario.names)

@@ -40,7 +40,13 @@ def _command_demo(args: argparse.Namespace) -> int:
     if args.live:
         from trajgen.cli.live import live_demo  # the broker, the vehicles and the master
 
-        return live_demo(scenario, method=method_from(args), time_scale=args.time_scale, output=args.output)
+        return live_demo(
+            scenario,
+            method=method_from(args),
+            time_scale=args.time_scale,
+            state_rate=args.state_rate,
+            output=args.output,
+        )
     result = run(
         scenario, method=method_from(args), outputs=Outputs(csv_dir=args.output, plot_dir=args.output)
     )
@@ -74,6 +80,13 @@ def register(commands) -> None:
     )
     demo.add_argument(
         "--time-scale", type=float, default=4.0, metavar="K", help="with --live: K times real time (4)"
+    )
+    demo.add_argument(
+        "--state-rate",
+        type=float,
+        default=10.0,
+        metavar="HZ",
+        help="with --live: each vehicle's states per second of the run, besides those on events (10)",
     )
     add_method(demo)
     demo.set_defaults(run=_command_demo)
