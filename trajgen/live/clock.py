@@ -3,14 +3,18 @@
 from __future__ import annotations
 
 import math
+import threading
 import time
+from collections.abc import Callable
 from datetime import UTC, datetime, timedelta
 
 from topology.validation import short_repr
 from trajgen.errors import InputError
 
-__all__ = ["TIME_SCALE_RANGE", "RunClock"]
+__all__ = ["LEAD", "TIME_SCALE_RANGE", "RunClock"]
 
+#: Seconds of the run a clock runs ahead of the slowest simulated vehicle it follows, at most.
+LEAD = 0.1
 #: Time scales a run takes: at most 100 times faster than the wall clock.
 TIME_SCALE_RANGE = (0.01, 100.0)
 
@@ -29,7 +33,7 @@ class RunClock:
         ``time_scale`` outside :data:`TIME_SCALE_RANGE`.
     """
 
-    __slots__ = ("_began", "_started_at", "time_scale")
+    __slots__ = ("_began", "_followers", "_lock", "_lost", "_started_at", "time_scale")
 
     def __init__(self, time_scale: float = 1.0) -> None:
         low, high = TIME_SCALE_RANGE
@@ -45,10 +49,30 @@ class RunClock:
         self.time_scale = float(time_scale)
         self._began = time.monotonic()
         self._started_at = datetime.now(UTC)
+        self._followers: list[Callable[[], float]] = []
+        self._lost = 0.0
+        self._lock = threading.Lock()
+
+    def follow(self, simulated_time: Callable[[], float]) -> None:
+        """Never run more than :data:`LEAD` seconds ahead of ``simulated_time()`` (a simulated vehicle's).
+
+        Vehicles simulated in one process share a clock; one whose thread was kept from running
+        (a loaded machine) would otherwise fall behind the others and the master in the run's time.
+        The clock waits for it instead: the time it waited is not the run's.
+        """
+        with self._lock:
+            self._followers.append(simulated_time)
 
     def now(self) -> float:
         """Seconds of the run so far."""
-        return (time.monotonic() - self._began) * self.time_scale
+        with self._lock:
+            raw = (time.monotonic() - self._began) * self.time_scale - self._lost
+            if self._followers:
+                cap = min(follower() for follower in self._followers) + LEAD
+                if raw > cap:
+                    self._lost += raw - cap
+                    raw = cap
+            return raw
 
     def wall_seconds(self, run_seconds: float) -> float:
         """Wall-clock seconds that ``run_seconds`` of the run take."""

@@ -245,6 +245,7 @@ class SimulatedVehicle:
         self._trace: list[VehicleSnapshot] = []
         self._halt = threading.Event()
         self._thread: threading.Thread | None = None
+        self.clock.follow(self._simulated_time)
         self._client = make_client(
             broker,
             f"trajgen-vehicle-{identity.manufacturer}-{identity.serial_number}",
@@ -333,6 +334,11 @@ class SimulatedVehicle:
 
     def __exit__(self, *exc) -> None:
         self.stop()
+
+    def _simulated_time(self) -> float:
+        """Its time, for the clock to wait for; unbounded when it is not driving (not started, stopped)."""
+        running = self._thread is not None and self._thread.is_alive() and not self._halt.is_set()
+        return self._t if running else float("inf")
 
     # ----------------------------------------------------------------- readouts
     @property
