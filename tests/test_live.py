@@ -26,8 +26,8 @@ from trajgen.live.broker import EmbeddedBroker, MosquittoBroker, mosquitto_avail
 from trajgen.live.clock import LEAD, RunClock
 from trajgen.live.master import LiveMaster, LiveOutcome
 from trajgen.live.mqtt import BrokerSettings, Topic, VehicleIdentity, make_client
-from trajgen.live.session import LiveDemo, identities, position_xy
-from trajgen.live.vehicle import SimulatedVehicle, StopFault
+from trajgen.live.session import ClosestApproach, LiveDemo, identities, position_xy
+from trajgen.live.vehicle import SimulatedVehicle, StopFault, VehicleSnapshot
 
 #: Time scale and state rate (Hz of the run) of the runs whose makespan is checked: states on every
 #: node reached carry the progress, so ~50 messages/s through amqtt (bench_live.py: +3.5 to +7.2 %).
@@ -97,6 +97,7 @@ def test_a_fault_free_run_is_safe_schema_valid_and_close_to_its_plan(optimal_pla
         demo.__exit__()
     run = outcome.run
     assert run.outcome is LiveOutcome.GOALS_REACHED
+    assert math.isfinite(outcome.closest)  # compared at every cycle both drove
     assert outcome.closest >= _separation(name) - 1e-9
     assert run.makespan <= run.planned * 1.05 + 1.0
     assert run.ignored == 0
@@ -128,6 +129,7 @@ def test_a_broker_restart_mid_run_is_survived_and_the_latest_orders_are_sent_aga
     finally:
         demo.__exit__()
     assert outcome.run.outcome is LiveOutcome.GOALS_REACHED
+    assert math.isfinite(outcome.closest)  # compared at every cycle both drove
     assert outcome.closest >= _separation("swap") - 1e-9
     records = list(outcome.log.records())
     again = [r for r in records if r["event"] == "order" and r["resent"] and r["t"] > restarted[0]]
@@ -146,6 +148,7 @@ def test_a_vehicle_that_drops_off_holds_the_other_at_its_released_base_until_it_
     finally:
         demo.__exit__()
     assert outcome.run.outcome is LiveOutcome.GOALS_REACHED
+    assert math.isfinite(outcome.closest)  # compared at every cycle both drove
     assert outcome.closest >= _separation("crossing") - 1e-9
     records = list(outcome.log.records())
     broken = next(r["t"] for r in records if r["event"] == "connection" and r["state"] == "CONNECTIONBROKEN")
@@ -184,6 +187,7 @@ def test_a_stop_fault_makes_the_other_wait_and_costs_at_most_the_online_bound():
     finally:
         demo.__exit__()
     assert stopped.run.outcome is LiveOutcome.GOALS_REACHED
+    assert math.isfinite(stopped.closest)
     assert stopped.closest >= scenario.limits.min_separation - 1e-9
     slack = max(
         v.max_velocity / v.max_acceleration + v.max_acceleration / v.max_jerk
@@ -203,6 +207,7 @@ def test_a_new_goal_mid_run_stops_both_at_their_bases_and_replans_from_there():
         demo.__exit__()
     assert outcome.run.outcome is LiveOutcome.GOALS_REACHED
     assert outcome.run.replans == 1
+    assert math.isfinite(outcome.closest)  # compared at every cycle both drove
     assert outcome.closest >= scenario.limits.min_separation - 1e-9
     for vehicle, position in zip(outcome.vehicles, (goal.first, goal.second), strict=True):
         assert (
@@ -546,3 +551,20 @@ def test_a_clock_waits_for_the_slowest_vehicle_it_follows_and_the_time_waited_is
     before = clock.now()
     time.sleep(0.02)
     assert clock.now() - before == pytest.approx(1.0, abs=0.5)  # 20 ms at 50x, from where it waited
+
+
+def test_the_closest_approach_compares_the_vehicles_at_the_same_cycle_and_keeps_few_snapshots():
+    scenario = execution_plan("swap", "exact")[0]
+    approach = ClosestApproach(scenario.track)
+    first, second = approach.observer(0), approach.observer(1)
+    a_leg = position_xy(scenario.track, Position("A", 1.0))
+    for k in range(5000):  # vehicle 1 stands 1 m into A; vehicle 2 drives in from B:10 to the junction
+        t = 0.02 * k
+        s = max(10.0 - 0.004 * k, 0.0)
+        b_leg = position_xy(scenario.track, Position("B", s)) if s > 0 else (0.0, 0.0)
+        first(VehicleSnapshot(t, *a_leg, 0.0, 0, False))
+        if k % 7 != 3:  # some cycles of vehicle 2 missing: those moments are never compared
+            second(VehicleSnapshot(t, *b_leg, 1.0, 0, False))
+    assert approach.closest == pytest.approx(1.0)  # at the junction: 1 m + 0 m
+    assert approach.compared == 5000 - len(range(3, 5000, 7))
+    assert approach.waiting <= 2  # bounded, not the whole run

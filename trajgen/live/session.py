@@ -12,7 +12,8 @@ from __future__ import annotations
 
 import logging
 import math
-from collections.abc import Sequence
+import threading
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 from topology import Position, StarGraph
@@ -21,12 +22,13 @@ from trajgen.live.clock import RunClock
 from trajgen.live.master import RELEASE_SPACING, LiveMaster, LiveRun
 from trajgen.live.mqtt import DEFAULT_INTERFACE, DEFAULT_VERSION, BrokerSettings, VehicleIdentity
 from trajgen.live.runlog import RunLog
-from trajgen.live.vehicle import SimulatedVehicle, StopFault
+from trajgen.live.vehicle import SimulatedVehicle, StopFault, VehicleSnapshot
 from trajgen.online.goals import plan_for_execution
 from trajgen.verification import VerifiedSchedule
 
 __all__ = [
     "DEFAULT_MANUFACTURER",
+    "ClosestApproach",
     "DemoRun",
     "LiveDemo",
     "closest_approach",
@@ -104,7 +106,8 @@ class DemoRun:
     log : RunLog
         Its run log (the caller closes it).
     closest : float
-        The smallest track distance between the vehicles' true positions, sampled every cycle, metres.
+        The smallest track distance between the vehicles' true positions at every control cycle, metres
+        (:class:`ClosestApproach`).
     vehicles : tuple of 2 SimulatedVehicle
         Stopped.
     """
@@ -167,6 +170,8 @@ class LiveDemo:
         self.state_rate = state_rate
         self.period = period
         self.log = log if log is not None else RunLog()
+        #: the closest approach of the vehicles' true positions, taken as they drive
+        self.approach = ClosestApproach(scenario.track)
         self.verified = verified if verified is not None else live_plan(scenario, method=method)
         self.method = method
         self.clock = RunClock(time_scale)
@@ -197,7 +202,7 @@ class LiveDemo:
                 faults=self.faults[v],
                 state_rate=self.state_rate,
                 period=self.period,
-                record=True,
+                observer=self.approach.observer(v),
             )
             for v in (0, 1)
         )
@@ -235,7 +240,7 @@ class LiveDemo:
         run = master.result()
         for vehicle in self.vehicles:
             vehicle.stop()
-        return DemoRun(run, master.log, closest_approach(self.scenario.track, self.vehicles), self.vehicles)
+        return DemoRun(run, master.log, self.approach.closest, self.vehicles)
 
     def __exit__(self, *exc) -> None:
         for vehicle in self.vehicles:
@@ -260,6 +265,58 @@ def run_demo(
     demo = LiveDemo(scenario, method=method, time_scale=time_scale, faults=faults, broker_url=broker_url)
     with demo:
         return demo.run(timeout=timeout)
+
+
+class ClosestApproach:
+    """The smallest track distance between two simulated vehicles, taken cycle by cycle as they drive.
+
+    Each vehicle hands in its snapshot of every control cycle (``SimulatedVehicle(observer=...)``);
+    snapshots of the same moment are compared, and only those still waiting for the other
+    vehicle's are kept (at most :attr:`MAX_WAITING` per vehicle): memory does not grow with the run.
+
+    Parameters
+    ----------
+    graph : StarGraph
+    """
+
+    #: Snapshots kept per vehicle while the other has not reached their moment.
+    MAX_WAITING = 1000
+
+    def __init__(self, graph: StarGraph) -> None:
+        self.graph = graph
+        self.closest = math.inf
+        self.compared = 0
+        self._waiting: tuple[dict, dict] = ({}, {})
+        self._lock = threading.Lock()
+
+    @property
+    def waiting(self) -> int:
+        """Snapshots kept, waiting for the other vehicle's of the same moment."""
+        with self._lock:
+            return len(self._waiting[0]) + len(self._waiting[1])
+
+    def observer(self, vehicle: int) -> Callable[[VehicleSnapshot], None]:
+        """What vehicle ``vehicle`` (0 or 1) calls with each cycle's snapshot."""
+        return lambda snapshot: self._add(vehicle, snapshot)
+
+    def _add(self, vehicle: int, snapshot: VehicleSnapshot) -> None:
+        moment = round(snapshot.time, 9)
+        with self._lock:
+            other = self._waiting[1 - vehicle].pop(moment, None)
+            if other is None:
+                mine = self._waiting[vehicle]
+                mine[moment] = snapshot
+                if len(mine) > self.MAX_WAITING:
+                    del mine[next(iter(mine))]
+                return
+            for old in [m for m in self._waiting[1 - vehicle] if m < moment]:
+                del self._waiting[1 - vehicle][old]  # never matched now: the vehicles step together
+            graph = self.graph
+            distance = graph.distance(
+                track_position(graph, snapshot.x, snapshot.y), track_position(graph, other.x, other.y)
+            )
+            self.closest = min(self.closest, distance)
+            self.compared += 1
 
 
 def closest_approach(graph: StarGraph, vehicles: Sequence[SimulatedVehicle]) -> float:

@@ -23,7 +23,7 @@ import queue
 import re
 import threading
 import time
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 from limits import VehicleLimits
@@ -192,6 +192,8 @@ class SimulatedVehicle:
         ``agvPosition.mapId`` (default ``"trajgen"``).
     record : bool
         Keep a :class:`VehicleSnapshot` of every cycle (:attr:`trace`; for tests: it grows with the run).
+    observer : callable, optional
+        Called with each cycle's :class:`VehicleSnapshot` (in the vehicle's thread).
     """
 
     def __init__(
@@ -207,6 +209,7 @@ class SimulatedVehicle:
         faults: Sequence[StopFault] = (),
         map_id: str = "trajgen",
         record: bool = False,
+        observer: Callable[[VehicleSnapshot], None] | None = None,
     ) -> None:
         from ruckig import InputParameter, OutputParameter, Ruckig
 
@@ -222,6 +225,7 @@ class SimulatedVehicle:
         self.faults = tuple(faults)
         self.map_id = map_id
         self.record = record
+        self.observer = observer
         self._start = (float(start[0]), float(start[1]))
         self._otg = Ruckig(1, self.period)
         self._input = InputParameter(1)
@@ -497,6 +501,8 @@ class SimulatedVehicle:
             self._snapshot = snapshot
             if self.record:
                 self._trace.append(snapshot)
+        if self.observer is not None:
+            self.observer(snapshot)
 
     def _state_message(self) -> bytes:
         from vda5050.model.state import State
