@@ -7,6 +7,7 @@ what they reported.
 
 from __future__ import annotations
 
+import contextlib
 import json
 import math
 import subprocess
@@ -272,6 +273,23 @@ def _last_base(order: dict) -> int:
     return max(k for k, node in enumerate(order["nodes"]) if node["released"])
 
 
+@contextlib.contextmanager
+def _master_and_fakes(scenario, verified):
+    """The master on a broker with :class:`FakeVehicles` in place of the vehicles."""
+    ids = identities(scenario.names)
+    with _broker() as broker:
+        fake = FakeVehicles(broker.url, ids)
+        master = LiveMaster(
+            verified, scenario.names, identities=ids, broker=BrokerSettings.from_url(broker.url)
+        )
+        master.start()
+        try:
+            yield master, fake
+        finally:
+            master.stop()
+            fake.close()
+
+
 def _releasing_vehicle(verified, spacing: float) -> int:
     """A vehicle whose arrival at its first decision point releases base (by the master's own rule)."""
     plan = plan_orders(verified, spacing=spacing)
@@ -296,31 +314,19 @@ UNTRUSTED = {
 @pytest.mark.parametrize("kind", list(UNTRUSTED), ids=list(UNTRUSTED))
 def test_an_untrusted_state_is_logged_and_ignored_and_releases_nothing(kind):
     scenario, verified = execution_plan("swap", "exact")
-    ids = identities(scenario.names)
-    with _broker() as broker:
-        fake = FakeVehicles(broker.url, ids)
-        master = LiveMaster(
-            verified, scenario.names, identities=ids, broker=BrokerSettings.from_url(broker.url)
-        )
-        master.start()
-        try:
-            deadline = time.monotonic() + 5.0
-            while len(fake.orders) < 2 and time.monotonic() < deadline:
-                time.sleep(0.02)
-            v = _releasing_vehicle(verified, master.spacing)
-            first = next(o for o in fake.orders if o["serialNumber"] == scenario.names[v])
-            sent = len(fake.orders)
-            node = _last_base(first)  # at its decision point: that releases base
-            fake.publish(v, fake.state(v, first, 0))  # genuine, at its start: releases nothing
-            assert len(fake.orders) == sent
-            fake.publish(v, UNTRUSTED[kind](fake, v, first, node))
-            assert len(fake.orders) == sent  # nothing released on its account
-            assert master.result().ignored == 1
-            fake.publish(v, fake.state(v, first, node))  # the genuine report does release
-            assert len(fake.orders) > sent
-        finally:
-            master.stop()
-            fake.close()
+    with _master_and_fakes(scenario, verified) as (master, fake):
+        _until(lambda: len(fake.orders) >= 2, 5.0)
+        v = _releasing_vehicle(verified, master.spacing)
+        first = next(o for o in fake.orders if o["serialNumber"] == scenario.names[v])
+        sent = len(fake.orders)
+        node = _last_base(first)  # at its decision point: that releases base
+        fake.publish(v, fake.state(v, first, 0))  # genuine, at its start: releases nothing
+        assert len(fake.orders) == sent
+        fake.publish(v, UNTRUSTED[kind](fake, v, first, node))
+        assert len(fake.orders) == sent  # nothing released on its account
+        assert master.result().ignored == 1
+        fake.publish(v, fake.state(v, first, node))  # the genuine report does release
+        assert len(fake.orders) > sent
     ignored = [r for r in master.log.records() if r["event"] == "ignored"]
     assert len(ignored) == 1
     assert ignored[0]["vehicle"] == scenario.names[v]
@@ -328,21 +334,11 @@ def test_an_untrusted_state_is_logged_and_ignored_and_releases_nothing(kind):
 
 def test_a_state_on_a_topic_of_no_vehicle_of_the_run_never_reaches_the_master():
     scenario, verified = execution_plan("swap", "exact")
-    ids = identities(scenario.names)
-    with _broker() as broker:
-        fake = FakeVehicles(broker.url, ids)
-        master = LiveMaster(
-            verified, scenario.names, identities=ids, broker=BrokerSettings.from_url(broker.url)
-        )
-        master.start()
-        try:
-            time.sleep(0.5)
-            sent = len(fake.orders)
-            fake.publish(0, b"{}", topic=VehicleIdentity("acme", "agv9").topic(Topic.STATE))
-            assert len(fake.orders) == sent
-        finally:
-            master.stop()
-            fake.close()
+    with _master_and_fakes(scenario, verified) as (master, fake):
+        time.sleep(0.5)
+        sent = len(fake.orders)
+        fake.publish(0, b"{}", topic=VehicleIdentity("acme", "agv9").topic(Topic.STATE))
+        assert len(fake.orders) == sent
     assert master.result().ignored == 0  # not subscribed: it never arrives
 
 

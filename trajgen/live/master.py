@@ -290,7 +290,6 @@ class LiveMaster:
     def _publish(self, v: int, payload: bytes, *, resent: bool, record: dict) -> None:
         view = self._views[v]
         self._client.publish(view.identity.topic(Topic.ORDER), payload, qos=0)
-        logger.debug("master: published %s %s", view.name, record.get("update"))
         view.sent_at = time.monotonic()
         self._counts["orders"] += 1
         self._counts["resent"] += resent

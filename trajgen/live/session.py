@@ -31,7 +31,6 @@ __all__ = [
     "ClosestApproach",
     "DemoRun",
     "LiveDemo",
-    "closest_approach",
     "identities",
     "live_plan",
     "position_xy",
@@ -317,17 +316,3 @@ class ClosestApproach:
             )
             self.closest = min(self.closest, distance)
             self.compared += 1
-
-
-def closest_approach(graph: StarGraph, vehicles: Sequence[SimulatedVehicle]) -> float:
-    """The smallest track distance between two recorded vehicles at the cycles both recorded, metres."""
-    first, second = (vehicle.trace for vehicle in vehicles)
-    by_time = {round(s.time, 9): s for s in second}
-    closest = math.inf
-    for a in first:
-        b = by_time.get(round(a.time, 9))
-        if b is not None:
-            closest = min(
-                closest, graph.distance(track_position(graph, a.x, a.y), track_position(graph, b.x, b.y))
-            )
-    return closest

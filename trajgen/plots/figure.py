@@ -73,3 +73,19 @@ def frame_painter(figure, animated):
         return np.array(np.asarray(canvas.buffer_rgba())[:, :, :3])
 
     return paint
+
+
+def time_label(axis, t: float, height: float, text: str, *, colour) -> None:
+    """A vertical label at time ``t`` (data units), its top at ``height`` of the axis (0 to 1)."""
+    axis.text(
+        t,
+        height,
+        f" {text}",
+        transform=axis.get_xaxis_transform(),
+        rotation=90,
+        ha="right",
+        va="top",
+        fontsize=7,
+        color=colour,
+        bbox={"facecolor": "white", "alpha": 0.7, "edgecolor": "none", "pad": 1},
+    )

@@ -10,7 +10,7 @@ import numpy as np
 
 from topology.validation import short_repr
 from trajgen.errors import InputError
-from trajgen.plots.figure import new_figure, png_bytes
+from trajgen.plots.figure import new_figure, png_bytes, time_label
 from trajgen.plots.speed import VEHICLE_COLOURS
 
 __all__ = ["render_live_run"]
@@ -203,18 +203,7 @@ def _mark_events(axis, events, name: str, names: tuple[str, str], last_t: float)
             text = f"{kind} {detail}".strip()
             if len(text) > MAX_DETAIL_CHARS:
                 text = text[: MAX_DETAIL_CHARS - 1] + "…"
-            axis.text(
-                t,
-                0.91,
-                f" {text}",
-                transform=axis.get_xaxis_transform(),
-                rotation=90,
-                ha="right",
-                va="top",
-                fontsize=7,
-                color=colour,
-                bbox={"facecolor": "white", "alpha": 0.7, "edgecolor": "none", "pad": 1},
-            )
+            time_label(axis, t, 0.91, text, colour=colour)
     if labelled < sum(kind in LINE_COLOURS for _, kind, _, _ in mine):
         logger.debug("%s: %s: only the first %d goal/replan lines labelled", _WHAT, name, MAX_EVENT_LABELS)
 

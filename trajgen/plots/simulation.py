@@ -8,7 +8,7 @@ import numpy as np
 
 from topology.validation import short_repr
 from trajgen.errors import InputError
-from trajgen.plots.figure import new_figure, png_bytes, polygon_patch
+from trajgen.plots.figure import new_figure, png_bytes, polygon_patch, time_label
 from trajgen.plots.speed import VEHICLE_COLOURS
 
 __all__ = ["render_simulation"]
@@ -24,18 +24,7 @@ def _mark_faults(axis, marks: list[tuple[float, float | None, str]]) -> None:
             axis.axvspan(time, time + duration, color=FAULT_COLOUR, alpha=0.2, linewidth=0)
         else:
             axis.axvline(time, color=FAULT_COLOUR, linestyle=":", linewidth=1.2)
-        axis.text(
-            time,
-            0.98,
-            f" {spec}",
-            transform=axis.get_xaxis_transform(),
-            rotation=90,
-            ha="right",
-            va="top",
-            fontsize=7,
-            color="dimgray",
-            bbox={"facecolor": "white", "alpha": 0.7, "edgecolor": "none", "pad": 1},
-        )
+        time_label(axis, time, 0.98, spec, colour="dimgray")
 
 
 def _progress(axis, result, names) -> None:
