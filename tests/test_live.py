@@ -409,6 +409,61 @@ def test_the_vehicle_ignores_a_duplicate_order_and_refuses_an_update_that_does_n
             fake.close()
 
 
+def test_a_vehicle_reports_at_once_when_it_comes_to_rest_and_says_its_last_state_before_going_offline():
+    scenario, verified = execution_plan("swap", "exact")
+    ids = identities(scenario.names)
+    with _broker() as broker:
+        settings = BrokerSettings.from_url(broker.url)
+        clock = RunClock(5.0)
+        rest = []  # run time of each cycle the vehicle ends at rest after moving
+        moving = [False]
+
+        def observe(snapshot: VehicleSnapshot) -> None:
+            if abs(snapshot.velocity) > 1e-3:
+                moving[0] = True
+            elif moving[0]:
+                moving[0] = False
+                rest.append(snapshot.time)
+
+        heard = []  # (run time of arrival, topic's last part, message)
+        watcher = make_client(settings, "watcher")
+        watcher.on_connect = lambda client, *_: client.subscribe(f"{ids[0].topic(Topic.STATE)[:-5]}#")
+        watcher.on_message = lambda c, u, m: heard.append(
+            (clock.now(), m.topic.rsplit("/", 1)[1], json.loads(m.payload))
+        )
+        watcher.connect(settings.host, settings.port)
+        watcher.loop_start()
+        # a state every 10 s of the run at most: any state sooner after stopping is the event's
+        vehicle = SimulatedVehicle(
+            ids[0],
+            scenario.limits.vehicles[0],
+            position_xy(scenario.track, scenario.start.first),
+            broker=settings,
+            clock=clock,
+            state_rate=0.1,
+            observer=observe,
+        ).start()
+        master = LiveMaster(verified, scenario.names, identities=ids, broker=settings, clock=clock)
+        try:
+            master.start()
+            assert _until(lambda: rest and clock.now() > rest[0] + 2.0)
+            stood = [t for t, kind, m in heard if kind == "state" and not m["driving"] and t >= rest[0]]
+            assert stood
+            assert stood[0] - rest[0] < 1.0  # not at the next periodic state, 10 s later
+            stopped_at = len(heard)
+            vehicle.stop()
+            assert _until(lambda: any(kind == "connection" for _, kind, _ in heard[stopped_at:]))
+            after = [(kind, m) for _, kind, m in heard[stopped_at:]]
+            assert [kind for kind, _ in after[:2]] == ["state", "connection"]
+            assert not after[0][1]["driving"]
+            assert after[1][1]["connectionState"] == "OFFLINE"
+        finally:
+            master.stop()
+            vehicle.stop()
+            watcher.disconnect()
+            watcher.loop_stop()
+
+
 # -- the command line ---------------------------------------------------------------------------------
 
 

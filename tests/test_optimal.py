@@ -19,7 +19,14 @@ from topology import Homotopy, YGraph, plan, region_sequence
 from trajgen import Exact, FallbackReason, Optimal, SolverCache, certify, lower_bound, make_schedule, verify
 from trajgen.errors import InputError
 from trajgen.methods.optimal import Solver, Source
-from trajgen.methods.optimal.solve import Outcome, abandoned_solver_calls, solve
+from trajgen.methods.optimal.solve import (
+    SOLUTIONS_REMEMBERED,
+    CompiledNlp,
+    Outcome,
+    SolveResult,
+    abandoned_solver_calls,
+    solve,
+)
 from trajgen.model.analysis import travelled
 from trajgen.model.profiles import rest_to_rest_time
 from trajgen.plots import render_coordination
@@ -120,6 +127,43 @@ def test_nlp_is_built_once_per_shape_and_reused():
     # one compiled copy per class: the swap's two classes are solved concurrently
     assert [c.makespan is not None for c in first.info.classes] == [True, True]
     assert len(method.cache) == 2
+
+
+def test_a_problem_solved_before_is_answered_from_memory_and_another_is_solved(monkeypatch):
+    calls = []
+    real_solver = CompiledNlp.solver
+
+    def counting(self, which, *, ipopt_wall_time):
+        calls.append(which)
+        return real_solver(self, which, ipopt_wall_time=ipopt_wall_time)
+
+    monkeypatch.setattr(CompiledNlp, "solver", counting)
+    method = Optimal(cache=SolverCache())
+    route = route_of(UNEQUAL, ("A:12", "B:8"), ("B:8", "A:12"))
+    first = method.schedule(route, LIMITS)
+    assert calls, "the first request solves"
+    calls.clear()
+    again = method.schedule(route, LIMITS)
+    assert calls == []  # the same problems: every pass answered from memory
+    assert again.duration == first.duration
+    assert again.info.attempts == first.info.attempts  # what each solver did, as it did it
+    assert again.info.classes == first.info.classes
+    np.testing.assert_array_equal(again.sample(0.1).axis, first.sample(0.1).axis)
+    assert verify(again).passed
+    method.schedule(route, MIXED)
+    assert calls, "other limits are another problem: solved, not recalled"
+
+
+def test_a_compiled_nlp_remembers_its_last_solutions_only():
+    compiled = SolverCache().get(Optimal().shape(route_of(UNEQUAL, ("A:12", "B:8"), ("B:8", "A:12"))))[0]
+    results = [SolveResult(np.full(2, float(i)), ()) for i in range(SOLUTIONS_REMEMBERED + 1)]
+    for i, result in enumerate(results):
+        compiled.remember(bytes([i]), result)
+    assert compiled.remembered(bytes([0])) is None  # the least recently used went first
+    assert compiled.remembered(bytes([1])) is results[1]
+    compiled.remember(bytes([99]), results[0])
+    assert compiled.remembered(bytes([1])) is results[1]  # used just now: kept
+    assert compiled.remembered(bytes([2])) is None
 
 
 def test_forced_solver_failure_falls_back_to_exact_and_logs(caplog):
@@ -305,6 +349,12 @@ class _StandInNlp:
 
     def solver(self, _which, *, ipopt_wall_time):
         return self._solver
+
+    def remembered(self, _key):
+        return None
+
+    def remember(self, _key, _result):
+        pass
 
 
 @pytest.mark.parametrize(("seconds", "abandoned"), [(0.0, False), (3.0, True)], ids=["prompt", "stuck"])

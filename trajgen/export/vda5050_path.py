@@ -278,54 +278,77 @@ def _edge_leg(a: _Event | PathNode, b: _Event | PathNode) -> int:
     return a.leg if a.leg != JUNCTION_INDEX else b.leg
 
 
-def _crossing(pieces: Pieces, vehicle: int, t0: float, t1: float, leg: int, s: float) -> float | None:
-    """The time in ``[t0, t1]`` at which the vehicle is at ``s`` on ``leg`` (its s monotone there)."""
+def _crossings(
+    pieces: Pieces, vehicle: int, t0: float, t1: float, leg: int, places: np.ndarray
+) -> np.ndarray:
+    """The times in ``[t0, t1]`` at which the vehicle is at each of ``places`` (s on ``leg``, m).
+
+    Its s is monotone there. Shape of ``places`` and of the result (n,); NaN where it is not
+    there. All places and pieces are searched in one vectorized root search.
+    """
     overlapping = (pieces.start < t1) & (pieces.start + pieces.length > t0)
-    for piece in np.nonzero(overlapping & (pieces.leg[vehicle] == leg))[0]:
-        sign = pieces.s_sign[vehicle, piece]
-        if sign == 0.0:
-            continue
-        low = max(t0 - pieces.start[piece], 0.0)
-        high = min(t1 - pieces.start[piece], pieces.length[piece])
-        c = pieces.axis[vehicle, piece].copy()
-        c[0] -= (s - pieces.s_offset[vehicle, piece]) / sign
-        root = root_in(c[None], np.array([low]), np.array([high]))[0]
-        if np.isfinite(root):
-            return float(pieces.start[piece] + root)
-    return None
+    candidates = np.nonzero(overlapping & (pieces.leg[vehicle] == leg) & (pieces.s_sign[vehicle] != 0.0))[0]
+    times = np.full(places.shape, np.nan)
+    if candidates.size == 0 or places.size == 0:
+        return times
+    # one row per (piece, place), pieces in time order: the first piece with a root wins
+    sign = pieces.s_sign[vehicle, candidates]
+    low = np.maximum(t0 - pieces.start[candidates], 0.0)
+    high = np.minimum(t1 - pieces.start[candidates], pieces.length[candidates])
+    rows = np.repeat(pieces.axis[vehicle, candidates], places.size, axis=0)
+    rows[:, 0] -= ((places[None, :] - pieces.s_offset[vehicle, candidates][:, None]) / sign[:, None]).ravel()
+    roots = root_in(rows, np.repeat(low, places.size), np.repeat(high, places.size))
+    roots = roots.reshape(candidates.size, places.size) + pieces.start[candidates][:, None]
+    for row in roots[::-1]:  # the earliest piece's root last, so it is the one kept
+        times = np.where(np.isfinite(row), row, times)
+    return times
 
 
 def _with_holds(schedule: Schedule, pieces: Pieces, vehicle: int, events: list[_Event]) -> list[_Event]:
     """Insert a hold node where the path crosses the edge of the junction zone (the separation from O)."""
     radius = schedule.limits.min_separation
-    out = [events[0]]
-    for a, b in itertools.pairwise(events):
+    inserted: list[list[tuple[int, float, float]]] = [[] for _ in events]  # (leg, s, time) after each
+    for k, (a, b) in enumerate(itertools.pairwise(events)):
         low, high = sorted((a.s, b.s))
         if low < radius - HOLD_MARGIN and high > radius + HOLD_MARGIN:
             leg = _edge_leg(a, b)
-            time = _crossing(pieces, vehicle, a.departure, b.arrival, leg, radius)
-            if time is not None:
-                axis = float(schedule.state(time).axis[vehicle, 0])
-                out.append(_Event(leg, radius, axis, time, time, {NodeKind.HOLD}))
-        out.append(b)
-    return out
+            time = _crossings(pieces, vehicle, a.departure, b.arrival, leg, np.array([radius]))[0]
+            if np.isfinite(time):
+                inserted[k].append((leg, radius, float(time)))
+    return _inserted(schedule, vehicle, events, inserted, NodeKind.HOLD)
 
 
 def _with_spacing(
     schedule: Schedule, pieces: Pieces, vehicle: int, events: list[_Event], spacing: float
 ) -> list[_Event]:
     """Insert release nodes so that no edge is longer than ``spacing`` metres."""
-    out = [events[0]]
-    for a, b in itertools.pairwise(events):
+    inserted: list[list[tuple[int, float, float]]] = [[] for _ in events]  # (leg, s, time) after each
+    for k, (a, b) in enumerate(itertools.pairwise(events)):
         count = math.ceil(abs(b.s - a.s) / spacing - 1e-9)
+        if count < 2:
+            continue
         leg = _edge_leg(a, b)
-        for k in range(1, count):
-            s = a.s + (b.s - a.s) * k / count
-            time = _crossing(pieces, vehicle, a.departure, b.arrival, leg, s)
-            if time is not None:
-                axis = float(schedule.state(time).axis[vehicle, 0])
-                out.append(_Event(leg, s, axis, time, time, {NodeKind.RELEASE}))
-        out.append(b)
+        places = a.s + (b.s - a.s) * np.arange(1, count) / count
+        times = _crossings(pieces, vehicle, a.departure, b.arrival, leg, places)
+        found = np.isfinite(times)
+        inserted[k] += [(leg, float(p), float(t)) for p, t in zip(places[found], times[found], strict=True)]
+    return _inserted(schedule, vehicle, events, inserted, NodeKind.RELEASE)
+
+
+def _inserted(
+    schedule: Schedule,
+    vehicle: int,
+    events: list[_Event],
+    inserted: list[list[tuple[int, float, float]]],
+    kind: NodeKind,
+) -> list[_Event]:
+    """``events`` with the new nodes ``inserted[k]`` (leg, s, time) after event ``k``, of ``kind``."""
+    times = np.array([time for new in inserted for _, _, time in new])
+    axes = iter(schedule.state(times).axis[vehicle] if times.size else ())
+    out = []
+    for event, new in zip(events, inserted, strict=True):
+        out.append(event)
+        out += [_Event(leg, s, float(next(axes)), time, time, {kind}) for leg, s, time in new]
     return out
 
 

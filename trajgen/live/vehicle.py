@@ -243,6 +243,7 @@ class SimulatedVehicle:
         self._headers = {Topic.STATE: 0, Topic.CONNECTION: 0}
         self._inbox: queue.SimpleQueue[tuple[float, bytes]] = queue.SimpleQueue()  # (arrival, payload)
         self._event = True
+        self._driving = False  # as the last state said
         self._next_state = 0.0
         self._lock = threading.Lock()
         self._snapshot = VehicleSnapshot(0.0, *self._start, 0.0, 0, False)
@@ -310,6 +311,8 @@ class SimulatedVehicle:
         if self._thread is not None:
             self._thread.join(5.0)
         if self._client.is_connected():
+            # its last state first: whatever it did since the last one reaches the master
+            self._client.publish(self.identity.topic(Topic.STATE), self._state_message(), qos=0)
             info = self._client.publish(
                 self.identity.topic(Topic.CONNECTION), self._connection_message("OFFLINE"), qos=1, retain=True
             )
@@ -560,6 +563,7 @@ class SimulatedVehicle:
             return
         self._client.publish(self.identity.topic(Topic.STATE), self._state_message(), qos=0)
         self._event = False
+        self._driving = self._state.driving
         self._next_state = self._t + 1.0 / self.state_rate
 
     def _advance(self, until: float) -> None:
@@ -567,7 +571,8 @@ class SimulatedVehicle:
         while self._t + self.period <= until:
             self._step()
             self._update_snapshot()
-            if self._event or self._t >= self._next_state:
+            # starting and stopping are events: the master learns at once that a vehicle stands
+            if self._event or self._t >= self._next_state or (abs(self._v) > AT_REST) != self._driving:
                 self._publish_state()
 
     def _run(self) -> None:
