@@ -355,6 +355,28 @@ def _until(condition, seconds: float = 10.0) -> bool:
     return True
 
 
+def _first_vehicle(scenario, ids, settings: BrokerSettings, clock: RunClock, **options) -> SimulatedVehicle:
+    """The scenario's first vehicle, simulated and started (``options``: of :class:`SimulatedVehicle`)."""
+    return SimulatedVehicle(
+        ids[0],
+        scenario.limits.vehicles[0],
+        position_xy(scenario.track, scenario.start.first),
+        broker=settings,
+        clock=clock,
+        **options,
+    ).start()
+
+
+def _watcher(settings: BrokerSettings, topic: str, take):
+    """A client that hands every message on ``topic`` to ``take``, connected and looping."""
+    watcher = make_client(settings, f"watcher-{id(take):x}")
+    watcher.on_connect = lambda client, *_: client.subscribe(topic)
+    watcher.on_message = lambda client, userdata, message: take(message)
+    watcher.connect(settings.host, settings.port)
+    watcher.loop_start()
+    return watcher
+
+
 def test_the_vehicle_ignores_a_duplicate_order_and_refuses_an_update_that_does_not_continue_its_base():
     scenario, verified = execution_plan("swap", "exact")
     ids = identities(scenario.names)
@@ -362,21 +384,13 @@ def test_the_vehicle_ignores_a_duplicate_order_and_refuses_an_update_that_does_n
         settings = BrokerSettings.from_url(broker.url)
         fake = FakeVehicles(broker.url, ids)
         clock = RunClock(FAST["time_scale"])
-        vehicle = SimulatedVehicle(
-            ids[0],
-            scenario.limits.vehicles[0],
-            position_xy(scenario.track, scenario.start.first),
-            broker=settings,
-            clock=clock,
-        ).start()
+        vehicle = _first_vehicle(scenario, ids, settings, clock)
         master = LiveMaster(verified, scenario.names, identities=ids, broker=settings, clock=clock)
         try:
             states = []
-            watcher = make_client(settings, "watcher")
-            watcher.on_connect = lambda client, *_: client.subscribe(ids[0].topic(Topic.STATE))
-            watcher.on_message = lambda c, u, m: states.append(json.loads(m.payload))
-            watcher.connect(settings.host, settings.port)
-            watcher.loop_start()
+            watcher = _watcher(
+                settings, ids[0].topic(Topic.STATE), lambda m: states.append(json.loads(m.payload))
+            )
             master.start()
             assert _until(lambda: any(o["serialNumber"] == "agv1" for o in fake.orders))
             sent = next(o for o in fake.orders if o["serialNumber"] == "agv1")
@@ -426,23 +440,13 @@ def test_a_vehicle_reports_at_once_when_it_comes_to_rest_and_says_its_last_state
                 rest.append(snapshot.time)
 
         heard = []  # (run time of arrival, topic's last part, message)
-        watcher = make_client(settings, "watcher")
-        watcher.on_connect = lambda client, *_: client.subscribe(f"{ids[0].topic(Topic.STATE)[:-5]}#")
-        watcher.on_message = lambda c, u, m: heard.append(
-            (clock.now(), m.topic.rsplit("/", 1)[1], json.loads(m.payload))
+        watcher = _watcher(
+            settings,
+            f"{ids[0].topic(Topic.STATE)[:-5]}#",
+            lambda m: heard.append((clock.now(), m.topic.rsplit("/", 1)[1], json.loads(m.payload))),
         )
-        watcher.connect(settings.host, settings.port)
-        watcher.loop_start()
         # a state every 10 s of the run at most: any state sooner after stopping is the event's
-        vehicle = SimulatedVehicle(
-            ids[0],
-            scenario.limits.vehicles[0],
-            position_xy(scenario.track, scenario.start.first),
-            broker=settings,
-            clock=clock,
-            state_rate=0.1,
-            observer=observe,
-        ).start()
+        vehicle = _first_vehicle(scenario, ids, settings, clock, state_rate=0.1, observer=observe)
         master = LiveMaster(verified, scenario.names, identities=ids, broker=settings, clock=clock)
         try:
             master.start()
