@@ -20,6 +20,7 @@ from logging import WARNING
 import paho.mqtt.client as mqtt
 import pytest
 
+import trajgen.live.broker as broker_module
 from tests.conftest import REPO
 from trajgen.errors import InputError, LiveError
 from trajgen.live.broker import (
@@ -235,13 +236,16 @@ def test_two_brokers_get_ports_of_their_own(broker, broker_class, peers):
     assert not other.running
 
 
-def test_a_taken_port_is_a_live_error_naming_it(broker_class):
+def test_a_taken_port_is_a_live_error_naming_it(broker_class, monkeypatch):
+    monkeypatch.setattr(broker_module, "REBIND_TIMEOUT_S", 0.2)  # how long it waits is not the point here
     with socket.socket() as taken:
         taken.bind(("127.0.0.1", 0))
         taken.listen()
         port = taken.getsockname()[1]
         broker = broker_class(port=port)
-        with pytest.raises(LiveError, match=f"cannot listen on 127.0.0.1:{port}"):
+        with pytest.raises(
+            LiveError, match=rf"cannot listen on 127.0.0.1:{port}: .* \(still so after 0.2 s\)"
+        ):
             broker.start()
     assert not broker.running
     assert not [thread for thread in threading.enumerate() if thread.name == THREAD_NAME]

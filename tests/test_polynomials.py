@@ -86,3 +86,41 @@ def test_a_root_found_has_a_sign_change_within_a_few_units_of_round_off(kind):
     after = evaluate(cb, np.minimum(r + delta, high[bracketed]))
     at = evaluate(cb, r)
     assert np.all((np.sign(before) * np.sign(after) <= 0.0) | (at == 0.0))
+
+
+def _cubics_with_double_roots(seed: int, count: int) -> np.ndarray:
+    """Random cubics, a third with a derivative's double root and a third with two roots 1e-9 apart."""
+    rng = np.random.default_rng(seed)
+    c = rng.normal(size=(count, 4))
+    third = count // 3
+    r, a = rng.uniform(0.0, 2.0, third), rng.normal(size=third)
+    c[:third] = np.column_stack([1.0 - a * r**3, 3.0 * a * r**2, -3.0 * a * r, a])  # a (t - r)^3 + 1
+    d = 1e-9
+    # derivative 3 a (t - r)(t - r - d): roots r and r + d
+    c[third : 2 * third] = np.column_stack(
+        [np.ones(third), 3.0 * a * r * (r + d), -1.5 * a * (2.0 * r + d), a]
+    )
+    return c
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2], ids=["seed-0", "seed-1", "seed-2"])
+def test_the_closed_form_of_cubics_agrees_with_the_bracketed_search(seed):
+    c = _cubics_with_double_roots(seed, 3000)
+    h = np.random.default_rng(seed + 100).uniform(0.1, 3.0, c.shape[0])
+    closed = extrema(c, h)  # degree 3: the derivative's roots in closed form
+    searched = extrema(np.pad(c, ((0, 0), (0, 1))), h)  # as a quartic: the safeguarded Newton search
+    scale = np.maximum(1.0, np.abs(searched[0]))
+    np.testing.assert_allclose(closed[0], searched[0], rtol=0.0, atol=1e-13 * scale.max())
+    np.testing.assert_allclose(closed[2], searched[2], rtol=0.0, atol=1e-13 * scale.max())
+    for value, where in ((closed[0], closed[1]), (closed[2], closed[3])):
+        np.testing.assert_allclose(evaluate(c, where), value, rtol=1e-12, atol=1e-12)  # attained there
+        assert np.all((where >= 0.0) & (where <= h))
+
+
+def test_a_cubic_flat_at_its_inflection_has_its_extrema_at_the_ends():
+    # (t - 1)^3 on [0, 2]: the derivative's double root at 1 is no extremum
+    low, t_low, high, t_high = extrema(np.array([[-1.0, 3.0, -3.0, 1.0]]), np.array([2.0]))
+    assert (low[0], t_low[0], high[0], t_high[0]) == (-1.0, 0.0, 1.0, 2.0)
+    # 2t - t^2 on [0, 3]: maximum 1 at 1, minimum -3 at 3
+    low, t_low, high, t_high = extrema(np.array([[0.0, 2.0, -1.0, 0.0]]), np.array([3.0]))
+    assert (high[0], t_high[0], low[0], t_low[0]) == (1.0, 1.0, -3.0, 3.0)
