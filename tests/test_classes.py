@@ -279,7 +279,7 @@ def test_a_class_that_fails_is_reported_and_the_other_class_is_returned(monkeypa
 
     monkeypatch.setattr(optimal_method, "initial_guess", broken_for_the_other_class)
     route = swap_route((12.0, 8.0, 15.0))
-    schedule = Optimal(cache=SolverCache()).schedule(route, MIXED)
+    schedule = Optimal().schedule(route, MIXED)
     assert schedule.fallback_reason is None
     assert schedule.route.homotopy is Homotopy.PAPER  # the slower class, but the only one solved
     assert verify(schedule).passed
@@ -298,7 +298,7 @@ def test_a_refinement_that_raises_keeps_the_passes_solved_before(monkeypatch, ca
 
     monkeypatch.setattr(optimal_method, "refine", broken)
     route = swap_route((12.0, 8.0, 15.0))
-    schedule = Optimal(homotopy="paper", cache=SolverCache()).schedule(route, LIMITS)
+    schedule = Optimal(homotopy="paper").schedule(route, LIMITS)
     assert schedule.fallback_reason is None
     assert schedule.info.refinements == 0
     assert "pass 1 of 1" in schedule.notes[0]

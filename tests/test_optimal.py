@@ -23,6 +23,7 @@ from trajgen.methods.optimal.solve import (
     SOLUTIONS_REMEMBERED,
     CompiledNlp,
     Outcome,
+    SolutionMemory,
     SolveResult,
     abandoned_solver_calls,
     solve,
@@ -154,16 +155,16 @@ def test_a_problem_solved_before_is_answered_from_memory_and_another_is_solved(m
     assert calls, "other limits are another problem: solved, not recalled"
 
 
-def test_a_compiled_nlp_remembers_its_last_solutions_only():
-    compiled = SolverCache().get(Optimal().shape(route_of(UNEQUAL, ("A:12", "B:8"), ("B:8", "A:12"))))[0]
+def test_the_memory_keeps_the_last_solutions_used_only():
+    memory = SolutionMemory(SOLUTIONS_REMEMBERED)
     results = [SolveResult(np.full(2, float(i)), ()) for i in range(SOLUTIONS_REMEMBERED + 1)]
     for i, result in enumerate(results):
-        compiled.remember(bytes([i]), result)
-    assert compiled.remembered(bytes([0])) is None  # the least recently used went first
-    assert compiled.remembered(bytes([1])) is results[1]
-    compiled.remember(bytes([99]), results[0])
-    assert compiled.remembered(bytes([1])) is results[1]  # used just now: kept
-    assert compiled.remembered(bytes([2])) is None
+        memory.put(bytes([i]), result)
+    assert memory.get(bytes([0])) is None  # the least recently used went first
+    assert memory.get(bytes([1])) is results[1]
+    memory.put(bytes([99]), results[0])
+    assert memory.get(bytes([1])) is results[1]  # used just now: kept
+    assert memory.get(bytes([2])) is None
 
 
 def test_forced_solver_failure_falls_back_to_exact_and_logs(caplog):
@@ -305,7 +306,7 @@ def test_a_separation_equal_to_the_shortest_leg_is_solved_not_fallen_back(a, b):
     start = conf(f"{a}:{track.length(a)}", f"{b}:{track.length(b)}")
     limits = Limits(vehicles=LIMITS.vehicles, min_separation=track.shortest_leg)
     route = plan(track, start, start.swapped(), min_separation=track.shortest_leg)
-    schedule = optimal_schedule(route, limits, cache=SolverCache())
+    schedule = optimal_schedule(route, limits)
     assert schedule.fallback_reason is None, schedule.notes
     report = verify(schedule)
     assert report.passed, report.failures

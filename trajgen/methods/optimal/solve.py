@@ -27,6 +27,7 @@ from trajgen.methods.optimal.transcription import Transcription, transcribe
 __all__ = [
     "CompiledNlp",
     "Outcome",
+    "SolutionMemory",
     "SolveResult",
     "Solver",
     "SolverAttempt",
@@ -97,6 +98,38 @@ class SolverAttempt:
         return f"{self.solver.value} did not converge ({self.status}, {self.iterations} iterations)"
 
 
+class SolutionMemory:
+    """Converged solves by problem key, the least recently used dropped first beyond ``size``.
+
+    Examples
+    --------
+    >>> memory = SolutionMemory(1)
+    >>> memory.put(b"a", "first"); memory.put(b"b", "second")
+    >>> memory.get(b"a") is None, memory.get(b"b")
+    (True, 'second')
+    """
+
+    __slots__ = ("_entries", "size")
+
+    def __init__(self, size: int) -> None:
+        self.size = size
+        self._entries: collections.OrderedDict[bytes, SolveResult] = collections.OrderedDict()
+
+    def get(self, key: bytes) -> SolveResult | None:
+        """The result kept for ``key`` (now the most recently used), or ``None``."""
+        result = self._entries.get(key)
+        if result is not None:
+            self._entries.move_to_end(key)
+        return result
+
+    def put(self, key: bytes, result: SolveResult) -> None:
+        """Keep ``result`` for ``key``, dropping the least recently used beyond :attr:`size`."""
+        self._entries[key] = result
+        self._entries.move_to_end(key)
+        while len(self._entries) > self.size:
+            self._entries.popitem(last=False)
+
+
 class CompiledNlp:
     """The NLP of one shape with its solvers; fatrop built at once, the Ipopt backups on first need.
 
@@ -117,7 +150,7 @@ class CompiledNlp:
         #: Set when a solver call on this NLP never returned: its solver object stays busy in the
         #: abandoned call, so the cache builds the shape afresh rather than reuse it.
         self.abandoned = False
-        self._solutions: collections.OrderedDict[bytes, SolveResult] = collections.OrderedDict()
+        self._solutions = SolutionMemory(SOLUTIONS_REMEMBERED)
         nlp = self.transcription.nlp
         self._solvers: dict[Solver | tuple[Solver, float], object] = {
             Solver.FATROP: ca.nlpsol(
@@ -190,16 +223,11 @@ class CompiledNlp:
 
     def remembered(self, key: bytes) -> SolveResult | None:
         """The converged solve of problem ``key`` if it is remembered (call with the lock held)."""
-        result = self._solutions.get(key)
-        if result is not None:
-            self._solutions.move_to_end(key)
-        return result
+        return self._solutions.get(key)
 
     def remember(self, key: bytes, result: SolveResult) -> None:
-        """Keep the converged ``result`` of problem ``key``, dropping the least recently used."""
-        self._solutions[key] = result
-        while len(self._solutions) > SOLUTIONS_REMEMBERED:
-            self._solutions.popitem(last=False)
+        """Keep the converged ``result`` of problem ``key`` (call with the lock held)."""
+        self._solutions.put(key, result)
 
 
 class SolverCache:
