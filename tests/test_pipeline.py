@@ -165,10 +165,10 @@ def test_run_refuses_what_is_not_a_scenario():
 
 
 def test_a_fallback_run_reports_the_method_asked_for_and_plots_its_own_schedule(tmp_path, caplog):
-    from trajgen import Optimal, SolverCache
+    from trajgen import Optimal
 
     # a generous budget: the solvers fail, not the clock
-    failing = Optimal(max_iterations=1, time_budget=60.0, cache=SolverCache())
+    failing = Optimal(max_iterations=1, time_budget=60.0)
     with caplog.at_level(logging.WARNING, logger="trajgen.methods.optimal"):
         result = run(default_scenario(), method=failing, outputs=Outputs(plot_dir=tmp_path))
     summary = result.summary()
