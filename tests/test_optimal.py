@@ -23,7 +23,7 @@ from trajgen.methods.optimal.solve import (
     SOLUTIONS_REMEMBERED,
     CompiledNlp,
     Outcome,
-    SolutionMemory,
+    RecentlyUsed,
     SolveResult,
     abandoned_solver_calls,
     solve,
@@ -156,7 +156,7 @@ def test_a_problem_solved_before_is_answered_from_memory_and_another_is_solved(m
 
 
 def test_the_memory_keeps_the_last_solutions_used_only():
-    memory = SolutionMemory(SOLUTIONS_REMEMBERED)
+    memory = RecentlyUsed(SOLUTIONS_REMEMBERED)
     results = [SolveResult(np.full(2, float(i)), ()) for i in range(SOLUTIONS_REMEMBERED + 1)]
     for i, result in enumerate(results):
         memory.put(bytes([i]), result)
@@ -347,15 +347,10 @@ class _StandInNlp:
         self.lock = threading.Lock()
         self.abandoned = False
         self._solver = _SleepySolver(seconds)
+        self.solutions = RecentlyUsed(0)  # remembers nothing
 
     def solver(self, _which, *, ipopt_wall_time):
         return self._solver
-
-    def remembered(self, _key):
-        return None
-
-    def remember(self, _key, _result):
-        pass
 
 
 @pytest.mark.parametrize(("seconds", "abandoned"), [(0.0, False), (3.0, True)], ids=["prompt", "stuck"])

@@ -243,7 +243,6 @@ class SimulatedVehicle:
         self._headers = {Topic.STATE: 0, Topic.CONNECTION: 0}
         self._inbox: queue.SimpleQueue[tuple[float, bytes]] = queue.SimpleQueue()  # (arrival, payload)
         self._event = True
-        self._driving = False  # as the last state said
         self._next_state = 0.0
         self._lock = threading.Lock()
         self._snapshot = VehicleSnapshot(0.0, *self._start, 0.0, 0, False)
@@ -563,7 +562,6 @@ class SimulatedVehicle:
             return
         self._client.publish(self.identity.topic(Topic.STATE), self._state_message(), qos=0)
         self._event = False
-        self._driving = self._state.driving
         self._next_state = self._t + 1.0 / self.state_rate
 
     def _advance(self, until: float) -> None:
@@ -572,7 +570,8 @@ class SimulatedVehicle:
             self._step()
             self._update_snapshot()
             # starting and stopping are events: the master learns at once that a vehicle stands
-            if self._event or self._t >= self._next_state or (abs(self._v) > AT_REST) != self._driving:
+            said_driving = self._state is not None and self._state.driving
+            if self._event or self._t >= self._next_state or (abs(self._v) > AT_REST) != said_driving:
                 self._publish_state()
 
     def _run(self) -> None:

@@ -144,6 +144,8 @@ def _quadratic_critical_points(first: np.ndarray, h: np.ndarray) -> np.ndarray:
 def _critical_points(c: np.ndarray, h: np.ndarray) -> np.ndarray:
     """Roots of the derivative inside ``[0, h]``, shape (n, 3), NaN where there are fewer."""
     first = derivative(c)
+    if first.shape[1] <= 3:
+        return _quadratic_critical_points(first, h)
     second = derivative(first)
     splits = _quadratic_roots(second[:, :3]) if second.shape[1] <= 3 else None
     if splits is None:  # degree above 4 is not used
@@ -151,8 +153,6 @@ def _critical_points(c: np.ndarray, h: np.ndarray) -> np.ndarray:
     splits = np.where((splits > 0.0) & (splits < h[:, None]), splits, np.nan)
     bounds = np.sort(np.column_stack([np.zeros_like(h), splits, h]), axis=1)  # NaN sort last
     bounds = np.where(np.isnan(bounds), h[:, None], bounds)
-    if first.shape[1] <= 3:
-        return _quadratic_critical_points(first, h)
     # the three monotone stretches of every polynomial in one vectorized bisection
     repeated = np.repeat(first, 3, axis=0)
     roots = root_in(repeated, bounds[:, :3].ravel(), bounds[:, 1:].ravel())

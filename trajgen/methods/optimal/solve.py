@@ -27,12 +27,13 @@ from trajgen.methods.optimal.transcription import Transcription, transcribe
 __all__ = [
     "CompiledNlp",
     "Outcome",
-    "SolutionMemory",
+    "RecentlyUsed",
     "SolveResult",
     "Solver",
     "SolverAttempt",
     "SolverCache",
     "abandoned_solver_calls",
+    "problem_key",
     "solve",
 ]
 
@@ -98,36 +99,52 @@ class SolverAttempt:
         return f"{self.solver.value} did not converge ({self.status}, {self.iterations} iterations)"
 
 
-class SolutionMemory:
-    """Converged solves by problem key, the least recently used dropped first beyond ``size``.
+class RecentlyUsed:
+    """A mapping that keeps its ``size`` most recently used entries, dropping the least recently used.
+
+    Not thread-safe: its owner holds a lock (:class:`SolverCache`, a :class:`CompiledNlp`'s).
 
     Examples
     --------
-    >>> memory = SolutionMemory(1)
-    >>> memory.put(b"a", "first"); memory.put(b"b", "second")
-    >>> memory.get(b"a") is None, memory.get(b"b")
-    (True, 'second')
+    >>> kept = RecentlyUsed(1)
+    >>> kept.put(b"a", "first"); kept.put(b"b", "second")
+    >>> kept.get(b"a") is None, kept.get(b"b"), len(kept)
+    (True, 'second', 1)
     """
 
     __slots__ = ("_entries", "size")
 
     def __init__(self, size: int) -> None:
         self.size = size
-        self._entries: collections.OrderedDict[bytes, SolveResult] = collections.OrderedDict()
+        self._entries: collections.OrderedDict = collections.OrderedDict()
 
-    def get(self, key: bytes) -> SolveResult | None:
-        """The result kept for ``key`` (now the most recently used), or ``None``."""
-        result = self._entries.get(key)
-        if result is not None:
+    def __len__(self) -> int:
+        return len(self._entries)
+
+    def __contains__(self, key: object) -> bool:
+        return key in self._entries
+
+    def get(self, key):
+        """The value kept for ``key`` (now the most recently used), or ``None``."""
+        value = self._entries.get(key)
+        if value is not None:
             self._entries.move_to_end(key)
-        return result
+        return value
 
-    def put(self, key: bytes, result: SolveResult) -> None:
-        """Keep ``result`` for ``key``, dropping the least recently used beyond :attr:`size`."""
-        self._entries[key] = result
+    def put(self, key, value) -> None:
+        """Keep ``value`` for ``key``, dropping the least recently used beyond :attr:`size`."""
+        self._entries[key] = value
         self._entries.move_to_end(key)
         while len(self._entries) > self.size:
             self._entries.popitem(last=False)
+
+    def pop(self, key) -> None:
+        """Drop ``key`` if it is kept."""
+        self._entries.pop(key, None)
+
+    def clear(self) -> None:
+        """Drop every entry."""
+        self._entries.clear()
 
 
 class CompiledNlp:
@@ -139,7 +156,7 @@ class CompiledNlp:
     state, a service answering the same request) gets the same answer without solving.
     """
 
-    __slots__ = ("_lock", "_solutions", "_solvers", "abandoned", "shape", "transcription")
+    __slots__ = ("_lock", "_solvers", "abandoned", "shape", "solutions", "transcription")
 
     def __init__(self, shape: NlpShape) -> None:
         import casadi as ca
@@ -150,7 +167,8 @@ class CompiledNlp:
         #: Set when a solver call on this NLP never returned: its solver object stays busy in the
         #: abandoned call, so the cache builds the shape afresh rather than reuse it.
         self.abandoned = False
-        self._solutions = SolutionMemory(SOLUTIONS_REMEMBERED)
+        #: converged solves by :func:`problem_key` (use with the lock held)
+        self.solutions = RecentlyUsed(SOLUTIONS_REMEMBERED)
         nlp = self.transcription.nlp
         self._solvers: dict[Solver | tuple[Solver, float], object] = {
             Solver.FATROP: ca.nlpsol(
@@ -221,14 +239,6 @@ class CompiledNlp:
         """Held while a solver of this NLP runs."""
         return self._lock
 
-    def remembered(self, key: bytes) -> SolveResult | None:
-        """The converged solve of problem ``key`` if it is remembered (call with the lock held)."""
-        return self._solutions.get(key)
-
-    def remember(self, key: bytes, result: SolveResult) -> None:
-        """Keep the converged ``result`` of problem ``key`` (call with the lock held)."""
-        self._solutions.put(key, result)
-
 
 class SolverCache:
     """Compiled NLPs by shape: bounded (least recently used dropped first) and thread-safe.
@@ -246,15 +256,19 @@ class SolverCache:
     (0, 4)
     """
 
-    __slots__ = ("_building", "_entries", "_lock", "maxsize")
+    __slots__ = ("_building", "_entries", "_lock")
 
     def __init__(self, maxsize: int = 32) -> None:
         if isinstance(maxsize, bool) or not isinstance(maxsize, int) or maxsize < 1:
             raise ValueError(f"solver cache maxsize must be an integer >= 1, got {maxsize!r}")
-        self.maxsize = maxsize
-        self._entries: collections.OrderedDict[NlpShape, CompiledNlp] = collections.OrderedDict()
+        self._entries = RecentlyUsed(maxsize)
         self._building: dict[NlpShape, threading.Lock] = {}
         self._lock = threading.Lock()
+
+    @property
+    def maxsize(self) -> int:
+        """Most shapes kept."""
+        return self._entries.size
 
     def __len__(self) -> int:
         with self._lock:
@@ -273,10 +287,8 @@ class SolverCache:
         with self._lock:
             entry = self._entries.get(shape)
             if entry is not None and getattr(entry, "abandoned", False):
-                del self._entries[shape]
+                self._entries.pop(shape)
                 return None
-            if entry is not None:
-                self._entries.move_to_end(shape)
             return entry
 
     def get(
@@ -299,9 +311,7 @@ class SolverCache:
                     self._building.pop(shape, None)
             logger.info("built the optimal-control NLP for %d phase(s)", shape.phase_count)
             with self._lock:
-                self._entries[shape] = entry
-                while len(self._entries) > self.maxsize:
-                    self._entries.popitem(last=False)
+                self._entries.put(shape, entry)
             return entry, True
 
 
@@ -399,9 +409,9 @@ def solve(
     attempts: list[SolverAttempt] = []
     previous = None  # the last solver's finite result, to warm-start the polish
     bounds = compiled.transcription.bounds
-    key = _problem_key(guess, parameters)
+    key = problem_key(guess, parameters)
     with compiled.lock:
-        known = compiled.remembered(key)
+        known = compiled.solutions.get(key)
         if known is not None:
             logger.debug("optimal: this problem was solved before; its solution is reused")
             return known
@@ -437,7 +447,7 @@ def solve(
                 solution = np.array(result["x"]).ravel()
                 solution.flags.writeable = False
                 solved = SolveResult(solution, tuple(attempts))
-                compiled.remember(key, solved)
+                compiled.solutions.put(key, solved)
                 return solved
             previous = result if np.all(np.isfinite(np.array(result["x"]))) else None
             attempts.append(SolverAttempt(which, Outcome.NOT_CONVERGED, iterations, status))
@@ -445,7 +455,7 @@ def solve(
     return SolveResult(None, tuple(attempts))
 
 
-def _problem_key(guess: np.ndarray, parameters: np.ndarray) -> bytes:
+def problem_key(guess: np.ndarray, parameters: np.ndarray) -> bytes:
     """The bytes that tell one problem on a compiled NLP from another: its guess and parameters."""
     return (
         np.ascontiguousarray(guess, dtype=float).tobytes()
