@@ -14,6 +14,7 @@ trajgen) is shown as code without a link. A name that does not exist still fails
 
 from __future__ import annotations
 
+import functools
 import importlib
 import os
 import re
@@ -58,6 +59,7 @@ NUMPYDOC_WORDS = frozenset(
 _DOTTED_NAME = re.compile(r"[A-Za-z_][A-Za-z0-9_]*(\.[A-Za-z_][A-Za-z0-9_]*)*")
 
 
+@functools.cache  # the build asks for the same names thousands of times; a failed import is slow
 def _import(dotted: str) -> tuple[bool, object]:
     """``(True, object)`` for an importable dotted name (module, then attributes), else ``(False, None)``."""
     parts = dotted.split(".")
@@ -75,15 +77,16 @@ def _import(dotted: str) -> tuple[bool, object]:
     return False, None
 
 
-def _defining_contexts(dotted: str) -> list[str]:
+@functools.cache
+def _defining_contexts(dotted: str) -> tuple[str, ...]:
     """The module (and class) that define the object ``dotted``, or its nearest parent that has one."""
     parts = dotted.split(".")
     for cut in range(len(parts), 0, -1):
         found, value = _import(".".join(parts[:cut]))
         module = getattr(value, "__module__", None) if found else None
         if isinstance(module, str):
-            return [f"{module}.{value.__qualname__}", module] if isinstance(value, type) else [module]
-    return []
+            return (f"{module}.{value.__qualname__}", module) if isinstance(value, type) else (module,)
+    return ()
 
 
 def _contexts(node: nodes.Element) -> list[str]:
