@@ -21,3 +21,18 @@ settings.load_profile(os.environ.get("HYPOTHESIS_PROFILE", "seeded"))
 
 #: The repository (a clone of it): the tests read nothing outside it (tests/test_clone.py).
 REPO = Path(__file__).resolve().parent.parent
+
+
+def pytest_configure(config) -> None:
+    """Compile the packages once, in the process that starts the others, before they import them.
+
+    The pytest-xdist workers, and the command-line, example and documentation runs the tests
+    start, all import the packages of this checkout; where no bytecode is written
+    (``PYTHONDONTWRITEBYTECODE``), each would compile them again (0.5 s a process).
+    """
+    if hasattr(config, "workerinput"):
+        return
+    import compileall
+
+    for package in ("trajgen", "topology", "limits"):
+        compileall.compile_dir(REPO / package, quiet=1)
