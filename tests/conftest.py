@@ -3,9 +3,15 @@
 from __future__ import annotations
 
 import os
+import sys
 from pathlib import Path
 
-from hypothesis import HealthCheck, settings
+# This run caches bytecode even where none is written by default (PYTHONDONTWRITEBYTECODE): pytest's
+# rewrite of hypothesis (a pytest plugin's modules, 2 s) is then done here once, before the workers
+# start, and the tests' modules are compiled once for all the processes (see pytest_configure).
+sys.dont_write_bytecode = False
+
+from hypothesis import HealthCheck, settings  # noqa: E402  (with the bytecode cached)
 
 # "seeded" (the default): what CI runs. "thorough": twenty times the examples, for a release or a
 # change to the planner (HYPOTHESIS_PROFILE=thorough); tests that set max_examples keep theirs.
