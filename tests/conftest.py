@@ -6,9 +6,9 @@ import os
 import sys
 from pathlib import Path
 
-# This run caches bytecode even where none is written by default (PYTHONDONTWRITEBYTECODE): pytest's
-# rewrite of hypothesis (a pytest plugin's modules, 2 s) is then done here once, before the workers
-# start, and the tests' modules are compiled once for all the processes (see pytest_configure).
+# The test run caches bytecode, also where none is written by default (PYTHONDONTWRITEBYTECODE):
+# pytest's rewrite of hypothesis (a pytest plugin's modules, 2 s) is then done once, here, before the
+# workers start, and they read it; the packages are compiled once for every process (pytest_configure).
 sys.dont_write_bytecode = False
 
 from hypothesis import HealthCheck, settings  # noqa: E402  (with the bytecode cached)
