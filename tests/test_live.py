@@ -77,6 +77,15 @@ def _demo(name: str, method: str, *, faults=((), ()), **settings) -> LiveDemo:
     return demo.__enter__()
 
 
+def _drive(name: str, method: str, *, at=(), faults=((), ()), **settings):
+    """The scenario driven live to its goals (``at``: actions during the run), its broker stopped after."""
+    demo = _demo(name, method, faults=faults, **settings)
+    try:
+        return demo.run(at=at)
+    finally:
+        demo.__exit__()
+
+
 def _separation(name: str) -> float:
     return execution_plan(name, "exact")[0].limits.min_separation
 
@@ -130,17 +139,13 @@ def test_fault_free_runs_are_safe_schema_valid_and_close_to_their_plans(optimal_
 
 
 def test_a_broker_restart_mid_run_is_survived_and_the_latest_orders_are_sent_again():
-    demo = _demo("swap", "exact")
     restarted = []
 
     def restart(demo):
         restarted.append(demo.clock.now())
         demo.broker.restart(down_for=0.3)
 
-    try:
-        outcome = demo.run(at=[(12.0, restart)])
-    finally:
-        demo.__exit__()
+    outcome = _drive("swap", "exact", at=[(12.0, restart)])
     assert outcome.run.outcome is LiveOutcome.GOALS_REACHED
     assert math.isfinite(outcome.closest)  # compared at every cycle both drove
     assert outcome.closest >= _separation("swap") - 1e-9
@@ -150,16 +155,14 @@ def test_a_broker_restart_mid_run_is_survived_and_the_latest_orders_are_sent_aga
 
 
 def test_a_vehicle_that_drops_off_holds_the_other_at_its_released_base_until_it_is_back():
-    demo = _demo("crossing", "exact")
-    try:
-        outcome = demo.run(
-            at=[
-                (3.0, lambda demo: demo.vehicles[0].drop_connection()),
-                (20.0, lambda demo: demo.vehicles[0].restore_connection()),
-            ]
-        )
-    finally:
-        demo.__exit__()
+    outcome = _drive(
+        "crossing",
+        "exact",
+        at=[
+            (3.0, lambda demo: demo.vehicles[0].drop_connection()),
+            (20.0, lambda demo: demo.vehicles[0].restore_connection()),
+        ],
+    )
     assert outcome.run.outcome is LiveOutcome.GOALS_REACHED
     assert math.isfinite(outcome.closest)  # compared at every cycle both drove
     assert outcome.closest >= _separation("crossing") - 1e-9
@@ -189,17 +192,12 @@ def test_a_vehicle_that_drops_off_holds_the_other_at_its_released_base_until_it_
 def test_a_stop_fault_makes_the_other_wait_and_costs_at_most_the_online_bound():
     scenario = execution_plan("crossing", "exact")[0]
     duration = 6.0
-
-    def run(faults):
-        demo = _demo("crossing", "exact", faults=faults)
-        try:
-            return demo.run()
-        finally:
-            demo.__exit__()
-
     # the run without the fault and the run with it, each on a broker of its own, at once
     with concurrent.futures.ThreadPoolExecutor(2) as pool:
-        free, stopped = pool.map(run, [((), ()), ((StopFault(8.0, duration),), ())])
+        free, stopped = pool.map(
+            lambda faults: _drive("crossing", "exact", faults=faults),
+            [((), ()), ((StopFault(8.0, duration),), ())],
+        )
     free = free.run
     assert stopped.run.outcome is LiveOutcome.GOALS_REACHED
     assert math.isfinite(stopped.closest)
@@ -215,11 +213,7 @@ def test_a_stop_fault_makes_the_other_wait_and_costs_at_most_the_online_bound():
 def test_a_new_goal_mid_run_stops_both_at_their_bases_and_replans_from_there():
     scenario = execution_plan("swap", "exact")[0]
     goal = Configuration(Position("C", 8.0), Position("A", 10.0))
-    demo = _demo("swap", "exact")
-    try:
-        outcome = demo.run(at=[(10.0, lambda demo: demo.master.request_goal(goal))])
-    finally:
-        demo.__exit__()
+    outcome = _drive("swap", "exact", at=[(10.0, lambda demo: demo.master.request_goal(goal))])
     assert outcome.run.outcome is LiveOutcome.GOALS_REACHED
     assert outcome.run.replans == 1
     assert math.isfinite(outcome.closest)  # compared at every cycle both drove
