@@ -31,8 +31,8 @@ def main() -> None:
     parser.add_argument("--random", type=int, default=10, help="random pairs in sets c and d (10)")
     args = parser.parse_args()
     logging.disable(logging.WARNING)
-    free = Optimal(cache=SolverCache(maxsize=128), time_budget=60.0)
-    ruled = Optimal(braking_rule=True, cache=SolverCache(maxsize=128), time_budget=60.0)
+    free = Optimal(cache=SolverCache(maxsize=128))
+    ruled = Optimal(braking_rule=True, cache=SolverCache(maxsize=128))
     cases = [
         (ref.label, ref.limits, ref.track, s) for ref in reference_sets(args.random) for s in ref.scenarios
     ]

@@ -93,7 +93,7 @@ def main() -> None:
         nodes=64,
         refinements=12,
         refinement_tolerance=1e-5,
-        time_budget=120.0,
+        time_limit=120.0,
         homotopy="paper",
         cache=SolverCache(maxsize=256),
     )

@@ -55,7 +55,7 @@ def main() -> None:
     parser.add_argument("--period", type=float, default=0.05, help="CSV sample period compared, seconds")
     args = parser.parse_args()
     options = CsvOptions(sample_period=args.period)
-    methods = {"exact": Exact(), "toppra": Toppra(), "optimal": Optimal(time_budget=120.0)}
+    methods = {"exact": Exact(), "toppra": Toppra(), "optimal": Optimal()}
 
     def exported(schedule):
         verified = certify(schedule)

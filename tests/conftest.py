@@ -30,15 +30,32 @@ REPO = Path(__file__).resolve().parent.parent
 
 
 def pytest_configure(config) -> None:
-    """Compile the packages once, in the process that starts the others, before they import them.
+    """Compile the packages once, and give the run its own store of compiled NLPs.
 
-    The pytest-xdist workers, and the command-line, example and documentation runs the tests
-    start, all import the packages of this checkout; where no bytecode is written
+    Runs in the process that starts the others, before they import the packages. The
+    pytest-xdist workers, and the command-line, example and documentation runs the tests start,
+    all import the packages of this checkout; where no bytecode is written
     (``PYTHONDONTWRITEBYTECODE``), each would compile them again (0.5 s a process).
+
+    The optimal method keeps the NLPs it builds in a disk store (``$TRAJGEN_CACHE_DIR``, else the
+    user's cache folder). The run points it at a new temporary folder, which every worker and
+    every process the tests start inherit: nothing of the user's cache is read, and each shape is
+    built once for the whole run. It is deleted when the run ends.
     """
     if hasattr(config, "workerinput"):
         return
     import compileall
+    import tempfile
 
     for package in ("trajgen", "topology", "limits"):
         compileall.compile_dir(REPO / package, quiet=1)
+    store = tempfile.TemporaryDirectory(prefix="trajgen-test-nlp-")
+    config._trajgen_store = store  # kept alive until pytest_unconfigure
+    os.environ["TRAJGEN_CACHE_DIR"] = store.name
+
+
+def pytest_unconfigure(config) -> None:
+    """Delete the run's store of compiled NLPs (after the workers and the runs they started)."""
+    store = getattr(config, "_trajgen_store", None)
+    if store is not None:
+        store.cleanup()

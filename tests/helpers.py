@@ -35,9 +35,8 @@ def too_close(schedule: Schedule, separation: float = 10.5) -> Schedule:
 def execution_plan(name: str, method: str):
     """``(scenario, plan_for_execution(scenario))`` of ``examples/NAME.toml``, once per test process.
 
-    ``optimal`` with a budget that a loaded machine cannot cut short (a fallback would be another
-    plan). Several modules test the same plans; solved once, each worker shares them.
+    Several modules test the same plans; solved once, each worker shares them.
     """
     scenario = load_scenario(REPO / "examples" / f"{name}.toml")
-    chosen = Optimal(time_budget=60.0) if method == "optimal" else method
+    chosen = Optimal() if method == "optimal" else method
     return scenario, plan_for_execution(scenario, method=chosen)

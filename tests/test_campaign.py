@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import pytest
 
-from trajgen import Exact, FallbackReason, Optimal, SolverCache, Toppra, certify, make_schedule
+from trajgen import Exact, Optimal, SolverCache, Toppra, certify, make_schedule
 from trajgen.scenario.sampling import campaign_scenarios
 
 SCENARIOS = campaign_scenarios(300, seed=9)
@@ -50,7 +50,7 @@ def test_the_optimal_schedule_verifies_and_is_no_slower_than_exact(optimal, inde
     scenario = SCENARIOS[index]
     route = scenario.plan()
     schedule = certify(make_schedule(route, scenario.limits, method=optimal)).schedule
-    # solved, or (on a machine too loaded for the budget) flagged and verified; a solver failure on
-    # these seeded scenarios would be a regression
-    assert schedule.fallback_reason in (None, FallbackReason.TIME_BUDGET)
+    # solved: the effort is fixed by iterations, not by the clock, so a fallback (a solver failure, or
+    # one that did not come back within the time limit) on these seeded scenarios is a regression
+    assert schedule.fallback_reason is None, schedule.notes
     assert schedule.duration <= Exact().schedule(route, scenario.limits).duration * (1 + 1e-9)

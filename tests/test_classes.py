@@ -90,7 +90,7 @@ def test_the_class_lower_bound_holds_in_both_classes(scenario):
 
 
 #: Converged solves (stored reference values): makespan of each class, seconds, the faster first, from
-#: ``Optimal(nodes=64, refinements=12, refinement_tolerance=1e-5, time_budget=60.0)`` (trajgen 0.7).
+#: ``Optimal(nodes=64, refinements=12, refinement_tolerance=1e-5)`` (trajgen 0.7).
 CONVERGED = {
     "into-one-leg": ((13.500020756816056, Homotopy.PAPER), (21.68482261852551, Homotopy.OTHER)),
     "swap-CA-mixed": ((41.15476274144109, Homotopy.PAPER), (47.47637861555721, Homotopy.OTHER)),
@@ -139,7 +139,7 @@ def test_the_converged_references_are_what_a_converged_solve_gives():
     # one of the stored converged solves, recomputed (the cheapest): the references are not stale
     route = route_of((12.0, 8.0, 15.0), ("A:3", "B:2"), ("C:4", "C:9"))
     converged = Optimal(
-        nodes=64, refinements=12, refinement_tolerance=1e-5, time_budget=60.0, cache=SolverCache()
+        nodes=64, refinements=12, refinement_tolerance=1e-5, time_limit=60.0, cache=SolverCache()
     ).schedule(route, LIMITS)
     makespans = sorted((c.makespan, c.homotopy) for c in converged.info.classes)
     assert makespans[0][1] is CONVERGED["into-one-leg"][0][1]
@@ -311,7 +311,7 @@ def test_a_fallback_summary_marks_no_failed_class_chosen_and_gives_the_reasons_o
     from trajgen.model.summary import format_run
 
     with caplog.at_level(logging.WARNING):
-        result = run(default_scenario(), method=Optimal(max_iterations=1, time_budget=60.0))
+        result = run(default_scenario(), method=Optimal(max_iterations=1))
     text = format_run(result.summary())
     assert result.summary()["fallback_reason"] == "solver-failed"
     class_lines = [line for line in text.splitlines() if line.startswith("class ")]
@@ -319,7 +319,7 @@ def test_a_fallback_summary_marks_no_failed_class_chosen_and_gives_the_reasons_o
     assert all("failed (solver-failed)" in line for line in class_lines)
     assert not any("<- chosen" in line for line in class_lines)
     assert "(the exact fallback keeps this class)" in class_lines[0]
-    # every solver attempt is listed once: in the note, not again in the log
+    # every solver attempt is listed once: in the note, not again in the log, which says why in words
     detail = "ipopt-polish did not converge"
     assert (text + caplog.text).count(detail) == text.count(detail) == 2  # two classes, one line
-    assert "fell back to exact (solver-failed)" in caplog.text
+    assert "fell back to the exact schedule (solver-failed): no solver converged" in caplog.text

@@ -19,15 +19,9 @@ from topology import Homotopy, YGraph, plan, region_sequence
 from trajgen import Exact, FallbackReason, Optimal, SolverCache, certify, lower_bound, make_schedule, verify
 from trajgen.errors import InputError
 from trajgen.methods.optimal import Solver, Source
-from trajgen.methods.optimal.solve import (
-    SOLUTIONS_REMEMBERED,
-    CompiledNlp,
-    Outcome,
-    RecentlyUsed,
-    SolveResult,
-    abandoned_solver_calls,
-    solve,
-)
+from trajgen.methods.optimal.compiled import SOLUTIONS_REMEMBERED, CompiledNlp, RecentlyUsed
+from trajgen.methods.optimal.solve import Outcome, SolveResult, abandoned_solver_calls, solve
+from trajgen.methods.optimal.units import ProblemUnits
 from trajgen.model.analysis import travelled
 from trajgen.model.profiles import rest_to_rest_time
 from trajgen.plots import render_coordination
@@ -170,8 +164,7 @@ def test_the_memory_keeps_the_last_solutions_used_only():
 def test_forced_solver_failure_falls_back_to_exact_and_logs(caplog):
     route = route_of(UNEQUAL, ("A:12", "B:8"), ("B:8", "A:12"))
     with caplog.at_level(logging.WARNING, logger="trajgen.methods.optimal"):
-        # a budget a loaded machine cannot spend on building the problems: the solvers fail first
-        schedule = optimal_schedule(route, LIMITS, max_iterations=1, time_budget=60.0)
+        schedule = optimal_schedule(route, LIMITS, max_iterations=1)
     exact = exact_schedule(route, LIMITS)
     assert schedule.fallback_reason is FallbackReason.SOLVER_FAILED
     assert "did not converge" in schedule.notes[0]
@@ -179,7 +172,12 @@ def test_forced_solver_failure_falls_back_to_exact_and_logs(caplog):
     assert schedule.method == Exact()
     assert schedule.duration == exact.duration
     assert verify(schedule).passed
-    assert any("fell back to exact" in record.message for record in caplog.records)
+    # the warning says why in words (not "see the notes"); the note lists the attempts
+    assert any(
+        "fell back to the exact schedule (solver-failed): no solver converged (fatrop, then Ipopt)"
+        in record.message
+        for record in caplog.records
+    )
 
 
 @pytest.mark.parametrize(
@@ -314,15 +312,23 @@ def test_a_separation_equal_to_the_shortest_leg_is_solved_not_fallen_back(a, b):
     assert schedule.duration < exact_schedule(route, limits).duration
 
 
-def test_a_spent_time_budget_returns_the_verified_exact_schedule_flagged():
+def test_a_reached_time_limit_returns_the_verified_exact_schedule_flagged():
     route = route_of(UNEQUAL, ("A:12", "B:8"), ("B:8", "A:12"))
-    schedule = optimal_schedule(route, LIMITS, time_budget=1e-4, cache=SolverCache())
-    assert schedule.fallback_reason is FallbackReason.TIME_BUDGET
+    schedule = optimal_schedule(route, LIMITS, time_limit=1e-4, cache=SolverCache())
+    assert schedule.fallback_reason is FallbackReason.TIME_LIMIT
+    assert FallbackReason.TIME_BUDGET is FallbackReason.TIME_LIMIT  # the deprecated name
     assert schedule.method == Exact()
     assert verify(schedule).passed
-    assert "not tried: the time budget is spent" in schedule.notes[0]
-    with pytest.raises(InputError, match="time_budget must be a finite number of seconds > 0, got 0"):
-        Optimal(time_budget=0)
+    assert "not tried: the time limit was reached" in schedule.notes[0]
+    with pytest.raises(InputError, match="time_limit must be a finite number of seconds > 0, got 0"):
+        Optimal(time_limit=0)
+
+
+def test_the_deprecated_time_budget_is_the_time_limit():
+    with pytest.warns(DeprecationWarning, match=r"Optimal\(time_budget=\.\.\.\) is deprecated"):
+        method = Optimal(time_budget=7.5)
+    assert method.time_limit == 7.5
+    assert method == Optimal(time_limit=7.5)
 
 
 class _SleepySolver:
@@ -343,7 +349,8 @@ class _StandInNlp:
     """The parts of a compiled NLP that ``solve`` uses, with a solver of a given speed."""
 
     def __init__(self, seconds: float) -> None:
-        self.transcription = types.SimpleNamespace(bounds={})
+        self.bounds = {}
+        self.shape = None  # solved in seconds and metres: the shape is not needed
         self.lock = threading.Lock()
         self.abandoned = False
         self._solver = _SleepySolver(seconds)
@@ -357,7 +364,7 @@ class _StandInNlp:
 def test_a_fatrop_call_not_back_by_the_deadline_is_abandoned(seconds, abandoned):
     compiled = _StandInNlp(seconds)
     began = time.perf_counter()
-    result = solve(compiled, np.zeros(3), np.zeros(0), deadline=began + 0.3)
+    result = solve(compiled, np.zeros(3), np.zeros(0), units=ProblemUnits(1.0, 1.0), deadline=began + 0.3)
     assert time.perf_counter() - began < 1.0  # the caller is back soon after the deadline
     assert compiled.abandoned is abandoned
     if abandoned:

@@ -230,10 +230,10 @@ def test_classes_of_different_shapes_share_the_first_copy_and_only_a_shape_neede
     assert all(shape in cache for shape in shapes)
 
 
-def test_a_new_time_budget_solves_on_the_nlp_already_built():
+def test_a_new_time_limit_solves_on_the_nlp_already_built():
     cache = SolverCache(maxsize=4)
     route = route_of(*SWAP)
-    assert Optimal(cache=cache, time_budget=2.0).warm_up(route) is True
-    schedule = Optimal(cache=cache, time_budget=7.5).schedule(route, LIMITS)
+    assert Optimal(cache=cache, time_limit=2.0).warm_up(route) is True
+    schedule = Optimal(cache=cache, time_limit=7.5).schedule(route, LIMITS)
     assert schedule.info.built is False
     assert len(cache) == 2

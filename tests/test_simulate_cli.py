@@ -340,6 +340,10 @@ def test_a_run_of_repeated_events_prints_as_one_line_with_its_count():
     events.append({"t_s": 30.0, "kind": "done", "detail": "both vehicles at their goals"})
     summary = {
         "reached_goal": True,
+        "method": "optimal",
+        "computed_by": "optimal",
+        "fallback_reason": None,
+        "time_limit_reached": False,
         "makespan_s": 30.0,
         "planned_s": 27.5,
         "time_lost_s": 2.5,

@@ -21,6 +21,7 @@ from trajgen.errors import InputError
 from trajgen.export import CsvOptions, check_output_paths, commit_files, profile_paths
 from trajgen.methods import METHODS
 from trajgen.model.schedule import TimingMethod
+from trajgen.model.summary import format_provenance
 from trajgen.online.messages import PERIOD_RANGE
 from trajgen.online.simulation import SimulationResult, parse_faults, simulate
 from trajgen.plots import render_simulation
@@ -210,6 +211,7 @@ def format_simulation(summary: dict, *, min_separation: float) -> str:
     lines = [
         f"reached goal: {reached}  makespan: {summary['makespan_s']:.3f} s "
         f"(planned {summary['planned_s']:.3f} s, lost {summary['time_lost_s']:.3f} s)",
+        f"plan: {format_provenance(summary)}",
         f"separation: min {summary['min_separation_m']:.4f} m, certified between cycles "
         f"{summary['certified_separation_m']:.4f} m (required {min_separation:g} m)",
         f"worst setpoints: |v|/limit {summary['velocity_ratio']:.6f}, |a|/limit "

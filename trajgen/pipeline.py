@@ -27,7 +27,7 @@ from trajgen.export.plc import PlcTables, check_dialect_method, plc_tables, tabl
 from trajgen.methods import METHODS, make_schedule
 from trajgen.model.analysis import lower_bound
 from trajgen.model.schedule import TimingMethod
-from trajgen.model.summary import route_summary
+from trajgen.model.summary import provenance, route_summary
 from trajgen.scenario import Scenario
 from trajgen.verification import VerifiedSchedule, certify
 
@@ -136,14 +136,12 @@ class RunResult:
         schedule, report = self.verified.schedule, self.verified.report
         return {
             "scenario": self.scenario.source,
-            "method": self.method.name,
-            "computed_by": schedule.method.name,
+            **provenance(schedule, self.method.name),
             "duration_s": schedule.duration,
             "jerk_limited": schedule.jerk_limited,
             "verified": report.passed,
             "worst_margins": report.summary(),
             "notes": [*schedule.notes, *self.notes],
-            "fallback_reason": None if schedule.fallback_reason is None else schedule.fallback_reason.value,
             "solver": None if schedule.info is None else schedule.info.summary(),
             "route": route_summary(self.route),
             "export": None if self.tables is None else self.tables.summary(),

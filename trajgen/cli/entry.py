@@ -18,9 +18,24 @@ from collections.abc import Sequence
 from trajgen.cli.parser import EXIT_BAD_INPUT, EXIT_FAILURE, CommandParser
 from trajgen.errors import InputError
 
-__all__ = ["COMMANDS", "Commands", "build_parser", "command_parsers", "console_main", "main"]
+__all__ = ["COMMANDS", "Commands", "LogFormatter", "build_parser", "command_parsers", "console_main", "main"]
 
 logger = logging.getLogger(__name__)
+
+
+class LogFormatter(logging.Formatter):
+    """The command's log lines: the program's name and the level first, as its error messages.
+
+    Warnings, ``-v`` progress and the solvers' messages all read ``trajgen: warning: optimal: ...``.
+    """
+
+    def format(self, record: logging.LogRecord) -> str:
+        """``trajgen: <level>: <message>``, the traceback below where there is one."""
+        text = f"trajgen: {record.levelname.lower()}: {record.getMessage()}"
+        if record.exc_info:
+            text += "\n" + self.formatException(record.exc_info)
+        return text
+
 
 #: Every sub-command, in help order: its one-line help and the module whose ``register(commands)``
 #: adds its parser. A run imports only its own command's module: ``trajgen schedule`` loads no
@@ -139,7 +154,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     try:
         argv = sys.argv[1:] if argv is None else list(argv)
         args = _build(_chosen(argv))[0].parse_args(argv)
-        logging.basicConfig(level=logging.INFO if args.verbose else logging.WARNING, format="%(message)s")
+        handler = logging.StreamHandler()
+        handler.setFormatter(LogFormatter())
+        logging.basicConfig(level=logging.INFO if args.verbose else logging.WARNING, handlers=[handler])
         return args.run(args)
     except InputError as error:
         print(f"trajgen: error: {error}", file=sys.stderr)

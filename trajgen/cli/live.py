@@ -102,6 +102,8 @@ def _commit(log, log_path: str, plot_path: str | None, names) -> None:
 
 
 def _report(run, args: argparse.Namespace, *, closest: float | None = None) -> int:
+    from trajgen.model.summary import format_provenance
+
     summary = run.summary()
     if closest is not None:
         summary["closest_m"] = closest
@@ -111,7 +113,8 @@ def _report(run, args: argparse.Namespace, *, closest: float | None = None) -> i
         latency = summary["release_latency_median_ms"]
         print(
             f"live run: {summary['outcome']} in {summary['makespan_s']:.3f} s of the run "
-            f"(plan {summary['planned_s']:.3f} s); {summary['orders']} orders and updates "
+            f"(plan {summary['planned_s']:.3f} s, {format_provenance(summary)}); "
+            f"{summary['orders']} orders and updates "
             f"({summary['resent']} sent again), {summary['ignored']} messages ignored, "
             f"{summary['replans']} re-plans"
             + (f"; release latency {latency:.2f} ms median" if latency is not None else "")
@@ -219,7 +222,9 @@ def _show_progress(record: dict) -> None:
     print(f"{t:9.2f} s  {line}", flush=True)
 
 
-def live_demo(scenario, *, method, time_scale: float, state_rate: float = 10.0, output: str) -> int:
+def live_demo(
+    scenario, *, method, time_scale: float, state_rate: float = 10.0, output: str, json_summary: bool = False
+) -> int:
     """``trajgen demo --live``: a broker, two simulated vehicles and the master in this process."""
     from trajgen.export.atomic import check_output_paths
     from trajgen.live.runlog import RunLog
@@ -227,23 +232,25 @@ def live_demo(scenario, *, method, time_scale: float, state_rate: float = 10.0, 
 
     log_path, plot_path = str(Path(output) / "live-run.jsonl"), str(Path(output) / "live-run.png")
     check_output_paths([log_path, plot_path])
-    print(
-        f"Live demo: {scenario.source} over VDA 5050 on an MQTT broker in this process, "
-        f"{time_scale:g}x real time ..."
-    )
+    if not json_summary:  # with --json, stdout is the summary alone
+        print(
+            f"Live demo: {scenario.source} over VDA 5050 on an MQTT broker in this process, "
+            f"{time_scale:g}x real time ..."
+        )
     demo = LiveDemo(
         scenario,
         method=method,
         time_scale=time_scale,
         state_rate=state_rate,
-        log=RunLog(listener=_show_progress),
+        log=RunLog(listener=None if json_summary else _show_progress),
     )
     with demo:
         demo = demo.run()
     _commit(demo.log, log_path, plot_path, scenario.names)
     demo.log.close()
-    status = _report(demo.run, argparse.Namespace(json=False), closest=demo.closest)
-    print(f"Run log and picture: {log_path}, {plot_path}")
+    status = _report(demo.run, argparse.Namespace(json=json_summary), closest=demo.closest)
+    if not json_summary:
+        print(f"Run log and picture: {log_path}, {plot_path}")
     return status
 
 

@@ -46,10 +46,14 @@ def _command_demo(args: argparse.Namespace) -> int:
             time_scale=args.time_scale,
             state_rate=args.state_rate,
             output=args.output,
+            json_summary=args.json,
         )
     result = run(
         scenario, method=method_from(args), outputs=Outputs(csv_dir=args.output, plot_dir=args.output)
     )
+    if args.json:
+        print(json.dumps(result.summary(), indent=2))
+        return EXIT_OK
     print(f"Demo: the built-in scenario {scenario.source} ({chosen.description}).")
     print(format_route(result.route))
     print(format_run(result.summary()))
@@ -87,6 +91,9 @@ def register(commands) -> None:
         default=10.0,
         metavar="HZ",
         help="with --live: each vehicle's states per second of the run, besides those on events (10)",
+    )
+    demo.add_argument(
+        "--json", action="store_true", help="print a machine-readable summary (of the live run with --live)"
     )
     add_method(demo)
     demo.set_defaults(run=_command_demo)

@@ -64,8 +64,10 @@ def _per_vehicle(values: list[str], names: tuple[str, str], option: str, default
 
 
 def _format(summary: dict) -> str:
+    from trajgen.model.summary import format_provenance
+
     lines = [
-        f"VDA 5050 orders of {summary['scenario']} ({summary['computed_by']}, "
+        f"VDA 5050 orders of {summary['scenario']} ({format_provenance(summary)}, "
         f"schedule {summary['duration_s']:.2f} s, planned with waits {summary['planned_duration_s']:.2f} s), "
         f"start {summary['start_time']}:"
     ]
@@ -88,6 +90,7 @@ def _format(summary: dict) -> str:
 
 def _command_export(args: argparse.Namespace) -> int:
     from trajgen.export.vda5050 import order_files, order_paths
+    from trajgen.model.summary import provenance
     from trajgen.pipeline import run
 
     scenario = scenario_from(args.scenario)
@@ -110,9 +113,7 @@ def _command_export(args: argparse.Namespace) -> int:
     schedule = result.verified.schedule
     summary = {
         "scenario": scenario.source,
-        "method": method.name,
-        "computed_by": schedule.method.name,
-        "fallback_reason": None if schedule.fallback_reason is None else schedule.fallback_reason.value,
+        **provenance(schedule, method.name),
         "duration_s": schedule.duration,
         "planned_duration_s": manifest["planned_duration_s"],
         "start_time": manifest["start_time"],

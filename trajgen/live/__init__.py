@@ -16,8 +16,9 @@ from trajgen.lazy import lazy_attributes
 if TYPE_CHECKING:
     from trajgen.live.broker import EmbeddedBroker, MosquittoBroker, mosquitto_available
     from trajgen.live.clock import RunClock
-    from trajgen.live.master import LiveMaster, LiveOutcome, LiveRun
+    from trajgen.live.master import LiveMaster
     from trajgen.live.mqtt import BrokerSettings, VehicleIdentity
+    from trajgen.live.outcome import LiveOutcome, LiveRun
     from trajgen.live.runlog import RunLog, read_run_log
     from trajgen.live.session import DemoRun, LiveDemo, identities, live_plan, run_demo
     from trajgen.live.vehicle import SimulatedVehicle, StopFault, VehicleSnapshot
@@ -50,8 +51,8 @@ _SOURCES = {
     "EmbeddedBroker": "trajgen.live.broker",
     "LiveDemo": "trajgen.live.session",
     "LiveMaster": "trajgen.live.master",
-    "LiveOutcome": "trajgen.live.master",
-    "LiveRun": "trajgen.live.master",
+    "LiveOutcome": "trajgen.live.outcome",
+    "LiveRun": "trajgen.live.outcome",
     "MosquittoBroker": "trajgen.live.broker",
     "RunClock": "trajgen.live.clock",
     "RunLog": "trajgen.live.runlog",

@@ -26,12 +26,10 @@ update stitched where it stands, with the new path.
 
 from __future__ import annotations
 
-import enum
 import logging
 import threading
 import time
 from collections.abc import Sequence
-from dataclasses import dataclass
 
 import numpy as np
 
@@ -41,7 +39,10 @@ from trajgen.export.vda5050_messages import VDA5050_VERSION, node_id, order_elem
 from trajgen.export.vda5050_release import BaseRelease, plan_orders
 from trajgen.live.clock import RunClock
 from trajgen.live.mqtt import BrokerSettings, Topic, VehicleIdentity, make_client
+from trajgen.live.outcome import LiveOutcome, LiveRun
 from trajgen.live.runlog import RunLog
+from trajgen.methods import METHODS
+from trajgen.model.summary import provenance
 from trajgen.online.goals import goal_refusal, plan_from_rest
 from trajgen.verification import VerifiedSchedule, require_verified
 
@@ -57,63 +58,6 @@ RELEASE_SPACING = 0.25
 _RESEND_INTERVAL_S = 0.25
 #: Slower than this (reported ``velocity``) a vehicle at its decision point stands, m/s.
 _AT_REST = 1e-6
-
-
-class LiveOutcome(enum.Enum):
-    """How a live run ended."""
-
-    GOALS_REACHED = "goals-reached"  #: both vehicles stand at their goals
-    TIMED_OUT = "timed-out"  #: the time limit passed first
-
-
-@dataclass(frozen=True, slots=True)
-class LiveRun:
-    """What a live run did.
-
-    Attributes
-    ----------
-    outcome : LiveOutcome
-    makespan : float
-        Seconds of the run from the first order to both vehicles at their goals (or to the time out).
-    planned : float
-        When the first plan's releases bring both vehicles to their goals, seconds
-        (:attr:`~trajgen.export.vda5050_release.OrderPlan.planned_duration`).
-    orders : int
-        Orders and order updates published, re-sends included.
-    resent : int
-        How many of them were re-sends (after a reconnection, or to a vehicle whose state lagged).
-    ignored : int
-        Messages logged and ignored.
-    replans : int
-        New goals taken.
-    release_latency : numpy.ndarray
-        Per release, wall seconds from taking the state that allowed it to publishing the update,
-        shape (releases,), read-only.
-    """
-
-    outcome: LiveOutcome
-    makespan: float
-    planned: float
-    orders: int
-    resent: int
-    ignored: int
-    replans: int
-    release_latency: np.ndarray
-
-    def summary(self) -> dict:
-        """A JSON-ready summary."""
-        latency = self.release_latency
-        return {
-            "outcome": self.outcome.value,
-            "makespan_s": self.makespan,
-            "planned_s": self.planned,
-            "orders": self.orders,
-            "resent": self.resent,
-            "ignored": self.ignored,
-            "replans": self.replans,
-            "releases": int(latency.size),
-            "release_latency_median_ms": float(np.median(latency) * 1e3) if latency.size else None,
-        }
 
 
 class _View:
@@ -187,6 +131,8 @@ class LiveMaster:
         self.limits = verified.schedule.limits
         self.names = tuple(names)
         self.method = method
+        self._asked = METHODS.create(method).name  # as the plans name it (exact after a fallback)
+        self._provenance: dict = {}
         self.broker = broker
         self.clock = clock if clock is not None else RunClock()
         self.order_id = order_id
@@ -231,11 +177,12 @@ class LiveMaster:
         self._rule = rule
         if first:
             self._planned = plan.planned_duration
+            self._provenance = provenance(verified.schedule, self._asked)
         self.log.write(
             {
                 "t": self.clock.now(),
                 "event": "plan",
-                "method": verified.schedule.method.name,
+                **provenance(verified.schedule, self._asked),
                 "planned_s": plan.planned_duration,
                 "nodes": [len(p.nodes) for p in plan.paths],
             }
@@ -593,6 +540,7 @@ class LiveMaster:
                 self._counts["ignored"],
                 self._counts["replans"],
                 latency,
+                dict(self._provenance),
             )
             self.log.write({"t": now, "event": "end", "outcome": outcome.value, "makespan_s": run.makespan})
             return run

@@ -94,7 +94,8 @@ class FallbackReason(enum.Enum):
     SOLVER_FAILED = "solver-failed"  #: no solver converged
     VERIFICATION_FAILED = "verification-failed"  #: the solution failed the verifier
     SETUP_FAILED = "setup-failed"  #: the problem could not be set up (initial guess, parameters)
-    TIME_BUDGET = "time-budget"  #: the solvers did not finish within the method's time budget
+    TIME_LIMIT = "time-limit"  #: a solver did not come back within the method's time limit (a safety stop)
+    TIME_BUDGET = "time-limit"  #: deprecated name of :attr:`TIME_LIMIT` (0.7)
 
 
 class MethodInfo(abc.ABC):

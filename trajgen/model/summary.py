@@ -11,7 +11,15 @@ from __future__ import annotations
 
 from topology import Homotopy, Instruction, Route, WayRound
 
-__all__ = ["class_label", "class_name", "format_route", "format_run", "route_summary"]
+__all__ = [
+    "class_label",
+    "class_name",
+    "format_provenance",
+    "format_route",
+    "format_run",
+    "provenance",
+    "route_summary",
+]
 
 #: Four or more legs: the class of the planner's route by its instruction (``{graph}``: ``G_k``).
 _PLANNER_CLASS = {
@@ -128,6 +136,35 @@ def _chosen_mark(comparison: dict, *, fallback: bool) -> str:
     return " <- chosen"
 
 
+def provenance(schedule, asked: str) -> dict:
+    """Which method was asked for and which computed ``schedule``, JSON-ready.
+
+    ``method`` (asked for), ``computed_by`` (``exact`` after a fallback), ``fallback_reason``
+    (``None`` or a :class:`~trajgen.model.schedule.FallbackReason` value) and
+    ``time_limit_reached`` (the method's safety stop ended its work early: the only way the same
+    request can give another schedule on another machine or under load).
+    """
+    info = None if schedule.info is None else schedule.info.summary()
+    return {
+        "method": asked,
+        "computed_by": schedule.method.name,
+        "fallback_reason": None if schedule.fallback_reason is None else schedule.fallback_reason.value,
+        "time_limit_reached": bool(info is not None and info.get("time_limit_reached", False)),
+    }
+
+
+def format_provenance(summary: dict) -> str:
+    """``method`` for people: ``optimal``, or ``exact (fallback from optimal: time-limit)``."""
+    text = summary["computed_by"]
+    if summary["fallback_reason"] is not None:
+        text += f" (fallback from {summary['method']}: {summary['fallback_reason']})"
+    elif summary["computed_by"] != summary["method"]:
+        text += f" (asked for {summary['method']})"
+    if summary.get("time_limit_reached"):
+        text += ", refinement ended by the time limit"
+    return text
+
+
 def format_run(summary: dict) -> str:
     """Human-readable lines of a run's JSON summary (:meth:`trajgen.pipeline.RunResult.summary`)."""
     margins = summary["worst_margins"]
@@ -136,7 +173,7 @@ def format_run(summary: dict) -> str:
     )
     lines = [
         f"scenario: {summary['scenario']}",
-        f"method: {summary['method']}  duration: {summary['duration_s']:.3f} s  "
+        f"method: {format_provenance(summary)}  duration: {summary['duration_s']:.3f} s  "
         f"verified: {summary['verified']}",
         f"worst margins: separation {margins['min_separation_m']:.4f} m "
         f"(margin {margins['separation_margin_m']:.4f} m), |v|/limit {max(margins['velocity_ratio']):.6f}, "

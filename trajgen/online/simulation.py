@@ -28,10 +28,11 @@ from topology.indexed import separation as indexed_separation
 from trajgen.errors import InputError
 from trajgen.export.csv import CsvOptions
 from trajgen.model.schedule import TimingMethod
+from trajgen.model.summary import provenance
 from trajgen.model.values import frozen
 from trajgen.online.executor import Executor
 from trajgen.online.faults import Fault, FaultError, FaultKind, parse_fault
-from trajgen.online.goals import execution_margin, plan_for_execution
+from trajgen.online.goals import execution_margin, for_execution, plan_for_execution
 from trajgen.online.messages import Command, Event, Mode, VehicleState
 from trajgen.online.plant import Plant
 from trajgen.online.trace import PLOT_SAMPLES, Decimated, Trace
@@ -92,6 +93,9 @@ class SimulationResult:
         The margin the executor's conflicts kept beyond the separation, metres.
     unapplied_faults : tuple of Fault
         The faults that never applied: due after the run had ended (both vehicles at their goals).
+    method : str
+        The timing method asked for the plan (its ``computed_by`` is the schedule's own, ``exact``
+        after a fallback).
     """
 
     reached_goal: bool
@@ -116,6 +120,7 @@ class SimulationResult:
     schedule: VerifiedSchedule = field(repr=False)
     position_margin: float = 0.0
     unapplied_faults: tuple[Fault, ...] = ()
+    method: str = "optimal"
 
     @property
     def violations(self) -> int:
@@ -126,6 +131,7 @@ class SimulationResult:
         """JSON-ready summary."""
         return {
             "reached_goal": self.reached_goal,
+            **provenance(self.schedule.schedule, self.method),
             "makespan_s": round(self.makespan_s, 6),
             "planned_s": round(self.planned_s, 6),
             "time_lost_s": round(self.time_lost_s, 6),
@@ -384,5 +390,6 @@ def simulate(
         schedule=verified,
         position_margin=margin,
         unapplied_faults=unapplied,
+        method=for_execution(method).name,
     )
     return result, spool

@@ -12,6 +12,7 @@ import time
 
 from limits import Limits
 from topology import Route
+from trajgen.methods.optimal.compiled import NlpOrigin
 from trajgen.methods.optimal.decode import PhaseSolution, sections
 from trajgen.methods.optimal.info import OptimalInfo
 from trajgen.methods.optimal.phases import NlpShape, Phase
@@ -62,7 +63,19 @@ class ClassRace:
 class ClassSolve:
     """What solving one homotopy class delivered: its passes, unverified, and how the solvers fared."""
 
-    __slots__ = ("attempts", "built", "detail", "failure", "limits", "passes", "phases", "route", "shape")
+    __slots__ = (
+        "attempts",
+        "built",
+        "cut_short",
+        "detail",
+        "failure",
+        "limits",
+        "origin",
+        "passes",
+        "phases",
+        "route",
+        "shape",
+    )
 
     def __init__(
         self, route: Route, limits: Limits, phases: tuple[Phase, ...], shape: NlpShape, *, built: bool
@@ -73,6 +86,10 @@ class ClassSolve:
         self.passes: list[tuple[float, list[PhaseSolution], SolverAttempt]] = []
         self.failure: FallbackReason | None = None
         self.detail = ""
+        #: where its compiled NLP came from, when this solve prepared it (None: it was in memory)
+        self.origin: NlpOrigin | None = None
+        #: whether the time limit (a safety stop) ended its refinement
+        self.cut_short = False
 
     @property
     def refinements(self) -> int:

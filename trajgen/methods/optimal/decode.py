@@ -111,7 +111,9 @@ def _phase_section(
 
     Each moving vehicle's profile runs from the solver's state at the phase start (the route's
     start, at rest, in the first phase) exactly to its state at the phase end (the route's goal,
-    at rest, in the last), every knot integrated from the one before.
+    at rest, in the last), every knot integrated from the one before. A vehicle that passes the
+    junction between two phases is there exactly (the solver meets that equality to ~1e-10 m):
+    its track position is continuous across the sections to round-off.
     """
     phase = phases[p]
     profiles, maps = [], []
@@ -124,8 +126,12 @@ def _phase_section(
         if moving:
             if p == 0:
                 start = np.array([route.start[vehicle].s, 0.0, 0.0])
+            elif phases[p - 1].switching == vehicle:  # it has just entered its leg at the junction
+                start[0] = 0.0
             if p == len(phases) - 1:
                 end = np.array([route.goal[vehicle].s, 0.0, 0.0])
+            elif phase.switching == vehicle:  # it leaves its leg at the junction
+                end[0] = 0.0
             jerk = _consistent(start, end, solved.times, jerk)
         node = _integrate(start, solved.times, jerk)[:-1] if moving else solved.states[:-1, columns]
         s0 = node[0, 0]

@@ -6,7 +6,8 @@ import enum
 from dataclasses import dataclass
 
 from topology import Homotopy, WayRound
-from trajgen.methods.optimal.solve import Solver, SolverAttempt
+from trajgen.methods.optimal.compiled import Solver
+from trajgen.methods.optimal.solve import SolverAttempt
 from trajgen.model.schedule import FallbackReason, MethodInfo
 
 __all__ = ["ClassComparison", "OptimalInfo", "Source"]
@@ -81,7 +82,7 @@ class OptimalInfo(MethodInfo):
         every class's solves and refinement passes (concurrent), and the build if it was built;
         verification excluded.
     built : bool
-        Whether an NLP had to be built (first query of its shape in the cache).
+        Whether an NLP had to be built (its shape was neither in memory nor in the disk store).
     attempts : tuple of SolverAttempt
         Every solver tried, in order (class by class).
     source : Source
@@ -92,6 +93,11 @@ class OptimalInfo(MethodInfo):
         The homotopy classes considered (empty when only the route's own was).
     solved_by : SolverAttempt or None
         The solver attempt that produced the returned solution (its class and pass).
+    loaded : bool
+        Whether an NLP was loaded from the disk store (:mod:`~.store`) for this request.
+    time_limit_reached : bool
+        Whether the time limit (a safety stop) ended a class's refinement early: the schedule
+        may then be slower than on a machine that finished it.
     """
 
     solve_time: float
@@ -101,6 +107,8 @@ class OptimalInfo(MethodInfo):
     refinements: int = 0
     classes: tuple[ClassComparison, ...] = ()
     solved_by: SolverAttempt | None = None
+    loaded: bool = False
+    time_limit_reached: bool = False
 
     @property
     def solver(self) -> Solver | None:
@@ -124,6 +132,8 @@ class OptimalInfo(MethodInfo):
         return {
             "solve_time_s": self.solve_time,
             "built": self.built,
+            "loaded": self.loaded,
+            "time_limit_reached": self.time_limit_reached,
             "solver": None if self.solver is None else self.solver.value,
             "iterations": self.iterations,
             "status": self.status,

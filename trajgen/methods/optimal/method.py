@@ -6,7 +6,9 @@ import concurrent.futures
 import dataclasses
 import logging
 import math
+import threading
 import time
+import warnings
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import ClassVar
@@ -17,27 +19,34 @@ from limits import Limits
 from topology import Homotopy, OptionError, Route, plan
 from trajgen.errors import InputError, SolverError
 from trajgen.methods.exact import Exact
+from trajgen.methods.optimal.braking import BRAKING_CURVATURE, BRAKING_MARGIN
 from trajgen.methods.optimal.choice import HomotopyChoice
 from trajgen.methods.optimal.classes import ClassRace, ClassSolve
+from trajgen.methods.optimal.compiled import NlpOrigin, SolverCache
 from trajgen.methods.optimal.decode import unpack
 from trajgen.methods.optimal.guess import assemble, initial_guess
 from trajgen.methods.optimal.info import ClassComparison, OptimalInfo, Source
 from trajgen.methods.optimal.mesh import refine
 from trajgen.methods.optimal.phases import NlpShape, default_fractions, route_phases
-from trajgen.methods.optimal.solve import SolverCache, solve
+from trajgen.methods.optimal.solve import solve
+from trajgen.methods.optimal.store import default_store
 from trajgen.methods.optimal.transcription import ParameterLayout
+from trajgen.methods.optimal.units import ProblemUnits
 from trajgen.model.analysis import class_lower_bound
 from trajgen.model.schedule import FallbackReason, Schedule, TimingMethod, check_request
 from trajgen.model.summary import class_name
 from trajgen.verification import verify
 
-__all__ = ["DEFAULT_NODES", "DEFAULT_REFINEMENT_TOLERANCE", "Optimal"]
+__all__ = ["DEFAULT_NODES", "DEFAULT_REFINEMENT_TOLERANCE", "DEFAULT_TIME_LIMIT", "Optimal"]
 
 logger = logging.getLogger(__name__)
 
 #: Intervals per segment. 32: with fewer, mesh refinement converges slowly where the optimum is one
 #: vehicle's own S-curve (24 nodes: 0.02 % a pass, still 0.24 % over after the tolerance stopped it).
 DEFAULT_NODES = 32
+#: Default of ``Optimal.time_limit``, seconds: a safety stop, about 20 times the slowest usual
+#: solve (a braking-rule plan of two classes, 1.5 s on the benchmark machine).
+DEFAULT_TIME_LIMIT = 30.0
 #: Smallest separation used when the scenario asks for 0 ("not the same point"), metres.
 _POSITIVE_SEPARATION = 1e-3
 #: Planned clearance above the minimum separation, metres: the solvers meet constraints to ~1e-8 m,
@@ -102,18 +111,23 @@ class Optimal(TimingMethod):
         Iteration limit of Ipopt (and of fatrop, with ``fatrop_iterations``).
     fatrop_iterations : int, optional
         Iteration limit of fatrop (default 500; it converges in < 150 when it converges).
+    time_limit : float, optional
+        A safety stop, seconds (default :data:`DEFAULT_TIME_LIMIT`, 30 s, about 20 times the
+        slowest usual solve; the one-time build or load of an NLP is not counted). The effort is
+        fixed by iteration limits, refinement passes and the tolerance, never by the clock, so
+        the same request gives the same schedule on an idle and on a loaded machine; only a
+        solver that does not come back meets this limit: no solver starts after it, a fatrop run
+        not back by then is abandoned and an Ipopt run stops. The result then says so:
+        ``fallback_reason`` ``time-limit`` if no class was solved, else
+        ``info.time_limit_reached`` and a note (the passes solved before it are kept).
     time_budget : float, optional
-        Seconds the solvers may take (default 2.0; the one-time build of an NLP the cache does
-        not hold yet is not counted): no solver starts after it is spent, no
-        refinement pass starts unless the previous one would fit in what is left, Ipopt stops
-        by itself at half of it, and a fatrop run that is not back by then is abandoned (fatrop
-        has no wall-time limit; its result is not used).
-        If no class was solved by then, the ``exact`` schedule is returned, flagged ``time-budget``.
+        Deprecated name of ``time_limit`` (0.7: it no longer decides how much of the optimum a
+        schedule gets).
     braking_rule : bool, optional
         State the braking rule (:mod:`trajgen.verification.braking_rule`) in the problem (default
         ``False``), so that the plan can be executed by the order-keeping :class:`~trajgen.online.Executor`
-        without holds; verify then checks it. Slower (seconds per solve), and fatrop may stall on
-        it (the time budget's watchdog then abandons the call); the executor's
+        without holds; verify then checks it. Slower (its NLP takes 1.2 s to build, 0.2 s to
+        load from the disk store, and about 0.25 s a solve); the executor's
         :func:`~trajgen.online.plan_for_execution` turns it on.
     refinements : int, optional
         Most mesh-refinement passes after the first solve (default 6): the grid's nodes move to the
@@ -131,25 +145,27 @@ class Optimal(TimingMethod):
         class only.
     cache : SolverCache or None, optional
         Where compiled NLPs are kept; ``None`` (default) uses the process-wide
-        :meth:`shared_cache`.
+        :meth:`shared_cache`, backed by the user's disk store (:mod:`~.store`).
     """
 
     name: ClassVar[str] = "optimal"
     summary: ClassVar[str] = (
         "time-optimal jerk-limited schedule, faster of the two shortest homotopy classes (CasADi)"
     )
-    _shared: ClassVar[SolverCache] = SolverCache(maxsize=32)
+    _shared: ClassVar[list[SolverCache]] = []
+    _shared_lock: ClassVar[threading.Lock] = threading.Lock()
 
     nodes: int = DEFAULT_NODES
     segments: int = 1
     max_iterations: int = 3000
     fatrop_iterations: int = 500
-    time_budget: float = 2.0
+    time_limit: float = DEFAULT_TIME_LIMIT
     refinements: int = 6
     refinement_tolerance: float = DEFAULT_REFINEMENT_TOLERANCE
     homotopy: HomotopyChoice = HomotopyChoice.FASTEST
     cache: SolverCache | None = field(default=None, compare=False, repr=False)
     braking_rule: bool = False
+    time_budget: float | None = field(default=None, compare=False, repr=False)
 
     def __post_init__(self) -> None:
         _positive_int(self.nodes, "nodes")
@@ -167,10 +183,19 @@ class Optimal(TimingMethod):
             raise InputError(
                 f"optimal option refinement_tolerance must be a number in (0, 1), got {tolerance!r}"
             )
-        budget = self.time_budget
-        if isinstance(budget, bool) or not isinstance(budget, (int, float)) or not 0.0 < budget < math.inf:
+        if self.time_budget is not None:
+            warnings.warn(
+                "Optimal(time_budget=...) is deprecated: the effort is fixed by iterations and passes; "
+                "use time_limit, a safety stop",
+                DeprecationWarning,
+                stacklevel=3,
+            )
+            object.__setattr__(self, "time_limit", self.time_budget)
+            object.__setattr__(self, "time_budget", None)
+        limit = self.time_limit
+        if isinstance(limit, bool) or not isinstance(limit, (int, float)) or not 0.0 < limit < math.inf:
             raise InputError(
-                f"optimal option time_budget must be a finite number of seconds > 0, got {budget!r}"
+                f"optimal option time_limit must be a finite number of seconds > 0, got {limit!r}"
             )
         if self.cache is not None and not isinstance(self.cache, SolverCache):
             raise InputError(
@@ -179,18 +204,20 @@ class Optimal(TimingMethod):
 
     @classmethod
     def shared_cache(cls) -> SolverCache:
-        """The process-wide solver cache used when no ``cache`` is given (32 shapes at most)."""
-        return cls._shared
+        """The process-wide solver cache used when no ``cache`` is given (32 shapes at most).
+
+        Created on first use, with the disk store of :func:`~.store.default_store`
+        (``$TRAJGEN_CACHE_DIR`` or the user's cache folder) as it is configured then.
+        """
+        with cls._shared_lock:
+            if not cls._shared:
+                cls._shared.append(SolverCache(maxsize=32, store=default_store()))
+            return cls._shared[0]
 
     @property
     def jerk_limited(self) -> bool:
         """Always True."""
         return True
-
-    @property
-    def _ipopt_wall_time(self) -> float:
-        """Seconds one Ipopt run may take: half the budget (fatrop and the build take the rest)."""
-        return 0.5 * float(self.time_budget)
 
     def _cache(self) -> SolverCache:
         return self.cache if self.cache is not None else Optimal.shared_cache()
@@ -260,7 +287,7 @@ class Optimal(TimingMethod):
         fastest_exact = min(exacts, key=lambda e: e.duration)
         # a class whose bound reaches the fastest exact schedule cannot beat it: not solved
         wanted = [k for k, bound in enumerate(bounds) if bound < fastest_exact.duration * (1.0 - 1e-9)]
-        deadline = began + self.time_budget
+        deadline = began + self.time_limit  # a safety stop: the effort is fixed by iterations and passes
         race = ClassRace(wanted)
         shapes = dict(zip(wanted, class_copies([self.shape(routes[k]) for k in wanted]), strict=True))
 
@@ -281,9 +308,11 @@ class Optimal(TimingMethod):
         attempts = tuple(a for k in wanted for a in solved[k].attempts)
         info = OptimalInfo(
             solve_time,
-            any(solved[k].built for k in wanted),
+            any(solved[k].origin is NlpOrigin.BUILT for k in wanted),
             attempts,
             refinements=max((solved[k].refinements for k in wanted), default=0),
+            loaded=any(solved[k].origin is NlpOrigin.LOADED for k in wanted),
+            time_limit_reached=any(solved[k].cut_short for k in wanted),
         )
 
         def comparisons(winner: Route) -> tuple[ClassComparison, ...]:
@@ -307,6 +336,11 @@ class Optimal(TimingMethod):
             f"({solved[k].failure.value}): {solved[k].detail}"
             for k in wanted
             if solved[k].failure is not None
+        ) + tuple(
+            f"class {class_name(routes[k])} ({routes[k].homotopy.value}): the time limit "
+            f"({self.time_limit:g} s, a safety stop) ended its refinement after pass {len(solved[k].passes)}"
+            for k in wanted
+            if solved[k].cut_short and solved[k].passes
         )
         # each candidate carries the whole call's diagnostics before it is verified: the object
         # verified is the object returned (a schedule is verified once)
@@ -329,8 +363,8 @@ class Optimal(TimingMethod):
             info = dataclasses.replace(info, source=Source.EXACT, classes=comparisons(route))
             if failures:
                 return _fallback(exact, FallbackReason.VERIFICATION_FAILED, "; ".join(failures), info)
-            late = any(c.failure is FallbackReason.TIME_BUDGET for c in unsolved)
-            reason = FallbackReason.TIME_BUDGET if late else unsolved[0].failure
+            late = any(c.failure is FallbackReason.TIME_LIMIT for c in unsolved)
+            reason = FallbackReason.TIME_LIMIT if late else unsolved[0].failure
             return _fallback(exact, reason, "; ".join(c.detail for c in unsolved), info)
         # The NLP's grid can only approach an S-curve from above; where an exact schedule is already
         # optimal in its class (e.g. the vehicles never interact) it is faster. Both are members of
@@ -391,17 +425,21 @@ class Optimal(TimingMethod):
 
         ``shape``: the NLP to solve it on (its copy, see :func:`class_copies`); ``slot``: this class's
         place in ``race``, through which a class that another beats by more than its refinement
-        could still gain stops refining; ``bound`` its lower bound, seconds.
+        could still gain stops refining; ``bound`` its lower bound, seconds. The problem is solved
+        in the units of :meth:`~.units.ProblemUnits.of` (its bound).
         """
         began = time.perf_counter()
         phases = route_phases(route)
         outcome = ClassSolve(route, limits, phases, shape, built=False)
+        units = ProblemUnits.of(bound)
         try:
-            building = time.perf_counter()
-            compiled, outcome.built = self._cache().get(shape)
-            if outcome.built:  # the budget is the solvers' time: a one-time build of the NLP does not count
-                deadline += time.perf_counter() - building
-            self._first_pass(outcome, compiled, exact, deadline)
+            preparing = time.perf_counter()
+            compiled, prepared = self._cache().get(shape)
+            if prepared:  # the time limit is the solvers': a one-time build or load does not count
+                outcome.origin = compiled.origin
+                outcome.built = compiled.origin is NlpOrigin.BUILT
+                deadline += time.perf_counter() - preparing
+            self._first_pass(outcome, compiled, exact, deadline, units)
         except Exception as error:  # a bug or a build failure must not lose the other class's result
             logger.exception("optimal: class %d could not be set up", slot)
             return outcome.failed(FallbackReason.SETUP_FAILED, f"{type(error).__name__}: {error}")
@@ -409,38 +447,58 @@ class Optimal(TimingMethod):
             race.first_pass(slot, outcome.makespan, deadline)
         if outcome.passes:
             try:
-                self._refine(outcome, compiled, slot=slot, deadline=deadline, race=race, bound=bound)
+                self._refine(
+                    outcome, compiled, slot=slot, deadline=deadline, race=race, bound=bound, units=units
+                )
             except Exception:  # keep the passes solved so far: each is verified before it is returned
                 logger.exception("optimal: refinement of class %d raised; keeping its earlier passes", slot)
         logger.debug("optimal: class %d solved in %.3f s", slot, time.perf_counter() - began)
         return outcome
 
     def _refine(
-        self, outcome: ClassSolve, compiled, *, slot: int, deadline: float, race: ClassRace, bound: float
+        self,
+        outcome: ClassSolve,
+        compiled,
+        *,
+        slot: int,
+        deadline: float,
+        race: ClassRace,
+        bound: float,
+        units: ProblemUnits,
     ) -> None:
-        """Mesh-refinement passes of one class until they converge, it is beaten, or time runs short."""
+        """Mesh-refinement passes of one class until they converge or it is beaten.
+
+        Deterministic: the passes depend on the solutions and the options only. The time limit
+        (``deadline``) is a safety stop; a class it stops is marked ``cut_short``.
+        """
         route, limits, phases, shape = outcome.route, outcome.limits, outcome.phases, outcome.shape
         jerks = tuple(v.max_jerk for v in limits.vehicles)
         remaining = _FIRST_GRID_GAIN
-        last_pass = 0.0
-        while outcome.refinements < self.refinements and time.perf_counter() + last_pass < deadline:
+        while outcome.refinements < self.refinements:
             current = outcome.passes[-1][0]
             if race.beaten(slot, current, remaining):
                 logger.debug("optimal: class %d not refined: another is faster by > %.3g", slot, remaining)
                 return
-            began = time.perf_counter()
+            if time.perf_counter() > deadline:
+                logger.warning(
+                    "optimal: the time limit (%g s, a safety stop) ended class %d's refinement",
+                    self.time_limit,
+                    slot,
+                )
+                outcome.cut_short = True
+                return
             fractions, states = refine(outcome.passes[-1][1], shape, jerks)
             try:
-                guess = assemble(states, shape, compiled.transcription.size)
+                guess = assemble(states, shape, compiled.size)
             except SolverError:
                 return
             parameters = _parameters(route, limits, phases, fractions)
             result = solve(
-                compiled, guess, parameters, deadline=deadline, ipopt_wall_time=self._ipopt_wall_time
+                compiled, guess, parameters, units=units, deadline=deadline, ipopt_wall_time=self.time_limit
             )
             outcome.attempts += result.attempts
-            last_pass = time.perf_counter() - began
             if result.solution is None:
+                outcome.cut_short = time.perf_counter() > deadline
                 return
             outcome.add(unpack(result.solution, phases, shape, fractions), result.attempts[-1])
             gain = (current - outcome.passes[-1][0]) / current
@@ -451,24 +509,26 @@ class Optimal(TimingMethod):
             # what is left: a few times the last gain where convergence is slow, at most the first bound
             remaining = min(_FIRST_GRID_GAIN, _REMAINING_FACTOR * max(gain, 0.0))
 
-    def _first_pass(self, outcome: ClassSolve, compiled, exact: Schedule, deadline: float) -> None:
+    def _first_pass(
+        self, outcome: ClassSolve, compiled, exact: Schedule, deadline: float, units: ProblemUnits
+    ) -> None:
         """Solve ``outcome``'s class on the first grid, from the exact schedule; records a failure."""
         route, limits, phases, shape = outcome.route, outcome.limits, outcome.phases, outcome.shape
         try:
             fractions = default_fractions(shape)
             waypoint_times = Exact().waypoint_times(exact)
-            guess = initial_guess(
-                exact, waypoint_times, phases, shape, compiled.transcription.size, fractions
-            )
+            guess = initial_guess(exact, waypoint_times, phases, shape, compiled.size, fractions)
             parameters = _parameters(route, limits, phases, fractions)
         except Exception as error:  # a malformed guess is a bug, but must not leak an unverified schedule
             outcome.failed(FallbackReason.SETUP_FAILED, f"{type(error).__name__}: {error}")
             return
-        result = solve(compiled, guess, parameters, deadline=deadline, ipopt_wall_time=self._ipopt_wall_time)
+        result = solve(
+            compiled, guess, parameters, units=units, deadline=deadline, ipopt_wall_time=self.time_limit
+        )
         outcome.attempts += result.attempts
         if result.solution is None:
             late = time.perf_counter() > deadline
-            reason = FallbackReason.TIME_BUDGET if late else FallbackReason.SOLVER_FAILED
+            reason = FallbackReason.TIME_LIMIT if late else FallbackReason.SOLVER_FAILED
             outcome.failed(reason, "; ".join(str(a) for a in result.attempts))
             return
         outcome.add(unpack(result.solution, phases, shape, fractions), result.attempts[-1])
@@ -499,15 +559,26 @@ def _parameters(route: Route, limits: Limits, phases, fractions: np.ndarray) -> 
         max_jerk=[v.max_jerk for v in vehicles],
         emergency=[v.emergency_braking for v in vehicles],
         separation=separation,
+        braking=[BRAKING_MARGIN, BRAKING_CURVATURE],
         start=[p.s for p in route.start],
         goal=[p.s for p in route.goal],
         fractions=fractions.ravel(),
     )
 
 
+#: Why a fallback happened, in a few words for the warning (the note lists every solver attempt).
+_FALLBACK_WHY = {
+    FallbackReason.SOLVER_FAILED: "no solver converged (fatrop, then Ipopt)",
+    FallbackReason.TIME_LIMIT: "a solver did not come back within the time limit (a safety stop)",
+    FallbackReason.SETUP_FAILED: "the problem could not be set up",
+}
+
+
 def _fallback(exact: Schedule, reason: FallbackReason, detail: str, info: OptimalInfo) -> Schedule:
-    # the detail (every solver attempt) is the schedule's note, printed with the summary: not twice
-    logger.warning("optimal schedule fell back to exact (%s): see the schedule's notes", reason.value)
+    # the reason in a few words, not every attempt again: the schedule's note, printed with the
+    # summary, lists them; a verification failure is named (its first line, shortened)
+    why = _FALLBACK_WHY.get(reason) or (detail if len(detail) <= 200 else detail[:197] + "...")
+    logger.warning("optimal: fell back to the exact schedule (%s): %s", reason.value, why)
     logger.debug("optimal fallback: %s", detail)
     return dataclasses.replace(
         exact, notes=(f"fallback to exact ({reason.value}): {detail}",), fallback_reason=reason, info=info

@@ -26,13 +26,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from trajgen.methods.optimal.braking import (
-    BRAKING_CURVATURE,
-    BRAKING_MARGIN,
-    BRAKING_SAMPLES,
-    VehicleSymbols,
-    braking_terms,
-)
+from trajgen.methods.optimal.braking import BRAKING_SAMPLES, VehicleSymbols, braking_terms
 from trajgen.methods.optimal.phases import DEPTH, DURATION, STATE_SIZE, NlpShape, PhaseKind, Stage, stages
 
 __all__ = ["ParameterLayout", "Transcription", "transcribe"]
@@ -50,11 +44,15 @@ class ParameterLayout:
     Parameters, in order: per phase the two vehicles' leg lengths (metres,
     0 for a vehicle parked at the junction), then ``max_velocity``,
     ``max_acceleration``, ``max_jerk``, ``emergency`` (the emergency
-    decelerations, m/s²) (2 each), ``separation`` (1),
+    decelerations, m/s²) (2 each), ``separation`` (1), ``braking`` (2: the braking rule's
+    clearance, metres, and its margin per squared second of an interval, m/s²),
     ``start`` and ``goal`` (each vehicle's ``s``, 2 each), and the grid:
     per phase and interval its share of its segment's duration
     (``phase_count * intervals``; each segment's shares sum to 1). The grid
     is a parameter so that mesh refinement re-solves the same compiled NLP.
+
+    Every quantity is in the problem's units (:class:`~.units.ProblemUnits`):
+    :attr:`dimensions` gives each block's powers of length and time.
     """
 
     phase_count: int
@@ -70,6 +68,7 @@ class ParameterLayout:
             ("max_jerk", 2),
             ("emergency", 2),
             ("separation", 1),
+            ("braking", 2),
             ("start", 2),
             ("goal", 2),
             ("fractions", self.phase_count * self.intervals),
@@ -79,6 +78,31 @@ class ParameterLayout:
     def size(self) -> int:
         """Number of parameters."""
         return sum(size for _, size in self.fields)
+
+    @property
+    def dimensions(self) -> tuple[np.ndarray, np.ndarray]:
+        """Powers of length and of time of each parameter, shape (size,) each."""
+        powers = {
+            "lengths": (1, 0),
+            "max_velocity": (1, -1),
+            "max_acceleration": (1, -2),
+            "max_jerk": (1, -3),
+            "emergency": (1, -2),
+            "separation": (1, 0),
+            "start": (1, 0),
+            "goal": (1, 0),
+            "fractions": (0, 0),
+        }
+        length: list[int] = []
+        time: list[int] = []
+        for name, size in self.fields:
+            if name == "braking":  # the clearance (m) and the margin per squared second (m/s²)
+                length += [1, 1]
+                time += [0, -2]
+            else:
+                length += [powers[name][0]] * size
+                time += [powers[name][1]] * size
+        return np.array(length), np.array(time)
 
     def split(self, vector) -> dict:
         """The blocks of a parameter vector (symbolic or numeric) by name."""
@@ -154,9 +178,10 @@ def _stage_function(
     """The interval function of one kind of stage, built once and inlined into every NLP.
 
     Inputs: ``x`` (8,) the node state, ``w`` (2,) jerk / max jerk, ``fraction``
-    the interval's share of the segment duration, ``limits`` (11,) the two leg
-    lengths, max velocities, accelerations, jerks, emergency decelerations and
-    the separation. Outputs: the exactly integrated next state (6,) (at a
+    the interval's share of the segment duration, ``limits`` (13,) the two leg
+    lengths, max velocities, accelerations, jerks, emergency decelerations, the
+    separation and the braking rule's clearance and curvature margin (all in the
+    problem's units, :mod:`~.units`). Outputs: the exactly integrated next state (6,) (at a
     ``phase_end``, ``v`` and ``a`` of the vehicle that switches negated: it
     enters its new leg), the node constraints, the between-node (Bernstein)
     constraints and the jerk regularization.
@@ -164,14 +189,16 @@ def _stage_function(
     With ``braking``, the braking rule
     (:mod:`~.braking`) joins the node constraints (``path``) and, at
     :data:`~.braking.BRAKING_SAMPLES` inside the interval, the between-node
-    ones (``between``). At a ``part_end`` the reversing vehicle ends the
+    ones (``between``), each with the clearance plus the curvature margin times the
+    squared interval. At a ``part_end`` the reversing vehicle ends the
     interval at rest at its turning point, the state ``c``.
     """
     import casadi as ca
 
-    x, w, fraction, limits = ca.SX.sym("x", STATE_SIZE), ca.SX.sym("w", 2), ca.SX.sym("f"), ca.SX.sym("q", 11)
+    x, w, fraction, limits = ca.SX.sym("x", STATE_SIZE), ca.SX.sym("w", 2), ca.SX.sym("f"), ca.SX.sym("q", 13)
     lengths, v_max, a_max, j_max = limits[0:2], limits[2:4], limits[4:6], limits[6:8]
     emergency, separation = limits[8:10], limits[10]
+    clearance, curvature = limits[11], limits[12]
     h = x[DURATION] * fraction
     following, cost = [], 0
     path_terms, between_terms = [], []  # (expression, low, high)
@@ -212,7 +239,7 @@ def _stage_function(
     elif inner[0] or inner[1]:  # the other vehicle is parked at the junction (s = 0)
         between_terms += [(c - separation, 0.0, np.inf) for c in inner[0] or inner[1]]
     if braking:
-        margin = BRAKING_MARGIN + BRAKING_CURVATURE * h * h
+        margin = clearance + curvature * h * h
 
         def rule(tau):
             symbols = []
@@ -339,6 +366,7 @@ class _Builder:
             parameters["max_jerk"],
             parameters["emergency"],
             parameters["separation"],
+            parameters["braking"],
         )
         following, node_path, between, cost = function.function(x, u[:2], fraction, limits)
         next_phase = stage.phase + 1 if stage.phase_end else stage.phase

@@ -1,0 +1,73 @@
+"""What a live run did: its outcome and its figures (:class:`LiveRun`)."""
+
+from __future__ import annotations
+
+import enum
+from dataclasses import dataclass, field
+
+import numpy as np
+
+__all__ = ["LiveOutcome", "LiveRun"]
+
+
+class LiveOutcome(enum.Enum):
+    """How a live run ended."""
+
+    GOALS_REACHED = "goals-reached"  #: both vehicles stand at their goals
+    TIMED_OUT = "timed-out"  #: the time limit passed first
+
+
+@dataclass(frozen=True, slots=True)
+class LiveRun:
+    """What a live run did.
+
+    Attributes
+    ----------
+    outcome : LiveOutcome
+    makespan : float
+        Seconds of the run from the first order to both vehicles at their goals (or to the time out).
+    planned : float
+        When the first plan's releases bring both vehicles to their goals, seconds
+        (:attr:`~trajgen.export.vda5050_release.OrderPlan.planned_duration`).
+    orders : int
+        Orders and order updates published, re-sends included.
+    resent : int
+        How many of them were re-sends (after a reconnection, or to a vehicle whose state lagged).
+    ignored : int
+        Messages logged and ignored.
+    replans : int
+        New goals taken.
+    release_latency : numpy.ndarray
+        Per release, wall seconds from taking the state that allowed it to publishing the update,
+        shape (releases,), read-only.
+    plan : dict
+        Which method was asked for the first plan and which computed it
+        (:func:`~trajgen.model.summary.provenance`: ``method``, ``computed_by``,
+        ``fallback_reason``, ``time_limit_reached``).
+    """
+
+    outcome: LiveOutcome
+    makespan: float
+    planned: float
+    orders: int
+    resent: int
+    ignored: int
+    replans: int
+    release_latency: np.ndarray
+    plan: dict = field(default_factory=dict)
+
+    def summary(self) -> dict:
+        """A JSON-ready summary."""
+        latency = self.release_latency
+        return {
+            "outcome": self.outcome.value,
+            **self.plan,
+            "makespan_s": self.makespan,
+            "planned_s": self.planned,
+            "orders": self.orders,
+            "resent": self.resent,
+            "ignored": self.ignored,
+            "replans": self.replans,
+            "releases": int(latency.size),
+            "release_latency_median_ms": float(np.median(latency) * 1e3) if latency.size else None,
+        }
