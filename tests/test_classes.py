@@ -65,6 +65,7 @@ def test_the_faster_class_wins_the_issue_swaps(legs, vehicles, baseline, before)
     assert all(c.lower_bound <= c.makespan * (1 + 1e-9) for c in classes)
 
 
+@pytest.mark.accuracy
 def test_the_four_times_faster_swap_reaches_its_closed_form_lower_bound():
     # the fast vehicle dodges into C while the slow one drives straight through: the slow vehicle's
     # own rest-to-rest S-curve over 20 m is the lower bound, and the faster class meets it
@@ -98,6 +99,7 @@ CONVERGED = {
 }
 
 
+@pytest.mark.accuracy
 @pytest.mark.parametrize(
     ("legs", "start", "goal", "limits", "converged"),
     [
@@ -147,6 +149,7 @@ def test_the_converged_references_are_what_a_converged_solve_gives():
         assert value == pytest.approx(stored, rel=1e-6)
 
 
+@pytest.mark.accuracy
 def test_mesh_refinement_makes_a_long_track_accurate():
     # issue 10: on 200/120/80 m the fixed 32-node grid was 1.1 % over the converged 404.00 s
     route = swap_route((200.0, 120.0, 80.0))

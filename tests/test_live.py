@@ -483,7 +483,7 @@ def test_a_vehicle_reports_at_once_when_it_comes_to_rest_and_says_its_last_state
 # -- the command line ---------------------------------------------------------------------------------
 
 
-def test_serve_drives_two_vehicle_processes_and_commits_its_log_and_picture(tmp_path):
+def test_serve_drives_two_vehicle_processes_and_commits_its_log_and_picture(tmp_path, capsys):
     with _broker() as broker:
         common = ["--broker", broker.url, "--time-scale", "25"]
         vehicles = [
@@ -520,11 +520,14 @@ def test_serve_drives_two_vehicle_processes_and_commits_its_log_and_picture(tmp_
                     str(tmp_path / "run.png"),
                     "--timeout",
                     "300",
+                    "--json",
                 ]
             )
         finally:
             outputs = [p.communicate(timeout=20) for p in vehicles]
     assert status == 0
+    summary = json.loads(capsys.readouterr().out)
+    assert (summary["method"], summary["computed_by"], summary["fallback_reason"]) == ("exact", "exact", None)
     assert all(p.returncode == 0 for p in vehicles), outputs
     assert all("at its goal" in out for out, _ in outputs)
     records = [json.loads(line) for line in (tmp_path / "run.jsonl").read_text().splitlines()]
@@ -539,8 +542,46 @@ def test_demo_live_runs_broker_vehicles_and_master_in_one_command(tmp_path, caps
     out = capsys.readouterr().out
     assert status == 0
     assert "goals-reached" in out
+    assert "plan 67.500 s, exact)" in out  # the plan's method, in the summary line
     assert (tmp_path / "live-run.png").read_bytes()[:4] == b"\x89PNG"
     assert (tmp_path / "live-run.jsonl").stat().st_size > 0
+
+
+def test_a_fallback_plan_of_demo_live_is_reported_in_its_json_and_its_log(tmp_path, capsys, monkeypatch):
+    from trajgen.methods.optimal import method as optimal_method
+
+    monkeypatch.setattr(optimal_method, "solve", _failing_solve)
+    fast = ["--time-scale", "25", "--state-rate", "1"]
+    status = main(["demo", "--live", "--json", *fast, "--output", str(tmp_path)])
+    captured = capsys.readouterr()
+    summary = json.loads(captured.out)  # stdout is the summary alone
+    assert status == 0
+    assert summary["outcome"] == "goals-reached"
+    assert (summary["method"], summary["computed_by"], summary["fallback_reason"]) == (
+        "optimal",
+        "exact",
+        "solver-failed",
+    )
+    assert summary["planned_s"] == pytest.approx(67.5)
+    assert "fell back to the exact schedule (solver-failed): no solver converged" in captured.err
+    plan = next(
+        json.loads(line)
+        for line in (tmp_path / "live-run.jsonl").read_text().splitlines()
+        if json.loads(line)["event"] == "plan"
+    )
+    assert (plan["method"], plan["computed_by"], plan["fallback_reason"]) == (
+        "optimal",
+        "exact",
+        "solver-failed",
+    )
+
+
+def _failing_solve(*_arguments, **_options):
+    """The optimal method's solver chain, made to fail: every class falls back to ``exact``."""
+    from trajgen.methods.optimal import Outcome, Solver, SolverAttempt
+    from trajgen.methods.optimal.solve import SolveResult
+
+    return SolveResult(None, (SolverAttempt(Solver.FATROP, Outcome.NOT_CONVERGED, 1, "made to fail"),))
 
 
 def test_serve_with_no_broker_listening_exits_1_naming_the_url(tmp_path, capsys):

@@ -225,6 +225,7 @@ BENCHMARK_SAMPLE = [
 ]
 
 
+@pytest.mark.accuracy
 @pytest.mark.parametrize(("reference", "start", "goal"), BENCHMARK_SAMPLE)
 def test_benchmark_scenarios_are_verified_and_between_their_bounds(reference, start, goal):
     # every set of benchmarks/bench_optimal.py (its 106 scenarios: `--count 50`), two of each random set here
@@ -400,3 +401,32 @@ def test_the_cache_builds_an_abandoned_nlp_afresh():
     assert was_built
     assert second is not first
     assert built == [shape, shape]
+
+
+def test_a_time_limit_reached_after_the_first_pass_keeps_that_pass_and_says_so(monkeypatch):
+    from trajgen.methods.optimal import method as optimal_method
+    from trajgen.model.summary import provenance
+
+    route = route_of(UNEQUAL, ("A:12", "B:8"), ("B:8", "A:12"))
+    solved = []
+    real_solve, real_clock = optimal_method.solve, time.perf_counter
+
+    def solve_once_then_late(*arguments, **options):
+        result = real_solve(*arguments, **options)
+        solved.append(result)
+        return result
+
+    # the clock jumps a million seconds once the first pass is solved: the safety stop is reached
+    late_clock = types.SimpleNamespace(perf_counter=lambda: real_clock() + (1e6 if solved else 0.0))
+    monkeypatch.setattr(optimal_method, "solve", solve_once_then_late)
+    monkeypatch.setattr(optimal_method, "time", late_clock)
+    schedule = Optimal(homotopy="paper", cache=SolverCache()).schedule(route, LIMITS)
+    assert len(solved) == 1  # no refinement pass started after the limit
+    assert schedule.fallback_reason is None  # the first pass is kept, verified
+    assert verify(schedule).passed
+    assert schedule.info.time_limit_reached is True
+    assert schedule.info.summary()["time_limit_reached"] is True
+    assert provenance(schedule, "optimal")["time_limit_reached"] is True
+    assert any(
+        "the time limit (30 s, a safety stop) ended its refinement after pass 1" in n for n in schedule.notes
+    )

@@ -51,17 +51,20 @@ FATROP_OPTIONS: dict[str, float | int] = {
 }
 #: What the braking rule's NLPs add. fatrop eliminates each stage's equality constraints (a
 #: reversal's rest condition, a junction crossing, the goal's rest handed back from later stages)
-#: by an LU of their control block. At its default pivot tolerance (1e-5) it accepts pivots such as
-#: j h^2 / (2 v_max), the effect of a short interval's jerk on the velocity at a reversal; the
-#: reduced Hessian is then numerically indefinite for every regularization, fatrop 1.1.8's inertia
-#: correction (which has no upper limit) raises it until it overflows, the matrix turns NaN,
-#: BLASFEO's Cholesky takes a NaN pivot for a non-positive one, and the loop never ends (3 of 120
-#: braking-rule plans of the online campaign, 48 of 140 of the wide one). At 1e-4 such a
-#: constraint is handed to the stage before, whose states it depends on strongly: none of those
-#: hung (``benchmarks/bench_braking_rule.py --campaign``). Larger tolerances leave the junction
-#: equalities less accurate (3e-4 failed the swap's verification); without the braking rule no
-#: plan hung at the default, and it stays there.
-BRAKING_FATROP_OPTIONS: dict[str, float | int] = {"linsol_lu_fact_tol": 1e-4}
+#: by an LU factorization of their control block, accepting pivots down to its tolerance
+#: (default 1e-5). Such a pivot can be tiny next to the rest of its row (a short interval's jerk
+#: acting on a position or a velocity through h^3 j / 6 or h^2 j / 2); the reduced Hessian of
+#: that stage then carries a rounding error that grows with the regularization itself. At some
+#: iterates no regularization makes it positive definite: fatrop 1.1.8's inertia correction
+#: (which has no upper limit) raises it until it overflows (measured: the same stage failing for
+#: every value up to 1e293), the matrix turns NaN, BLASFEO's Cholesky takes a NaN pivot for a
+#: non-positive one, and the loop never ends. That happened on 3 of 120 braking-rule plans of
+#: the online campaign and 48 of about 140 of the wide one (``benchmarks/bench_braking_rule.py
+#: --campaign 40 [--wide]``). At 1e-3 such constraints are handed to the stage before, whose
+#: states they act on strongly: none of those plans hangs (1e-4 still hung on one). Without the
+#: braking rule no plan hung at the default, and it stays there (1e-3 made fatrop fail on the
+#: slower class of the 1000/800/1200 m track).
+BRAKING_FATROP_OPTIONS: dict[str, float | int] = {"linsol_lu_fact_tol": 1e-3}
 
 
 class Solver(enum.Enum):
@@ -117,6 +120,10 @@ class RecentlyUsed:
         self._entries.move_to_end(key)
         while len(self._entries) > self.size:
             self._entries.popitem(last=False)
+
+    def values(self) -> list:
+        """The values kept, least recently used first."""
+        return list(self._entries.values())
 
     def pop(self, key) -> None:
         """Drop ``key`` if it is kept."""
@@ -322,6 +329,11 @@ class SolverCache:
     def __contains__(self, shape: object) -> bool:
         with self._lock:
             return shape in self._entries
+
+    def compiled(self) -> list[CompiledNlp]:
+        """The compiled NLPs kept in memory, least recently used first (for diagnostics)."""
+        with self._lock:
+            return list(self._entries.values())
 
     def clear(self) -> None:
         """Drop every compiled NLP kept in memory (the store keeps its files)."""

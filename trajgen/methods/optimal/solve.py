@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import enum
 import logging
+import math
 import os
 import threading
 import time
@@ -135,7 +136,8 @@ def _call_with_watchdog(
 
     thread = threading.Thread(target=run, name="trajgen-fatrop", daemon=True)
     thread.start()
-    thread.join(max(deadline - time.perf_counter(), 0.0) + _WATCHDOG_GRACE)
+    wait = deadline - time.perf_counter()
+    thread.join(None if math.isinf(wait) else max(wait, 0.0) + _WATCHDOG_GRACE)
     if thread.is_alive():
         compiled.abandoned = True
         _ABANDONED_THREADS.append(thread)
