@@ -1,14 +1,16 @@
 """The MQTT brokers of the live demonstration: amqtt in a thread, or mosquitto, behind one interface.
 
 Each test runs against both kinds (``amqtt``, ``mosquitto``; the latter skipped where it is not
-installed), with paho-mqtt 2.x clients on their own network threads, as the vehicles and the
-master use them: a round trip, a last will on a broken connection, clients that reconnect by
-themselves after a restart, a restart on the same port, and a port of its own for each broker.
+installed, unless ``TRAJGEN_TEST_REQUIRE_MOSQUITTO=1``, as in CI), with paho-mqtt 2.x clients on
+their own network threads, as the vehicles and the master use them: a round trip, a last will on a
+broken connection, clients that reconnect by themselves after a restart, a restart on the same
+port, and a port of its own for each broker.
 """
 
 from __future__ import annotations
 
 import json
+import os
 import queue
 import socket
 import subprocess
@@ -35,7 +37,10 @@ KINDS = [
     pytest.param(
         MosquittoBroker,
         id="mosquitto",
-        marks=pytest.mark.skipif(not mosquitto_available(), reason="mosquitto is not installed"),
+        marks=pytest.mark.skipif(
+            not mosquitto_available() and os.environ.get("TRAJGEN_TEST_REQUIRE_MOSQUITTO") != "1",
+            reason="mosquitto is not installed",
+        ),
     ),
 ]
 #: Seconds a test waits for something the broker should do at once.
@@ -249,6 +254,25 @@ def test_a_taken_port_is_a_live_error_naming_it(broker_class, monkeypatch):
             broker.start()
     assert not broker.running
     assert not [thread for thread in threading.enumerate() if thread.name == THREAD_NAME]
+
+
+def test_a_missing_mosquitto_is_a_live_error_saying_so(monkeypatch):
+    monkeypatch.setattr(MosquittoBroker, "executable", staticmethod(lambda: None))
+    with pytest.raises(LiveError, match=r"mosquitto is not installed .*expected the mosquitto broker"):
+        MosquittoBroker().start()
+
+
+def test_mosquitto_is_found_in_sbin_when_the_path_lacks_it(monkeypatch, tmp_path):
+    fake = tmp_path / "mosquitto"
+    fake.write_text("#!/bin/sh\n", encoding="utf-8")
+    fake.chmod(0o755)
+    monkeypatch.setenv("PATH", "/nonexistent")
+    monkeypatch.setattr(broker_module, "MOSQUITTO_FOLDERS", (str(tmp_path),))
+    assert MosquittoBroker.executable() == str(fake)
+    assert mosquitto_available()
+    monkeypatch.setattr(broker_module, "MOSQUITTO_FOLDERS", ())
+    assert MosquittoBroker.executable() is None
+    assert not mosquitto_available()
 
 
 @pytest.mark.parametrize("port", [0, 65536, -1, 1883.0, "1883", True])

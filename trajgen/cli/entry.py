@@ -37,6 +37,42 @@ class LogFormatter(logging.Formatter):
         return text
 
 
+class StderrHandler(logging.StreamHandler):
+    """A log handler on whatever ``sys.stderr`` is when a record is written (not when it was made).
+
+    :func:`main` run twice in one process (tests, a host program redirecting ``sys.stderr``) logs to
+    the stream of the moment, as ``print(..., file=sys.stderr)`` does.
+    """
+
+    def __init__(self) -> None:
+        super().__init__()
+        self.setFormatter(LogFormatter())
+
+    @property
+    def stream(self):
+        return sys.stderr
+
+    @stream.setter
+    def stream(self, value) -> None:
+        pass
+
+
+def _log_to_stderr(level: int) -> None:
+    """Send log records of ``level`` and above to stderr as ``trajgen: <level>: ...`` lines.
+
+    One handler on the root logger, added next to any there already (a host's, pytest's): the
+    solvers' and libraries' records reach it too. Calling again only changes the level.
+    """
+    root = logging.getLogger()
+    handler = next((each for each in root.handlers if isinstance(each, StderrHandler)), None)
+    if handler is None:
+        handler = StderrHandler()
+        root.addHandler(handler)
+    handler.setLevel(level)
+    if root.getEffectiveLevel() > level:
+        root.setLevel(level)
+
+
 #: Every sub-command, in help order: its one-line help and the module whose ``register(commands)``
 #: adds its parser. A run imports only its own command's module: ``trajgen schedule`` loads no
 #: plotting, VDA 5050 or closed-loop code.
@@ -154,9 +190,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     try:
         argv = sys.argv[1:] if argv is None else list(argv)
         args = _build(_chosen(argv))[0].parse_args(argv)
-        handler = logging.StreamHandler()
-        handler.setFormatter(LogFormatter())
-        logging.basicConfig(level=logging.INFO if args.verbose else logging.WARNING, handlers=[handler])
+        _log_to_stderr(logging.INFO if args.verbose else logging.WARNING)
         return args.run(args)
     except InputError as error:
         print(f"trajgen: error: {error}", file=sys.stderr)

@@ -27,6 +27,7 @@ import asyncio
 import contextlib
 import errno
 import logging
+import os
 import shutil
 import socket
 import subprocess
@@ -68,9 +69,13 @@ _PORTS_GIVEN: set[int] = set()
 _PORTS_LOCK = threading.Lock()
 
 
+#: Debian's and Homebrew's folders of mosquitto, looked in after the ``PATH`` (which often lacks them).
+MOSQUITTO_FOLDERS = ("/usr/sbin", "/usr/local/sbin", "/opt/homebrew/sbin")
+
+
 def mosquitto_available() -> bool:
-    """Whether a ``mosquitto`` executable is on the ``PATH``."""
-    return shutil.which("mosquitto") is not None
+    """Whether a ``mosquitto`` executable is installed (see :meth:`MosquittoBroker.executable`)."""
+    return MosquittoBroker.executable() is not None
 
 
 def _free_port() -> int:
@@ -519,6 +524,11 @@ class MosquittoBroker(_Broker):
         self._folder: tempfile.TemporaryDirectory[str] | None = None
         self._finalizer: weakref.finalize | None = None
 
+    @staticmethod
+    def executable() -> str | None:
+        """The ``mosquitto`` executable: on the ``PATH``, else in :data:`MOSQUITTO_FOLDERS`; or ``None``."""
+        return shutil.which("mosquitto") or shutil.which("mosquitto", path=os.pathsep.join(MOSQUITTO_FOLDERS))
+
     @property
     def running(self) -> bool:
         """Whether the broker is started (and not stopped since), its process alive."""
@@ -542,9 +552,9 @@ class MosquittoBroker(_Broker):
             if self.running:
                 return self
             self.stop()  # a process that ended by itself
-            executable = shutil.which("mosquitto")
+            executable = self.executable()
             if executable is None:
-                raise LiveError("mosquitto is not installed (not on the PATH): expected the mosquitto broker")
+                raise LiveError("mosquitto is not installed (PATH, sbin): expected the mosquitto broker")
             deadline = time.monotonic() + START_TIMEOUT_S
             _wait_until_bindable(self._port, f"the {self.kind}")
             self._folder = tempfile.TemporaryDirectory(prefix="trajgen-mosquitto-")
@@ -577,10 +587,7 @@ class MosquittoBroker(_Broker):
         return " ".join(text.split())[-limit:]
 
     def stop(self) -> None:
-        """Terminate ``mosquitto`` (it closes every client connection) and wait for it to end.
-
-        Does nothing if the broker is not running.
-        """
+        """Terminate ``mosquitto`` (closing every client connection), wait for it to end; if running."""
         with self._lock:
             process, folder, finalizer = self._process, self._folder, self._finalizer
             self._process = self._folder = self._finalizer = None

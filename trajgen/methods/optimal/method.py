@@ -88,11 +88,7 @@ def _positive_int(value: object, name: str, minimum: int = 1) -> None:
 
 
 def class_copies(shapes: list[NlpShape]) -> list[NlpShape]:
-    """``shapes`` with a copy each where classes solved at once share a shape.
-
-    A compiled NLP runs one solve at a time, so a shape that two classes need gets a second
-    copy; a class whose shape no other class shares uses copy 0, which earlier solves built.
-    """
+    """``shapes``, a second copy (slot) where classes solved at once share one (one solve per NLP)."""
     return [dataclasses.replace(shape, slot=shapes[:k].count(shape)) for k, shape in enumerate(shapes)]
 
 
