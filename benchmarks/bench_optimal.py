@@ -12,7 +12,8 @@ The optimal method is timed three ways over the same scenarios, in this order:
 1. **cold**: an empty disk store (a new temporary folder) and an empty cache: every NLP shape is
    built (transcribed and differentiated) the first time a scenario needs it, then kept;
 2. **load**: a new, empty cache over the store that pass 1 filled: every shape is loaded from disk;
-3. **warm**: the cache of pass 2 again, every shape in memory: the solve time alone.
+3. **warm**: the cache of pass 2 again, every shape in memory, the solves it remembers forgotten
+   (:meth:`~trajgen.SolverCache.forget_solutions`): the solve time alone.
 
 Per scenario (pass 3): makespans of exact, toppra, optimal and the lower bound (larger of the two
 vehicles' own jerk-limited rest-to-rest times over their shortest paths), optimal/exact,
@@ -89,6 +90,7 @@ def main() -> None:
         warm_cache = SolverCache(maxsize=256, store=store)
         method = Optimal(nodes=args.nodes, braking_rule=args.braking, cache=warm_cache)
         loaded = _pass(cases, method, "load")
+        warm_cache.forget_solutions()  # else pass 3 repeats pass 2's solves from memory
         warm = _pass(cases, method, "warm")
         stored = sum(path.stat().st_size for path in store.files())
         built, load_times = _prepared(cold_cache, NlpOrigin.BUILT), _prepared(warm_cache, NlpOrigin.LOADED)

@@ -430,3 +430,26 @@ def test_a_time_limit_reached_after_the_first_pass_keeps_that_pass_and_says_so(m
     assert any(
         "the time limit (30 s, a safety stop) ended its refinement after pass 1" in n for n in schedule.notes
     )
+
+
+def test_forgotten_solutions_are_solved_again_to_the_same_schedule(monkeypatch):
+    calls = []
+    real_solver = CompiledNlp.solver
+
+    def counting(self, which, *, ipopt_wall_time):
+        calls.append(which)
+        return real_solver(self, which, ipopt_wall_time=ipopt_wall_time)
+
+    monkeypatch.setattr(CompiledNlp, "solver", counting)
+    method = Optimal(cache=SolverCache())
+    route = route_of(UNEQUAL, ("A:12", "B:8"), ("B:8", "A:12"))
+    first = method.schedule(route, LIMITS)
+    solved = len(calls)
+    method.cache.forget_solutions()
+    assert all(len(entry.solutions) == 0 for entry in method.cache.compiled())
+    assert len(method.cache.compiled()) > 0  # the NLPs stay
+    calls.clear()
+    again = method.schedule(route, LIMITS)
+    assert len(calls) == solved  # every pass solved again, none recalled
+    assert again.duration == first.duration
+    assert again.info.classes == first.info.classes

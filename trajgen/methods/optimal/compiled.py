@@ -340,6 +340,15 @@ class SolverCache:
         with self._lock:
             self._entries.clear()
 
+    def forget_solutions(self) -> None:
+        """Drop the solves each compiled NLP remembers (the NLPs stay): the next solves run the solvers.
+
+        For timing the solvers alone (``benchmarks/bench_optimal.py``'s warm pass).
+        """
+        for entry in self.compiled():
+            with entry.lock:
+                entry.solutions.clear()
+
     def _cached(self, shape: NlpShape) -> CompiledNlp | None:
         with self._lock:
             entry = self._entries.get(shape)

@@ -1,9 +1,10 @@
 """Compiled NLPs kept on disk across processes: built once per machine, loaded in a fraction of the time.
 
-Building the NLP of one shape (transcription and CasADi's derivatives) takes 0.25 s without the
-braking rule and about 1.2 s with it; its solver deserialized from a string takes 0.04 s and
-0.18 s. A :class:`NlpStore` keeps each shape's fatrop solver (CasADi's own serialization, zlib
-compressed) with the bounds and equality flags of its transcription, in one file per shape:
+Building the NLP of one shape (transcription and CasADi's derivatives) takes about 0.36 s without
+the braking rule and 1.6 s with it; loading it from this store (read, decompress, deserialize)
+0.14 s and 0.7 s (medians on a 2-core machine). A :class:`NlpStore` keeps each shape's fatrop
+solver (CasADi's own serialization, zlib compressed) with the bounds and equality flags of its
+transcription, in one file per shape:
 
 * the file name is a hash of everything the compiled function depends on: the shape, the solver
   options, this module's format version, the CasADi version and the machine; another CasADi
