@@ -584,7 +584,9 @@ def _failing_solve(*_arguments, **_options):
     return SolveResult(None, (SolverAttempt(Solver.FATROP, Outcome.NOT_CONVERGED, 1, "made to fail"),))
 
 
-def test_serve_with_no_broker_listening_exits_1_naming_the_url(tmp_path, capsys):
+def test_serve_with_no_broker_retries_says_so_once_and_commits_its_log_without_a_picture(tmp_path, capsys):
+    # issue 35, items 1 and 5: the first connection is retried until --timeout, said once; the log
+    # and the summary are committed, the picture (nothing to draw) skipped with a warning; exit 1
     status = main(
         [
             "serve",
@@ -593,13 +595,26 @@ def test_serve_with_no_broker_listening_exits_1_naming_the_url(tmp_path, capsys)
             "mqtt://127.0.0.1:1",
             "--method",
             "exact",
+            "--timeout",
+            "3",
             "--log",
             str(tmp_path / "run.jsonl"),
+            "--plot",
+            str(tmp_path / "run.png"),
         ]
     )
+    captured = capsys.readouterr()
     assert status == 1
-    assert "mqtt://127.0.0.1:1 cannot be reached" in capsys.readouterr().err
-    assert not (tmp_path / "run.jsonl").exists()
+    assert captured.err.count("cannot reach mqtt://127.0.0.1:1: connection refused; retrying") == 1
+    assert "trajgen: error: master: the broker mqtt://127.0.0.1:1 was never reached" in captured.err
+    assert "picture of the run" in captured.err
+    assert "is not drawn" in captured.err
+    assert "internal failure" not in captured.err
+    assert "live run: timed-out" in captured.out
+    records = [json.loads(line) for line in (tmp_path / "run.jsonl").read_text().splitlines()]
+    assert records[-1]["event"] == "end"
+    assert "never reached" in records[-1]["error"]
+    assert not (tmp_path / "run.png").exists()
 
 
 @pytest.mark.parametrize(

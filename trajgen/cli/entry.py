@@ -16,7 +16,7 @@ import sys
 from collections.abc import Sequence
 
 from trajgen.cli.parser import EXIT_BAD_INPUT, EXIT_FAILURE, CommandParser
-from trajgen.errors import InputError
+from trajgen.errors import InputError, LiveError
 
 __all__ = ["COMMANDS", "Commands", "LogFormatter", "build_parser", "command_parsers", "console_main", "main"]
 
@@ -195,6 +195,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     except InputError as error:
         print(f"trajgen: error: {error}", file=sys.stderr)
         return EXIT_BAD_INPUT
+    except LiveError as error:  # the environment (broker, network, certificates), not a bug
+        print(f"trajgen: error: {error}", file=sys.stderr)
+        return EXIT_FAILURE
     except Exception as error:
         logger.debug("internal failure", exc_info=True)
         print(f"trajgen: internal failure: {type(error).__name__}: {error}", file=sys.stderr)

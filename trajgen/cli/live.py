@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import logging
 import re
 import signal
 import sys
@@ -24,6 +25,8 @@ from trajgen.cli.parser import EXIT_FAILURE, EXIT_OK
 from trajgen.errors import InputError
 
 __all__ = ["live_demo", "register"]
+
+logger = logging.getLogger(__name__)
 
 _GOAL = re.compile(r"(?P<at>[^=]+)=(?P<first>[^,]+),(?P<second>.+)")
 
@@ -89,7 +92,11 @@ def _identities(args: argparse.Namespace, scenario):
 
 
 def _commit(log, log_path: str, plot_path: str | None, names) -> None:
-    """The run log and the picture, committed together."""
+    """The run log and the picture, committed together; a run too short to draw keeps its log.
+
+    A picture that cannot be drawn (no vehicle ever reported a state: the broker or the vehicles
+    were never reached) is skipped with a warning; the log is always written.
+    """
     from trajgen.export.atomic import commit_files
 
     contents = {Path(log_path): log.chunks()}
@@ -97,7 +104,10 @@ def _commit(log, log_path: str, plot_path: str | None, names) -> None:
         from trajgen.live.runlog import read_run_log
         from trajgen.plots.live_run import render_live_run
 
-        contents[Path(plot_path)] = render_live_run(read_run_log(log.records()), names=tuple(names))
+        try:
+            contents[Path(plot_path)] = render_live_run(read_run_log(log.records()), names=tuple(names))
+        except InputError as error:
+            logger.warning("the picture of the run %s is not drawn: %s", plot_path, error)
     commit_files(contents)
 
 
@@ -120,6 +130,9 @@ def _report(run, args: argparse.Namespace, *, closest: float | None = None) -> i
             + (f"; release latency {latency:.2f} ms median" if latency is not None else "")
             + (f"; closest approach {closest:.3f} m" if closest is not None else "")
         )
+    if summary.get("error"):
+        print(f"trajgen: error: {summary['error']}", file=sys.stderr)
+        return EXIT_FAILURE
     if summary["outcome"] != "goals-reached":
         print("trajgen: the live run did not reach both goals in time", file=sys.stderr)
         return EXIT_FAILURE
@@ -165,7 +178,15 @@ def _command_serve(args: argparse.Namespace) -> int:
     return _report(run, args)
 
 
+def _start(args: argparse.Namespace, scenario, v: int) -> Position:
+    """Where the vehicle stands when it starts: ``--start`` (a restart), else its scenario start."""
+    if args.start is None:
+        return (scenario.start.first, scenario.start.second)[v]
+    return scenario.track.check(Position.parse(args.start))
+
+
 def _command_vehicle(args: argparse.Namespace) -> int:
+    from trajgen.errors import LiveError
     from trajgen.live.clock import RunClock
     from trajgen.live.session import position_xy
     from trajgen.live.vehicle import SimulatedVehicle, StopFault
@@ -177,12 +198,15 @@ def _command_vehicle(args: argparse.Namespace) -> int:
         )
     v = scenario.names.index(args.name)
     faults = [StopFault.parse(text) for text in args.fault]
+    if args.timeout is not None and not args.timeout > 0.0:
+        raise InputError(f"vehicle --timeout {args.timeout!r} is not positive: expected run seconds > 0")
+    clock = RunClock(args.time_scale)
     vehicle = SimulatedVehicle(
         _identities(args, scenario)[v],
         scenario.limits.vehicles[v],
-        position_xy(scenario.track, (scenario.start.first, scenario.start.second)[v]),
+        position_xy(scenario.track, _start(args, scenario, v)),
         broker=_settings(args),
-        clock=RunClock(args.time_scale),
+        clock=clock,
         state_rate=args.state_rate,
         faults=faults,
         map_id=args.map_id,
@@ -191,17 +215,29 @@ def _command_vehicle(args: argparse.Namespace) -> int:
     for signum in (signal.SIGINT, signal.SIGTERM):
         signal.signal(signum, lambda *_: stopped.set())
     vehicle.start()
+    timed_out = False
     try:
         while not stopped.wait(0.1):
             if args.exit_at_goal and vehicle.snapshot.finished:
                 break
+            if vehicle.link.failed.is_set():
+                break
+            if args.timeout is not None and clock.now() >= args.timeout:
+                timed_out = True
+                break
     finally:
         vehicle.stop()
+    if vehicle.link.failure is not None:
+        raise LiveError(vehicle.link.failure)
     snapshot = vehicle.snapshot
     print(
         f"vehicle {args.name}: stopped at x={snapshot.x:.3f} m, y={snapshot.y:.3f} m after "
         f"{snapshot.time:.3f} s of the run ({'at its goal' if snapshot.finished else 'not at a goal'})"
     )
+    if timed_out and (args.exit_at_goal or not vehicle.link.ever_connected):
+        why = "never reached the broker" if not vehicle.link.ever_connected else "not at its goal"
+        print(f"trajgen: vehicle {args.name}: {why} within --timeout {args.timeout:g} s", file=sys.stderr)
+        return EXIT_FAILURE
     return EXIT_OK
 
 
@@ -297,5 +333,17 @@ def register(commands) -> None:
     )
     vehicle.add_argument(
         "--exit-at-goal", action="store_true", help="end once at the goal of an order (else: until Ctrl-C)"
+    )
+    vehicle.add_argument(
+        "--start",
+        metavar="LEG:S",
+        help="where it stands at start (a restart mid-run); default: its start in the scenario",
+    )
+    vehicle.add_argument(
+        "--timeout",
+        type=float,
+        metavar="S",
+        help="end after S s of the run (exit 1 if the broker was never reached or, with\n"
+        "--exit-at-goal, the goal not reached)",
     )
     vehicle.set_defaults(run=_command_vehicle)

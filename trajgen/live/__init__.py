@@ -16,6 +16,7 @@ from trajgen.lazy import lazy_attributes
 if TYPE_CHECKING:
     from trajgen.live.broker import EmbeddedBroker, MosquittoBroker, mosquitto_available
     from trajgen.live.clock import RunClock
+    from trajgen.live.link import BrokerLink, LinkState
     from trajgen.live.master import LiveMaster
     from trajgen.live.mqtt import BrokerSettings, VehicleIdentity
     from trajgen.live.outcome import LiveOutcome, LiveRun
@@ -24,9 +25,11 @@ if TYPE_CHECKING:
     from trajgen.live.vehicle import SimulatedVehicle, StopFault, VehicleSnapshot
 
 __all__ = [
+    "BrokerLink",
     "BrokerSettings",
     "DemoRun",
     "EmbeddedBroker",
+    "LinkState",
     "LiveDemo",
     "LiveMaster",
     "LiveOutcome",
@@ -46,10 +49,12 @@ __all__ = [
 ]
 
 _SOURCES = {
+    "BrokerLink": "trajgen.live.link",
     "BrokerSettings": "trajgen.live.mqtt",
     "DemoRun": "trajgen.live.session",
     "EmbeddedBroker": "trajgen.live.broker",
     "LiveDemo": "trajgen.live.session",
+    "LinkState": "trajgen.live.link",
     "LiveMaster": "trajgen.live.master",
     "LiveOutcome": "trajgen.live.outcome",
     "LiveRun": "trajgen.live.outcome",

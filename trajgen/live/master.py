@@ -34,13 +34,16 @@ from collections.abc import Sequence
 import numpy as np
 
 from topology import JUNCTION_INDEX, Configuration, Position
-from trajgen.errors import InputError, LiveError
+from trajgen.errors import InputError
 from trajgen.export.vda5050_messages import VDA5050_VERSION, node_id, order_elements
 from trajgen.export.vda5050_release import BaseRelease, plan_orders
 from trajgen.live.clock import RunClock
+from trajgen.live.geometry import track_position
+from trajgen.live.link import BrokerLink
 from trajgen.live.mqtt import BrokerSettings, Topic, VehicleIdentity, make_client
 from trajgen.live.outcome import LiveOutcome, LiveRun
 from trajgen.live.runlog import RunLog
+from trajgen.live.view import RESEND_INTERVAL_S, VehicleView
 from trajgen.methods import METHODS
 from trajgen.model.summary import provenance
 from trajgen.online.goals import goal_refusal, plan_from_rest
@@ -54,32 +57,12 @@ logger = logging.getLogger(__name__)
 NODE_DEVIATION = 1e-3
 #: Longest edge of the paths sent by default, metres.
 RELEASE_SPACING = 0.25
-#: Wall seconds between two re-sends of one vehicle's latest order while its state lags behind it.
-_RESEND_INTERVAL_S = 0.25
+#: Longest wait between two re-sends to a vehicle whose states show it lacks the latest order.
+_RESEND_MAX_S = 8.0
+#: The re-send interval at which an order not taken is reported (after three re-sends, about 2 s).
+_NOT_TAKEN_AFTER = 8 * RESEND_INTERVAL_S
 #: Slower than this (reported ``velocity``) a vehicle at its decision point stands, m/s.
 _AT_REST = 1e-6
-
-
-class _View:
-    """What the master knows of one vehicle."""
-
-    def __init__(self, name: str, identity: VehicleIdentity) -> None:
-        self.name = name
-        self.identity = identity
-        self.path = None  # OrderPath of the current plan
-        self.arcs: list[float] = []  # distance along the whole run at each node of the current path
-        self.offset = 0  # sequenceId of the current path's node 0
-        self.update = -1  # the latest orderUpdateId sent
-        self.message: bytes | None = None  # the latest order (update) sent
-        self.sent_at = -float("inf")  # wall time of the latest send
-        self.header = 0
-        self.state_header: int | None = None
-        self.node = 0  # last node reached (index on the current path)
-        self.driving = False
-        self.online: bool | None = None
-        self.errors: set[str] = set()
-        self.record: dict = {}
-        self.elements: list = []  # [(nodes, edges) in horizon, (nodes, edges) in base]
 
 
 class LiveMaster:
@@ -138,7 +121,7 @@ class LiveMaster:
         self.order_id = order_id
         self.map_id = map_id
         self.log = log if log is not None else RunLog()
-        self._views = [_View(self.names[v], identities[v]) for v in (0, 1)]
+        self._views = [VehicleView(self.names[v], identities[v]) for v in (0, 1)]
         self._topics = {}
         for v, identity in enumerate(identities):
             self._topics[identity.topic(Topic.STATE)] = (v, Topic.STATE)
@@ -154,12 +137,13 @@ class LiveMaster:
         self._end_time = 0.0
         self._adopt(verified, first=True)
         self._client = make_client(broker, f"trajgen-master-{identities[0].interface}-{id(self):x}")
-        self._client.on_connect = self._on_connect
         self._client.on_message = self._on_message
+        self.link = BrokerLink(self._client, broker, who="master", on_connected=self._connected)
 
     # ----------------------------------------------------------------- plans and orders
     def _adopt(self, verified: VerifiedSchedule, *, first: bool) -> None:
         """Take a new plan: paths, release rule, and (after a goal change) the stitch offsets."""
+        self._plan_goal = verified.schedule.route.goal
         plan = plan_orders(verified, spacing=self.spacing)
         rule = BaseRelease(plan.paths, verified.schedule.limits.min_separation)
         for v, view in enumerate(self._views):
@@ -248,25 +232,27 @@ class LiveMaster:
         view = self._views[v]
         order = self._order(v, first, decision_point)
         view.update += 1
-        view.message = order.to_json().encode()
+        view.order = order
+        view.resend_after = RESEND_INTERVAL_S
         view.record = {
             "update": view.update,
             "first": first,
             "decision_point": decision_point,
             "frontier_m": view.arcs[decision_point],
         }
-        self._publish(v, view.message, resent=False, record=view.record)
+        self._publish(v, order.to_json().encode(), resent=False, record=view.record)
 
     def _resend(self, v: int) -> None:
+        """The latest order (update) again, under a new headerId (VDA 5050: one per message)."""
         view = self._views[v]
-        if view.message is not None:
-            self._publish(v, view.message, resent=True, record=view.record)
+        if view.order is not None:
+            view.header += 1
+            header = {"header_id": view.header, "timestamp": self.clock.timestamp()}
+            again = view.order.model_copy(update=header)
+            self._publish(v, again.to_json().encode(), resent=True, record=view.record)
 
     # ----------------------------------------------------------------- MQTT
-    def _on_connect(self, client, userdata, flags, reason_code, properties) -> None:
-        if reason_code.is_failure:
-            logger.warning("master: broker refused the connection: %s", reason_code)
-            return
+    def _connected(self, client) -> None:
         for topic in self._topics:
             client.subscribe(topic, qos=1)
         with self._lock:
@@ -277,7 +263,6 @@ class LiveMaster:
             else:  # reconnected (the broker restarted): the latest orders again
                 for v in (0, 1):
                     self._resend(v)
-        logger.info("master: connected to %s", self.broker.url)
 
     def _ignore(self, topic: str, reason: str, vehicle: str | None = None) -> None:
         self._counts["ignored"] += 1
@@ -326,6 +311,7 @@ class LiveMaster:
         online = message.connection_state.value == "ONLINE"
         if online == view.online:
             return
+        back = view.online is False  # None: the first news (a retained message), after the first order
         view.online = online
         self.log.write(
             {
@@ -338,10 +324,40 @@ class LiveMaster:
         if online:
             logger.info("master: %s is online", view.name)
             view.state_header = None  # a vehicle that restarted counts its headers afresh
-            self._resend(v)
-            self._release()
+            view.rejoined = back  # its first state tells whether it kept its order
+        elif view.arcs and view.node == len(view.arcs) - 1:
+            logger.info("master: %s is %s at its goal", view.name, message.connection_state.value)
         else:
             logger.warning("master: %s is %s: no base is released", view.name, message.connection_state.value)
+
+    def _not_taken(self, view: VehicleView, state) -> None:
+        """Say that a vehicle still reports an older order than the one sent (three re-sends)."""
+        held = f"order {state.order_id!r} update {state.order_update_id}" if state.order_id else "no order"
+        why = "the broker may refuse the master's publishes (an ACL) or the vehicle its orders"
+        logger.warning(
+            "master: %s has not taken its order (it reports %s after 4 sends): %s", view.name, held, why
+        )
+        self.log.write(
+            {"t": self.clock.now(), "event": "order-not-taken", "vehicle": view.name, "reports": held}
+        )
+
+    def _report_errors(self, view: VehicleView, state) -> None:
+        """A vehicle's new errors (an order it refused, say), said at once and logged, each once."""
+        for error in state.errors:
+            if error.error_description not in view.errors:
+                view.errors.add(error.error_description)
+                logger.warning(
+                    "master: %s reports %s: %s", view.name, error.error_type, error.error_description
+                )
+                self.log.write(
+                    {
+                        "t": self.clock.now(),
+                        "event": "vehicle-error",
+                        "vehicle": view.name,
+                        "type": error.error_type,
+                        "description": error.error_description,
+                    }
+                )
 
     def _take_state(self, v: int, topic: str, payload: bytes, taken: float) -> None:
         from vda5050.model.state import State
@@ -353,13 +369,23 @@ class LiveMaster:
         if view.state_header is not None and state.header_id <= view.state_header:
             self._ignore(topic, f"headerId {state.header_id} is not after {view.state_header}", view.name)
             return
+        self._report_errors(view, state)
+        if view.rejoined:
+            view.rejoined = False
+            if not state.order_id and state.agv_position is not None:  # restarted: its order is gone
+                self._recover(v, state)
+                return
         expected = f"{self.order_id}-{view.name}"
         if state.order_id != expected or state.order_update_id < view.update:
             view.state_header = state.header_id
-            if time.monotonic() - view.sent_at >= _RESEND_INTERVAL_S:  # it lacks the latest order
+            if time.monotonic() - view.sent_at >= view.resend_after:  # it lacks the latest order
                 logger.debug("master: %s has not the latest order: sent again", view.name)
                 self._resend(v)
+                view.resend_after = min(2.0 * view.resend_after, _RESEND_MAX_S)
+                if view.resend_after == _NOT_TAKEN_AFTER:  # said once per order
+                    self._not_taken(view, state)
             return
+        view.resend_after = RESEND_INTERVAL_S
         j = (state.last_node_sequence_id - view.offset) // 2
         if not (
             0 <= j <= self._rule.released[v]
@@ -374,12 +400,6 @@ class LiveMaster:
             )
             return
         view.state_header = state.header_id
-        for error in state.errors:
-            if error.error_description not in view.errors:
-                view.errors.add(error.error_description)
-                logger.warning(
-                    "master: %s reports %s: %s", view.name, error.error_type, error.error_description
-                )
         view.node = max(view.node, j)
         view.driving = state.driving
         self.log.write(
@@ -448,20 +468,41 @@ class LiveMaster:
             logger.info("master: new goal %s: holding both vehicles at their bases", goal)
             self._maybe_replan()
 
+    def _recover(self, v: int, state) -> None:
+        """A vehicle back without its order (restarted): hold the other, re-plan from where both stand."""
+        view = self._views[v]
+        view.restart = track_position(self.graph, state.agv_position.x, state.agv_position.y)
+        view.driving = state.driving
+        if self._goal is None:
+            self._goal = self._plan_goal
+        self.log.write(
+            {"t": self.clock.now(), "event": "restart", "vehicle": view.name, "at": str(view.restart)}
+        )
+        logger.warning("master: %s is back without its order, at %s: re-planning", view.name, view.restart)
+        self._maybe_replan()
+
     def _maybe_replan(self) -> None:
         views = self._views
         if not all(
-            view.node == self._rule.released[v] and not view.driving and view.online is not False
+            (view.restart is not None or view.node == self._rule.released[v])
+            and not view.driving
+            and view.online is not False
             for v, view in enumerate(views)
         ):
             return
         here = [views[v].path.nodes[views[v].node] for v in (0, 1)]
         start = Configuration(
             *(
-                Position(None, 0.0) if n.leg == JUNCTION_INDEX else Position(self.graph.names[n.leg], n.s)
-                for n in here
+                views[v].restart
+                if views[v].restart is not None
+                else Position(None, 0.0)
+                if n.leg == JUNCTION_INDEX
+                else Position(self.graph.names[n.leg], n.s)
+                for v, n in enumerate(here)
             )
         )
+        for view in views:
+            view.restart = None
         goal, self._goal = self._goal, None
         verified = plan_from_rest(self.graph, self.limits, start, goal, method=self.method, margin=0.0)
         self._counts["replans"] += 1
@@ -483,11 +524,8 @@ class LiveMaster:
         Returns
         -------
         LiveRun
-
-        Raises
-        ------
-        LiveError
-            The broker could not be reached.
+            Outcome ``broker-failed`` with its ``error`` when the connection failed for good (a
+            refused login, an untrusted certificate); ``timed-out`` if the broker never answered.
         """
         self.start()
         try:
@@ -497,21 +535,17 @@ class LiveMaster:
         return self.result()
 
     def start(self) -> LiveMaster:
-        """Connect (in paho's thread); the orders go out once connected. Returns itself."""
-        try:
-            self._client.connect(self.broker.host, self.broker.port, keepalive=5)
-        except OSError as error:
-            raise LiveError(
-                f"broker {self.broker.url} cannot be reached ({error}): expected an MQTT broker "
-                "listening there"
-            ) from None
-        self._client.loop_start()
+        """Connect in the background (see :class:`~trajgen.live.BrokerLink`); returns itself at once.
+
+        The orders go out once connected; an unreachable broker is retried until :meth:`wait` ends.
+        """
+        self.link.start()
         return self
 
     def wait(self, *, timeout: float) -> bool:
         """Wait until both vehicles stand at their goals or ``timeout`` seconds of the run pass."""
         deadline = self.clock.now() + timeout
-        while not self._done.is_set():
+        while not self._done.is_set() and not self.link.failed.is_set():
             left = deadline - self.clock.now()
             if left <= 0.0:
                 return False
@@ -520,8 +554,14 @@ class LiveMaster:
 
     def stop(self) -> None:
         """Disconnect."""
-        self._client.disconnect()
-        self._client.loop_stop()
+        self.link.close()
+
+    def _failure(self, outcome: LiveOutcome) -> str | None:
+        if outcome is LiveOutcome.BROKER_FAILED:
+            return self.link.failure
+        if outcome is LiveOutcome.TIMED_OUT and not self.link.ever_connected:
+            return f"master: the broker {self.broker.url} was never reached (retried until the time limit)"
+        return None
 
     def result(self) -> LiveRun:
         """The run so far (see :class:`LiveRun`); logs its end."""
@@ -529,6 +569,8 @@ class LiveMaster:
             now = self.clock.now()
             began = self._started_at if self._started_at is not None else now
             outcome = LiveOutcome.GOALS_REACHED if self._done.is_set() else LiveOutcome.TIMED_OUT
+            if outcome is LiveOutcome.TIMED_OUT and self.link.failed.is_set():
+                outcome = LiveOutcome.BROKER_FAILED
             latency = np.array(self._latencies, dtype=float)
             latency.flags.writeable = False
             run = LiveRun(
@@ -541,6 +583,10 @@ class LiveMaster:
                 self._counts["replans"],
                 latency,
                 dict(self._provenance),
+                self._failure(outcome),
             )
-            self.log.write({"t": now, "event": "end", "outcome": outcome.value, "makespan_s": run.makespan})
+            end = {"t": now, "event": "end", "outcome": outcome.value, "makespan_s": run.makespan}
+            if run.error is not None:
+                end["error"] = run.error
+            self.log.write(end)
             return run

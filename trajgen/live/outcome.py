@@ -15,6 +15,7 @@ class LiveOutcome(enum.Enum):
 
     GOALS_REACHED = "goals-reached"  #: both vehicles stand at their goals
     TIMED_OUT = "timed-out"  #: the time limit passed first
+    BROKER_FAILED = "broker-failed"  #: the broker connection failed for good (see ``LiveRun.error``)
 
 
 @dataclass(frozen=True, slots=True)
@@ -44,6 +45,9 @@ class LiveRun:
         Which method was asked for the first plan and which computed it
         (:func:`~trajgen.model.summary.provenance`: ``method``, ``computed_by``,
         ``fallback_reason``, ``time_limit_reached``).
+    error : str or None
+        Why the run ended early, in one sentence (a refused login, an untrusted certificate);
+        ``None`` otherwise.
     """
 
     outcome: LiveOutcome
@@ -55,6 +59,7 @@ class LiveRun:
     replans: int
     release_latency: np.ndarray
     plan: dict = field(default_factory=dict)
+    error: str | None = None
 
     def summary(self) -> dict:
         """A JSON-ready summary."""
@@ -70,4 +75,5 @@ class LiveRun:
             "replans": self.replans,
             "releases": int(latency.size),
             "release_latency_median_ms": float(np.median(latency) * 1e3) if latency.size else None,
+            "error": self.error,
         }

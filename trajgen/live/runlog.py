@@ -11,8 +11,13 @@ Every line has ``t`` (seconds of the run) and ``event``:
   path, ``driving``);
 - ``ignored``: a message was logged and ignored (``topic``, ``reason``);
 - ``connection``: a vehicle's connection state changed (``vehicle``, ``state``);
+- ``vehicle-error``: a vehicle reported a new error (``vehicle``, ``type``, ``description``: an order
+  it refused, say); ``order-not-taken``: a vehicle still reports an older order after four sends
+  (``vehicle``, ``reports``);
+- ``restart``: a vehicle came back without its order (``vehicle``, ``at``: where it stands);
 - ``goal``: a new goal was asked for; ``replan``: both vehicles stood at their bases and were
-  re-planned; ``end``: the run ended (``outcome``, ``makespan_s``).
+  re-planned; ``end``: the run ended (``outcome``, ``makespan_s``, and ``error`` when the broker
+  connection failed for good or was never made).
 
 The log grows with the run's length; it is kept on disk, not in memory, and
 :func:`read_run_log` thins the states it returns to a bounded number.

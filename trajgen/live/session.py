@@ -16,9 +16,10 @@ import threading
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
-from topology import Position, StarGraph
+from topology import StarGraph
 from trajgen.errors import InputError
 from trajgen.live.clock import RunClock
+from trajgen.live.geometry import position_xy, track_position
 from trajgen.live.master import RELEASE_SPACING, LiveMaster, LiveRun
 from trajgen.live.mqtt import DEFAULT_INTERFACE, DEFAULT_VERSION, BrokerSettings, VehicleIdentity
 from trajgen.live.runlog import RunLog
@@ -73,26 +74,6 @@ def identities(
     if len(serials) != 2 or serials[0] == serials[1]:
         raise InputError(f"serial numbers {serials!r}: expected two different ones, one per vehicle")
     return tuple(VehicleIdentity(manufacturer, serial, interface, version) for serial in serials)
-
-
-def position_xy(graph: StarGraph, position: Position) -> tuple[float, float]:
-    """Map x/y of a track position, metres (leg drawn at its angle from the junction at 0, 0)."""
-    if position.leg is None or position.s == 0.0:
-        return (0.0, 0.0)
-    angle = math.radians(graph.angles_deg[graph.index(position.leg)])
-    return (position.s * math.cos(angle), position.s * math.sin(angle))
-
-
-def track_position(graph: StarGraph, x: float, y: float) -> Position:
-    """The track position at map x/y (the nearest leg by angle; at the junction within 1 µm)."""
-    s = math.hypot(x, y)
-    if s < 1e-6:
-        return Position(None, 0.0)
-    angle = math.degrees(math.atan2(y, x))
-    leg = min(
-        range(len(graph.names)), key=lambda k: abs((graph.angles_deg[k] - angle + 180.0) % 360.0 - 180.0)
-    )
-    return Position(graph.names[leg], min(s, graph.lengths[leg]))
 
 
 @dataclass(frozen=True, slots=True)

@@ -30,6 +30,7 @@ from limits import VehicleLimits
 from topology.validation import short_repr
 from trajgen.errors import InputError
 from trajgen.live.clock import RunClock
+from trajgen.live.link import BrokerLink
 from trajgen.live.mqtt import BrokerSettings, Topic, VehicleIdentity, make_client
 
 __all__ = ["SimulatedVehicle", "StopFault", "VehicleSnapshot"]
@@ -255,8 +256,10 @@ class SimulatedVehicle:
             f"trajgen-vehicle-{identity.manufacturer}-{identity.serial_number}",
             will=(identity.topic(Topic.CONNECTION), self._connection_message("CONNECTIONBROKEN")),
         )
-        self._client.on_connect = self._on_connect
         self._client.on_message = self._on_message
+        self.link = BrokerLink(
+            self._client, broker, who=f"vehicle {identity.serial_number}", on_connected=self._connected
+        )
         self._broker = broker
         self.rejections = 0
 
@@ -275,18 +278,12 @@ class SimulatedVehicle:
         )
         return message.to_json().encode()
 
-    def _on_connect(self, client, userdata, flags, reason_code, properties) -> None:
-        if reason_code.is_failure:
-            logger.warning(
-                "vehicle %s: broker refused the connection: %s", self.identity.serial_number, reason_code
-            )
-            return
+    def _connected(self, client) -> None:
         client.subscribe(self.identity.topic(Topic.ORDER), qos=0)
         client.publish(
             self.identity.topic(Topic.CONNECTION), self._connection_message("ONLINE"), qos=1, retain=True
         )
         self._event = True  # a state at once: the master learns where the vehicle is
-        logger.info("vehicle %s: connected to %s", self.identity.serial_number, self._broker.url)
 
     def _on_message(self, client, userdata, message) -> None:
         if message.topic != self.identity.topic(Topic.ORDER):  # amqtt may replay others' retained messages
@@ -296,8 +293,7 @@ class SimulatedVehicle:
 
     def start(self) -> SimulatedVehicle:
         """Connect and start driving (in threads of its own); returns itself."""
-        self._client.connect_async(self._broker.host, self._broker.port, keepalive=5)
-        self._client.loop_start()
+        self.link.start()
         self._thread = threading.Thread(
             target=self._run, name=f"trajgen-vehicle-{self.identity.serial_number}", daemon=True
         )
@@ -316,8 +312,7 @@ class SimulatedVehicle:
                 self.identity.topic(Topic.CONNECTION), self._connection_message("OFFLINE"), qos=1, retain=True
             )
             info.wait_for_publish(1.0)
-        self._client.disconnect()
-        self._client.loop_stop()
+        self.link.close()
 
     def drop_connection(self) -> None:
         """Lose the broker without a word (the broker sends the last will); it keeps driving its base."""
@@ -558,7 +553,7 @@ class SimulatedVehicle:
         return state.to_json().encode()
 
     def _publish_state(self) -> None:
-        if not self._client.is_connected():  # offline: the next state after reconnecting tells all
+        if not (self.link.connected and self._client.is_connected()):  # offline, or not yet ONLINE
             return
         self._client.publish(self.identity.topic(Topic.STATE), self._state_message(), qos=0)
         self._event = False

@@ -153,6 +153,12 @@ def store_description(shape: NlpShape) -> str:
     return repr((dataclasses.replace(shape, slot=0), sorted(fatrop_options(shape, ())["fatrop"].items())))
 
 
+#: Held while CasADi builds, loads or serializes a function: its symbolic objects are reference
+#: counted without atomics, and two threads building at once crashed (a segmentation fault in
+#: nlpsol, seen in CI). Solves, which only evaluate, run in parallel.
+CONSTRUCTION_LOCK = threading.RLock()
+
+
 class CompiledNlp:
     """The NLP of one shape with its solvers; fatrop at once, the Ipopt backups on first need.
 
@@ -204,7 +210,7 @@ class CompiledNlp:
         self.abandoned = False
         #: converged solves by :func:`~.solve.problem_key` (use with the lock held)
         self.solutions = RecentlyUsed(SOLUTIONS_REMEMBERED)
-        with casadi_output():
+        with CONSTRUCTION_LOCK, casadi_output():
             if stored is None:
                 self._transcription: Transcription | None = transcribe(shape)
                 self.bounds = self._transcription.bounds
@@ -229,13 +235,14 @@ class CompiledNlp:
     def transcription(self) -> Transcription:
         """The symbolic NLP (built now if this one was loaded: only the Ipopt backups need it)."""
         if self._transcription is None:
-            with casadi_output():
+            with CONSTRUCTION_LOCK, casadi_output():
                 self._transcription = transcribe(self.shape)
         return self._transcription
 
     def serialization(self) -> str:
         """The fatrop solver, CasADi-serialized (what the disk store keeps)."""
-        return self._solvers[Solver.FATROP].serialize()
+        with CONSTRUCTION_LOCK:
+            return self._solvers[Solver.FATROP].serialize()
 
     def solver(self, which: Solver, *, ipopt_wall_time: float):
         """The CasADi solver ``which``, built on first use (call with the lock held).
@@ -245,7 +252,7 @@ class CompiledNlp:
         """
         key = which if which is Solver.FATROP else (which, ipopt_wall_time)
         if key not in self._solvers:
-            with casadi_output():
+            with CONSTRUCTION_LOCK, casadi_output():
                 self._solvers[key] = self._ipopt(warm=which is Solver.IPOPT_POLISH, wall_time=ipopt_wall_time)
         return self._solvers[key]
 

@@ -1,0 +1,97 @@
+"""The watched broker connection of the master and the vehicles (issue 35, items 2 and 5).
+
+Closed-form expectations on real brokers: one line per change of the connection's state, never one
+per retry; the first connection retried until the broker is there, whatever was started first.
+"""
+
+from __future__ import annotations
+
+import logging
+import time
+
+import pytest
+
+from tests.helpers import execution_plan
+from trajgen.live.broker import EmbeddedBroker, MosquittoBroker, mosquitto_available
+from trajgen.live.link import RETRY_MAX_S, BrokerLink, LinkState
+from trajgen.live.mqtt import BrokerSettings, make_client
+from trajgen.live.outcome import LiveOutcome
+from trajgen.live.session import LiveDemo
+
+#: The issue's longest gap between two starts, wall seconds.
+GAP_S = 15.0
+
+
+def _broker():
+    """Mosquitto where it is installed, else amqtt in this process; not started."""
+    return MosquittoBroker() if mosquitto_available() else EmbeddedBroker()
+
+
+def _messages(caplog, text: str) -> list[str]:
+    return [
+        r.getMessage() for r in caplog.records if r.name == "trajgen.live.link" and text in r.getMessage()
+    ]
+
+
+def _until(condition, seconds: float) -> bool:
+    deadline = time.monotonic() + seconds
+    while time.monotonic() < deadline:
+        if condition():
+            return True
+        time.sleep(0.02)
+    return condition()
+
+
+def test_each_change_of_the_connection_is_said_once_and_retries_are_not(caplog):
+    caplog.set_level(logging.INFO, logger="trajgen.live.link")
+    broker = _broker()  # its port is chosen, nothing listens yet
+    settings = BrokerSettings.from_url(broker.url)
+    link = BrokerLink(make_client(settings, "trajgen-test-link"), settings, who="vehicle probe").start()
+    try:
+        assert _until(lambda: link.state is LinkState.UNREACHABLE, 5.0)
+        time.sleep(3.0)  # several retries (0.5, 1, 2 s apart)
+        assert len(_messages(caplog, "cannot reach")) == 1
+        assert (
+            f"cannot reach {broker.url}: connection refused; retrying" in _messages(caplog, "cannot reach")[0]
+        )
+        broker.start()
+        assert _until(lambda: link.connected, RETRY_MAX_S + 2.0)
+        connected = [
+            r for r in caplog.records if r.getMessage() == f"vehicle probe: connected to {broker.url}"
+        ]
+        assert len(connected) == 1
+        assert connected[0].levelno == logging.WARNING  # said loudly: it follows a problem
+        broker.restart(down_for=1.0)
+        assert _until(lambda: bool(_messages(caplog, "connected again")), 10.0)
+        assert len(_messages(caplog, "lost the broker")) == 1
+        assert len(_messages(caplog, "connected again")) == 1
+        assert link.failure is None
+    finally:
+        link.close()
+        broker.stop()
+    assert link.state is LinkState.CLOSED
+
+
+@pytest.mark.parametrize("method", ["exact"])
+def test_vehicles_then_the_master_then_the_broker_with_long_gaps_complete_the_run(method, caplog):
+    caplog.set_level(logging.WARNING, logger="trajgen.live.link")
+    scenario, verified = execution_plan("swap", method)
+    broker = _broker()
+    scale = 25.0
+    demo = LiveDemo(
+        scenario, verified, method=method, time_scale=scale, broker_url=broker.url, state_rate=2.0
+    )
+    demo.__enter__()  # the vehicles start: no broker yet
+    try:
+        time.sleep(GAP_S)  # the vehicles keep trying, said once each
+        assert len(_messages(caplog, "cannot reach")) == 2
+        outcome = demo.run(
+            at=[(5.0 * scale, lambda _demo: broker.start())]
+        )  # the broker 5 s after the master
+    finally:
+        demo.__exit__()
+        broker.stop()
+    assert outcome.run.outcome is LiveOutcome.GOALS_REACHED
+    assert outcome.run.error is None
+    assert outcome.closest >= scenario.limits.min_separation
+    assert len(_messages(caplog, "cannot reach")) == 3  # both vehicles and the master, once each
