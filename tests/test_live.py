@@ -610,7 +610,7 @@ def test_serve_with_no_broker_retries_says_so_once_and_commits_its_log_without_a
     assert "picture of the run" in captured.err
     assert "is not drawn" in captured.err
     assert "internal failure" not in captured.err
-    assert "live run: timed-out" in captured.out
+    assert "live run: timed-out before any order was sent" in captured.out
     records = [json.loads(line) for line in (tmp_path / "run.jsonl").read_text().splitlines()]
     assert records[-1]["event"] == "end"
     assert "never reached" in records[-1]["error"]

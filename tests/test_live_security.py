@@ -164,6 +164,7 @@ def test_a_connection_that_cannot_work_ends_in_seconds_with_a_plain_error(
     err = capsys.readouterr().err
     assert status == 1, err
     assert seconds < PLAIN_WITHIN_S, f"{seconds:.1f} s"
+    print(f"{case}, {command}: exit 1 in {seconds:.2f} s: {err.strip().splitlines()[-1]}")
     assert expected in err, err
     assert "trajgen: error: " in err
     assert "internal failure" not in err

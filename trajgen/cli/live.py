@@ -121,8 +121,13 @@ def _report(run, args: argparse.Namespace, *, closest: float | None = None) -> i
         print(json.dumps(summary, indent=2))
     else:
         latency = summary["release_latency_median_ms"]
+        took = (
+            f"in {summary['makespan_s']:.3f} s of the run"
+            if summary["orders"]
+            else "before any order was sent"
+        )
         print(
-            f"live run: {summary['outcome']} in {summary['makespan_s']:.3f} s of the run "
+            f"live run: {summary['outcome']} {took} "
             f"(plan {summary['planned_s']:.3f} s, {format_provenance(summary)}); "
             f"{summary['orders']} orders and updates "
             f"({summary['resent']} sent again), {summary['ignored']} messages ignored, "
@@ -150,8 +155,8 @@ def _command_serve(args: argparse.Namespace) -> int:
     check_output_paths([args.log] + ([args.plot] if args.plot else []))
     settings = _settings(args)
     ids = _identities(args, scenario)
-    clock = RunClock(args.time_scale)
     verified = live_plan(scenario, method=method_from(args))
+    clock = RunClock(args.time_scale)  # the run's time (and --timeout) starts after planning
     master = LiveMaster(
         verified,
         scenario.names,
@@ -309,7 +314,9 @@ def register(commands) -> None:
         help="at T s of the run, new goals for both vehicles (repeatable): both stop at\n"
         "their released base, then are re-planned from there",
     )
-    serve.add_argument("--timeout", type=float, help="seconds of the run before giving up (4x plan + 60)")
+    serve.add_argument(
+        "--timeout", type=float, help="seconds of the run, after planning, before giving up (4x plan + 60)"
+    )
     serve.add_argument("--log", default="trajgen-live.jsonl", help="JSON-lines run log (trajgen-live.jsonl)")
     serve.add_argument("--plot", metavar="FILE", help="PNG picture of the run: progress, releases, events")
     serve.add_argument("--json", action="store_true", help="print a machine-readable summary")

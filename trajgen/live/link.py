@@ -85,6 +85,8 @@ class BrokerLink:
         self._closing = threading.Event()
         self._answered = threading.Event()  # a CONNACK (either way) or a close came for this attempt
         self._connections = 0
+        self._pumping = False  # the first connection's loop runs in the link's thread
+        self._accepted = False  # the CONNACK of the connection being pumped accepted it
         self._thread: threading.Thread | None = None
         client.on_connect = self._on_connect
         client.on_disconnect = self._on_disconnect
@@ -171,12 +173,22 @@ class BrokerLink:
                 return
 
     def _pump_until_answered(self) -> bool:
-        """Run the client's loop here until the CONNACK; hand over to paho's thread once accepted."""
+        """Run the client's loop here until the CONNACK; hand over to paho's thread once accepted.
+
+        The link says it is connected only after the hand-over: while this thread runs the loop, a
+        publish from another thread would write to the socket beside it (paho writes at once when
+        no loop thread runs), and interleaved packets make the broker drop the connection.
+        """
         deadline = time.monotonic() + CONNACK_TIMEOUT_S
-        while not self._answered.is_set() and time.monotonic() < deadline and not self._closing.is_set():
-            self.client.loop(timeout=0.05)
-        if self.connected:
+        self._pumping, self._accepted = True, False
+        try:
+            while not self._answered.is_set() and time.monotonic() < deadline and not self._closing.is_set():
+                self.client.loop(timeout=0.05)
+        finally:
+            self._pumping = False
+        if self._accepted:
             self.client.loop_start()  # paho's thread from here: keep-alive and reconnection
+            self._now_connected()
             return True
         if not self._answered.is_set():  # no CONNACK in time: as unanswered as a close
             self.client.disconnect()
@@ -193,9 +205,15 @@ class BrokerLink:
             client.disconnect()
             return
         self._connections += 1
-        again = self._connections > 1
         if self._on_connected is not None:  # first: the owner's hello goes out before anything else
             self._on_connected(client)
+        if self._pumping:
+            self._accepted = True  # connected once paho's thread has the loop (_pump_until_answered)
+            return
+        self._now_connected()
+
+    def _now_connected(self) -> None:
+        again = self._connections > 1
         before = self._change(LinkState.CONNECTED)
         level = logging.WARNING if before in (LinkState.UNREACHABLE, LinkState.LOST) else logging.INFO
         logger.log(level, "%s: connected%s to %s", self.who, " again" if again else "", self.settings.url)

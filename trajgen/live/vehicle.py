@@ -305,7 +305,7 @@ class SimulatedVehicle:
         self._halt.set()
         if self._thread is not None:
             self._thread.join(5.0)
-        if self._client.is_connected():
+        if self.link.connected and self._client.is_connected():
             # its last state first: whatever it did since the last one reaches the master
             self._client.publish(self.identity.topic(Topic.STATE), self._state_message(), qos=0)
             info = self._client.publish(
@@ -555,7 +555,10 @@ class SimulatedVehicle:
     def _publish_state(self) -> None:
         if not (self.link.connected and self._client.is_connected()):  # offline, or not yet ONLINE
             return
-        self._client.publish(self.identity.topic(Topic.STATE), self._state_message(), qos=0)
+        try:
+            self._client.publish(self.identity.topic(Topic.STATE), self._state_message(), qos=0)
+        except OSError as error:  # the connection broke under it: the link notices and reconnects
+            logger.debug("vehicle %s: state not sent: %s", self.identity.serial_number, error)
         self._event = False
         self._next_state = self._t + 1.0 / self.state_rate
 
