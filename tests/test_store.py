@@ -186,3 +186,22 @@ def test_the_long_track_is_solved_in_its_units_within_its_bound_and_agrees_with_
     assert in_units.attempts[0].iterations < plain.attempts[0].iterations
     durations = [solution[6] for solution in (plain.solution, in_units.solution)]  # the first segment
     assert durations[1] == pytest.approx(durations[0], rel=1e-5)
+
+
+def test_an_nlp_busy_solving_is_not_serialized_and_the_store_keeps_nothing(tmp_path):
+    # serializing a function while it is being called crashed CasADi: the store waits for the
+    # solve to end, and gives up (saves nothing) if it does not
+    shape = Optimal().shape(route_of(*SWAP, separation=1.6))
+    compiled = CompiledNlp(shape)
+    store = NlpStore(tmp_path)
+    with compiled.lock:  # a solve under way (or abandoned)
+        assert compiled.serialization(wait=0.05) is None
+        store.save_later(
+            store_description(shape),
+            lambda: compiled.serialization(wait=0.05),
+            compiled.bounds,
+            compiled.equality,
+        )
+        assert store.flush(timeout=10.0)
+    assert store.load(store_description(shape)) is None
+    assert compiled.serialization(wait=0.05) is not None  # between solves it is

@@ -157,6 +157,8 @@ def store_description(shape: NlpShape) -> str:
 #: counted without atomics, and two threads building at once crashed (a segmentation fault in
 #: nlpsol, seen in CI). Solves, which only evaluate, run in parallel.
 CONSTRUCTION_LOCK = threading.RLock()
+#: Seconds a serialization for the disk store waits for the NLP's current solve to end.
+SERIALIZATION_WAIT_S = 60.0
 
 
 class CompiledNlp:
@@ -239,10 +241,20 @@ class CompiledNlp:
                 self._transcription = transcribe(self.shape)
         return self._transcription
 
-    def serialization(self) -> str:
-        """The fatrop solver, CasADi-serialized (what the disk store keeps)."""
-        with CONSTRUCTION_LOCK:
-            return self._solvers[Solver.FATROP].serialize()
+    def serialization(self, *, wait: float = SERIALIZATION_WAIT_S) -> str | None:
+        """The fatrop solver, CasADi-serialized (what the disk store keeps); ``None`` if it stays busy.
+
+        Taken between solves (with :attr:`lock`): serializing a function while it is being called
+        crashed CasADi (seen in CI). ``wait``: seconds to wait for a solve to end (an abandoned one
+        never does).
+        """
+        if not self._lock.acquire(timeout=wait):
+            return None
+        try:
+            with CONSTRUCTION_LOCK:
+                return self._solvers[Solver.FATROP].serialize()
+        finally:
+            self._lock.release()
 
     def solver(self, which: Solver, *, ipopt_wall_time: float):
         """The CasADi solver ``which``, built on first use (call with the lock held).

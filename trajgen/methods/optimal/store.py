@@ -149,13 +149,18 @@ class NlpStore:
     def save_later(self, description: str, serialize, bounds: dict, equality: tuple[bool, ...]) -> None:
         """Serialize and save in a background thread (CasADi releases the GIL while it serializes).
 
-        ``serialize`` returns the solver's serialization. A failure is logged, never raised: the
-        store only saves time. :meth:`flush` waits for the writes still under way.
+        ``serialize`` returns the solver's serialization, or ``None`` to save nothing. A failure is
+        logged, never raised: the store only saves time. :meth:`flush` waits for the writes still
+        under way.
         """
 
         def write() -> None:
             try:
-                self.save(description, StoredNlp(serialize(), bounds, equality))
+                solver = serialize()
+                if solver is None:  # the NLP stayed busy (a solve that never returned): not kept
+                    logger.debug("optimal: a compiled NLP was not kept: its solver stayed busy")
+                    return
+                self.save(description, StoredNlp(solver, bounds, equality))
             except Exception as error:  # a full disk or a read-only folder must not fail a schedule
                 logger.warning("optimal: could not keep the compiled NLP in %s: %s", self.directory, error)
 
