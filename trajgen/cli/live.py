@@ -336,7 +336,7 @@ def register(commands) -> None:
         action="append",
         default=[],
         metavar="stop@T+D",
-        help="stop at T s of the run for D s (repeatable)",
+        help="stop T s after its first order, for D s (repeatable)",
     )
     vehicle.add_argument(
         "--exit-at-goal", action="store_true", help="end once at the goal of an order (else: until Ctrl-C)"

@@ -16,13 +16,14 @@ from trajgen.lazy import lazy_attributes
 if TYPE_CHECKING:
     from trajgen.live.broker import EmbeddedBroker, MosquittoBroker, mosquitto_available
     from trajgen.live.clock import RunClock
+    from trajgen.live.faults import StopFault
     from trajgen.live.link import BrokerLink, LinkState
     from trajgen.live.master import LiveMaster
     from trajgen.live.mqtt import BrokerSettings, VehicleIdentity
     from trajgen.live.outcome import LiveOutcome, LiveRun
     from trajgen.live.runlog import RunLog, read_run_log
     from trajgen.live.session import DemoRun, LiveDemo, identities, live_plan, run_demo
-    from trajgen.live.vehicle import SimulatedVehicle, StopFault, VehicleSnapshot
+    from trajgen.live.vehicle import SimulatedVehicle, VehicleSnapshot
 
 __all__ = [
     "BrokerLink",
@@ -62,7 +63,7 @@ _SOURCES = {
     "RunClock": "trajgen.live.clock",
     "RunLog": "trajgen.live.runlog",
     "SimulatedVehicle": "trajgen.live.vehicle",
-    "StopFault": "trajgen.live.vehicle",
+    "StopFault": "trajgen.live.faults",
     "VehicleIdentity": "trajgen.live.mqtt",
     "VehicleSnapshot": "trajgen.live.vehicle",
     "identities": "trajgen.live.session",

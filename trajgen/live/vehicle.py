@@ -20,7 +20,6 @@ import itertools
 import logging
 import math
 import queue
-import re
 import threading
 import time
 from collections.abc import Callable, Sequence
@@ -30,6 +29,7 @@ from limits import VehicleLimits
 from topology.validation import short_repr
 from trajgen.errors import InputError
 from trajgen.live.clock import RunClock
+from trajgen.live.faults import StopFault
 from trajgen.live.link import BrokerLink
 from trajgen.live.mqtt import BrokerSettings, Topic, VehicleIdentity, make_client
 
@@ -47,43 +47,6 @@ _REVERSAL_COSINE = -0.999
 _BASE_REQUEST_DISTANCE = 2.0
 #: Wall seconds the drive loop sleeps between its catch-ups.
 _LOOP_SLEEP_S = 0.004
-_FAULT = re.compile(r"stop@(?P<at>[^+]+)\+(?P<duration>.+)")
-
-
-@dataclass(frozen=True, slots=True)
-class StopFault:
-    """The vehicle stops at ``at`` (seconds of the run) and stands ``duration`` seconds.
-
-    It brakes as hard as its limits allow, then goes on.
-    """
-
-    at: float
-    duration: float
-
-    @classmethod
-    def parse(cls, text: str) -> StopFault:
-        """Read ``stop@T+D`` (seconds).
-
-        Raises
-        ------
-        InputError
-            Not of that form, or T, D negative or not finite.
-        """
-        match = _FAULT.fullmatch(text.strip()) if isinstance(text, str) else None
-        try:
-            at, duration = (float(match["at"]), float(match["duration"])) if match else (math.nan, math.nan)
-        except ValueError:
-            at = duration = math.nan
-        if not (math.isfinite(at) and math.isfinite(duration) and at >= 0.0 and duration >= 0.0):
-            raise InputError(
-                f"vehicle fault {short_repr(text)} cannot be read: expected stop@T+D with T, D seconds >= 0 "
-                "(e.g. stop@12+3)"
-            )
-        return cls(at, duration)
-
-    def active(self, t: float) -> bool:
-        """Whether the vehicle is held at run time ``t``."""
-        return self.at <= t < self.at + self.duration
 
 
 @dataclass(frozen=True, slots=True)
@@ -224,6 +187,7 @@ class SimulatedVehicle:
         self.state_rate = float(state_rate)
         self.period = float(period)
         self.faults = tuple(faults)
+        self._first_order: float | None = None  # its time when it took its first order: faults count from it
         self.map_id = map_id
         self.record = record
         self.observer = observer
@@ -301,10 +265,13 @@ class SimulatedVehicle:
         return self
 
     def stop(self) -> None:
-        """Say OFFLINE, disconnect and stop driving."""
+        """Say OFFLINE, disconnect and stop driving (saying which faults never applied)."""
+        halted = self._halt.is_set()
         self._halt.set()
         if self._thread is not None:
             self._thread.join(5.0)
+        if not halted:
+            self._report_faults()
         if self.link.connected and self._client.is_connected():
             # its last state first: whatever it did since the last one reaches the master
             self._client.publish(self.identity.topic(Topic.STATE), self._state_message(), qos=0)
@@ -414,6 +381,8 @@ class SimulatedVehicle:
             return
         self._errors.clear()
         if result.decision is AcceptanceDecision.ACCEPT_NEW:
+            if self._first_order is None:
+                self._first_order = self._t
             self._path = _Path(list(order.nodes), list(order.edges))
             self._order = order
             self._last = 0
@@ -436,7 +405,26 @@ class SimulatedVehicle:
 
     # ----------------------------------------------------------------- driving
     def _held(self, t: float) -> bool:
-        return any(fault.active(t) for fault in self.faults)
+        began = self._first_order
+        return began is not None and any(fault.active(t - began) for fault in self.faults)
+
+    def _report_faults(self) -> None:
+        """Say which faults never applied: no order came, or the run ended before their time."""
+        began = self._first_order
+        for fault in self.faults:
+            if began is None or self._t - began < fault.at:
+                why = (
+                    "no order came"
+                    if began is None
+                    else f"it ended {self._t - began:.1f} s after its first order"
+                )
+                logger.warning(
+                    "vehicle %s: fault stop@%g+%g never applied (%s)",
+                    self.identity.serial_number,
+                    fault.at,
+                    fault.duration,
+                    why,
+                )
 
     def _next_stop(self) -> float:
         path = self._path
