@@ -124,7 +124,9 @@ def test_nlp_is_built_once_per_shape_and_reused():
     assert len(method.cache) == 2
 
 
-def test_a_problem_solved_before_is_answered_from_memory_and_another_is_solved(monkeypatch):
+@pytest.fixture
+def solver_calls(monkeypatch) -> list:
+    """Every solver a compiled NLP is asked for (``CompiledNlp.solver``), in order, as the solves run."""
     calls = []
     real_solver = CompiledNlp.solver
 
@@ -133,6 +135,11 @@ def test_a_problem_solved_before_is_answered_from_memory_and_another_is_solved(m
         return real_solver(self, which, ipopt_wall_time=ipopt_wall_time)
 
     monkeypatch.setattr(CompiledNlp, "solver", counting)
+    return calls
+
+
+def test_a_problem_solved_before_is_answered_from_memory_and_another_is_solved(solver_calls):
+    calls = solver_calls
     method = Optimal(cache=SolverCache())
     route = route_of(UNEQUAL, ("A:12", "B:8"), ("B:8", "A:12"))
     first = method.schedule(route, LIMITS)
@@ -432,15 +439,8 @@ def test_a_time_limit_reached_after_the_first_pass_keeps_that_pass_and_says_so(m
     )
 
 
-def test_forgotten_solutions_are_solved_again_to_the_same_schedule(monkeypatch):
-    calls = []
-    real_solver = CompiledNlp.solver
-
-    def counting(self, which, *, ipopt_wall_time):
-        calls.append(which)
-        return real_solver(self, which, ipopt_wall_time=ipopt_wall_time)
-
-    monkeypatch.setattr(CompiledNlp, "solver", counting)
+def test_forgotten_solutions_are_solved_again_to_the_same_schedule(solver_calls):
+    calls = solver_calls
     method = Optimal(cache=SolverCache())
     route = route_of(UNEQUAL, ("A:12", "B:8"), ("B:8", "A:12"))
     first = method.schedule(route, LIMITS)
