@@ -147,24 +147,17 @@ class BrokerLink:
                 return
             except (ConnectionResetError, ConnectionAbortedError, BrokenPipeError) as error:
                 # reached, then hung up on: a listener that cannot speak this client's language
-                unanswered += 1
                 logger.debug("%s: %s hung up: %s", self.who, self.settings.url, error)
-                if unanswered >= _UNANSWERED_LIMIT:
-                    self._fail(self._hung_up(unanswered))
-                    return
-                if self._closing.wait(delay):
-                    return
-                continue
             except OSError as error:
                 self._unreachable(_reason(error), delay)
                 if self._closing.wait(delay):
                     return
                 delay = min(2.0 * delay, RETRY_MAX_S)
                 continue
-            if self._pump_until_answered():
-                return
-            if self.failed.is_set() or self._closing.is_set():
-                return
+            else:
+                if self._pump_until_answered() or self.failed.is_set() or self._closing.is_set():
+                    return
+            # hung up on, or no CONNACK: unanswered
             unanswered += 1
             if unanswered >= _UNANSWERED_LIMIT:
                 self._fail(self._hung_up(unanswered))
