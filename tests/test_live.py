@@ -12,6 +12,7 @@ import contextlib
 import json
 import logging
 import math
+import re
 import subprocess
 import sys
 import threading
@@ -29,6 +30,7 @@ from trajgen.live.broker import EmbeddedBroker, MosquittoBroker, mosquitto_avail
 from trajgen.live.clock import LEAD, RunClock
 from trajgen.live.master import LiveMaster, LiveOutcome
 from trajgen.live.mqtt import BrokerSettings, Topic, VehicleIdentity, make_client
+from trajgen.live.orders import horizon_length
 from trajgen.live.session import ClosestApproach, LiveDemo, identities, position_xy
 from trajgen.live.vehicle import SimulatedVehicle, StopFault, VehicleSnapshot
 
@@ -128,6 +130,16 @@ def test_fault_free_runs_are_safe_schema_valid_and_close_to_their_plans(optimal_
             assert documents, (name, kind)
             for document in documents:
                 assert schema_errors(document, schema) == [], (name, kind, document.get("headerId"))
+        scenario = execution_plan(name, "optimal")[0]
+        for order in tap.of("order"):  # a short horizon: the vehicle's stop from full speed, a node at least
+            v = scenario.names.index(order["serialNumber"])
+            horizon = [edge["length"] for edge in order["edges"] if not edge["released"]]
+            last = order["nodes"][-1]["nodePosition"]
+            goal = (scenario.goal.first, scenario.goal.second)[v]
+            at_goal = math.dist((last["x"], last["y"]), position_xy(scenario.track, goal)) < 1e-6
+            assert horizon or at_goal, (name, order["headerId"])
+            if horizon:
+                assert sum(horizon) - horizon[-1] < horizon_length(scenario.limits.vehicles[v]), name
         updates = [d for d in tap.of("order") if d["orderUpdateId"] > 0]
         assert updates, name  # the base was released in steps
         for update in updates:  # stitched at the previous decision point: the first node is released
@@ -228,6 +240,20 @@ def test_a_new_goal_mid_run_stops_both_at_their_bases_and_replans_from_there():
 # -- the master alone, fed states by the test: what it takes and what it ignores ---------------------
 
 
+def connection_message(identity: VehicleIdentity, state: str) -> bytes:
+    """A vehicle's ``connection`` message saying ``state``."""
+    return json.dumps(
+        {
+            "headerId": 7,
+            "timestamp": "2026-11-26T10:00:00.000Z",
+            "version": "2.1.0",
+            "manufacturer": identity.manufacturer,
+            "serialNumber": identity.serial_number,
+            "connectionState": state,
+        }
+    ).encode()
+
+
 class FakeVehicles:
     """A client that publishes states for both vehicles and reads the orders the master sends."""
 
@@ -241,6 +267,10 @@ class FakeVehicles:
         settings = BrokerSettings.from_url(url)
         self._client.connect(settings.host, settings.port)
         self._client.loop_start()
+        for v in (0, 1):  # there, as a vehicle says (retained): the master sends its first orders
+            self._client.publish(
+                ids[v].topic(Topic.CONNECTION), connection_message(ids[v], "ONLINE"), qos=1, retain=True
+            ).wait_for_publish(2.0)
 
     def publish(self, v: int, payload: bytes, topic: str | None = None) -> None:
         self._client.publish(topic or self.ids[v].topic(Topic.STATE), payload).wait_for_publish(2.0)
@@ -282,13 +312,13 @@ def _last_base(order: dict) -> int:
 
 
 @contextlib.contextmanager
-def _master_and_fakes(scenario, verified):
+def _master_and_fakes(scenario, verified, **options):
     """The master on a broker with :class:`FakeVehicles` in place of the vehicles."""
     ids = identities(scenario.names)
     with _broker() as broker:
         fake = FakeVehicles(broker.url, ids)
         master = LiveMaster(
-            verified, scenario.names, identities=ids, broker=BrokerSettings.from_url(broker.url)
+            verified, scenario.names, identities=ids, broker=BrokerSettings.from_url(broker.url), **options
         )
         master.start()
         try:
@@ -458,6 +488,10 @@ def test_a_vehicle_reports_at_once_when_it_comes_to_rest_and_says_its_last_state
             f"{ids[0].topic(Topic.STATE)[:-5]}#",
             lambda m: heard.append((clock.now(), m.topic.rsplit("/", 1)[1], json.loads(m.payload))),
         )
+        # the other vehicle is there (it never drives): the master sends the first orders
+        watcher.publish(
+            ids[1].topic(Topic.CONNECTION), connection_message(ids[1], "ONLINE"), qos=1, retain=True
+        )
         # a state every 10 s of the run at most: any state sooner after stopping is the event's
         vehicle = _first_vehicle(scenario, ids, settings, clock, state_rate=0.1, observer=observe)
         master = LiveMaster(verified, scenario.names, identities=ids, broker=settings, clock=clock)
@@ -507,6 +541,7 @@ def test_serve_drives_two_vehicle_processes_and_commits_its_log_and_picture(tmp_
             )
             for name in ("agv1", "agv2")
         ]
+        time.sleep(2.0)
         try:
             status = main(
                 [
@@ -535,6 +570,21 @@ def test_serve_drives_two_vehicle_processes_and_commits_its_log_and_picture(tmp_
     assert records[-1]["event"] == "end"
     assert records[-1]["outcome"] == "goals-reached"
     assert (tmp_path / "run.png").read_bytes()[:4] == b"\x89PNG"
+    # one clock: the run's time starts at the first order, for the log, the makespan and the vehicles;
+    # planning and the wait for the broker are reported apart
+    plan = next(r for r in records if r["event"] == "plan")
+    assert plan["t"] == 0.0  # logged with the first orders, after the vehicles were heard
+    for wait in ("broker_wait_s", "vehicle_wait_s"):
+        assert plan[wait] == summary[wait] >= 0.0
+    assert summary["planning_s"] > 0.0
+    assert min(r["t"] for r in records) == 0.0
+    assert next(r for r in records if r["event"] == "order")["t"] < 1.0  # its message built at 25x
+    assert 0.0 <= records[-1]["t"] - summary["makespan_s"] < 2.0  # logged when the master stops
+    assert summary["makespan_s"] == pytest.approx(67.5, abs=10.0)  # the plan, give or take the releases
+    # the vehicles started 50 s of the run before the master: their time counts from the first order
+    # too (a vehicle's clock may lose time on a loaded machine, never gain it)
+    since = [float(re.search(r"([0-9.]+) s after its first order", out).group(1)) for out, _ in outputs]
+    assert 0.0 < min(since) <= max(since) <= summary["makespan_s"] + 3.0
 
 
 def test_demo_live_runs_broker_vehicles_and_master_in_one_command(tmp_path, capsys):
@@ -543,7 +593,7 @@ def test_demo_live_runs_broker_vehicles_and_master_in_one_command(tmp_path, caps
     out = capsys.readouterr().out
     assert status == 0
     assert "goals-reached" in out
-    assert "plan 67.500 s, exact)" in out  # the plan's method, in the summary line
+    assert "plan 67.500 s, exact; before the first order, planning took " in out  # said apart
     assert (tmp_path / "live-run.png").read_bytes()[:4] == b"\x89PNG"
     assert (tmp_path / "live-run.jsonl").stat().st_size > 0
 
@@ -737,6 +787,46 @@ def test_a_refused_order_is_reported_at_once_and_its_resends_back_off_with_new_h
     assert headers == sorted(set(headers)), headers  # one headerId per message, increasing
 
 
+def test_a_refusal_that_stands_ends_the_run_as_order_not_taken_naming_the_vehicle_and_its_reason():
+    scenario, verified = execution_plan("swap", "exact")
+    name = scenario.names[0]
+    with _master_and_fakes(scenario, verified, give_up_after=1.5) as (master, fake):
+        assert _until(lambda: len(_orders_of(fake, name)) >= 1, 5.0)
+        first = _orders_of(fake, name)[0]
+        error = {"errorType": "orderError", "errorLevel": "WARNING", "errorDescription": REFUSAL}
+        began = time.monotonic()
+        while not master.wait(timeout=0.1) and time.monotonic() - began < 10.0:
+            fake.publish(
+                0, fake.state(0, first, 0, orderId="", orderUpdateId=0, lastNodeId="", errors=[error])
+            )
+        ended = time.monotonic() - began
+        run = master.result()
+    assert run.outcome is LiveOutcome.ORDER_NOT_TAKEN
+    assert 1.5 <= ended < 4.0  # after the time given, not at the run's time limit
+    assert run.error.startswith(f"master: {name} has not taken its order in 1.5 s of re-sends")
+    assert f"it reports no order; orderError: {REFUSAL}" in run.error
+    end = list(master.log.records())[-1]
+    assert (end["event"], end["outcome"], end["error"]) == ("end", "order-not-taken", run.error)
+
+
+def test_a_vehicle_that_takes_its_order_late_is_not_given_up():
+    scenario, verified = execution_plan("swap", "exact")
+    with _master_and_fakes(scenario, verified, give_up_after=1.0) as (master, fake):
+        assert _until(lambda: len(_orders_of(fake, scenario.names[0])) >= 1, 5.0)
+        first = _orders_of(fake, scenario.names[0])[0]
+        for _ in range(8):  # 0.8 s without the order, then it has it: the wait starts again
+            fake.publish(0, fake.state(0, first, 0, orderId="", orderUpdateId=0, lastNodeId=""))
+            time.sleep(0.1)
+        for _ in range(8):
+            fake.publish(0, fake.state(0, first, 0))
+            time.sleep(0.1)
+        for _ in range(8):
+            fake.publish(0, fake.state(0, first, 0, orderId="", orderUpdateId=0, lastNodeId=""))
+            time.sleep(0.1)
+        assert not master.wait(timeout=0.1)
+        assert master.result().outcome is LiveOutcome.TIMED_OUT
+
+
 def test_a_retained_online_of_an_earlier_run_sends_no_second_order():
     scenario, verified = execution_plan("swap", "exact")
     ids = identities(scenario.names)
@@ -746,16 +836,9 @@ def test_a_retained_online_of_an_earlier_run_sends_no_second_order():
         earlier.connect(settings.host, settings.port)
         earlier.loop_start()
         for identity in ids:
-            online = {
-                "headerId": 7,
-                "timestamp": "2026-11-26T10:00:00.000Z",
-                "version": "2.1.0",
-                "manufacturer": identity.manufacturer,
-                "serialNumber": identity.serial_number,
-                "connectionState": "ONLINE",
-            }
+            online = connection_message(identity, "ONLINE")
             topic = identity.topic(Topic.CONNECTION)
-            earlier.publish(topic, json.dumps(online).encode(), qos=1, retain=True).wait_for_publish(2.0)
+            earlier.publish(topic, online, qos=1, retain=True).wait_for_publish(2.0)
         earlier.disconnect()
         earlier.loop_stop()
         fake = FakeVehicles(broker.url, ids)

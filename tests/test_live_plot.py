@@ -70,6 +70,23 @@ def test_render_live_run_leaves_the_run_unchanged():
     assert run == before
 
 
+def test_the_time_axis_is_the_runs_from_the_first_order_to_the_end(monkeypatch):
+    import trajgen.plots.live_run as live_run
+
+    drawn = []
+    monkeypatch.setattr(live_run, "png_bytes", lambda figure: drawn.append(figure) or PNG_SIGNATURE)
+    run = synthetic_run()
+    run["states"] = {
+        name: [(t + 2.0, along, driving) for t, along, driving in run["states"][name]] for name in NAMES
+    }
+    run["orders"] = {name: [(t + 2.0, frontier) for t, frontier in run["orders"][name]] for name in NAMES}
+    render_live_run(run, names=NAMES)  # nothing before 2 s of the run: the axis starts at 0 all the same
+    axis = drawn[0].axes[-1]
+    assert axis.get_xlim() == (0.0, 32.0)
+    assert axis.get_xlabel() == "time of the run since the first order, s"
+    assert any("makespan 29.80 s" in text.get_text() for text in drawn[0].texts)
+
+
 def test_render_live_run_takes_a_run_without_orders_events_or_end():
     run = synthetic_run()
     run.update(orders={}, events=[], end=None)

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import getpass
 import os
+import re
 import socket
 import subprocess
 import time
@@ -21,6 +22,7 @@ from trajgen.cli import main
 from trajgen.live.broker import MosquittoBroker, mosquitto_available
 from trajgen.live.clock import RunClock
 from trajgen.live.mqtt import BrokerSettings, VehicleIdentity
+from trajgen.live.outcome import LiveOutcome
 from trajgen.live.vehicle import SimulatedVehicle
 from trajgen.scenario import load_scenario
 
@@ -245,7 +247,9 @@ def test_an_acl_that_forbids_the_masters_orders_is_reported_within_seconds_namin
         ).start()
         for v in (0, 1)
     ]
-    master = LiveMaster(verified, scenario.names, identities=ids, broker=login("master"), clock=clock)
+    master = LiveMaster(
+        verified, scenario.names, identities=ids, broker=login("master"), clock=clock, give_up_after=6.0
+    )
     began = time.monotonic()
     master.start()
     try:
@@ -255,6 +259,8 @@ def test_an_acl_that_forbids_the_masters_orders_is_reported_within_seconds_namin
                 break
             time.sleep(0.05)
         seconds = time.monotonic() - began
+        ended = master.wait(timeout=30.0)  # nothing changes: the run ends with its status
+        run = master.result()
     finally:
         master.stop()
         for vehicle in vehicles:
@@ -264,3 +270,8 @@ def test_an_acl_that_forbids_the_masters_orders_is_reported_within_seconds_namin
     assert seconds < 5.0
     records = [r for r in master.log.records() if r["event"] == "order-not-taken"]
     assert all(r["reports"] == "no order" for r in records)
+    assert ended
+    assert run.outcome is LiveOutcome.ORDER_NOT_TAKEN
+    assert re.match(
+        r"master: agv[12] has not taken its order in 6 s of re-sends \(it reports no order\)", run.error
+    )

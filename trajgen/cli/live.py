@@ -16,6 +16,7 @@ import re
 import signal
 import sys
 import threading
+import time
 from pathlib import Path
 
 from topology import Configuration, Position
@@ -111,10 +112,11 @@ def _commit(log, log_path: str, plot_path: str | None, names) -> None:
     commit_files(contents)
 
 
-def _report(run, args: argparse.Namespace, *, closest: float | None = None) -> int:
+def _report(run, args: argparse.Namespace, *, planning: float, closest: float | None = None) -> int:
     from trajgen.model.summary import format_provenance
 
     summary = run.summary()
+    summary["planning_s"] = planning
     if closest is not None:
         summary["closest_m"] = closest
     if args.json:
@@ -126,9 +128,15 @@ def _report(run, args: argparse.Namespace, *, closest: float | None = None) -> i
             if summary["orders"]
             else "before any order was sent"
         )
+        before = f"planning took {planning:.2f} s" + "".join(
+            f", the {who} {summary[key]:.2f} s of the run"
+            for who, key in (("broker", "broker_wait_s"), ("vehicles", "vehicle_wait_s"))
+            if summary[key] is not None
+        )
         print(
             f"live run: {summary['outcome']} {took} "
-            f"(plan {summary['planned_s']:.3f} s, {format_provenance(summary)}); "
+            f"(plan {summary['planned_s']:.3f} s, {format_provenance(summary)}; before the first order, "
+            f"{before}); "
             f"{summary['orders']} orders and updates "
             f"({summary['resent']} sent again), {summary['ignored']} messages ignored, "
             f"{summary['replans']} re-plans"
@@ -155,7 +163,9 @@ def _command_serve(args: argparse.Namespace) -> int:
     check_output_paths([args.log] + ([args.plot] if args.plot else []))
     settings = _settings(args)
     ids = _identities(args, scenario)
+    began = time.perf_counter()
     verified = live_plan(scenario, method=method_from(args))
+    planning = time.perf_counter() - began  # reported, never used to decide
     clock = RunClock(args.time_scale)  # the run's time (and --timeout) starts after planning
     master = LiveMaster(
         verified,
@@ -180,7 +190,7 @@ def _command_serve(args: argparse.Namespace) -> int:
     run = master.result()
     _commit(master.log, args.log, args.plot, scenario.names)
     master.log.close()
-    return _report(run, args)
+    return _report(run, args, planning=planning)
 
 
 def _start(args: argparse.Namespace, scenario, v: int) -> Position:
@@ -235,9 +245,11 @@ def _command_vehicle(args: argparse.Namespace) -> int:
     if vehicle.link.failure is not None:
         raise LiveError(vehicle.link.failure)
     snapshot = vehicle.snapshot
+    run_time = vehicle.since_first_order
     print(
-        f"vehicle {args.name}: stopped at x={snapshot.x:.3f} m, y={snapshot.y:.3f} m after "
-        f"{snapshot.time:.3f} s of the run ({'at its goal' if snapshot.finished else 'not at a goal'})"
+        f"vehicle {args.name}: stopped at x={snapshot.x:.3f} m, y={snapshot.y:.3f} m "
+        + (f"{run_time:.3f} s after its first order" if run_time is not None else "without any order")
+        + f" ({'at its goal' if snapshot.finished else 'not at a goal'})"
     )
     if timed_out and (args.exit_at_goal or not vehicle.link.ever_connected):
         why = "never reached the broker" if not vehicle.link.ever_connected else "not at its goal"
@@ -278,6 +290,7 @@ def live_demo(
             f"Live demo: {scenario.source} over VDA 5050 on an MQTT broker in this process, "
             f"{time_scale:g}x real time ..."
         )
+    began = time.perf_counter()
     demo = LiveDemo(
         scenario,
         method=method,
@@ -285,11 +298,12 @@ def live_demo(
         state_rate=state_rate,
         log=RunLog(listener=None if json_summary else _show_progress),
     )
+    planning = time.perf_counter() - began  # reported, never used to decide
     with demo:
         demo = demo.run()
     _commit(demo.log, log_path, plot_path, scenario.names)
     demo.log.close()
-    status = _report(demo.run, argparse.Namespace(json=json_summary), closest=demo.closest)
+    status = _report(demo.run, argparse.Namespace(json=json_summary), planning=planning, closest=demo.closest)
     if not json_summary:
         print(f"Run log and picture: {log_path}, {plot_path}")
     return status

@@ -1,8 +1,10 @@
 """The live master: drives two VDA 5050 vehicles over MQTT, releasing base by the frontier.
 
-It sends each vehicle one order: its whole path, the base up to its current
-frontier (the last released node) and the rest as horizon. Then it follows the
-vehicles' states. When a vehicle reports a node reached, the release rule
+Once the broker and both vehicles are there, it sends each vehicle one order: its
+base up to its frontier (the last released node) and a short horizon past it
+(:mod:`trajgen.live.orders`). Then it follows the vehicles' states; a vehicle
+whose states keep showing it lacks its order ends the run (``ORDER_NOT_TAKEN``).
+When a vehicle reports a node reached, the release rule
 (:class:`~trajgen.export.vda5050_release.BaseRelease`) may let the base of
 either vehicle grow; each growth is an order update (same ``orderId``,
 ``orderUpdateId`` + 1, stitched at the previous decision point).
@@ -33,17 +35,28 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from topology import JUNCTION_INDEX, Configuration, Position
+from topology import Configuration
 from trajgen.errors import InputError
-from trajgen.export.vda5050_messages import VDA5050_VERSION, node_id, order_elements
+from trajgen.export.vda5050_messages import node_id
 from trajgen.export.vda5050_release import BaseRelease, plan_orders
 from trajgen.live.clock import RunClock
 from trajgen.live.geometry import track_position
 from trajgen.live.link import BrokerLink
 from trajgen.live.mqtt import BrokerSettings, Topic, VehicleIdentity, make_client
+from trajgen.live.orders import NODE_DEVIATION, horizon_length, order_message, path_elements
 from trajgen.live.outcome import LiveOutcome, LiveRun
 from trajgen.live.runlog import RunLog
-from trajgen.live.view import RESEND_INTERVAL_S, VehicleView
+from trajgen.live.view import (
+    GIVE_UP_AFTER_S,
+    NOT_TAKEN_AFTER,
+    NOT_TAKEN_WHY,
+    RESEND_INTERVAL_S,
+    RESEND_MAX_S,
+    VehicleView,
+    never_heard_message,
+    not_taken_message,
+    reported_order,
+)
 from trajgen.methods import METHODS
 from trajgen.model.summary import provenance
 from trajgen.online.goals import goal_refusal, plan_from_rest
@@ -53,16 +66,8 @@ __all__ = ["NODE_DEVIATION", "RELEASE_SPACING", "LiveMaster", "LiveOutcome", "Li
 
 logger = logging.getLogger(__name__)
 
-#: ``allowedDeviationXY`` of every node sent: how close a vehicle must be to count as on it, metres.
-NODE_DEVIATION = 1e-3
 #: Longest edge of the paths sent by default, metres.
 RELEASE_SPACING = 0.25
-#: Longest wait between two re-sends to a vehicle whose states show it lacks the latest order.
-_RESEND_MAX_S = 8.0
-#: The re-send interval at which an order not taken is reported (after three re-sends, about 2 s).
-_NOT_TAKEN_AFTER = 8 * RESEND_INTERVAL_S
-#: Slower than this (reported ``velocity``) a vehicle at its decision point stands, m/s.
-_AT_REST = 1e-6
 
 
 class LiveMaster:
@@ -105,6 +110,7 @@ class LiveMaster:
         map_id: str = "trajgen",
         log: RunLog | None = None,
         spacing: float = RELEASE_SPACING,
+        give_up_after: float = GIVE_UP_AFTER_S,
     ) -> None:
         verified = require_verified(verified, "LiveMaster")
         self.spacing = spacing
@@ -121,20 +127,27 @@ class LiveMaster:
         self.order_id = order_id
         self.map_id = map_id
         self.log = log if log is not None else RunLog()
+        self._horizons = [horizon_length(limits) for limits in self.limits.vehicles]
         self._views = [VehicleView(self.names[v], identities[v]) for v in (0, 1)]
-        self._topics = {}
-        for v, identity in enumerate(identities):
-            self._topics[identity.topic(Topic.STATE)] = (v, Topic.STATE)
-            self._topics[identity.topic(Topic.CONNECTION)] = (v, Topic.CONNECTION)
+        self._topics = {
+            identity.topic(kind): (v, kind)
+            for v, identity in enumerate(identities)
+            for kind in (Topic.STATE, Topic.CONNECTION)
+        }
         self._lock = threading.RLock()
         self._done = threading.Event()
         self._goal: Configuration | None = None
         self._rule: BaseRelease | None = None
-        self._started_at: float | None = None
+        self._started_at: float | None = None  # run clock at the first orders: the run's time 0
+        self._broker_at: float | None = None  # run clock at the first connection to the broker
+        self._began_at = 0.0  # run clock at start()
         self._latencies: list[float] = []
         self._counts = {"orders": 0, "resent": 0, "ignored": 0, "replans": 0}
         self._planned = 0.0
         self._end_time = 0.0
+        self._first_plan: dict | None = None
+        self.give_up_after = give_up_after
+        self._gave_up: str | None = None  # why the run ended before its goals (an order not taken)
         self._adopt(verified, first=True)
         self._client = make_client(broker, f"trajgen-master-{identities[0].interface}-{id(self):x}")
         self._client.on_message = self._on_message
@@ -157,66 +170,48 @@ class LiveMaster:
             for edge in view.path.edges:
                 view.arcs.append(view.arcs[-1] + edge.length)
             view.node = 0
-            self._elements(v)
+            view.elements = path_elements(self.graph, view, map_id=self.map_id)
         self._rule = rule
         if first:
             self._planned = plan.planned_duration
             self._provenance = provenance(verified.schedule, self._asked)
-        self.log.write(
-            {
-                "t": self.clock.now(),
-                "event": "plan",
-                **provenance(verified.schedule, self._asked),
-                "planned_s": plan.planned_duration,
-                "nodes": [len(p.nodes) for p in plan.paths],
-            }
-        )
+        record = {
+            "event": "plan",
+            **provenance(verified.schedule, self._asked),
+            "planned_s": plan.planned_duration,
+            "nodes": [len(p.nodes) for p in plan.paths],
+        }
+        if first:  # logged with the first order, where the run's time starts
+            self._first_plan = record
+        else:
+            self.log.write({"t": self._now(), **record})
 
-    def _elements(self, v: int) -> None:
-        """Each node and edge of vehicle ``v``'s path as a validated model, in base and in horizon."""
-        from vda5050.model.order import Edge, Node
+    def _now(self) -> float:
+        """Seconds of the run: since the first order was sent (0 before it)."""
+        return 0.0 if self._started_at is None else self.clock.now() - self._started_at
 
-        view = self._views[v]
-        last = len(view.path.nodes) - 1
-        forms = []
-        for released in (False, True):
-            nodes, edges = order_elements(
-                self.graph, view.path, first=0, decision_point=last if released else -1, map_id=self.map_id
-            )
-            for node in nodes:
-                node["sequenceId"] += view.offset
-                node["nodePosition"]["allowedDeviationXY"] = NODE_DEVIATION
-            for edge in edges:
-                edge["sequenceId"] += view.offset
-            forms.append(([Node.model_validate(n) for n in nodes], [Edge.model_validate(e) for e in edges]))
-        view.elements = forms
+    def _maybe_begin(self) -> None:
+        """The first orders, once the broker and both vehicles are there: the run's time starts."""
+        if self._started_at is not None or self._broker_at is None or not all(v.heard for v in self._views):
+            return
+        self._started_at = self.clock.now()
+        self._log_first_plan()
+        for v in (0, 1):
+            self._send(v, 0, self._rule.released[v])
 
-    def _order(self, v: int, first: int, decision_point: int):
-        """The order (update) of vehicle ``v`` from node ``first``, its base up to ``decision_point``."""
-        from vda5050.model.order import Order
+    def _waits(self) -> dict:
+        """Run seconds from the master's start to the broker, and from there to both vehicles heard."""
+        broker, began = self._broker_at, self._started_at
+        return {
+            "broker_wait_s": None if broker is None else broker - self._began_at,
+            "vehicle_wait_s": None if began is None or broker is None else began - broker,
+        }
 
-        view = self._views[v]
-        (horizon_nodes, horizon_edges), (base_nodes, base_edges) = view.elements
-        nodes = [
-            base_nodes[j] if j <= decision_point else horizon_nodes[j] for j in range(first, len(base_nodes))
-        ]
-        edges = [
-            base_edges[k] if k < decision_point else horizon_edges[k] for k in range(first, len(base_edges))
-        ]
-        view.header += 1
-        # its nodes and edges were validated once per plan (_elements), its header is this master's
-        order = Order.model_construct(
-            header_id=view.header,
-            timestamp=self.clock.timestamp(),
-            version=VDA5050_VERSION,
-            manufacturer=view.identity.manufacturer,
-            serial_number=view.identity.serial_number,
-            order_id=f"{self.order_id}-{view.name}",
-            order_update_id=view.update + 1,
-            nodes=nodes,
-            edges=edges,
-        )
-        return order
+    def _log_first_plan(self) -> None:
+        """The first plan's record, at the run's time 0, with the waits before it (once)."""
+        if self._first_plan is not None:
+            self.log.write({"t": 0.0, **self._first_plan, **self._waits()})
+            self._first_plan = None
 
     def _publish(self, v: int, payload: bytes, *, resent: bool, record: dict) -> None:
         view = self._views[v]
@@ -224,16 +219,22 @@ class LiveMaster:
         view.sent_at = time.monotonic()
         self._counts["orders"] += 1
         self._counts["resent"] += resent
-        self.log.write(
-            {"t": self.clock.now(), "event": "order", "vehicle": view.name, "resent": resent, **record}
-        )
+        self.log.write({"t": self._now(), "event": "order", "vehicle": view.name, "resent": resent, **record})
 
     def _send(self, v: int, first: int, decision_point: int) -> None:
         view = self._views[v]
-        order = self._order(v, first, decision_point)
+        order = order_message(
+            view,
+            first=first,
+            decision_point=decision_point,
+            horizon_m=self._horizons[v],
+            order_id=f"{self.order_id}-{view.name}",
+            timestamp=self.clock.timestamp(),
+        )
         view.update += 1
         view.order = order
         view.resend_after = RESEND_INTERVAL_S
+        view.lacking_since = None  # a new order: what the vehicle lacked is another
         view.record = {
             "update": view.update,
             "first": first,
@@ -257,9 +258,9 @@ class LiveMaster:
             client.subscribe(topic, qos=1)
         with self._lock:
             if self._started_at is None:
-                self._started_at = self.clock.now()
-                for v in (0, 1):
-                    self._send(v, 0, self._rule.released[v])
+                if self._broker_at is None:
+                    self._broker_at = self.clock.now()
+                self._maybe_begin()
             else:  # reconnected (the broker restarted): the latest orders again
                 for v in (0, 1):
                     self._resend(v)
@@ -268,7 +269,7 @@ class LiveMaster:
         self._counts["ignored"] += 1
         logger.warning("master: ignored a message on %s: %s", topic, reason)
         self.log.write(
-            {"t": self.clock.now(), "event": "ignored", "topic": topic, "vehicle": vehicle, "reason": reason}
+            {"t": self._now(), "event": "ignored", "topic": topic, "vehicle": vehicle, "reason": reason}
         )
 
     def _on_message(self, client, userdata, message) -> None:
@@ -315,7 +316,7 @@ class LiveMaster:
         view.online = online
         self.log.write(
             {
-                "t": self.clock.now(),
+                "t": self._now(),
                 "event": "connection",
                 "vehicle": view.name,
                 "state": message.connection_state.value,
@@ -324,7 +325,9 @@ class LiveMaster:
         if online:
             logger.info("master: %s is online", view.name)
             view.state_header = None  # a vehicle that restarted counts its headers afresh
-            view.rejoined = back  # its first state tells whether it kept its order
+            view.rejoined = back and self._started_at is not None  # its first state: kept its order?
+            view.heard = True
+            self._maybe_begin()
         elif view.arcs and view.node == len(view.arcs) - 1:
             logger.info("master: %s is %s at its goal", view.name, message.connection_state.value)
         else:
@@ -332,32 +335,26 @@ class LiveMaster:
 
     def _not_taken(self, view: VehicleView, state) -> None:
         """Say that a vehicle still reports an older order than the one sent (three re-sends)."""
-        held = f"order {state.order_id!r} update {state.order_update_id}" if state.order_id else "no order"
-        why = "the broker may refuse the master's publishes (an ACL) or the vehicle its orders"
+        held = reported_order(state)
         logger.warning(
-            "master: %s has not taken its order (it reports %s after 4 sends): %s", view.name, held, why
+            "master: %s has not taken its order (it reports %s after 4 sends): %s",
+            view.name,
+            held,
+            NOT_TAKEN_WHY,
         )
-        self.log.write(
-            {"t": self.clock.now(), "event": "order-not-taken", "vehicle": view.name, "reports": held}
-        )
+        self.log.write({"t": self._now(), "event": "order-not-taken", "vehicle": view.name, "reports": held})
 
     def _report_errors(self, view: VehicleView, state) -> None:
         """A vehicle's new errors (an order it refused, say), said at once and logged, each once."""
-        for error in state.errors:
-            if error.error_description not in view.errors:
-                view.errors.add(error.error_description)
-                logger.warning(
-                    "master: %s reports %s: %s", view.name, error.error_type, error.error_description
-                )
-                self.log.write(
-                    {
-                        "t": self.clock.now(),
-                        "event": "vehicle-error",
-                        "vehicle": view.name,
-                        "type": error.error_type,
-                        "description": error.error_description,
-                    }
-                )
+        for kind, description in view.new_errors(state):
+            logger.warning("master: %s reports %s: %s", view.name, kind, description)
+            record = {
+                "event": "vehicle-error",
+                "vehicle": view.name,
+                "type": kind,
+                "description": description,
+            }
+            self.log.write({"t": self._now(), **record})
 
     def _take_state(self, v: int, topic: str, payload: bytes, taken: float) -> None:
         from vda5050.model.state import State
@@ -366,6 +363,10 @@ class LiveMaster:
         if state is None:
             return
         view = self._views[v]
+        if self._started_at is None:  # it is there: the run begins once the other is too
+            view.heard = True
+            self._maybe_begin()
+            return
         if view.state_header is not None and state.header_id <= view.state_header:
             self._ignore(topic, f"headerId {state.header_id} is not after {view.state_header}", view.name)
             return
@@ -378,14 +379,22 @@ class LiveMaster:
         expected = f"{self.order_id}-{view.name}"
         if state.order_id != expected or state.order_update_id < view.update:
             view.state_header = state.header_id
+            if view.restart is not None:  # restarted: its new order comes with the re-plan
+                return
             if time.monotonic() - view.sent_at >= view.resend_after:  # it lacks the latest order
                 logger.debug("master: %s has not the latest order: sent again", view.name)
                 self._resend(v)
-                view.resend_after = min(2.0 * view.resend_after, _RESEND_MAX_S)
-                if view.resend_after == _NOT_TAKEN_AFTER:  # said once per order
+                view.resend_after = min(2.0 * view.resend_after, RESEND_MAX_S)
+                if view.resend_after == NOT_TAKEN_AFTER:  # said once per order
                     self._not_taken(view, state)
+            if view.lacking_since is None:
+                view.lacking_since = self.clock.now()
+            elif self.clock.now() - view.lacking_since >= self.give_up_after and self._gave_up is None:
+                self._gave_up = f"master: {view.name} {not_taken_message(state, self.give_up_after)}"
+                logger.error("%s", self._gave_up)
             return
         view.resend_after = RESEND_INTERVAL_S
+        view.lacking_since = None
         j = (state.last_node_sequence_id - view.offset) // 2
         if not (
             0 <= j <= self._rule.released[v]
@@ -404,7 +413,7 @@ class LiveMaster:
         view.driving = state.driving
         self.log.write(
             {
-                "t": self.clock.now(),
+                "t": self._now(),
                 "event": "state",
                 "vehicle": view.name,
                 "x": state.agv_position.x if state.agv_position else None,
@@ -464,7 +473,7 @@ class LiveMaster:
         with self._lock:
             self._goal = goal
             self._done.clear()
-            self.log.write({"t": self.clock.now(), "event": "goal", "goal": str(goal)})
+            self.log.write({"t": self._now(), "event": "goal", "goal": str(goal)})
             logger.info("master: new goal %s: holding both vehicles at their bases", goal)
             self._maybe_replan()
 
@@ -475,9 +484,7 @@ class LiveMaster:
         view.driving = state.driving
         if self._goal is None:
             self._goal = self._plan_goal
-        self.log.write(
-            {"t": self.clock.now(), "event": "restart", "vehicle": view.name, "at": str(view.restart)}
-        )
+        self.log.write({"t": self._now(), "event": "restart", "vehicle": view.name, "at": str(view.restart)})
         logger.warning("master: %s is back without its order, at %s: re-planning", view.name, view.restart)
         self._maybe_replan()
 
@@ -490,23 +497,13 @@ class LiveMaster:
             for v, view in enumerate(views)
         ):
             return
-        here = [views[v].path.nodes[views[v].node] for v in (0, 1)]
-        start = Configuration(
-            *(
-                views[v].restart
-                if views[v].restart is not None
-                else Position(None, 0.0)
-                if n.leg == JUNCTION_INDEX
-                else Position(self.graph.names[n.leg], n.s)
-                for v, n in enumerate(here)
-            )
-        )
+        start = Configuration(*(view.standing(self.graph) for view in views))
         for view in views:
             view.restart = None
         goal, self._goal = self._goal, None
         verified = plan_from_rest(self.graph, self.limits, start, goal, method=self.method, margin=0.0)
         self._counts["replans"] += 1
-        self.log.write({"t": self.clock.now(), "event": "replan", "goal": str(goal)})
+        self.log.write({"t": self._now(), "event": "replan", "goal": str(goal)})
         self._adopt(verified, first=False)
         for v in (0, 1):
             self._send(v, 0, self._rule.released[v])
@@ -524,8 +521,7 @@ class LiveMaster:
         Returns
         -------
         LiveRun
-            Outcome ``broker-failed`` with its ``error`` when the connection failed for good (a
-            refused login, an untrusted certificate); ``timed-out`` if the broker never answered.
+            With its ``error`` when it ended early (see :class:`LiveOutcome`).
         """
         self.start()
         try:
@@ -537,15 +533,17 @@ class LiveMaster:
     def start(self) -> LiveMaster:
         """Connect in the background (see :class:`~trajgen.live.BrokerLink`); returns itself at once.
 
-        The orders go out once connected; an unreachable broker is retried until :meth:`wait` ends.
+        The first orders go out once the broker and both vehicles are there; an unreachable broker
+        is retried until :meth:`wait` ends.
         """
+        self._began_at = self.clock.now()
         self.link.start()
         return self
 
     def wait(self, *, timeout: float) -> bool:
         """Wait until both vehicles stand at their goals or ``timeout`` seconds of the run pass."""
         deadline = self.clock.now() + timeout
-        while not self._done.is_set() and not self.link.failed.is_set():
+        while not self._done.is_set() and not self.link.failed.is_set() and self._gave_up is None:
             left = deadline - self.clock.now()
             if left <= 0.0:
                 return False
@@ -559,8 +557,13 @@ class LiveMaster:
     def _failure(self, outcome: LiveOutcome) -> str | None:
         if outcome is LiveOutcome.BROKER_FAILED:
             return self.link.failure
+        if outcome is LiveOutcome.ORDER_NOT_TAKEN:
+            return self._gave_up
         if outcome is LiveOutcome.TIMED_OUT and not self.link.ever_connected:
             return f"master: the broker {self.broker.url} was never reached (retried until the time limit)"
+        silent = [view for view in self._views if not view.heard]
+        if outcome is LiveOutcome.TIMED_OUT and self._started_at is None and silent:
+            return f"master: no order was sent: {never_heard_message(silent)}"
         return None
 
     def result(self) -> LiveRun:
@@ -571,6 +574,9 @@ class LiveMaster:
             outcome = LiveOutcome.GOALS_REACHED if self._done.is_set() else LiveOutcome.TIMED_OUT
             if outcome is LiveOutcome.TIMED_OUT and self.link.failed.is_set():
                 outcome = LiveOutcome.BROKER_FAILED
+            elif outcome is LiveOutcome.TIMED_OUT and self._gave_up is not None:
+                outcome = LiveOutcome.ORDER_NOT_TAKEN
+            self._log_first_plan()
             latency = np.array(self._latencies, dtype=float)
             latency.flags.writeable = False
             run = LiveRun(
@@ -584,8 +590,9 @@ class LiveMaster:
                 latency,
                 dict(self._provenance),
                 self._failure(outcome),
+                self._waits(),
             )
-            end = {"t": now, "event": "end", "outcome": outcome.value, "makespan_s": run.makespan}
+            end = {"t": self._now(), "event": "end", "outcome": outcome.value, "makespan_s": run.makespan}
             if run.error is not None:
                 end["error"] = run.error
             self.log.write(end)

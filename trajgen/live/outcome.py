@@ -16,6 +16,7 @@ class LiveOutcome(enum.Enum):
     GOALS_REACHED = "goals-reached"  #: both vehicles stand at their goals
     TIMED_OUT = "timed-out"  #: the time limit passed first
     BROKER_FAILED = "broker-failed"  #: the broker connection failed for good (see ``LiveRun.error``)
+    ORDER_NOT_TAKEN = "order-not-taken"  #: a vehicle kept reporting it lacks its order (``LiveRun.error``)
 
 
 @dataclass(frozen=True, slots=True)
@@ -46,8 +47,12 @@ class LiveRun:
         (:func:`~trajgen.model.summary.provenance`: ``method``, ``computed_by``,
         ``fallback_reason``, ``time_limit_reached``).
     error : str or None
-        Why the run ended early, in one sentence (a refused login, an untrusted certificate);
-        ``None`` otherwise.
+        Why the run ended early, in one sentence (a refused login, an untrusted certificate, an
+        order a vehicle never took); ``None`` otherwise.
+    waits : dict
+        What came before the run's time 0, seconds of the run's clock: ``broker_wait_s`` from the
+        master's start (after planning) to its connection to the broker, ``vehicle_wait_s`` from
+        there to both vehicles heard and the first orders sent (``None``: not reached).
     """
 
     outcome: LiveOutcome
@@ -60,6 +65,7 @@ class LiveRun:
     release_latency: np.ndarray
     plan: dict = field(default_factory=dict)
     error: str | None = None
+    waits: dict = field(default_factory=dict)
 
     def summary(self) -> dict:
         """A JSON-ready summary."""
@@ -75,5 +81,7 @@ class LiveRun:
             "replans": self.replans,
             "releases": int(latency.size),
             "release_latency_median_ms": float(np.median(latency) * 1e3) if latency.size else None,
+            "broker_wait_s": self.waits.get("broker_wait_s"),
+            "vehicle_wait_s": self.waits.get("vehicle_wait_s"),
             "error": self.error,
         }

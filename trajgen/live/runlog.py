@@ -1,9 +1,13 @@
 """The run log of a live run: one JSON object per line, streamed to a temporary file as the run goes.
 
-Every line has ``t`` (seconds of the run) and ``event``:
+Every line has ``t`` and ``event``. ``t`` is the run's time, seconds since the first order was
+sent: the same zero as the makespan, the picture's axis and the vehicles' faults. Planning and
+the wait for the broker come before it and are reported apart.
 
 - ``plan``: a verified plan was made (``method``, ``planned_s``: when the releases would bring both
-  vehicles to their goals, ``nodes``: each vehicle's node count);
+  vehicles to their goals, ``nodes``: each vehicle's node count); the first plan is logged at
+  ``t`` = 0 with what came before it, run seconds: ``broker_wait_s`` (from the master's start to
+  the broker) and ``vehicle_wait_s`` (from there to both vehicles heard; ``null``: not reached);
 - ``order``: an order or order update was published (``vehicle``, ``update``, ``first`` and
   ``decision_point`` node indices, ``frontier_m``: the decision point's distance along the path,
   ``resent``);
@@ -17,7 +21,7 @@ Every line has ``t`` (seconds of the run) and ``event``:
 - ``restart``: a vehicle came back without its order (``vehicle``, ``at``: where it stands);
 - ``goal``: a new goal was asked for; ``replan``: both vehicles stood at their bases and were
   re-planned; ``end``: the run ended (``outcome``, ``makespan_s``, and ``error`` when the broker
-  connection failed for good or was never made).
+  connection failed for good or was never made, or a vehicle never took its order).
 
 The log grows with the run's length; it is kept on disk, not in memory, and
 :func:`read_run_log` thins the states it returns to a bounded number.

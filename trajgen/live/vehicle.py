@@ -257,6 +257,9 @@ class SimulatedVehicle:
 
     def start(self) -> SimulatedVehicle:
         """Connect and start driving (in threads of its own); returns itself."""
+        # its time is the clock's from here (a vehicle started late must not pull the clock back), on
+        # the grid of its cycles, so that vehicles of one clock drive their cycles at the same times
+        self._t = self._next_state = math.floor(self.clock.now() / self.period) * self.period
         self.link.start()
         self._thread = threading.Thread(
             target=self._run, name=f"trajgen-vehicle-{self.identity.serial_number}", daemon=True
@@ -314,6 +317,12 @@ class SimulatedVehicle:
         """Where it truly is now."""
         with self._lock:
             return self._snapshot
+
+    @property
+    def since_first_order(self) -> float | None:
+        """Seconds of the run since it took its first order (the run's time); ``None``: no order yet."""
+        began = self._first_order
+        return None if began is None else self.snapshot.time - began
 
     @property
     def trace(self) -> tuple[VehicleSnapshot, ...]:

@@ -286,9 +286,10 @@ def render_live_run(run: dict, *, names: tuple[str, str]) -> bytes:
         axis.set_ylabel("along its path, m")
         axis.grid(True, alpha=0.3)
         axis.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=8)
+    first_t = min(first_t, 0.0)  # the run's time starts at the first order
     if last_t > first_t:
         axes[0].set_xlim(first_t, last_t)
-    axes[-1].set_xlabel("time of the run, s")
+    axes[-1].set_xlabel("time of the run since the first order, s")
     if not ended:
         heading = "live run: no end record (still running, or cut short)"
     else:
