@@ -498,6 +498,10 @@ def test_a_vehicle_reports_at_once_when_it_comes_to_rest_and_says_its_last_state
         try:
             master.start()
             assert _until(lambda: rest and clock.now() > rest[0] + 2.0)
+            # issue 35, item 10: ONLINE comes first, then its states
+            assert heard[0][1] == "connection"
+            assert heard[0][2]["connectionState"] == "ONLINE"
+            assert heard[1][1] == "state"
             stood = [t for t, kind, m in heard if kind == "state" and not m["driving"] and t >= rest[0]]
             assert stood
             assert stood[0] - rest[0] < 1.0  # not at the next periodic state, 10 s later
@@ -518,7 +522,8 @@ def test_a_vehicle_reports_at_once_when_it_comes_to_rest_and_says_its_last_state
 # -- the command line ---------------------------------------------------------------------------------
 
 
-def test_serve_drives_two_vehicle_processes_and_commits_its_log_and_picture(tmp_path, capsys):
+def test_serve_drives_two_vehicle_processes_and_commits_its_log_and_picture(tmp_path, capsys, caplog):
+    caplog.set_level(logging.INFO, logger="trajgen.live.master")
     with _broker() as broker:
         common = ["--broker", broker.url, "--time-scale", "25"]
         vehicles = [
@@ -585,6 +590,9 @@ def test_serve_drives_two_vehicle_processes_and_commits_its_log_and_picture(tmp_
     # too (a vehicle's clock may lose time on a loaded machine, never gain it)
     since = [float(re.search(r"([0-9.]+) s after its first order", out).group(1)) for out, _ in outputs]
     assert 0.0 < min(since) <= max(since) <= summary["makespan_s"] + 3.0
+    # issue 35, item 10: a vehicle that leaves at its goal (--exit-at-goal) is said to be there
+    said = [r.getMessage() for r in caplog.records if r.name == "trajgen.live.master"]
+    assert not [line for line in said if "no base is released" in line], said
 
 
 def test_demo_live_runs_broker_vehicles_and_master_in_one_command(tmp_path, capsys):
@@ -666,6 +674,36 @@ def test_serve_with_no_broker_retries_says_so_once_and_commits_its_log_without_a
     assert records[-1]["event"] == "end"
     assert "never reached" in records[-1]["error"]
     assert not (tmp_path / "run.png").exists()
+
+
+def test_serve_timeout_counts_after_planning_and_names_vehicles_never_heard(tmp_path, capsys, monkeypatch):
+    # issue 35, item 9: planning (here 1.5 s) is not the run's; a broker with no vehicle on it is said
+    import trajgen.live.session as session
+
+    planned = session.live_plan
+
+    def slow_plan(scenario, *, method=None):
+        time.sleep(1.5)
+        return planned(scenario, method=method)
+
+    monkeypatch.setattr(session, "live_plan", slow_plan)
+    with _broker() as broker:
+        began = time.monotonic()
+        scenario, log = str(REPO / "examples" / "swap.toml"), str(tmp_path / "run.jsonl")
+        options = ["--broker", broker.url, "--method", "exact", "--timeout", "2", "--log", log, "--json"]
+        status = main(["serve", scenario, *options])
+        seconds = time.monotonic() - began
+    captured = capsys.readouterr()
+    summary = json.loads(captured.out)
+    assert status == 1
+    assert seconds >= 1.5 + 2.0  # the whole --timeout after planning
+    assert summary["planning_s"] >= 1.5
+    assert summary["outcome"] == "timed-out"
+    assert summary["orders"] == 0
+    assert summary["broker_wait_s"] >= 0.0
+    assert summary["vehicle_wait_s"] is None
+    assert summary["error"].startswith("master: no order was sent: agv1 and agv2 never came online")
+    assert "uagv/v2/unspecified/agv1/connection" in summary["error"]
 
 
 @pytest.mark.parametrize(
