@@ -12,8 +12,8 @@ from tests.helpers import LIMITS, MIXED, route_of, too_close
 from topology import Configuration, Position, YGraph, plan
 from trajgen import METHODS, Exact, Schedule, Toppra, certify, make_schedule, verify
 from trajgen.errors import OptionError, VerificationError
-from trajgen.methods.toppra import ToppraKinematics
 from trajgen.model.axes import route_axes, straight_pieces
+from trajgen.model.blended import ToppraKinematics
 from trajgen.scenario.sampling import random_scenarios
 
 SWAP = ((10.0, 10.0, 10.0), ("A:10", "B:10"), ("B:10", "A:10"))

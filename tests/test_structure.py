@@ -14,6 +14,24 @@ import pytest
 from tests.conftest import REPO
 
 PACKAGES = ("topology", "limits", "trajgen")
+PACKAGE = REPO / "trajgen"
+#: Attributes that name a type as text.
+NAME_ATTRIBUTES = {"__module__", "__qualname__", "__name__"}
+
+
+def _class_names() -> set[str]:
+    """Every class the package defines, by name."""
+    names = set()
+    for source in PACKAGE.rglob("*.py"):
+        names |= {
+            n.name
+            for n in ast.walk(ast.parse(source.read_text(encoding="utf-8")))
+            if isinstance(n, ast.ClassDef)
+        }
+    return names
+
+
+CLASS_NAMES = _class_names()
 FILES = sorted(path for package in PACKAGES for path in (REPO / package).rglob("*.py"))
 
 
@@ -253,3 +271,20 @@ def test_no_module_is_over_600_lines(module):
 def test_at_most_eight_modules_at_the_root_of_trajgen():
     root = sorted(path.name for path in (REPO / "trajgen").glob("*.py"))
     assert len(root) <= 8, root
+
+
+def test_the_model_and_the_verifier_recognise_no_type_by_its_name():
+    """Kinds are told apart by identity (``type(x) is K``), never by module or class names as text."""
+    offending = []
+    for folder in ("model", "verification"):
+        for source in sorted((PACKAGE / folder).glob("*.py")):
+            tree = ast.parse(source.read_text(encoding="utf-8"))
+            for node in ast.walk(tree):
+                if not isinstance(node, ast.Compare):
+                    continue
+                for part in ast.walk(node):
+                    if isinstance(part, ast.Attribute) and part.attr in NAME_ATTRIBUTES:
+                        offending.append(f"{source.name}:{node.lineno} compares .{part.attr}")
+                    if isinstance(part, ast.Constant) and part.value in CLASS_NAMES:
+                        offending.append(f"{source.name}:{node.lineno} compares the text {part.value!r}")
+    assert offending == []

@@ -14,6 +14,7 @@ from math import comb
 import numpy as np
 
 from topology import JUNCTION_INDEX
+from trajgen.model.blended import ToppraKinematics
 from trajgen.model.polynomials import evaluate, root_in
 from trajgen.model.schedule import AxisMap, CubicKinematics, Schedule, Section
 from trajgen.model.values import ArrayValue, readonly, sorted_unique
@@ -153,18 +154,12 @@ def _toppra_section(kinematics) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     return np.asarray(times, dtype=float), coefficients, intervals
 
 
-def _is_toppra(kinematics: object) -> bool:
-    # by name: the verifier does not import the method it checks
-    kind = type(kinematics)
-    return (kind.__module__, kind.__qualname__) == ("trajgen.methods.toppra", "ToppraKinematics")
-
-
 def _section_polynomials(section: Section) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     kinematics = section.kinematics
     # exact types only: a subclass could evaluate (and so export) something else than this form
     if type(kinematics) is CubicKinematics:
         return _cubic_section(kinematics)
-    if _is_toppra(kinematics):
+    if type(kinematics) is ToppraKinematics:
         return _toppra_section(kinematics)
     raise UncheckableKinematicsError(
         f"section kinematics {type(kinematics).__name__} have no polynomial form the verifier knows"
@@ -189,7 +184,7 @@ def motion_arrays(schedule: Schedule, section: int, vehicle: int, interval: int 
         sections[2].maps[0].{axis_start,axis_end,s_start}``.
     """
     kinematics = schedule.sections[section].kinematics
-    if _is_toppra(kinematics):
+    if type(kinematics) is ToppraKinematics:
         arrays = f"sections[{section}].kinematics.{{grid,speed,times}}"
     else:
         arrays = f"sections[{section}].kinematics.vehicles[{vehicle}].{{times,initial,jerk}}"

@@ -20,6 +20,7 @@ import math
 
 import numpy as np
 
+from trajgen.model.blended import BlendedPath, ToppraKinematics
 from trajgen.model.profiles import PiecewiseCubic
 from trajgen.model.schedule import AxisMap, CubicKinematics, Schedule
 
@@ -144,8 +145,8 @@ def _cubic(kinematics: CubicKinematics, path: str, failures: list[str]) -> None:
         )
 
 
-def _toppra(kinematics: object, path: str, failures: list[str]) -> None:
-    grid, speed, times = kinematics.grid, kinematics.speed, kinematics.times  # type: ignore[attr-defined]
+def _toppra(kinematics: ToppraKinematics, path: str, failures: list[str]) -> None:
+    grid, speed, times = kinematics.grid, kinematics.speed, kinematics.times
     if not all(
         _shape(values, f"{path}.{name}", (None,), failures)
         for name, values in (("grid", grid), ("speed", speed), ("times", times))
@@ -186,7 +187,10 @@ def _toppra(kinematics: object, path: str, failures: list[str]) -> None:
             f"{float(times[k + 1] - times[k])!r} s by the times and {float(expected[k])!r} s by the grid "
             "and speeds: expected knot times that agree with them"
         )
-    path_object = kinematics.path  # type: ignore[attr-defined]
+    path_object = kinematics.path
+    if type(path_object) is not BlendedPath:
+        failures.append(f"{path}.path is a {type(path_object).__name__}: expected a BlendedPath")
+        return
     if not _finite(path_object.vertices, f"{path}.path.vertices", failures):
         return
     for k, blend in enumerate(path_object.blends):
@@ -213,10 +217,7 @@ def _axis_map(axis_map: object, path: str, failures: list[str]) -> None:
 def _kinematics(kinematics: object, path: str, failures: list[str]) -> None:
     if type(kinematics) is CubicKinematics:
         _cubic(kinematics, path, failures)
-    elif (type(kinematics).__module__, type(kinematics).__qualname__) == (
-        "trajgen.methods.toppra",
-        "ToppraKinematics",
-    ):
+    elif type(kinematics) is ToppraKinematics:
         _toppra(kinematics, path, failures)
     # any other kind is refused by the verifier as uncheckable
 
