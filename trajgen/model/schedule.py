@@ -326,7 +326,7 @@ class ScheduleState(ArrayValue):
         return frozen(names[np.where(self.leg == JUNCTION_INDEX, len(graph.names), self.leg)])
 
 
-@dataclass(frozen=True, slots=True, weakref_slot=True)
+@dataclass(frozen=True, slots=True)
 class Schedule:
     """A timed motion of both vehicles along a route.
 
