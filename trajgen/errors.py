@@ -27,6 +27,7 @@ __all__ = [
     "InputError",
     "LimitsError",
     "LiveError",
+    "MissingExtraError",
     "OptionError",
     "OutputError",
     "OutputLimitError",
@@ -73,6 +74,10 @@ class VerificationError(ScheduleError):
 
 class SolverError(ScheduleError):
     """A numerical solver failed to deliver a usable result."""
+
+
+class MissingExtraError(InputError):
+    """A feature needs an optional part of the install (an extra, like ``trajgen[live]``) that is missing."""
 
 
 class LiveError(TrajgenError, RuntimeError):

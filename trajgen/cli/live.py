@@ -24,6 +24,7 @@ from topology.validation import short_repr
 from trajgen.cli.options import add_method, method_from, scenario_from
 from trajgen.cli.parser import EXIT_FAILURE, EXIT_OK
 from trajgen.errors import InputError
+from trajgen.live.mqtt import require_live
 
 __all__ = ["live_demo", "register"]
 
@@ -158,6 +159,7 @@ def _command_serve(args: argparse.Namespace) -> int:
     from trajgen.live.master import LiveMaster
     from trajgen.live.session import live_plan
 
+    require_live("paho", "trajgen serve")
     scenario = scenario_from(args.scenario)
     goals = sorted((_goal(text) for text in args.goal_at), key=lambda goal: goal[0])
     check_output_paths([args.log] + ([args.plot] if args.plot else []))
@@ -206,6 +208,7 @@ def _command_vehicle(args: argparse.Namespace) -> int:
     from trajgen.live.session import position_xy
     from trajgen.live.vehicle import SimulatedVehicle, StopFault
 
+    require_live("paho", "trajgen vehicle")
     scenario = scenario_from(args.scenario)
     if args.name not in scenario.names:
         raise InputError(
@@ -283,6 +286,7 @@ def live_demo(
     from trajgen.live.runlog import RunLog
     from trajgen.live.session import LiveDemo
 
+    require_live("paho", "trajgen demo --live")
     log_path, plot_path = str(Path(output) / "live-run.jsonl"), str(Path(output) / "live-run.png")
     check_output_paths([log_path, plot_path])
     if not json_summary:  # with --json, stdout is the summary alone

@@ -11,16 +11,19 @@ undone by the next commit into any of those folders, or by
 :func:`recover_folder`, which finds the journal and restores the backups.
 Hidden files a crashed run left (``*.trajgen-tmp``, ``*.trajgen-bak``) are
 removed then too.
+
+``flock`` is POSIX (Linux, macOS): the module imports anywhere, and a commit on a system
+without it is refused with an :class:`~trajgen.errors.OutputError` saying so.
 """
 
 from __future__ import annotations
 
 import contextlib
-import fcntl
 import json
 import logging
 import os
 import shutil
+import sys
 import tempfile
 from collections.abc import Iterable, Mapping, Sequence
 from pathlib import Path
@@ -335,6 +338,13 @@ class _FolderLocks:
         self.handles: list[int] = []
 
     def __enter__(self) -> _FolderLocks:
+        try:
+            import fcntl
+        except ImportError:  # Windows: no flock on folders
+            raise OutputError(
+                f"committing files on {sys.platform!r}: this needs POSIX folder locks (flock): "
+                "expected Linux or macOS"
+            ) from None
         while True:
             try:
                 for folder in self.folders:

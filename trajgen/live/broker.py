@@ -12,13 +12,11 @@ only, let anyone in without a password, keep their port across a
 
 Stopping a broker closes every client's connection (the clients see it drop,
 as after a crash of the broker: their sessions are gone after a restart) and
-its listening socket. A client whose connection breaks without an MQTT
-DISCONNECT has its last will published.
+its listening socket; a client whose connection breaks has its last will published.
 
-amqtt is imported when an embedded broker first starts (paho never is). Its
-loggers (``amqtt``, ``transitions``, chatty at INFO) are left as the application
-configured them: this module configures no logging, and a stop or restart logs
-no warning or traceback.
+amqtt (of the ``trajgen[live]`` extra) is imported when an embedded broker first starts
+(paho never is). Its loggers are left as the application configured them; a stop or
+restart logs no warning or traceback.
 """
 
 from __future__ import annotations
@@ -41,6 +39,7 @@ from typing import Any, Self
 
 from topology.validation import finite_real, short_repr
 from trajgen.errors import InputError, LiveError
+from trajgen.live.mqtt import require_live
 
 __all__ = ["HOST", "THREAD_NAME", "EmbeddedBroker", "MosquittoBroker", "mosquitto_available"]
 
@@ -403,6 +402,7 @@ class EmbeddedBroker(_Broker):
             self.stop()  # a thread that ended by itself
             deadline = time.monotonic() + START_TIMEOUT_S
             # imported here, not on the broker's loop: an import would hold the loop up for 0.1 s
+            require_live("amqtt", "the MQTT broker of this process (no mosquitto is installed)")
             import amqtt.broker
             import amqtt.plugins.authentication  # noqa: F401  (the plugin of _broker_config)
 

@@ -11,6 +11,7 @@ reconnects by itself after the broker restarts.
 
 from __future__ import annotations
 
+import importlib
 import logging
 import re
 import ssl
@@ -19,15 +20,17 @@ from pathlib import Path
 from urllib.parse import urlsplit
 
 from topology.validation import short_repr
-from trajgen.errors import InputError
+from trajgen.errors import InputError, MissingExtraError
 
 __all__ = [
     "DEFAULT_INTERFACE",
     "DEFAULT_VERSION",
+    "LIVE_EXTRA",
     "BrokerSettings",
     "Topic",
     "VehicleIdentity",
     "make_client",
+    "require_live",
 ]
 
 logger = logging.getLogger(__name__)
@@ -193,6 +196,26 @@ class BrokerSettings:
         )
 
 
+#: The extra that installs what live runs need (the MQTT client, the embedded broker).
+LIVE_EXTRA = "trajgen[live]"
+
+
+def require_live(module: str, what: str) -> None:
+    """Refuse ``what`` at once when ``module`` (``"paho"``, ``"amqtt"``) of the live extra is missing.
+
+    Raises
+    ------
+    MissingExtraError
+        ``module`` cannot be imported (``pip install trajgen`` without the ``live`` extra).
+    """
+    try:
+        importlib.import_module(module)
+    except ImportError:
+        raise MissingExtraError(
+            f"{what} needs {module!r}, which is not installed: expected pip install '{LIVE_EXTRA}'"
+        ) from None
+
+
 def make_client(settings: BrokerSettings, client_id: str, *, will: tuple[str, bytes] | None = None):
     """A paho-mqtt 2.x client for ``settings``, not yet connected.
 
@@ -209,6 +232,7 @@ def make_client(settings: BrokerSettings, client_id: str, *, will: tuple[str, by
     paho.mqtt.client.Client
         Reconnecting by itself (0.1 s after a loss, up to 2 s apart) once its loop runs.
     """
+    require_live("paho", "an MQTT connection")
     import paho.mqtt.client as mqtt
 
     client = mqtt.Client(
