@@ -16,7 +16,7 @@ from pathlib import Path
 
 from trajgen import METHODS, certify, load_scenario, lower_bound, make_schedule
 from trajgen.export import commit_files
-from trajgen.plots import render_coordination, render_speed
+from trajgen.plots import plot_coordination, plot_speed, png_bytes
 
 here = Path(__file__).resolve().parent
 scenario = load_scenario(here / "swap.toml")
@@ -52,11 +52,11 @@ waiting = max(range(2), key=lambda v: (state.leg[v] == 2).sum())  # the vehicle 
 deepest = state.s[waiting][state.leg[waiting] == 2].max()
 print(f"deepest point of vehicle {waiting + 1} in leg C: {deepest:.2f} m of 10 m")
 
-# Renderers return bytes; the files are committed together.
+# Plots return matplotlib Figures; as PNG bytes, the files are committed together.
 files = commit_files(
     {
-        output / "speed.png": render_speed(verified["optimal"], names=scenario.names),
-        output / "coordination.png": render_coordination(verified),
+        output / "speed.png": png_bytes(plot_speed(verified["optimal"], names=scenario.names)),
+        output / "coordination.png": png_bytes(plot_coordination(verified)),
     }
 )
 for path in files:

@@ -24,7 +24,7 @@ from trajgen import load_scenario
 from trajgen.export import commit_files
 from trajgen.online import plan_for_execution
 from trajgen.online.simulation import parse_faults, simulate
-from trajgen.plots import render_simulation
+from trajgen.plots import plot_simulation, png_bytes
 
 here = Path(__file__).resolve().parent
 scenario = load_scenario(here / "swap.toml")
@@ -69,9 +69,8 @@ assert result.replans == 0  # nothing re-routes
 assert result.emergency_brakes == 0
 
 path = output / "simulation.png"
-commit_files(
-    {path: render_simulation(result, names=scenario.names, min_separation=scenario.limits.min_separation)}
-)
+figure = plot_simulation(result, names=scenario.names, min_separation=scenario.limits.min_separation)
+commit_files({path: png_bytes(figure)})
 print(f"wrote {path}")
 if scratch is not None:
     print(f"(the files in {output} are removed now: set TRAJGEN_EXAMPLE_OUTPUT=DIR to keep them)")

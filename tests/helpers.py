@@ -40,3 +40,13 @@ def execution_plan(name: str, method: str):
     scenario = load_scenario(REPO / "examples" / f"{name}.toml")
     chosen = Optimal() if method == "optimal" else method
     return scenario, plan_for_execution(scenario, method=chosen)
+
+
+def animation_gif(verified, **options) -> bytes:
+    """The GIF the command line writes of ``animate(verified, **options)``."""
+    from trajgen.plots import animate, gif_bytes
+
+    animation = animate(verified, **options)
+    return gif_bytes(
+        animation.frames(), delays_ms=animation.delays_ms, palette_samples=animation.palette_samples
+    )

@@ -129,7 +129,7 @@ def test_the_api_refuses_a_route_planned_for_a_smaller_separation():
 @pytest.mark.parametrize("value", [None, 5, "x", 1.5, [], {}, b"x", (1, 2)], ids=repr)
 def test_wrong_types_in_the_api_are_type_or_value_errors(value):
     from trajgen import CsvOptions, Optimal, Outputs, default_scenario, run, verify
-    from trajgen.plots import render_coordination
+    from trajgen.plots import plot_coordination
 
     scenario = default_scenario()
     route = scenario.plan()
@@ -144,7 +144,7 @@ def test_wrong_types_in_the_api_are_type_or_value_errors(value):
         lambda: Outputs(csv_dir=value) if not isinstance(value, str | None) else Outputs(csv=value),
         lambda: CsvOptions(delimiter=value),
         lambda: Optimal(nodes=value if not isinstance(value, int) else -value),
-        lambda: render_coordination(value),
+        lambda: plot_coordination(value),
         lambda: write_profiles(value, ("a", "b"), "unused"),
     ]
     for call in calls:

@@ -13,8 +13,14 @@ from PIL import Image
 
 from trajgen.errors import InputError
 from trajgen.live.runlog import RunLog, read_run_log
-from trajgen.plots import render_live_run
+from trajgen.plots import plot_live_run, png_bytes
 from trajgen.plots.speed import VEHICLE_COLOURS
+
+
+def live_run_png(*arguments, **options) -> bytes:
+    """The PNG the pipeline writes of ``plot_live_run(...)``."""
+    return png_bytes(plot_live_run(*arguments, **options))
+
 
 NAMES = ("agv1", "agv2")
 PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
@@ -52,8 +58,8 @@ def decoded(png: bytes) -> Image.Image:
     return image
 
 
-def test_render_live_run_draws_a_png_of_a_sensible_size():
-    image = decoded(render_live_run(synthetic_run(), names=NAMES))
+def test_the_live_run_plot_draws_a_png_of_a_sensible_size():
+    image = decoded(live_run_png(synthetic_run(), names=NAMES))
     width, height = image.size
     assert 800 <= width <= 2500
     assert 500 <= height <= 2000
@@ -63,51 +69,49 @@ def test_render_live_run_draws_a_png_of_a_sensible_size():
         assert near.sum() > 500, colour
 
 
-def test_render_live_run_leaves_the_run_unchanged():
+def test_the_live_run_plot_leaves_the_run_unchanged():
     run = synthetic_run()
     before = copy.deepcopy(run)
-    render_live_run(run, names=NAMES)
+    live_run_png(run, names=NAMES)
     assert run == before
 
 
-def test_the_time_axis_is_the_runs_from_the_first_order_to_the_end(monkeypatch):
-    import trajgen.plots.live_run as live_run
-
-    drawn = []
-    monkeypatch.setattr(live_run, "png_bytes", lambda figure: drawn.append(figure) or PNG_SIGNATURE)
+def test_the_time_axis_is_the_runs_from_the_first_order_to_the_end():
     run = synthetic_run()
     run["states"] = {
         name: [(t + 2.0, along, driving) for t, along, driving in run["states"][name]] for name in NAMES
     }
     run["orders"] = {name: [(t + 2.0, frontier) for t, frontier in run["orders"][name]] for name in NAMES}
-    render_live_run(run, names=NAMES)  # nothing before 2 s of the run: the axis starts at 0 all the same
-    axis = drawn[0].axes[-1]
+    figure = plot_live_run(
+        run, names=NAMES
+    )  # nothing before 2 s of the run: the axis starts at 0 all the same
+    axis = figure.axes[-1]
     assert axis.get_xlim() == (0.0, 32.0)
     assert axis.get_xlabel() == "time of the run since the first order, s"
-    assert any("makespan 29.80 s" in text.get_text() for text in drawn[0].texts)
+    assert any("makespan 29.80 s" in text.get_text() for text in figure.texts)
 
 
-def test_render_live_run_takes_a_run_without_orders_events_or_end():
+def test_the_live_run_plot_takes_a_run_without_orders_events_or_end():
     run = synthetic_run()
     run.update(orders={}, events=[], end=None)
-    decoded(render_live_run(run, names=NAMES))
+    decoded(live_run_png(run, names=NAMES))
 
 
-def test_render_live_run_takes_one_state_per_vehicle_and_states_out_of_order():
+def test_the_live_run_plot_takes_one_state_per_vehicle_and_states_out_of_order():
     run = synthetic_run()
     run["states"] = {"agv1": [(2.0, 1.0, True)], "agv2": [(5.0, 2.0, True), (1.0, 0.0, False)]}
     run["events"].append((40.0, "connection", "agv1", "OFFLINE"))  # never back online: up to the end
-    decoded(render_live_run(run, names=NAMES))
+    decoded(live_run_png(run, names=NAMES))
 
 
-def test_render_live_run_draws_the_most_states_a_log_keeps():
+def test_the_live_run_plot_draws_the_most_states_a_log_keeps():
     t = np.linspace(0.0, 600.0, 8000)
     run = synthetic_run()
     run["states"] = {name: [(float(x), float(0.01 * x), True) for x in t] for name in NAMES}
-    decoded(render_live_run(run, names=NAMES))
+    decoded(live_run_png(run, names=NAMES))
 
 
-def test_render_live_run_of_a_run_log():
+def test_the_live_run_plot_of_a_run_log():
     log = RunLog()
     try:
         log.write({"t": 0.0, "event": "plan", "method": "exact", "planned_s": 20.0, "nodes": [5, 4]})
@@ -170,7 +174,7 @@ def test_render_live_run_of_a_run_log():
     assert len(run["states"]["agv1"]) == 200
     assert run["orders"]["agv2"] == [(0.1, 3.0), (8.0, 6.0)]
     assert (12.0, "ignored", "agv1", "old header") in [(round(e[0], 6), *e[1:]) for e in run["events"]]
-    decoded(render_live_run(run, names=NAMES))
+    decoded(live_run_png(run, names=NAMES))
 
 
 def _broken(change):
@@ -192,7 +196,7 @@ BAD_NAMES = [
 @pytest.mark.parametrize("names", BAD_NAMES)
 def test_bad_names_are_refused(names):
     with pytest.raises(InputError, match="names must be two different non-empty vehicle names"):
-        render_live_run(synthetic_run(), names=names)
+        live_run_png(synthetic_run(), names=names)
 
 
 BAD_RUNS = [
@@ -261,9 +265,9 @@ BAD_RUNS = [
 @pytest.mark.parametrize(("run", "message"), BAD_RUNS)
 def test_bad_runs_are_refused_with_what_is_wrong(run, message):
     with pytest.raises(InputError, match=message):
-        render_live_run(run, names=NAMES)
+        live_run_png(run, names=NAMES)
 
 
 def test_the_input_error_is_a_value_error():
     with pytest.raises(ValueError, match="live run picture"):
-        render_live_run({"states": {}, "orders": {}, "events": [], "end": None}, names=NAMES)
+        live_run_png({"states": {}, "orders": {}, "events": [], "end": None}, names=NAMES)

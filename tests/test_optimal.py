@@ -24,8 +24,14 @@ from trajgen.methods.optimal.solve import Outcome, SolveResult, abandoned_solver
 from trajgen.methods.optimal.units import ProblemUnits
 from trajgen.model.analysis import travelled
 from trajgen.model.profiles import rest_to_rest_time
-from trajgen.plots import render_coordination
+from trajgen.plots import plot_coordination, png_bytes
 from trajgen.scenario.sampling import random_scenarios, reference_sets
+
+
+def coordination_png(*arguments, **options) -> bytes:
+    """The PNG the pipeline writes of ``plot_coordination(...)``."""
+    return png_bytes(plot_coordination(*arguments, **options))
+
 
 EQUAL = (10.0, 10.0, 10.0)
 UNEQUAL = (12.0, 8.0, 15.0)
@@ -294,7 +300,7 @@ def test_coordination_plot_is_rendered_for_verified_schedules():
         "exact": exact_schedule(route, LIMITS),
         "optimal": optimal_schedule(route, LIMITS),
     }
-    png = render_coordination({name: certify(s) for name, s in schedules.items()})
+    png = coordination_png({name: certify(s) for name, s in schedules.items()})
     assert png.startswith(b"\x89PNG")
     # travelled distances never decrease, and the optimal one parks shallower (drives less)
     _, exact_distance, _, _ = travelled(schedules["exact"])

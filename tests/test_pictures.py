@@ -13,14 +13,14 @@ from matplotlib.colors import to_rgb
 from PIL import Image
 
 from tests.conftest import REPO
-from tests.helpers import LIMITS, conf, route_of
+from tests.helpers import LIMITS, animation_gif, conf, route_of
 from topology import JUNCTION_INDEX, YGraph, plan
 from topology.indexed import segment_region_key
 from trajgen import Exact, certify, default_scenario, make_schedule
 from trajgen.cli import EXIT_BAD_INPUT, EXIT_OK, main
 from trajgen.errors import OptionError, UnverifiedScheduleError
 from trajgen.pipeline import PLOT_NAMES
-from trajgen.plots import render_animation, render_configuration
+from trajgen.plots import plot_configuration, png_bytes
 from trajgen.plots.animation import (
     DEFAULT_MAX_FRAMES,
     END_HOLD_MS,
@@ -36,6 +36,12 @@ from trajgen.plots.animation import (
 from trajgen.plots.configuration import ConfigurationLayout, route_samples, schedule_samples
 from trajgen.plots.gif import gif_bytes
 from trajgen.plots.speed import VEHICLE_COLOURS
+
+
+def configuration_png(*arguments, **options) -> bytes:
+    """The PNG the pipeline writes of ``plot_configuration(...)``."""
+    return png_bytes(plot_configuration(*arguments, **options))
+
 
 SWAP = str(REPO / "examples" / "swap.toml")
 
@@ -97,7 +103,7 @@ def swap():
 @pytest.fixture(scope="module")
 def swap_gif(swap):
     scenario, verified = swap
-    return render_animation(verified, names=scenario.names, max_frames=80)
+    return animation_gif(verified, names=scenario.names, max_frames=80)
 
 
 # -- playback ----------------------------------------------------------------------------------------
@@ -211,7 +217,7 @@ def test_the_separation_bar_is_red_near_the_minimum():
     # both on leg A, 1.6 m apart (under 1.25 x 1.5 m): the nearer one drives out first
     route = route_of((10.0, 10.0, 10.0), ("A:3", "A:4.6"), ("B:5", "C:5"))
     verified = certify(make_schedule(route, LIMITS, method=Exact()))
-    gif = render_animation(verified, max_frames=6)
+    gif = animation_gif(verified, max_frames=6)
     play = playback(verified.schedule.duration, max_frames=6)
     geometry = frame_geometry(verified, play.times())
     layout = frame_layout(route.graph, geometry)
@@ -242,7 +248,7 @@ def test_a_long_schedule_is_played_faster_within_the_frame_cap():
     play = playback(verified.schedule.duration, fps=10, max_frames=30)
     assert verified.schedule.duration > 5000.0
     assert play.speedup >= verified.schedule.duration / 2.9
-    gif = render_animation(verified, names=("a", "b"), fps=10, max_frames=30)
+    gif = animation_gif(verified, names=("a", "b"), fps=10, max_frames=30)
     image = Image.open(io.BytesIO(gif))
     assert image.n_frames == play.frame_count <= 30
     assert image.size == (FRAME_WIDTH_PX, FRAME_HEIGHT_PX)
@@ -252,15 +258,15 @@ def test_a_zero_duration_schedule_is_one_frame():
     route = route_of((10.0, 10.0, 10.0), ("A:10", "B:10"), ("A:10", "B:10"))
     verified = certify(make_schedule(route, LIMITS, method=Exact()))
     assert verified.schedule.duration == 0.0
-    image = Image.open(io.BytesIO(render_animation(verified)))
+    image = Image.open(io.BytesIO(animation_gif(verified)))
     assert image.n_frames == 1
 
 
 @pytest.mark.parametrize(
     ("render", "what"),
     [
-        pytest.param(render_animation, "render_animation", id="animation"),
-        pytest.param(render_configuration, "render_configuration", id="configuration"),
+        pytest.param(animation_gif, "animate", id="animation"),
+        pytest.param(configuration_png, "plot_configuration", id="configuration"),
         pytest.param(lambda s: frame_geometry(s, [0.0]), "frame_geometry", id="geometry"),
     ],
 )
@@ -450,13 +456,13 @@ def test_the_schedules_path_stays_in_its_class(swap):
 def test_render_configuration_of_a_route_and_of_a_schedule(swap):
     _, verified = swap
     for subject in (ROUTES["from-a-triangle"], verified):
-        png = render_configuration(subject)
+        png = configuration_png(subject)
         image = Image.open(io.BytesIO(png))
         assert image.format == "PNG"
         assert image.size[0] > 800
         assert image.size[1] > 900
-    with pytest.raises(UnverifiedScheduleError, match="render_configuration takes a VerifiedSchedule"):
-        render_configuration("a route")
+    with pytest.raises(UnverifiedScheduleError, match="plot_configuration takes a VerifiedSchedule"):
+        configuration_png("a route")
 
 
 # -- the pipeline and the command line -------------------------------------------------------------------
@@ -533,10 +539,10 @@ def test_the_coordination_plot_draws_the_too_close_region_as_the_diagrams_exact_
     from matplotlib.patches import Polygon
 
     from trajgen.model.coordination import CoordinationDiagram, plan_paths
-    from trajgen.plots.coordination import coordination_figure
+    from trajgen.plots import plot_coordination
 
     exact = swap_by_method["exact"].schedule
-    figure = coordination_figure({"exact": swap_by_method["exact"]})
+    figure = plot_coordination({"exact": swap_by_method["exact"]})
     (axis,) = figure.axes
     drawn = sorted(
         tuple(map(tuple, np.round(p.get_xy()[:-1], 9))) for p in axis.patches if isinstance(p, Polygon)
@@ -552,9 +558,9 @@ def test_the_coordination_plot_draws_the_too_close_region_as_the_diagrams_exact_
 
 
 def test_a_curve_along_the_frame_stays_inside_it(swap_by_method):
-    from trajgen.plots.coordination import coordination_figure
+    from trajgen.plots import plot_coordination
 
-    (axis,) = coordination_figure({"exact": swap_by_method["exact"]}).axes
+    (axis,) = plot_coordination({"exact": swap_by_method["exact"]}).axes
     (curve,) = axis.get_lines()
     x, y = curve.get_xdata(), curve.get_ydata()
     (x0, x1), (y0, y1) = axis.get_xlim(), axis.get_ylim()
@@ -567,20 +573,20 @@ def test_a_curve_along_the_frame_stays_inside_it(swap_by_method):
 
 
 def test_two_panels_say_why_each_has_its_own_axes(swap_by_method):
-    from trajgen.plots.coordination import coordination_figure
+    from trajgen.plots import plot_coordination
 
-    figure = coordination_figure(swap_by_method)
+    figure = plot_coordination(swap_by_method)
     assert len(figure.axes) == 2
     why = figure.get_suptitle()
     assert "different paths" in why
     assert "homotopy class" in why
     assert all("class " in axis.get_title() for axis in figure.axes)
-    one = coordination_figure({"exact": swap_by_method["exact"]})
+    one = plot_coordination({"exact": swap_by_method["exact"]})
     assert one.get_suptitle() == ""
 
 
 def test_the_speed_plot_says_what_a_negative_velocity_means(swap_by_method):
-    from trajgen.plots.speed import speed_figure
+    from trajgen.plots import plot_speed
 
-    title = speed_figure(swap_by_method["optimal"], names=("agv1", "agv2")).axes[0].get_title()
+    title = plot_speed(swap_by_method["optimal"], names=("agv1", "agv2")).axes[0].get_title()
     assert "v < 0 is backing out of a side leg" in title

@@ -11,7 +11,7 @@ from tests.conftest import REPO
 from tests.helpers import too_close
 from trajgen import Outputs, Toppra, default_scenario, run
 from trajgen.cli import EXIT_BAD_INPUT, main
-from trajgen.errors import InputError, OutputError
+from trajgen.errors import InputError, OptionError, OutputError
 from trajgen.export import atomic, commit_files
 
 SWAP = str(REPO / "examples" / "swap.toml")
@@ -242,3 +242,18 @@ def test_a_schedule_longer_than_a_day_is_run_with_a_warning_and_a_note(tmp_path,
     assert note in caplog.text
     # a schedule of an hour is not warned about
     assert not [n for n in run(load_scenario(REPO / "examples" / "swap.toml"), method="exact").notes]
+
+
+def test_the_compared_methods_are_the_ones_named_and_no_other_is_solved(tmp_path, caplog):
+    with caplog.at_level(logging.DEBUG, logger="trajgen.verification"):
+        result = run(default_scenario(), method="exact", outputs=Outputs(plot_dir=tmp_path, compare=()))
+    verified = [r.message.split()[2] for r in caplog.records if r.message.startswith("verified a")]
+    assert verified == ["exact"]  # the run's own schedule alone: no NLP solved for the plot
+    assert (tmp_path / "coordination.png").is_file()
+    assert result.verified.schedule.method.name == "exact"
+    assert Outputs(compare=("TOPPRA", " exact")).compare == ("toppra", "exact")
+    assert Outputs().compare == ("exact", "toppra", "optimal")
+    with pytest.raises(OptionError, match=r"method 'fast' is unknown: expected one of \['exact'"):
+        Outputs(compare=("fast",))
+    with pytest.raises(InputError, match="compare must be a tuple of method names, got 'exact'"):
+        Outputs(compare="exact")

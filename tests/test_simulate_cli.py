@@ -19,8 +19,14 @@ from trajgen.errors import InputError
 from trajgen.online.faults import FaultError
 from trajgen.online.goals import plan_for_execution
 from trajgen.online.simulation import parse_faults, simulate
-from trajgen.plots import render_simulation
+from trajgen.plots import plot_simulation, png_bytes
 from trajgen.scenario import load_scenario
+
+
+def simulation_png(*arguments, **options) -> bytes:
+    """The PNG the pipeline writes of ``plot_simulation(...)``."""
+    return png_bytes(plot_simulation(*arguments, **options))
+
 
 SWAP = str(REPO / "examples" / "swap.toml")
 PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
@@ -284,7 +290,7 @@ def test_an_output_folder_that_is_a_file_exits_2_before_computing(tmp_path, caps
 def test_render_simulation_refuses_bad_arguments(stopped_run, result, min_separation, match):
     result = stopped_run.result if result is None else result
     with pytest.raises(InputError, match=match):
-        render_simulation(result, names=("agv1", "agv2"), min_separation=min_separation)
+        simulation_png(result, names=("agv1", "agv2"), min_separation=min_separation)
 
 
 @pytest.mark.parametrize("method", ["exact", "toppra"])

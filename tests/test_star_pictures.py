@@ -11,7 +11,7 @@ import pytest
 from matplotlib.colors import to_rgb
 from PIL import Image
 
-from tests.helpers import LIMITS, conf
+from tests.helpers import LIMITS, animation_gif, conf
 from topology import JUNCTION_INDEX, Instruction, StarGraph, YGraph, plan
 from topology.cycle import retract_indexed
 from trajgen import Exact, certify, load_scenario, make_schedule
@@ -19,7 +19,7 @@ from trajgen.cli import EXIT_OK, main
 from trajgen.errors import InputError, UnverifiedScheduleError
 from trajgen.model.summary import class_label, class_name
 from trajgen.pipeline import PLOT_NAMES
-from trajgen.plots import render_animation, render_configuration
+from trajgen.plots import plot_configuration, png_bytes
 from trajgen.plots.animation import FRAME_HEIGHT_PX, FRAME_WIDTH_PX, frame_geometry, frame_layout, playback
 from trajgen.plots.configuration import ConfigurationLayout
 from trajgen.plots.retract_graph import (
@@ -27,11 +27,22 @@ from trajgen.plots.retract_graph import (
     RULE_WORDS,
     RetractGraphLayout,
     instruction_text,
-    render_retract_graph,
+    plot_retract_graph,
     route_points,
     schedule_points,
 )
 from trajgen.plots.speed import VEHICLE_COLOURS
+
+
+def configuration_png(*arguments, **options) -> bytes:
+    """The PNG the pipeline writes of ``plot_configuration(...)``."""
+    return png_bytes(plot_configuration(*arguments, **options))
+
+
+def retract_graph_png(*arguments, **options) -> bytes:
+    """The PNG the pipeline writes of ``plot_retract_graph(...)``."""
+    return png_bytes(plot_retract_graph(*arguments, **options))
+
 
 NAMES = {
     4: ("N", "W", "S", "E"),
@@ -108,7 +119,7 @@ def _near(pixel: np.ndarray, colour: str, tolerance: int = 12) -> bool:
 def test_the_gif_of_a_k_leg_schedule_decodes_and_shows_the_start_and_the_goal(timed):
     k, verified = timed
     route = verified.schedule.route
-    gif = render_animation(verified, names=("agv1", "agv2"), max_frames=12)
+    gif = animation_gif(verified, names=("agv1", "agv2"), max_frames=12)
     play = playback(verified.schedule.duration, max_frames=12)
     image = Image.open(io.BytesIO(gif))
     assert image.format == "GIF"
@@ -330,16 +341,16 @@ def test_render_configuration_of_a_k_leg_route_and_schedule(k):
     route = _route(k)
     verified = certify(make_schedule(route, LIMITS, method=Exact()))
     for subject in (route, verified):
-        png = render_configuration(subject, names=("agv1", "agv2"))
-        assert png == render_retract_graph(subject, names=("agv1", "agv2"))
+        png = configuration_png(subject, names=("agv1", "agv2"))
+        assert png == retract_graph_png(subject, names=("agv1", "agv2"))
         image = Image.open(io.BytesIO(png))
         assert image.format == "PNG"
         assert image.size[0] > 800
         assert image.size[1] > 900
-    with pytest.raises(UnverifiedScheduleError, match="render_configuration takes a VerifiedSchedule"):
-        render_configuration(verified.schedule)
+    with pytest.raises(UnverifiedScheduleError, match="plot_configuration takes a VerifiedSchedule"):
+        configuration_png(verified.schedule)
     with pytest.raises(InputError, match="names must be two strings"):
-        render_configuration(route, names=("only one",))
+        configuration_png(route, names=("only one",))
     with pytest.raises(InputError, match=r"needs a YGraph .*retract graph"):
         ConfigurationLayout.of(route.graph)
 

@@ -24,7 +24,7 @@ from trajgen.model.schedule import TimingMethod
 from trajgen.model.summary import format_provenance
 from trajgen.online.messages import PERIOD_RANGE
 from trajgen.online.simulation import SimulationResult, parse_faults, simulate
-from trajgen.plots import render_simulation
+from trajgen.plots import plot_simulation, png_bytes
 from trajgen.scenario import Scenario
 
 __all__ = ["SIMULATION_PLOT_NAME", "SimulationRun", "format_simulation", "run_simulation", "simulation_paths"]
@@ -133,7 +133,7 @@ def run_simulation(
     trace_dir : path, optional
         Folder for ``<vehicle name>.csv`` of both vehicles: their executed (true) motion.
     plot_dir : path, optional
-        Folder for ``simulation.png`` (:func:`~trajgen.plots.render_simulation`).
+        Folder for ``simulation.png`` (:func:`~trajgen.plots.plot_simulation`).
     csv_options : CsvOptions, optional
         Dialect of the trace (delimiter, decimal mark, units); its ``sample_period`` and
         ``max_rows`` do not apply: the trace has one row per control period.
@@ -177,8 +177,8 @@ def run_simulation(
             for vehicle, path in enumerate(paths[:2]):
                 files[path] = trace.chunks(vehicle)
         if plot_dir is not None:
-            files[paths[-1]] = render_simulation(
-                result, names=scenario.names, min_separation=scenario.limits.min_separation
+            files[paths[-1]] = png_bytes(
+                plot_simulation(result, names=scenario.names, min_separation=scenario.limits.min_separation)
             )
         written = commit_files(files) if files else ()
     finally:

@@ -68,6 +68,10 @@ class Outputs:
         :data:`~trajgen.export.dialects.DIALECTS`).
     max_points : int or None
         Points per table of a table dialect (default: the dialect's limit).
+    compare : tuple of str
+        The timing methods whose schedules ``coordination.png`` compares with the run's own
+        (default: every registered one). Each is computed and certified for the plot: naming
+        ``optimal`` solves its NLPs. ``()``: the run's schedule alone.
     """
 
     csv_dir: Path | None = None
@@ -75,8 +79,12 @@ class Outputs:
     csv: CsvOptions = field(default_factory=CsvOptions)
     dialect: Dialect | str = "generic"
     max_points: int | None = None
+    compare: tuple = METHODS.names
 
     def __post_init__(self) -> None:
+        if isinstance(self.compare, str) or not all(isinstance(name, str) for name in self.compare):
+            raise InputError(f"compare must be a tuple of method names, got {self.compare!r}")
+        object.__setattr__(self, "compare", tuple(METHODS.canonical(name) for name in self.compare))
         object.__setattr__(self, "csv_dir", _folder(self.csv_dir, "CSV output folder"))
         object.__setattr__(self, "plot_dir", _folder(self.plot_dir, "plot output folder"))
         if not isinstance(self.csv, CsvOptions):
@@ -150,16 +158,20 @@ class RunResult:
 
 
 def _comparison(
-    route: Route, scenario: Scenario, chosen: TimingMethod, verified_chosen: VerifiedSchedule
+    route: Route,
+    scenario: Scenario,
+    chosen: TimingMethod,
+    verified_chosen: VerifiedSchedule,
+    compare: tuple[str, ...],
 ) -> tuple[dict, list[str]]:
-    """Every registered method's verified schedule of ``route`` for the coordination plot.
+    """The verified schedules of ``route`` by the ``compare`` methods, for the coordination plot.
 
     The run's own schedule stands for the method asked for (also after a fallback).
     """
     verified = {chosen.name: verified_chosen}
     notes = []
     for method in METHODS:
-        if method.name == chosen.name:
+        if method.name == chosen.name or method.name not in compare:
             continue
         try:
             verified[method.name] = certify(make_schedule(route, scenario.limits, method=method()))
@@ -229,15 +241,21 @@ def run(
         paths = profile_paths(scenario.names, outputs.csv_dir)
         files.update(zip(paths, profile_chunk_pair(verified, outputs.csv), strict=True))
     if outputs.plot_dir is not None:
-        from trajgen.plots import render_configuration, render_coordination, render_separation, render_speed
+        from trajgen.plots import (
+            plot_configuration,
+            plot_coordination,
+            plot_separation,
+            plot_speed,
+            png_bytes,
+        )
 
-        compared, plot_notes = _comparison(route, scenario, chosen, verified)
+        compared, plot_notes = _comparison(route, scenario, chosen, verified, outputs.compare)
         notes += plot_notes
         speed, separation, coordination, configuration = (outputs.plot_dir / name for name in PLOT_NAMES)
-        files[speed] = render_speed(verified, names=scenario.names)
-        files[separation] = render_separation(verified)
-        files[coordination] = render_coordination(compared)
-        files[configuration] = render_configuration(verified, names=scenario.names)
+        files[speed] = png_bytes(plot_speed(verified, names=scenario.names))
+        files[separation] = png_bytes(plot_separation(verified))
+        files[coordination] = png_bytes(plot_coordination(compared))
+        files[configuration] = png_bytes(plot_configuration(verified, names=scenario.names))
     written = commit_files(files) if files else ()
     # the schedule's route: optimal may have taken the other homotopy class
     return RunResult(scenario, chosen, verified.schedule.route, verified, written, tuple(notes), tables)

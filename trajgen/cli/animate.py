@@ -44,11 +44,14 @@ def _command_animate(args: argparse.Namespace) -> int:
     path = gif_path(args.out)
     playback(0.0, fps=args.fps, max_frames=args.max_frames)  # bad options are refused before computing
     from trajgen.pipeline import run
-    from trajgen.plots.animation_drawing import render_animation
+    from trajgen.plots.animation_drawing import animate
+    from trajgen.plots.gif import gif_bytes
 
     scenario = scenario_from(args.scenario)
     verified = run(scenario, method=method_from(args)).verified
-    gif = render_animation(verified, names=scenario.names, fps=args.fps, max_frames=args.max_frames)
+    animation = animate(verified, names=scenario.names, fps=args.fps, max_frames=args.max_frames)
+    samples = animation.palette_samples
+    gif = gif_bytes(animation.frames(), delays_ms=animation.delays_ms, palette_samples=samples)
     (written,) = commit_files({path: gif})
     play = playback(verified.schedule.duration, fps=args.fps, max_frames=args.max_frames)
     print(

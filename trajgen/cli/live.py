@@ -104,10 +104,11 @@ def _commit(log, log_path: str, plot_path: str | None, names) -> None:
     contents = {Path(log_path): log.chunks()}
     if plot_path is not None:
         from trajgen.live.runlog import read_run_log
-        from trajgen.plots.live_run import render_live_run
+        from trajgen.plots import plot_live_run, png_bytes
 
         try:
-            contents[Path(plot_path)] = render_live_run(read_run_log(log.records()), names=tuple(names))
+            figure = plot_live_run(read_run_log(log.records()), names=tuple(names))
+            contents[Path(plot_path)] = png_bytes(figure)
         except InputError as error:
             logger.warning("the picture of the run %s is not drawn: %s", plot_path, error)
     commit_files(contents)

@@ -106,8 +106,8 @@ class MethodRegistry:
             method = self._by_name[name] = method.load()
         return method
 
-    def lookup(self, name: object) -> type[TimingMethod]:
-        """The method class named ``name`` (case-insensitive).
+    def canonical(self, name: object) -> str:
+        """The registered name ``name`` means (case-insensitive), without loading the method.
 
         Raises
         ------
@@ -118,7 +118,17 @@ class MethodRegistry:
         if key not in self._by_name:
             text = repr(name) if len(repr(name)) <= 40 else repr(name)[:37] + "..."
             raise OptionError(f"method {text} is unknown: expected one of {list(self._by_name)!r}")
-        return self._load(key)
+        return key
+
+    def lookup(self, name: object) -> type[TimingMethod]:
+        """The method class named ``name`` (case-insensitive).
+
+        Raises
+        ------
+        OptionError
+            Naming the value and the accepted names.
+        """
+        return self._load(self.canonical(name))
 
     def create(self, method: TimingMethod | str | None = None) -> TimingMethod:
         """A method object: ``method`` itself, the named method with default options, or the default."""

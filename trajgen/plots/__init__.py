@@ -1,7 +1,10 @@
-"""Plots of verified schedules and simulated runs, rendered to PNG (or GIF) bytes (nothing here writes files).
+"""Plots of verified schedules and runs: each draws into an ``ax`` or ``figure`` and returns the Figure.
 
-Only :mod:`trajgen.plots.figure` imports matplotlib, and only when a plot is rendered. Each renderer is
-imported from its module when first used.
+Nothing here writes files: the pipeline and the command line turn Figures into PNG bytes
+(:func:`png_bytes`) and an :class:`Animation`'s frames into a GIF (:func:`gif_bytes`). A notebook
+composes and restyles them as it likes (``docs/plots.md``). Only :mod:`trajgen.plots.figure`
+imports matplotlib, and only when a plot is drawn; each plot is imported from its module when
+first used. The ``render_*`` functions of 0.6 (bytes) are deprecated shims for one release.
 """
 
 from typing import TYPE_CHECKING
@@ -9,16 +12,37 @@ from typing import TYPE_CHECKING
 from trajgen.lazy import lazy_attributes
 
 if TYPE_CHECKING:
-    from trajgen.plots.animation_drawing import render_animation
-    from trajgen.plots.configuration_drawing import render_configuration
-    from trajgen.plots.coordination import METHOD_COLOURS, render_coordination
-    from trajgen.plots.live_run import render_live_run
-    from trajgen.plots.separation import render_separation
-    from trajgen.plots.simulation import render_simulation
-    from trajgen.plots.speed import render_speed
+    from trajgen.plots.animation_drawing import Animation, animate
+    from trajgen.plots.configuration_drawing import plot_configuration
+    from trajgen.plots.coordination import METHOD_COLOURS, plot_coordination
+    from trajgen.plots.deprecated import (
+        render_animation,
+        render_configuration,
+        render_coordination,
+        render_live_run,
+        render_separation,
+        render_simulation,
+        render_speed,
+    )
+    from trajgen.plots.figure import png_bytes
+    from trajgen.plots.gif import gif_bytes
+    from trajgen.plots.live_run import plot_live_run
+    from trajgen.plots.separation import plot_separation
+    from trajgen.plots.simulation import plot_simulation
+    from trajgen.plots.speed import plot_speed
 
 __all__ = [
     "METHOD_COLOURS",
+    "Animation",
+    "animate",
+    "gif_bytes",
+    "plot_configuration",
+    "plot_coordination",
+    "plot_live_run",
+    "plot_separation",
+    "plot_simulation",
+    "plot_speed",
+    "png_bytes",
     "render_animation",
     "render_configuration",
     "render_coordination",
@@ -30,13 +54,17 @@ __all__ = [
 
 _SOURCES = {
     "METHOD_COLOURS": "trajgen.plots.coordination",
-    "render_animation": "trajgen.plots.animation_drawing",
-    "render_configuration": "trajgen.plots.configuration_drawing",
-    "render_coordination": "trajgen.plots.coordination",
-    "render_live_run": "trajgen.plots.live_run",
-    "render_separation": "trajgen.plots.separation",
-    "render_simulation": "trajgen.plots.simulation",
-    "render_speed": "trajgen.plots.speed",
+    "Animation": "trajgen.plots.animation_drawing",
+    "animate": "trajgen.plots.animation_drawing",
+    "gif_bytes": "trajgen.plots.gif",
+    "plot_configuration": "trajgen.plots.configuration_drawing",
+    "plot_coordination": "trajgen.plots.coordination",
+    "plot_live_run": "trajgen.plots.live_run",
+    "plot_separation": "trajgen.plots.separation",
+    "plot_simulation": "trajgen.plots.simulation",
+    "plot_speed": "trajgen.plots.speed",
+    "png_bytes": "trajgen.plots.figure",
+    **{name: "trajgen.plots.deprecated" for name in __all__ if name.startswith("render_")},
 }
 
 __getattr__, __dir__ = lazy_attributes(__name__, globals(), _SOURCES)

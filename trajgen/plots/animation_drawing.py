@@ -45,12 +45,11 @@ from trajgen.plots.animation import (
     speed_text,
 )
 from trajgen.plots.figure import frame_painter, new_figure
-from trajgen.plots.gif import gif_bytes
 from trajgen.plots.speed import VEHICLE_COLOURS
 from trajgen.progress import progress
 from trajgen.verification import VerifiedSchedule, require_verified
 
-__all__ = ["render_animation"]
+__all__ = ["Animation", "animate"]
 
 
 def _round_length(target: float) -> float:
@@ -295,14 +294,53 @@ def _check_names(names: object) -> tuple[str, str]:
     return (names[0], names[1])
 
 
-def render_animation(
+class Animation:
+    """A schedule played on the track seen from above: its frames, made one at a time when asked.
+
+    Made by :func:`animate`. The GIF is made at the edge (the command line):
+    ``gif_bytes(animation.frames(), delays_ms=animation.delays_ms,
+    palette_samples=animation.palette_samples)``.
+
+    Attributes
+    ----------
+    frame_count : int
+    delays_ms : tuple of float, shape (frame_count,)
+        How long each frame is shown, milliseconds (the last, the goal, is held
+        :data:`~trajgen.plots.animation.END_HOLD_MS`).
+    palette_samples : tuple of ndarray, each (height, width, 3), uint8
+        The first frame, the closest approach's and the last: the colours a GIF palette needs.
+    figure : matplotlib.figure.Figure
+        The scene, showing the frame drawn last.
+    """
+
+    __slots__ = ("_scene", "delays_ms", "frame_count", "palette_samples")
+
+    def __init__(self, scene: _Scene, frame_count: int, delays_ms, palette_samples) -> None:
+        self._scene = scene
+        self.frame_count = frame_count
+        self.delays_ms = tuple(delays_ms)
+        self.palette_samples = tuple(palette_samples)
+
+    @property
+    def figure(self):
+        """The scene's Figure, showing the frame drawn last."""
+        return self._scene.figure
+
+    def frames(self):
+        """Each frame in order, an RGB array of shape (height, width, 3), uint8, drawn when asked."""
+        count = self.frame_count
+        shown = progress(range(count), total=count, description="animation frames")
+        return (self._scene.pixels(k) for k in shown)
+
+
+def animate(
     verified: VerifiedSchedule,
     *,
     names: tuple[str, str] = ("vehicle 1", "vehicle 2"),
     fps: int = DEFAULT_FPS,
     max_frames: int = DEFAULT_MAX_FRAMES,
-) -> bytes:
-    """The schedule played on the track seen from above, as GIF bytes (nothing is written).
+) -> Animation:
+    """The schedule played on the track seen from above: an :class:`Animation` (nothing is encoded).
 
     Parameters
     ----------
@@ -319,10 +357,9 @@ def render_animation(
 
     Returns
     -------
-    bytes
-        An animated GIF of :data:`~trajgen.plots.animation.FRAME_WIDTH_PX` x
-        :data:`~trajgen.plots.animation.FRAME_HEIGHT_PX` pixels that loops; the last frame (the
-        goal) is held :data:`~trajgen.plots.animation.END_HOLD_MS` ms.
+    Animation
+        Frames of :data:`~trajgen.plots.animation.FRAME_WIDTH_PX` x
+        :data:`~trajgen.plots.animation.FRAME_HEIGHT_PX` pixels.
 
     Raises
     ------
@@ -333,7 +370,7 @@ def render_animation(
     InputError
         ``names`` is not two strings.
     """
-    schedule = require_verified(verified, "render_animation").schedule
+    schedule = require_verified(verified, "animate").schedule
     names = _check_names(names)
     play = playback(schedule.duration, fps=fps, max_frames=max_frames)
     geometry = frame_geometry(verified, play.times())
@@ -341,6 +378,5 @@ def render_animation(
     scene = _Scene(verified, geometry, layout, names, play)
     count = play.frame_count
     samples = [scene.pixels(k) for k in sorted({0, int(np.argmin(geometry.distance)), count - 1})]
-    frames = (scene.pixels(k) for k in progress(range(count), total=count, description="animation frames"))
     delays = [play.delay_ms] * (count - 1) + [END_HOLD_MS]
-    return gif_bytes(frames, delays_ms=delays, palette_samples=samples)
+    return Animation(scene, count, delays, samples)

@@ -5,7 +5,7 @@ The picture is drawn on :class:`trajgen.plots.configuration.ConfigurationLayout`
 boundary circle, the too-close parts, the route, a schedule's path, retraction
 traces and the motion retracted onto the circle, rendered to PNG bytes. A
 junction of four or more legs has no flat drawing: it is handed to
-:func:`trajgen.plots.retract_graph.render_retract_graph`.
+:func:`trajgen.plots.retract_graph.plot_retract_graph`.
 """
 
 from __future__ import annotations
@@ -16,11 +16,11 @@ from topology import JUNCTION_INDEX, RegionKey, Route, YGraph
 from topology.indexed import IndexedConfiguration
 from trajgen.model.summary import class_label
 from trajgen.plots.configuration import ConfigurationLayout, rotate, route_samples, schedule_samples
-from trajgen.plots.figure import new_figure, png_bytes
-from trajgen.plots.retract_graph import configuration_subject, render_retract_graph
+from trajgen.plots.figure import drawing_area, finished
+from trajgen.plots.retract_graph import configuration_subject, plot_retract_graph
 from trajgen.verification import VerifiedSchedule
 
-__all__ = ["render_configuration"]
+__all__ = ["plot_configuration"]
 
 
 #: Fill colours of the quadrangles and the triangles; colours of the route, the schedule and the retraction.
@@ -163,11 +163,13 @@ def _draw_retraction(
         )
 
 
-def render_configuration(subject: Route | VerifiedSchedule, *, names: tuple[str, str] | None = None) -> bytes:
-    """The configuration space drawn flat with the route, the motion and its retraction, as PNG bytes.
+def plot_configuration(
+    subject: Route | VerifiedSchedule, *, names: tuple[str, str] | None = None, figure=None
+):
+    """The configuration space drawn flat with the route, the motion and its retraction.
 
     Four or more legs: the retract graph ``G_k`` with the route on it instead
-    (:func:`trajgen.plots.retract_graph.render_retract_graph`): the space has no flat drawing.
+    (:func:`trajgen.plots.retract_graph.plot_retract_graph`): the space has no flat drawing.
 
     Drawn: the six quadrangles and six triangles (folded out beside their valleys, see
     :class:`~trajgen.plots.configuration.ConfigurationLayout`) round the deleted point, the
@@ -183,6 +185,12 @@ def render_configuration(subject: Route | VerifiedSchedule, *, names: tuple[str,
         (its route and its path are drawn).
     names : pair of str, optional
         The vehicles' names, for the title (default: "vehicle 1", "vehicle 2").
+    figure : matplotlib Figure or SubFigure, optional
+        Where to draw (default: a new Figure of 8.6 x 9.6 inches).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
 
     Raises
     ------
@@ -197,11 +205,11 @@ def render_configuration(subject: Route | VerifiedSchedule, *, names: tuple[str,
         required = max(verified.schedule.limits.min_separation, required)
     graph = route.graph
     if graph.cycle is None:  # four or more legs: no flat drawing, the retract graph G_k instead
-        return render_retract_graph(subject, names=names)
+        return plot_retract_graph(subject, names=names, figure=figure)
     layout = ConfigurationLayout.of(graph, min_separation=required)
     who = "vehicle 1 and vehicle 2" if names is None else f"{names[0]} (vehicle 1) and {names[1]} (vehicle 2)"
-    figure = new_figure(figsize=(8.6, 9.6))
-    axis = figure.add_axes((0.02, 0.265, 0.96, 0.655))
+    area = drawing_area(figure, figsize=(8.6, 9.6))
+    axis = area.add_axes((0.02, 0.265, 0.96, 0.655))
     axis.set_aspect("equal")
     axis.set_axis_off()
     axis.set_xlim(-1.32, 1.32)
@@ -263,7 +271,7 @@ def render_configuration(subject: Route | VerifiedSchedule, *, names: tuple[str,
         f"Configuration space of {who}, drawn flat\nroute: {class_label(route)}; regions {regions}",
         fontsize=11,
     )
-    figure.text(
+    area.text(
         0.05,
         0.015,
         "\n".join(
@@ -282,4 +290,4 @@ def render_configuration(subject: Route | VerifiedSchedule, *, names: tuple[str,
         va="bottom",
         family="sans-serif",
     )
-    return png_bytes(figure)
+    return finished(area, laid_out=False)  # its axes are placed by hand

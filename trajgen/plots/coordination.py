@@ -11,25 +11,43 @@ from trajgen.methods import METHODS
 from trajgen.model.analysis import travelled
 from trajgen.model.coordination import CoordinationDiagram, plan_paths
 from trajgen.model.summary import class_label
-from trajgen.plots.figure import new_figure, png_bytes, polygon_patch
+from trajgen.plots.figure import drawing_area, finished, polygon_patch
 from trajgen.plots.speed import VEHICLE_COLOURS, plot_period
 from trajgen.verification import VerifiedSchedule, require_verified
 
-__all__ = ["METHOD_COLOURS", "coordination_figure", "render_coordination"]
+__all__ = ["METHOD_COLOURS", "plot_coordination"]
 
 _PALETTE = ("tab:blue", "tab:green", "tab:red", "tab:purple", "tab:brown", "tab:pink", "tab:olive")
 #: Curve colour of each registered method, in registry order.
 METHOD_COLOURS = {name: _PALETTE[k % len(_PALETTE)] for k, name in enumerate(METHODS.names)}
 
 
-def coordination_figure(verified: Mapping[str, VerifiedSchedule]):
-    """The coordination diagram as a matplotlib Figure (see :func:`render_coordination`)."""
+def plot_coordination(verified: Mapping[str, VerifiedSchedule], *, figure=None):
+    """The coordination diagram: both vehicles' travel, one panel per pair of paths.
+
+    Each panel holds the schedules that drive the same paths (the route's paths for ``exact`` and
+    ``toppra``; ``optimal`` may take the other homotopy class or park shallower, so its paths, and
+    therefore its axes and its too-close region, differ: the figure says so). The too-close region
+    is drawn exactly, as the convex polygons of :class:`~trajgen.model.coordination.CoordinationDiagram`.
+    A schedule's curve must stay out of the shaded region of its panel.
+
+    Parameters
+    ----------
+    verified : mapping of method name to VerifiedSchedule
+        At least one: the schedules to compare (the pipeline's ``Outputs(compare=...)``).
+    figure : matplotlib Figure or SubFigure, optional
+        Where to draw the panels (default: a new Figure, 5.2 inches wide per panel).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
     if not isinstance(verified, Mapping) or not verified:
         raise InputError(
             "the coordination plot needs a mapping of method name to VerifiedSchedule, "
             f"got {type(verified).__name__}"
         )
-    schedules = {name: require_verified(v, "render_coordination").schedule for name, v in verified.items()}
+    schedules = {name: require_verified(v, "plot_coordination").schedule for name, v in verified.items()}
     distances = {
         name: travelled(schedule, plot_period(schedule.duration))[1] for name, schedule in schedules.items()
     }
@@ -37,8 +55,8 @@ def coordination_figure(verified: Mapping[str, VerifiedSchedule]):
     for name, distance in distances.items():
         key = tuple(np.round(distance[:, -1], 6))  # same paths drive the same distances
         groups.setdefault(key, []).append(name)
-    figure = new_figure(figsize=(5.2 * len(groups), 5.4 if len(groups) > 1 else 5.0))
-    panels = figure.subplots(1, len(groups), squeeze=False)[0]
+    area = drawing_area(figure, figsize=(5.2 * len(groups), 5.4 if len(groups) > 1 else 5.0))
+    panels = area.subplots(1, len(groups), squeeze=False)[0]
     for axis, names in zip(panels, groups.values(), strict=True):
         reference = schedules[names[0]]
         required = max(reference.limits.min_separation, reference.route.min_separation)
@@ -74,27 +92,9 @@ def coordination_figure(verified: Mapping[str, VerifiedSchedule]):
         axis.legend(loc="best", fontsize=7)
         axis.grid(True, alpha=0.3)
     if len(groups) > 1:
-        figure.suptitle(
+        area.suptitle(
             "one panel per pair of paths: the methods drive different paths (another homotopy class, "
             "or parking less deep),\nso each panel has its own axes and its own too-close region",
             fontsize=9,
         )
-    figure.tight_layout()
-    return figure
-
-
-def render_coordination(verified: Mapping[str, VerifiedSchedule]) -> bytes:
-    """The coordination diagram as PNG bytes.
-
-    Each panel holds the schedules that drive the same paths (the route's paths for ``exact`` and
-    ``toppra``; ``optimal`` may take the other homotopy class or park shallower, so its paths, and
-    therefore its axes and its too-close region, differ: the figure says so). The too-close region
-    is drawn exactly, as the convex polygons of :class:`~trajgen.model.coordination.CoordinationDiagram`.
-    A schedule's curve must stay out of the shaded region of its panel.
-
-    Parameters
-    ----------
-    verified : mapping of method name to VerifiedSchedule
-        At least one.
-    """
-    return png_bytes(coordination_figure(verified))
+    return finished(area, laid_out=figure is None)

@@ -1,10 +1,25 @@
-"""The one module that imports matplotlib (lazily): figures without pyplot, rendered to PNG bytes."""
+"""The one module that imports matplotlib (lazily): figures without pyplot, and their PNG bytes.
+
+The plots draw into an ``ax`` or ``figure`` a caller gives (a notebook composing several) or into
+a new Figure, and return the Figure; :func:`png_bytes` is for the edges (the pipeline, the command
+line) that write files.
+"""
 
 from __future__ import annotations
 
 import io
 
-__all__ = ["PNG_DPI", "frame_painter", "new_figure", "png_bytes", "polygon_patch"]
+__all__ = [
+    "PNG_DPI",
+    "drawing_area",
+    "drawing_axis",
+    "finished",
+    "frame_painter",
+    "new_figure",
+    "png_bytes",
+    "polygon_patch",
+    "root_figure",
+]
 
 #: Resolution of the PNGs, dots per inch.
 PNG_DPI = 110
@@ -21,6 +36,35 @@ def new_figure(*, figsize: tuple[float, float]):
     from matplotlib.figure import Figure
 
     return Figure(figsize=figsize)
+
+
+def drawing_area(figure, *, figsize: tuple[float, float]):
+    """Where a plot of several axes draws: ``figure`` (a Figure or SubFigure), else a new Figure."""
+    return new_figure(figsize=figsize) if figure is None else figure
+
+
+def drawing_axis(ax, *, figsize: tuple[float, float]):
+    """Where a plot of one axis draws: ``ax``, else the one axis of a new Figure of ``figsize`` inches."""
+    return new_figure(figsize=figsize).subplots() if ax is None else ax
+
+
+def root_figure(part):
+    """The Figure that holds ``part`` (an Axes, a SubFigure or the Figure itself)."""
+    figure = part.figure
+    while figure.figure is not figure:  # a SubFigure's figure is its parent's
+        figure = figure.figure
+    return figure
+
+
+def finished(area, *, laid_out: bool):
+    """The Figure of a plot drawn into ``area``; laid out tightly when the plot made it (``laid_out``).
+
+    A figure given by the caller keeps the layout the caller chose.
+    """
+    figure = root_figure(area)
+    if laid_out:
+        figure.tight_layout()
+    return figure
 
 
 def polygon_patch(vertices, *, facecolor, alpha: float, edgecolor, label: str | None = None):

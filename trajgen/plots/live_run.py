@@ -10,10 +10,10 @@ import numpy as np
 
 from topology.validation import short_repr
 from trajgen.errors import InputError
-from trajgen.plots.figure import new_figure, png_bytes, time_label
+from trajgen.plots.figure import drawing_area, finished, time_label
 from trajgen.plots.speed import VEHICLE_COLOURS
 
-__all__ = ["render_live_run"]
+__all__ = ["plot_live_run"]
 
 logger = logging.getLogger(__name__)
 
@@ -233,8 +233,8 @@ def _progress(axis, states: np.ndarray, orders: np.ndarray, colour: str, last_t:
     )
 
 
-def render_live_run(run: dict, *, names: tuple[str, str]) -> bytes:
-    """PNG picture of a live run: each vehicle's progress along its path against time, and the events.
+def plot_live_run(run: dict, *, names: tuple[str, str], figure=None):
+    """A live run: each vehicle's progress along its path against time, and the events.
 
     Each vehicle's progress along its path against time with its released base (frontier) as a step
     line above it, and the run's events. One axis per vehicle (titled with its name, in its colour of
@@ -256,11 +256,12 @@ def render_live_run(run: dict, *, names: tuple[str, str]) -> bytes:
         ``replan``) and ``end`` (the end record, with ``outcome`` and ``makespan_s`` s, or ``None``).
     names : pair of str
         The two vehicles' names, as in the log: the first is drawn above in the first colour.
+    figure : matplotlib Figure or SubFigure, optional
+        Where to draw the two axes (default: a new Figure of 11 x 7.5 inches).
 
     Returns
     -------
-    bytes
-        The PNG image (nothing is written to disk).
+    matplotlib.figure.Figure
 
     Raises
     ------
@@ -275,8 +276,8 @@ def render_live_run(run: dict, *, names: tuple[str, str]) -> bytes:
     times += [event[0] for event in events[-1:]] + ([float(end_t)] if end_t is not None else [])
     last_t = max(times)
     first_t = min([rows[0, 0] for rows in progress] + [rows[0, 0] for rows in frontiers if rows.shape[0]])
-    figure = new_figure(figsize=(11, 7.5))
-    axes = figure.subplots(2, 1, sharex=True)
+    area = drawing_area(figure, figsize=(11, 7.5))
+    axes = area.subplots(2, 1, sharex=True)
     for vehicle, (axis, name) in enumerate(zip(axes, names, strict=True)):
         colour = VEHICLE_COLOURS[vehicle]
         _progress(axis, progress[vehicle], frontiers[vehicle], colour, last_t)
@@ -296,10 +297,9 @@ def render_live_run(run: dict, *, names: tuple[str, str]) -> bytes:
         heading = f"live run: {outcome if outcome is not None else 'ended'}"
         if makespan is not None:
             heading += f", makespan {makespan:.2f} s"
-    figure.suptitle(
+    area.suptitle(
         f"{heading}\n(solid: progress along the path; dashed: the released base's frontier, "
         "not to be passed; grey: offline)",
         fontsize=10,
     )
-    figure.tight_layout()
-    return png_bytes(figure)
+    return finished(area, laid_out=figure is None)

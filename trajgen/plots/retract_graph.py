@@ -44,7 +44,7 @@ from topology.indexed import IndexedConfiguration, step
 from trajgen.errors import InputError
 from trajgen.model.summary import class_label
 from trajgen.model.values import ArrayValue, readonly
-from trajgen.plots.figure import new_figure, png_bytes
+from trajgen.plots.figure import drawing_area, finished
 from trajgen.plots.speed import VEHICLE_COLOURS, plot_period
 from trajgen.verification import VerifiedSchedule, require_verified
 
@@ -53,8 +53,8 @@ __all__ = [
     "RULE_WORDS",
     "RetractGraphLayout",
     "instruction_text",
+    "plot_retract_graph",
     "point_name",
-    "render_retract_graph",
     "route_points",
     "schedule_points",
     "vertex_name",
@@ -485,12 +485,14 @@ def configuration_subject(
         raise InputError(f"configuration plot names must be two strings, got {names!r}")
     if isinstance(subject, Route):
         return subject, None
-    verified = require_verified(subject, "render_configuration")
+    verified = require_verified(subject, "plot_configuration")
     return verified.schedule.route, verified
 
 
-def render_retract_graph(subject: Route | VerifiedSchedule, *, names: tuple[str, str] | None = None) -> bytes:
-    """The retract graph ``G_k`` drawn as a table with the route on it, as PNG bytes.
+def plot_retract_graph(
+    subject: Route | VerifiedSchedule, *, names: tuple[str, str] | None = None, figure=None
+):
+    """The retract graph ``G_k`` drawn as a table with the route on it.
 
     Drawn (see :class:`RetractGraphLayout`): the ``k (k + 1)`` vertices and ``2 k (k - 1)``
     edges of ``G_k`` (each edge in the colour of the vehicle that drives its leg on it), the
@@ -507,6 +509,13 @@ def render_retract_graph(subject: Route | VerifiedSchedule, *, names: tuple[str,
     names : pair of str, optional
         The vehicles' names, for the title (default: "vehicle 1", "vehicle 2").
 
+    figure : matplotlib Figure or SubFigure, optional
+        Where to draw (default: a new Figure of of the table's size inches).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+
     Raises
     ------
     UnverifiedScheduleError
@@ -521,8 +530,8 @@ def render_retract_graph(subject: Route | VerifiedSchedule, *, names: tuple[str,
     points = route_points(route)
     passed = {p.vertex for p in points if p.vertex >= 0}
     who = "vehicle 1 and vehicle 2" if names is None else f"{names[0]} (vehicle 1) and {names[1]} (vehicle 2)"
-    figure = new_figure(figsize=(_WIDTH_IN, _HEIGHT_IN))
-    axis = figure.add_axes((0.02, 0.27, 0.96, 0.655))
+    area = drawing_area(figure, figsize=(_WIDTH_IN, _HEIGHT_IN))
+    axis = area.add_axes((0.02, 0.27, 0.96, 0.655))
     axis.set_aspect("equal")
     axis.set_axis_off()
     axis.set_xlim(-1.5, k + 0.55)
@@ -561,11 +570,11 @@ def render_retract_graph(subject: Route | VerifiedSchedule, *, names: tuple[str,
         label=f"goal {route.goal} retracts to {point_name(graph, points[-1])}",
     )
     axis.legend(loc="upper left", bbox_to_anchor=(0.0, -0.005), fontsize=8, frameon=False)
-    _draw_track(figure, graph, route, (0.8, 0.11, 0.18, 0.13))
+    _draw_track(area, graph, route, (0.8, 0.11, 0.18, 0.13))
     axis.set_title(
         f"Retract graph G_{k} of {who}: {len(layout.vertices)} vertices, {len(layout.edges)} edges\n"
         f"class {class_label(route)}\n{instruction_text(route)}",
         fontsize=11,
     )
-    figure.text(0.03, 0.012, "\n".join(_FOOTNOTE), fontsize=7.5, va="bottom", family="sans-serif")
-    return png_bytes(figure)
+    area.text(0.03, 0.012, "\n".join(_FOOTNOTE), fontsize=7.5, va="bottom", family="sans-serif")
+    return finished(area, laid_out=False)  # its axes are placed by hand

@@ -6,21 +6,32 @@ import numpy as np
 
 from topology.indexed import track_distance
 from trajgen.model.summary import class_label
-from trajgen.plots.figure import new_figure, png_bytes
+from trajgen.plots.figure import drawing_axis, finished
 from trajgen.plots.speed import plot_period
 from trajgen.verification import VerifiedSchedule, require_verified
 
-__all__ = ["render_separation"]
+__all__ = ["plot_separation"]
 
 
-def render_separation(verified: VerifiedSchedule) -> bytes:
-    """Track distance between the vehicles over time with the minimum line, as PNG bytes."""
-    schedule = require_verified(verified, "render_separation").schedule
+def plot_separation(verified: VerifiedSchedule, *, ax=None):
+    """Track distance between the vehicles over time, with the minimum line.
+
+    Parameters
+    ----------
+    verified : VerifiedSchedule
+    ax : matplotlib Axes, optional
+        Where to draw (default: a new Figure of 10.5 x 4 inches).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        The figure holding the plot.
+    """
+    schedule = require_verified(verified, "plot_separation").schedule
     state = schedule.sample(plot_period(schedule.duration))
     distance = track_distance(state.leg[0], state.s[0], state.leg[1], state.s[1])
     required = max(schedule.limits.min_separation, schedule.route.min_separation)
-    figure = new_figure(figsize=(10.5, 4))
-    axis = figure.subplots()
+    axis = drawing_axis(ax, figsize=(10.5, 4))
     axis.plot(state.t, distance, label="track distance")
     axis.axhline(required, color="tab:red", linestyle="--", label=f"minimum {required:g} m")
     closest = int(np.argmin(distance))
@@ -41,5 +52,4 @@ def render_separation(verified: VerifiedSchedule) -> bytes:
     )
     axis.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=9)
     axis.grid(True, alpha=0.3)
-    figure.tight_layout()
-    return png_bytes(figure)
+    return finished(axis, laid_out=ax is None)

@@ -8,10 +8,10 @@ import numpy as np
 
 from topology.validation import short_repr
 from trajgen.errors import InputError
-from trajgen.plots.figure import new_figure, png_bytes, polygon_patch, time_label
+from trajgen.plots.figure import drawing_area, finished, polygon_patch, time_label
 from trajgen.plots.speed import VEHICLE_COLOURS
 
-__all__ = ["render_simulation"]
+__all__ = ["plot_simulation"]
 
 #: Colour of the fault marks (lines and spans).
 FAULT_COLOUR = "tab:gray"
@@ -90,8 +90,8 @@ def _coordination(axis, result, names, min_separation: float) -> None:
     axis.legend(loc="lower right", fontsize=7)
 
 
-def render_simulation(result, *, names: tuple[str, str], min_separation: float) -> bytes:
-    """A simulated run as PNG bytes: speeds, separation, progress with frontiers, coordination diagram.
+def plot_simulation(result, *, names: tuple[str, str], min_separation: float, figure=None):
+    """A simulated run: speeds, separation, progress with frontiers, coordination diagram.
 
     Left: each vehicle's velocity along its axis, m/s, planned (the undisturbed schedule, dashed)
     and executed (the plant's true motion); below, the true track distance, m, with the minimum
@@ -109,6 +109,12 @@ def render_simulation(result, *, names: tuple[str, str], min_separation: float) 
         Legend labels of the vehicles.
     min_separation : float
         The separation the run had to keep, metres (the scenario's, not the plan's wider one).
+    figure : matplotlib Figure or SubFigure, optional
+        Where to draw the four axes (default: a new Figure of 15 x 8.5 inches).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
 
     Raises
     ------
@@ -119,7 +125,7 @@ def render_simulation(result, *, names: tuple[str, str], min_separation: float) 
     from trajgen.online.simulation import SimulationResult
 
     if not isinstance(result, SimulationResult):
-        raise InputError(f"render_simulation expects a SimulationResult, got {type(result).__name__}")
+        raise InputError(f"plot_simulation expects a SimulationResult, got {type(result).__name__}")
     if (
         isinstance(min_separation, bool)
         or not isinstance(min_separation, (int, float))
@@ -129,12 +135,12 @@ def render_simulation(result, *, names: tuple[str, str], min_separation: float) 
         raise InputError(f"min_separation (m) must be a finite number >= 0, got {short_repr(min_separation)}")
     t = np.asarray(result.plot["t"])
     planned = result.schedule.schedule.state(t).velocity
-    figure = new_figure(figsize=(15, 8.5))
-    grid = figure.add_gridspec(2, 2, width_ratios=(1.25, 1.0))
-    speed_axis = figure.add_subplot(grid[0, 0])
-    separation_axis = figure.add_subplot(grid[1, 0], sharex=speed_axis)
-    progress_axis = figure.add_subplot(grid[0, 1], sharex=speed_axis)
-    coordination_axis = figure.add_subplot(grid[1, 1])
+    area = drawing_area(figure, figsize=(15, 8.5))
+    grid = area.add_gridspec(2, 2, width_ratios=(1.25, 1.0))
+    speed_axis = area.add_subplot(grid[0, 0])
+    separation_axis = area.add_subplot(grid[1, 0], sharex=speed_axis)
+    progress_axis = area.add_subplot(grid[0, 1], sharex=speed_axis)
+    coordination_axis = area.add_subplot(grid[1, 1])
     for vehicle in range(2):
         colour = VEHICLE_COLOURS[vehicle]
         speed_axis.plot(
@@ -173,5 +179,4 @@ def render_simulation(result, *, names: tuple[str, str], min_separation: float) 
         f"{result.violations} violations\n(dashed: the undisturbed plan; grey: faults)",
         fontsize=10,
     )
-    figure.tight_layout()
-    return png_bytes(figure)
+    return finished(area, laid_out=figure is None)

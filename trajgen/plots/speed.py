@@ -3,10 +3,10 @@
 from __future__ import annotations
 
 from trajgen.model.summary import class_label
-from trajgen.plots.figure import new_figure, png_bytes
+from trajgen.plots.figure import drawing_area, finished
 from trajgen.verification import VerifiedSchedule, require_verified
 
-__all__ = ["MAX_PLOT_POINTS", "PLOT_PERIOD", "VEHICLE_COLOURS", "plot_period", "render_speed", "speed_figure"]
+__all__ = ["MAX_PLOT_POINTS", "PLOT_PERIOD", "VEHICLE_COLOURS", "plot_period", "plot_speed"]
 
 #: Sample period of the plotted curves, seconds (longer for long schedules: see :func:`plot_period`).
 PLOT_PERIOD = 0.01
@@ -23,8 +23,10 @@ def plot_period(duration: float) -> float:
 VEHICLE_COLOURS = ("tab:blue", "tab:orange")
 
 
-def render_speed(verified: VerifiedSchedule, *, names: tuple[str, str] = ("vehicle 1", "vehicle 2")) -> bytes:
-    """``v``, ``a``, ``j`` over time for both vehicles with their limit lines, as PNG bytes.
+def plot_speed(
+    verified: VerifiedSchedule, *, names: tuple[str, str] = ("vehicle 1", "vehicle 2"), figure=None
+):
+    """``v``, ``a``, ``j`` over time for both vehicles with their limit lines, one axis each.
 
     Each is along the vehicle's own axis, which grows in the direction of its first move: a
     negative ``v`` is a vehicle moving against it, backing out of a side leg it entered to make
@@ -35,16 +37,17 @@ def render_speed(verified: VerifiedSchedule, *, names: tuple[str, str] = ("vehic
     verified : VerifiedSchedule
     names : pair of str
         Legend labels.
+    figure : matplotlib Figure or SubFigure, optional
+        Where to draw the three axes (default: a new Figure of 10.5 x 7.5 inches).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
     """
-    return png_bytes(speed_figure(verified, names=names))
-
-
-def speed_figure(verified: VerifiedSchedule, *, names: tuple[str, str] = ("vehicle 1", "vehicle 2")):
-    """The figure of :func:`render_speed`, a matplotlib Figure."""
-    schedule = require_verified(verified, "render_speed").schedule
+    schedule = require_verified(verified, "plot_speed").schedule
     state = schedule.sample(plot_period(schedule.duration))
-    figure = new_figure(figsize=(10.5, 7.5))
-    axes = figure.subplots(3, 1, sharex=True)
+    area = drawing_area(figure, figsize=(10.5, 7.5))
+    axes = area.subplots(3, 1, sharex=True)
     rows = [
         (state.velocity, "max_velocity", "v [m/s]", "m/s"),
         (state.acceleration, "max_acceleration", "a [m/s²]", "m/s²"),
@@ -78,5 +81,4 @@ def speed_figure(verified: VerifiedSchedule, *, names: tuple[str, str] = ("vehic
         fontsize=10,
     )
     axes[-1].set_xlabel("t [s]")
-    figure.tight_layout()
-    return figure
+    return finished(area, laid_out=figure is None)
