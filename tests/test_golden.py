@@ -65,3 +65,26 @@ def test_a_long_schedule_hashes_to_the_golden_digests(length):
     # a different duration means the schedule changed, not its formatting
     assert verified.schedule.duration == duration
     assert profile_digests(verified, CsvOptions()) == digests
+
+
+#: VDA 5050 exports stored before the orders were built from the vda5050-sdk models (issue 36).
+VDA5050_GOLDEN = GOLDEN.parent / "golden-vda5050"
+VDA5050_START = "2026-05-01T08:00:00Z"
+
+
+@pytest.mark.parametrize("case", ["swap-exact", "crossing-toppra"])
+def test_the_vda5050_export_is_byte_identical_to_its_golden_files(case, tmp_path):
+    from tests.conftest import REPO
+    from trajgen.cli import main
+
+    scenario, method = case.split("-")
+    out = tmp_path / case
+    options = ["--method", method, "--start-time", VDA5050_START, "--out", str(out)]
+    status = main(["export-vda5050", str(REPO / "examples" / f"{scenario}.toml"), *options])
+    assert status == 0
+    stored = VDA5050_GOLDEN / case
+    names = sorted(p.relative_to(stored).as_posix() for p in stored.rglob("*.json"))
+    assert names == sorted(p.relative_to(out).as_posix() for p in out.rglob("*.json"))
+    for name in names:
+        problem = first_difference((stored / name).read_bytes(), (out / name).read_bytes())
+        assert problem is None, f"{case}/{name}: {problem}"

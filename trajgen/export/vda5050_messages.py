@@ -29,6 +29,7 @@ __all__ = [
     "OrderMessage",
     "edge_id",
     "node_id",
+    "order_document",
     "order_elements",
     "render_manifest",
     "render_orders",
@@ -83,46 +84,61 @@ def _node_description(node: PathNode) -> str:
     return ", ".join(parts)
 
 
-def _node_json(graph: StarGraph, node: PathNode, sequence: int, released: bool, map_id: str) -> dict:
+def _node(graph: StarGraph, node: PathNode, sequence: int, released: bool, map_id: str, deviation):
+    from vda5050.model.order import Node
+
     angle = math.radians(graph.angles_deg[node.leg]) if node.leg != JUNCTION_INDEX else 0.0
-    return {
-        "nodeId": node_id(graph, node.leg, node.s),
-        "sequenceId": sequence,
-        "nodeDescription": _node_description(node),
-        "released": released,
-        "nodePosition": {
+    return Node(
+        node_id=node_id(graph, node.leg, node.s),
+        sequence_id=sequence,
+        node_description=_node_description(node),
+        released=released,
+        node_position={
             "x": _coordinate(node.s * math.cos(angle)),
             "y": _coordinate(node.s * math.sin(angle)),
-            "mapId": map_id,
+            "allowed_deviation_xy": deviation,
+            "map_id": map_id,
         },
-        "actions": [],
-    }
+        actions=[],
+    )
 
 
-def _edge_json(graph: StarGraph, path: OrderPath, edge: PathEdge, released: bool) -> dict:
+def _edge(graph: StarGraph, path: OrderPath, edge: PathEdge, sequence: int, released: bool):
+    from vda5050.model.order import Edge
+
     start, end = path.nodes[edge.index], path.nodes[edge.index + 1]
     first, second = node_id(graph, start.leg, start.s), node_id(graph, end.leg, end.s)
-    data = {
-        "edgeId": edge_id(first, second),
-        "sequenceId": 2 * edge.index + 1,
-        "released": released,
-        "startNodeId": first,
-        "endNodeId": second,
-        "maxSpeed": edge.max_speed,
-        "length": _coordinate(edge.length),
-        "orientation": math.pi if edge.backward else 0.0,
-        "orientationType": "TANGENTIAL",
-        "actions": [],
-    }
-    if start.leg == JUNCTION_INDEX and end.leg != JUNCTION_INDEX:
-        data["direction"] = graph.names[end.leg]  # the leg taken at the junction
-    return data
+    return Edge(
+        edge_id=edge_id(first, second),
+        sequence_id=sequence,
+        released=released,
+        start_node_id=first,
+        end_node_id=second,
+        max_speed=edge.max_speed,
+        length=_coordinate(edge.length),
+        orientation=math.pi if edge.backward else 0.0,
+        orientation_type="TANGENTIAL",
+        # the leg taken at the junction
+        direction=graph.names[end.leg] if start.leg == JUNCTION_INDEX and end.leg != JUNCTION_INDEX else None,
+        actions=[],
+    )
 
 
 def order_elements(
-    graph: StarGraph, path: OrderPath, *, first: int, decision_point: int, map_id: str
-) -> tuple[list[dict], list[dict]]:
-    """The ``nodes`` and ``edges`` of an order (update) of ``path``, as JSON documents.
+    graph: StarGraph,
+    path: OrderPath,
+    *,
+    first: int,
+    decision_point: int,
+    map_id: str,
+    last: int | None = None,
+    sequence_offset: int = 0,
+    node_deviation: float | None = None,
+) -> tuple[list, list]:
+    """The ``nodes`` and ``edges`` of an order (update) of ``path``, as vda5050-sdk models.
+
+    The one builder of VDA 5050 order elements: the file export (:func:`render_orders`) and the
+    live master (:mod:`trajgen.live.orders`) both take theirs from here.
 
     Parameters
     ----------
@@ -134,23 +150,75 @@ def order_elements(
         Index of the last base node; the nodes and edges after it are the horizon.
     map_id : str
         ``nodePosition.mapId``.
+    last : int, optional
+        Index of the last node sent (default: the path's last).
+    sequence_offset : int, optional
+        Added to every ``sequenceId`` (a path stitched after a goal change continues the numbering).
+    node_deviation : float, optional
+        ``nodePosition.allowedDeviationXY``, metres (default: none written).
 
     Returns
     -------
-    nodes, edges : list of dict
-        Node ``j`` has ``sequenceId`` ``2 j``, edge ``k`` ``2 k + 1``.
+    nodes : list of vda5050.model.order.Node
+        Node ``j`` has ``sequenceId`` ``2 j`` (plus the offset).
+    edges : list of vda5050.model.order.Edge
+        Edge ``k`` has ``sequenceId`` ``2 k + 1`` (plus the offset).
     """
+    last = len(path.nodes) - 1 if last is None else last
     nodes = [
-        _node_json(graph, node, 2 * j, j <= decision_point, map_id)
-        for j, node in enumerate(path.nodes)
-        if j >= first
+        _node(graph, path.nodes[j], sequence_offset + 2 * j, j <= decision_point, map_id, node_deviation)
+        for j in range(first, last + 1)
     ]
     edges = [
-        _edge_json(graph, path, edge, edge.index < decision_point)
-        for edge in path.edges
-        if edge.index >= first
+        _edge(graph, path, path.edges[k], sequence_offset + 2 * k + 1, k < decision_point)
+        for k in range(first, last)
     ]
     return nodes, edges
+
+
+#: Key order of each kind of object in the files (the sdk's models order some fields otherwise).
+_FILE_KEYS = {
+    "order": (
+        "headerId",
+        "timestamp",
+        "version",
+        "manufacturer",
+        "serialNumber",
+        "orderId",
+        "orderUpdateId",
+        "nodes",
+        "edges",
+    ),
+    "node": ("nodeId", "sequenceId", "nodeDescription", "released", "nodePosition", "actions"),
+    "edge": (
+        "edgeId",
+        "sequenceId",
+        "released",
+        "startNodeId",
+        "endNodeId",
+        "maxSpeed",
+        "length",
+        "orientation",
+        "orientationType",
+        "actions",
+        "direction",
+    ),
+}
+
+
+def _in_file_order(document: dict, kind: str) -> dict:
+    keys = _FILE_KEYS[kind]
+    ordered = {key: document[key] for key in keys if key in document}
+    ordered.update((key, value) for key, value in document.items() if key not in ordered)
+    return ordered
+
+
+def order_document(order) -> dict:
+    """An order model (vda5050-sdk ``Order``) as the JSON document of the files, keys in their order."""
+    document = _in_file_order(order.model_dump(mode="json", by_alias=True, exclude_none=True), "order")
+    document["nodes"] = [_in_file_order(node, "node") for node in document["nodes"]]
+    document["edges"] = [_in_file_order(edge, "edge") for edge in document["edges"]]
+    return document
 
 
 @dataclass(frozen=True, slots=True)
@@ -220,6 +288,8 @@ def render_orders(
     InputError
         Bad names or options.
     """
+    from vda5050.model.order import Order
+
     schedule, names = _checked(verified, names, options, "render_orders")
     plan = plan_orders(verified) if plan is None else plan
     graph = schedule.route.graph
@@ -232,17 +302,18 @@ def render_orders(
         )
         header_id = options.first_header_id + release.update
         timestamp = _timestamp(options.start_time, release.send_at)
-        document = {
-            "headerId": header_id,
-            "timestamp": timestamp,
-            "version": VDA5050_VERSION,
-            "manufacturer": options.manufacturers[vehicle],
-            "serialNumber": options.serial_number(vehicle, names),
-            "orderId": f"{options.order_id}-{names[vehicle]}",
-            "orderUpdateId": release.update,
-            "nodes": nodes,
-            "edges": edges,
-        }
+        order = Order(
+            header_id=header_id,
+            timestamp=timestamp,
+            version=VDA5050_VERSION,
+            manufacturer=options.manufacturers[vehicle],
+            serial_number=options.serial_number(vehicle, names),
+            order_id=f"{options.order_id}-{names[vehicle]}",
+            order_update_id=release.update,
+            nodes=nodes,
+            edges=edges,
+        )
+        document = order_document(order)
         messages.append(
             OrderMessage(
                 vehicle,

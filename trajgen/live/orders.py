@@ -28,7 +28,7 @@ def horizon_length(limits: VehicleLimits) -> float:
 
 
 def path_elements(graph, view: VehicleView, *, map_id: str) -> list:
-    """Each node and edge of ``view``'s path as a validated model, as horizon and as base.
+    """Each node and edge of ``view``'s path as a vda5050-sdk model, as horizon and as base.
 
     Returns
     -------
@@ -36,21 +36,19 @@ def path_elements(graph, view: VehicleView, *, map_id: str) -> list:
         ``[(nodes, edges) as horizon, (nodes, edges) as base]``, their ``sequenceId`` shifted by
         the view's ``offset`` (a path stitched after a goal change continues the numbering).
     """
-    from vda5050.model.order import Edge, Node
-
     last = len(view.path.nodes) - 1
-    forms = []
-    for released in (False, True):
-        nodes, edges = order_elements(
-            graph, view.path, first=0, decision_point=last if released else -1, map_id=map_id
+    return [
+        order_elements(
+            graph,
+            view.path,
+            first=0,
+            decision_point=last if released else -1,
+            map_id=map_id,
+            sequence_offset=view.offset,
+            node_deviation=NODE_DEVIATION,
         )
-        for node in nodes:
-            node["sequenceId"] += view.offset
-            node["nodePosition"]["allowedDeviationXY"] = NODE_DEVIATION
-        for edge in edges:
-            edge["sequenceId"] += view.offset
-        forms.append(([Node.model_validate(n) for n in nodes], [Edge.model_validate(e) for e in edges]))
-    return forms
+        for released in (False, True)
+    ]
 
 
 def order_message(
