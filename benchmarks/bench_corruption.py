@@ -21,7 +21,7 @@ import numpy as np
 REPO = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(REPO))  # the tests' helpers
 
-from tests.corruption import corrupted, float_arrays, names  # noqa: E402
+from tests.support.corruption import corrupted, float_arrays, names  # noqa: E402
 from trajgen import Exact, Optimal, Toppra, certify, load_scenario  # noqa: E402
 from trajgen.errors import VerificationError  # noqa: E402
 from trajgen.export.csv import CsvOptions, render_profile  # noqa: E402

@@ -1,8 +1,8 @@
 """The verifier's mutation table: mutants of valid schedules, caught or passed, closed form vs 1 ms samples.
 
 Run from the repository root: ``python benchmarks/bench_mutants.py``. The mutants
-are built with ``tests/mutants.py``; the sampled second opinion is
-``tests/sampled_verifier.py`` (it sees only its 1 ms samples).
+are built with ``tests/support/mutants.py``; the sampled second opinion is
+``tests/support/sampled_verifier.py`` (it sees only its 1 ms samples).
 """
 
 from __future__ import annotations
@@ -18,9 +18,9 @@ from tqdm import tqdm
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))  # the tests' helpers
 
 from limits import Limits, VehicleLimits
-from tests.helpers import LIMITS, route_of, too_close
-from tests.mutants import between_samples, free_window, with_bump, with_coefficient
-from tests.sampled_verifier import sampled_verify
+from tests.support.helpers import LIMITS, route_of, too_close
+from tests.support.mutants import between_samples, free_window, with_bump, with_coefficient
+from tests.support.sampled_verifier import sampled_verify
 from topology.indexed import track_distance
 from trajgen import Exact, Optimal, Schedule, verify
 from trajgen.progress import progress

@@ -11,6 +11,7 @@ from pathlib import Path
 # workers start, and they read it; the packages are compiled once for every process (pytest_configure).
 sys.dont_write_bytecode = False
 
+import pytest  # noqa: E402
 from hypothesis import HealthCheck, settings  # noqa: E402  (with the bytecode cached)
 
 # "seeded" (the default): what CI runs. "thorough": twenty times the examples, for a release or a
@@ -27,6 +28,57 @@ settings.load_profile(os.environ.get("HYPOTHESIS_PROFILE", "seeded"))
 
 #: The repository (a clone of it): the tests read nothing outside it (tests/test_clone.py).
 REPO = Path(__file__).resolve().parent.parent
+
+#: End-to-end tests, marked ``slow``: the docs build, the examples, installs, live runs over a broker,
+#: demos and simulations on the command line, runs under load, other processes, the optimal
+#: method's accuracy set, the online campaign, and the property tests over many random solves.
+#: ``pytest -m "not slow" -n auto`` is the fast set a developer runs after a change (about a minute
+#: on two cores); CI runs everything.
+SLOW_FILES = {
+    "test_accuracy.py",
+    "test_campaign.py",
+    "test_determinism.py",
+    "test_docs.py",
+    "test_docs_broker.py",
+    "test_examples.py",
+    "test_readme.py",
+    "test_install.py",
+    "test_live.py",
+    "test_live_broker.py",
+    "test_live_faults.py",
+    "test_live_link.py",
+    "test_live_restart.py",
+    "test_live_security.py",
+    "test_simulate_cli.py",
+    "test_star_pipeline.py",
+    "test_star_pictures.py",
+    "test_store.py",
+    "test_commit_processes.py",
+}
+SLOW_TESTS = {
+    "test_online.py::test_campaign_scenarios_that_failed_reach_their_goals_safely",
+    "test_online.py::test_a_new_goal_mid_run_is_reached_with_no_violation",
+    "test_online.py::test_a_lagging_drive_never_moves_a_frontier_back",
+    "test_online.py::test_seed_12_campaign_scenarios_that_braked_hard_keep_the_braking_invariant",
+    "test_online.py::test_single_stops_on_random_tracks_cost_at_most_their_bound",
+    "test_coordination.py::test_every_methods_plan_for_execution_obeys_the_braking_rule",
+    "test_classes.py::test_the_class_lower_bound_holds_in_both_classes",
+    "test_classes.py::test_the_converged_references_are_what_a_converged_solve_gives",
+    "test_optimal.py::test_lower_bound_optimal_exact_order_and_verification",
+    "test_optimal.py::test_fatrop_solves_the_five_phase_reordering_on_one_leg",
+    "test_optimal.py::test_backup_solvers_reach_fatrops_optimum",
+    "test_schedule.py::test_the_closed_form_verifier_agrees_with_the_sampled_second_opinion",
+    "test_coordination.py::test_the_rule_binds_the_optimal_swap_two_centimetres_more_is_refused",
+    "test_cli.py::test_schedule_writes_verified_csv_and_plots",
+    "test_cli.py::test_demo_runs_the_default_scenario_end_to_end",
+    "test_online.py::test_an_undisturbed_run_executes_its_plan_within_one_percent_and_never_brakes",
+    "test_plot_api.py::test_a_renderer_of_0_6_warns_and_returns_the_png_of_its_plot",
+    "test_coordination.py::test_verify_refuses_a_plan_that_breaks_the_rule_naming_when_and_where",
+    "test_online.py::test_a_stop_costs_about_its_own_length",
+    "test_online.py::test_a_single_stop_at_any_moment_costs_at_most_its_bound",
+    "test_online.py::test_seed_12_campaign_scenarios_that_deadlocked_reach_their_goals_safely",
+    "test_optimal.py::test_swaps_are_at_most_half_of_exact_and_stay_in_the_class",
+}
 
 
 def pytest_configure(config) -> None:
@@ -59,3 +111,13 @@ def pytest_unconfigure(config) -> None:
     store = getattr(config, "_trajgen_store", None)
     if store is not None:
         store.cleanup()
+
+
+def pytest_collection_modifyitems(config, items) -> None:
+    """Mark the end-to-end tests ``slow`` (:data:`SLOW_FILES`, :data:`SLOW_TESTS`, the accuracy set)."""
+    slow = pytest.mark.slow
+    for item in items:
+        name = item.path.name
+        test = f"{name}::{getattr(item, 'originalname', item.name)}"
+        if name in SLOW_FILES or test in SLOW_TESTS or item.get_closest_marker("accuracy"):
+            item.add_marker(slow)

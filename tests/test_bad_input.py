@@ -8,7 +8,7 @@ from __future__ import annotations
 import pytest
 
 from tests.conftest import REPO
-from tests.helpers import LIMITS, route_of
+from tests.support.helpers import LIMITS, route_of
 from trajgen import Exact, certify, make_schedule, write_profiles
 from trajgen.cli import EXIT_BAD_INPUT, EXIT_OK, main
 from trajgen.errors import InputError

@@ -14,7 +14,7 @@ import re
 import pytest
 
 from limits import Limits, VehicleLimits
-from tests.helpers import AGV, LIMITS, MIXED, SLOW, route_of
+from tests.support.helpers import AGV, LIMITS, MIXED, SLOW, route_of
 from topology import Homotopy, WayRound, plan
 from trajgen import FallbackReason, Optimal, SolverCache, lower_bound, verify
 from trajgen.cli import EXIT_BAD_INPUT, EXIT_OK, main

@@ -119,7 +119,7 @@ def test_bad_scenario_file_exits_2_naming_the_file(tmp_path, capsys):
 
 
 def test_a_schedule_failing_verification_exits_1_and_writes_nothing(tmp_path, capsys, monkeypatch):
-    from tests.helpers import too_close
+    from tests.support.helpers import too_close
     from trajgen import make_schedule, pipeline
 
     def broken(route, limits, *, method):

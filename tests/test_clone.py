@@ -120,7 +120,7 @@ def test_the_scan_reads_every_kind_of_file():
         "docs/formats/vda5050.md",
         "examples/swap.toml",
         "tests/conftest.py",
-        "tests/vda5050_reference.py",
+        "tests/support/vda5050_reference.py",
         "benchmarks/bench_continuity.py",
         "trajgen/export/vda5050.py",
         "topology/__init__.py",

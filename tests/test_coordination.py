@@ -18,7 +18,7 @@ from ruckig import ControlInterface, InputParameter, Ruckig, Trajectory
 
 from limits import Limits, VehicleLimits
 from tests.conftest import REPO
-from tests.helpers import conf, execution_plan
+from tests.support.helpers import conf, execution_plan
 from topology import YGraph, plan
 from trajgen import Exact, Optimal, certify, load_scenario, verify
 from trajgen.model.coordination import (

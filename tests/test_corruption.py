@@ -1,7 +1,7 @@
 """Every number a schedule holds is checked: a corrupted float array is refused, or changes nothing exported.
 
 For each method on the swap and the crossing, every float array reachable from
-the schedule (:func:`tests.corruption.float_arrays`) gets, in turn, a NaN, +inf,
+the schedule (:func:`tests.support.corruption.float_arrays`) gets, in turn, a NaN, +inf,
 -inf, two adjacent entries swapped, and one entry moved by 1e-3 of its value, at a
 seeded place, with nothing recomputed. Each corrupted schedule must either fail
 :func:`trajgen.verification.certify` with a :class:`VerificationError` that names the
@@ -17,7 +17,7 @@ import numpy as np
 import pytest
 
 from tests.conftest import REPO
-from tests.corruption import CORRUPTIONS, corrupt_array, corrupted, float_arrays, names
+from tests.support.corruption import CORRUPTIONS, corrupt_array, corrupted, float_arrays, names
 from trajgen import Exact, Optimal, Toppra, certify, load_scenario
 from trajgen.errors import VerificationError
 from trajgen.export.csv import CsvOptions, render_profile

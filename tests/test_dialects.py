@@ -11,7 +11,7 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from tests.conftest import REPO
-from tests.helpers import LIMITS, MIXED, route_of
+from tests.support.helpers import LIMITS, MIXED, route_of
 from trajgen import Exact, Optimal, Toppra, certify, default_scenario, make_schedule, run
 from trajgen.cli import EXIT_BAD_INPUT, EXIT_FAILURE, EXIT_OK, main
 from trajgen.errors import InputError, OptionError, OutputLimitError, ProfileFileError, VerificationError

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from tests.helpers import LIMITS, MIXED, route_of, too_close
+from tests.support.helpers import LIMITS, MIXED, route_of, too_close
 from trajgen import Exact, Schedule, Toppra, certify
 from trajgen.errors import OptionError, UnverifiedScheduleError, VerificationError
 from trajgen.export import (

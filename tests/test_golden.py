@@ -1,6 +1,6 @@
 """Golden files: every dialect and unit setting renders, byte for byte, what the per-value formatter wrote.
 
-The cases and the stored files are those of :mod:`tests.golden_profiles`; a long schedule is compared
+The cases and the stored files are those of :mod:`tests.support.golden_profiles`; a long schedule is compared
 by SHA-256 digest.
 """
 
@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import pytest
 
-from tests.golden_profiles import (
+from tests.support.golden_profiles import (
     CASES,
     GOLDEN,
     LONG_DIGESTS,

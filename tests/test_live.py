@@ -20,8 +20,8 @@ import time
 
 import pytest
 
-from tests.helpers import REPO, execution_plan
-from tests.vda5050_reference import schema_errors
+from tests.support.helpers import REPO, execution_plan
+from tests.support.vda5050_reference import schema_errors
 from topology import Configuration, Position
 from trajgen.cli import main
 from trajgen.errors import InputError, LiveError

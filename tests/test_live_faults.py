@@ -11,7 +11,7 @@ import logging
 import time
 from datetime import datetime
 
-from tests.helpers import execution_plan
+from tests.support.helpers import execution_plan
 from tests.test_live import Tap
 from trajgen.live.faults import StopFault
 from trajgen.live.outcome import LiveOutcome

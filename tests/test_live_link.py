@@ -12,7 +12,7 @@ import time
 
 import pytest
 
-from tests.helpers import execution_plan
+from tests.support.helpers import execution_plan
 from trajgen.live.broker import EmbeddedBroker, MosquittoBroker, mosquitto_available
 from trajgen.live.clock import RunClock
 from trajgen.live.link import RETRY_MAX_S, BrokerLink, LinkState

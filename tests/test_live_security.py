@@ -212,7 +212,7 @@ def test_tls_with_the_right_ca_connects(tls_broker, certificates):
 
 
 def test_an_acl_that_forbids_the_masters_orders_is_reported_within_seconds_naming_each_vehicle(tmp_path):
-    from tests.helpers import execution_plan
+    from tests.support.helpers import execution_plan
     from trajgen.live.master import LiveMaster
     from trajgen.live.session import identities, position_xy
 

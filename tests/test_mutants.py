@@ -5,9 +5,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from tests.helpers import LIMITS, route_of
-from tests.mutants import between_samples, free_window, with_bump
-from tests.sampled_verifier import sampled_verify
+from tests.support.helpers import LIMITS, route_of
+from tests.support.mutants import between_samples, free_window, with_bump
+from tests.support.sampled_verifier import sampled_verify
 from topology.indexed import track_distance
 from trajgen import Exact, Optimal, verify
 from trajgen.model.analysis import travelled

@@ -19,7 +19,7 @@ from ruckig import ControlInterface, InputParameter, Ruckig, Trajectory
 
 from limits import ILLUSTRATIVE_LIMITS, Limits, VehicleLimits
 from tests.conftest import REPO
-from tests.helpers import execution_plan
+from tests.support.helpers import execution_plan
 from topology import JUNCTION_INDEX, Configuration, Position, StarGraph, YGraph
 from topology.indexed import separation as indexed_separation
 from trajgen import certify, default_scenario, load_scenario, make_schedule

@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 
 from limits import Limits, VehicleLimits
-from tests.helpers import LIMITS, MIXED, conf, route_of
+from tests.support.helpers import LIMITS, MIXED, conf, route_of
 from topology import Homotopy, YGraph, plan, region_sequence
 from trajgen import Exact, FallbackReason, Optimal, SolverCache, certify, lower_bound, make_schedule, verify
 from trajgen.errors import InputError

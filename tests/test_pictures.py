@@ -13,7 +13,7 @@ from matplotlib.colors import to_rgb
 from PIL import Image
 
 from tests.conftest import REPO
-from tests.helpers import LIMITS, animation_gif, conf, route_of
+from tests.support.helpers import LIMITS, animation_gif, conf, route_of
 from topology import JUNCTION_INDEX, YGraph, plan
 from topology.indexed import segment_region_key
 from trajgen import Exact, certify, default_scenario, make_schedule

@@ -8,7 +8,7 @@ import os
 import pytest
 
 from tests.conftest import REPO
-from tests.helpers import too_close
+from tests.support.helpers import too_close
 from trajgen import Outputs, Toppra, default_scenario, run
 from trajgen.cli import EXIT_BAD_INPUT, main
 from trajgen.errors import InputError, OptionError, OutputError

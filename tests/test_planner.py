@@ -9,7 +9,7 @@ import pytest
 from hypothesis import assume, given
 from hypothesis import strategies as st
 
-from tests.strategies import configurations, queries, tracks
+from tests.support.strategies import configurations, queries, tracks
 from topology import (
     Cell,
     Configuration,

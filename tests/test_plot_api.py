@@ -15,7 +15,7 @@ import pytest
 from matplotlib.figure import Figure
 
 from tests.conftest import REPO
-from tests.helpers import animation_gif
+from tests.support.helpers import animation_gif
 from trajgen import Exact, certify, default_scenario, make_schedule
 from trajgen.online.simulation import parse_faults, simulate
 from trajgen.plots import (

@@ -9,7 +9,7 @@ from hypothesis import strategies as st
 from ruckig import InputParameter, Result, Ruckig, Trajectory
 
 from limits import Limits, VehicleLimits
-from tests.helpers import route_of
+from tests.support.helpers import route_of
 from trajgen import Exact
 from trajgen.model.profiles import PiecewiseCubic, rest_to_rest_time, scurve_phases, trapezoid_phases
 

@@ -9,7 +9,7 @@ from typing import ClassVar
 
 import pytest
 
-from tests.helpers import LIMITS, route_of
+from tests.support.helpers import LIMITS, route_of
 from trajgen import (
     METHODS,
     Exact,

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from limits import Limits, VehicleLimits
-from tests.helpers import LIMITS, MIXED, route_of, too_close
+from tests.support.helpers import LIMITS, MIXED, route_of, too_close
 from topology import Configuration, Position, YGraph, plan
 from trajgen import METHODS, Exact, Schedule, Toppra, certify, make_schedule, verify
 from trajgen.errors import OptionError, VerificationError
@@ -211,7 +211,7 @@ def test_the_last_sample_is_the_goal_at_rest_with_no_jerk(method, period):
 @pytest.mark.parametrize("method", ["exact", "toppra", "optimal"])
 @pytest.mark.parametrize("scenario", RANDOM[:6], ids=[s.source for s in RANDOM[:6]])
 def test_the_closed_form_verifier_agrees_with_the_sampled_second_opinion(scenario, method):
-    from tests.sampled_verifier import sampled_verify
+    from tests.support.sampled_verifier import sampled_verify
 
     schedule = make_schedule(scenario.plan(), scenario.limits, method=method)
     certified, sampled = verify(schedule), sampled_verify(schedule)

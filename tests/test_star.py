@@ -23,7 +23,7 @@ from dataclasses import dataclass
 import pytest
 from hypothesis import assume, given
 
-from tests.strategies import queries, star_queries
+from tests.support.strategies import queries, star_queries
 from topology import (
     Configuration,
     Homotopy,

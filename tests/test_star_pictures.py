@@ -11,7 +11,7 @@ import pytest
 from matplotlib.colors import to_rgb
 from PIL import Image
 
-from tests.helpers import LIMITS, animation_gif, conf
+from tests.support.helpers import LIMITS, animation_gif, conf
 from topology import JUNCTION_INDEX, Instruction, StarGraph, YGraph, plan
 from topology.cycle import retract_indexed
 from trajgen import Exact, certify, load_scenario, make_schedule

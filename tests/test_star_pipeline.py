@@ -24,9 +24,9 @@ from vda5050.domain.order import AcceptanceDecision
 
 from limits import Limits, VehicleLimits
 from tests.conftest import REPO
-from tests.sampled_verifier import sampled_verify
-from tests.strategies import star_queries
-from tests.vda5050_reference import SimulatedVehicle, parse_order, schema_errors
+from tests.support.sampled_verifier import sampled_verify
+from tests.support.strategies import star_queries
+from tests.support.vda5050_reference import SimulatedVehicle, parse_order, schema_errors
 from topology import JUNCTION_INDEX, Homotopy, StarGraph, WayRound, plan
 from trajgen import (
     BuiltinScenario,

@@ -13,7 +13,7 @@ import logging
 import numpy as np
 import pytest
 
-from tests.helpers import LIMITS, MIXED, route_of
+from tests.support.helpers import LIMITS, MIXED, route_of
 from trajgen import Exact, Optimal, SolverCache, lower_bound, verify
 from trajgen.methods.optimal import NlpOrigin, NlpStore, ProblemUnits
 from trajgen.methods.optimal.compiled import CompiledNlp, store_description

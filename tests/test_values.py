@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from tests.helpers import LIMITS, route_of
+from tests.support.helpers import LIMITS, route_of
 from trajgen import Exact, Optimal, Toppra
 from trajgen.model.axes import route_axes
 

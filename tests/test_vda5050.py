@@ -1,7 +1,8 @@
 """VDA 5050 orders: valid and accepted messages, paths on the route, safe releases, factsheet limits, CLI.
 
-The messages are checked against references of the ``vda5050-sdk`` package (:mod:`tests.vda5050_reference`):
-the official schemas, the sdk's pydantic models, and its order acceptance (VDA 5050 figure 8).
+The messages are checked against references of the ``vda5050-sdk`` package
+(:mod:`tests.support.vda5050_reference`): the official schemas, the sdk's pydantic models, and its
+order acceptance (VDA 5050 figure 8).
 """
 
 from __future__ import annotations
@@ -21,7 +22,7 @@ from pydantic import ValidationError
 from vda5050.domain.order import AcceptanceDecision
 
 from tests.conftest import REPO
-from tests.vda5050_reference import SimulatedVehicle, parse_order, schema_errors
+from tests.support.vda5050_reference import SimulatedVehicle, parse_order, schema_errors
 from topology import JUNCTION_INDEX, Homotopy
 from trajgen import Exact, Optimal, Toppra, certify, make_schedule, parse_scenario, run
 from trajgen.cli import EXIT_BAD_INPUT, EXIT_FAILURE, EXIT_OK, main

@@ -10,9 +10,9 @@ import re
 import numpy as np
 import pytest
 
-from tests.corruption import corrupted
-from tests.helpers import LIMITS, route_of, too_close
-from tests.mutants import with_coefficient
+from tests.support.corruption import corrupted
+from tests.support.helpers import LIMITS, route_of, too_close
+from tests.support.mutants import with_coefficient
 from trajgen import Exact, VerifiedSchedule, certify, verify
 from trajgen.errors import InputError, UnverifiedScheduleError, VerificationError
 from trajgen.model.profiles import PiecewiseCubic

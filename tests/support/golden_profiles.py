@@ -8,7 +8,7 @@ ones as SHA-256 digests (:data:`LONG_DIGESTS`).
 
 Remake the files only for an intended format change, and say so in the commit::
 
-    python -m tests.golden_profiles
+    python -m tests.support.golden_profiles
 """
 
 from __future__ import annotations

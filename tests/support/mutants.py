@@ -6,7 +6,7 @@ import dataclasses
 
 import numpy as np
 
-from tests.corruption import corrupted
+from tests.support.corruption import corrupted
 from trajgen import Schedule
 from trajgen.model.profiles import PiecewiseCubic
 from trajgen.model.schedule import CubicKinematics
@@ -99,7 +99,7 @@ def with_coefficient(schedule: Schedule, vehicle: int, column: int, value: float
     """One initial-state coefficient (0 position, 1 velocity, 2 acceleration) of section 0 replaced.
 
     The constructors refuse non-finite numbers, so the array is replaced behind them
-    (:func:`tests.corruption.corrupted`), as a bug or a stray write would. Returns the
+    (:func:`tests.support.corruption.corrupted`), as a bug or a stray write would. Returns the
     schedule and the path of the entry replaced (``sections[0]...initial[3, 1]``).
     """
     path = f"sections[0].kinematics.vehicles[{vehicle}].initial"
