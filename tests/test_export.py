@@ -8,17 +8,9 @@ import pytest
 from tests.support.helpers import LIMITS, MIXED, route_of, too_close
 from trajgen import Exact, Schedule, Toppra, certify
 from trajgen.errors import OptionError, UnverifiedScheduleError, VerificationError
-from trajgen.export import (
-    CsvOptions,
-    Units,
-    commit_files,
-    format_block,
-    format_rows,
-    profile_chunk_pair,
-    write_profiles,
-)
+from trajgen.export import CsvOptions, Units, commit_files, write_profiles
 from trajgen.export import csv as csv_export
-from trajgen.export.csv import render_profile
+from trajgen.export.csv import format_block, format_rows, profile_chunk_pair, render_profile
 
 SWAP = ((10.0, 10.0, 10.0), ("A:10", "B:10"), ("B:10", "A:10"))
 NAMES = ("agv1", "agv2")

@@ -24,7 +24,8 @@ from topology import JUNCTION_INDEX, Configuration, Position, StarGraph, YGraph
 from topology.indexed import separation as indexed_separation
 from trajgen import certify, default_scenario, load_scenario, make_schedule
 from trajgen.errors import InputError, UnverifiedScheduleError
-from trajgen.online import BrakingCheck, Executor, Mode, PathState, VehiclePath, VehicleState
+from trajgen.model.paths import VehiclePath
+from trajgen.online import BrakingCheck, Executor, Mode, PathState, VehicleState
 from trajgen.online.braking import emergency_position
 from trajgen.online.goals import execution_margin, plan_for_execution
 from trajgen.online.messages import Command, Setpoint, checked_state

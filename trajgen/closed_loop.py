@@ -18,7 +18,8 @@ from pathlib import Path
 
 from topology.validation import finite_real, short_repr
 from trajgen.errors import InputError
-from trajgen.export import CsvOptions, check_output_paths, commit_files, profile_paths
+from trajgen.export.atomic import check_output_paths, commit_files
+from trajgen.export.csv import CsvOptions, profile_paths
 from trajgen.methods import METHODS
 from trajgen.model.schedule import TimingMethod
 from trajgen.model.summary import format_provenance

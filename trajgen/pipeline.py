@@ -14,14 +14,8 @@ from pathlib import Path
 
 from topology import Route
 from trajgen.errors import InputError, VerificationError
-from trajgen.export import (
-    CsvOptions,
-    check_output_paths,
-    check_row_limit,
-    commit_files,
-    profile_chunk_pair,
-    profile_paths,
-)
+from trajgen.export.atomic import check_output_paths, commit_files
+from trajgen.export.csv import CsvOptions, check_row_limit, profile_chunk_pair, profile_paths
 from trajgen.export.dialects import DIALECTS, Dialect, TableDialect
 from trajgen.export.plc import PlcTables, check_dialect_method, plc_tables, table_paths
 from trajgen.methods import METHODS, make_schedule

@@ -7,11 +7,10 @@ leader at each conflict could still come to rest), under an independent
 braking check. :func:`~trajgen.online.goals.plan_for_execution` makes the plan
 it plays; :func:`~trajgen.online.simulation.simulate` runs it against a
 simulated plant with faults (:mod:`trajgen.online.faults`). The argument is
-in docs/online.md.
+in docs/online.md. The model types it uses (``VehiclePath``, ``CoordinationDiagram``,
+``Conflict``) have one import path, :mod:`trajgen.model`.
 """
 
-from trajgen.model.coordination import Conflict, CoordinationDiagram
-from trajgen.model.paths import VehiclePath
 from trajgen.online.braking import BrakingCheck, PathState
 from trajgen.online.executor import Command, Event, Executor, GoalDecision, Mode, Setpoint, VehicleState
 from trajgen.online.goals import execution_margin, plan_for_execution
@@ -19,15 +18,12 @@ from trajgen.online.goals import execution_margin, plan_for_execution
 __all__ = [
     "BrakingCheck",
     "Command",
-    "Conflict",
-    "CoordinationDiagram",
     "Event",
     "Executor",
     "GoalDecision",
     "Mode",
     "PathState",
     "Setpoint",
-    "VehiclePath",
     "VehicleState",
     "execution_margin",
     "plan_for_execution",
