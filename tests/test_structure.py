@@ -2,7 +2,10 @@
 
 Every import statement counts, also the ones inside functions. A name starting
 with one underscore is private to the file that defines it: no other file may
-import it or reach it as an attribute.
+import it or reach it as an attribute. A module whose name starts with one underscore
+(``trajgen/export/_shared.py``) is private to its package: its files may import its
+public names, no file outside that folder may import it, so that helpers shared within
+a package need not become public names of the distribution.
 """
 
 from __future__ import annotations
@@ -156,6 +159,34 @@ def test_the_circle_finder_finds_a_circle():
 @pytest.mark.parametrize("module", sorted(MODULES), ids=sorted(MODULES))
 def test_no_private_names_across_files(module):
     assert _private_uses(module) == []
+
+
+def _outside_imports_of_private_modules(graph: dict[str, set[str]]) -> list[str]:
+    problems = []
+    for module, targets in graph.items():
+        for target in targets:
+            last = target.split(".")[-1]
+            if last.startswith("_") and not last.startswith("__"):
+                package = target.rsplit(".", 1)[0]
+                if not (module == package or module.startswith(package + ".")):
+                    problems.append(f"{module} imports {target}, private to {package}")
+    return problems
+
+
+def test_a_private_module_is_imported_only_within_its_package():
+    graph = {module: _imports(module) for module in MODULES}
+    assert _outside_imports_of_private_modules(graph) == []
+
+
+def test_the_private_module_rule_sees_an_import_from_outside():
+    graph = {
+        "trajgen.export.csv": {"trajgen.export._shared"},  # within: allowed
+        "trajgen.export.plc.tables": {"trajgen.export._shared"},  # a subpackage: within
+        "trajgen.pipeline": {"trajgen.export._shared"},  # outside: refused
+    }
+    assert _outside_imports_of_private_modules(graph) == [
+        "trajgen.pipeline imports trajgen.export._shared, private to trajgen.export"
+    ]
 
 
 def test_topology_and_limits_do_not_import_trajgen():
