@@ -172,3 +172,16 @@ INSIDE = {
 @pytest.mark.parametrize(("relative", "line"), INSIDE.values(), ids=list(INSIDE))
 def test_the_scan_passes_what_stays_inside(relative, line):
     assert escapes(relative, line) == []
+
+
+def test_the_packages_cite_only_documents_of_the_repository():
+    """A docstring or comment that cites a document (``docs/planner.md``) names one a clone has."""
+    cited = re.compile(r"(?<![\w/.-])((?:docs/)?[\w.-]+\.md)\b")
+    missing = []
+    for package in ("trajgen", "topology", "limits"):
+        for source in sorted((REPO / package).rglob("*.py")):
+            for number, line in enumerate(source.read_text(encoding="utf-8").splitlines(), 1):
+                for name in cited.findall(line):
+                    if not (REPO / name).is_file() and not (REPO / "docs" / name).is_file():
+                        missing.append(f"{source.relative_to(REPO)}:{number}: {name}")
+    assert missing == []

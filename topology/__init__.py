@@ -1,10 +1,10 @@
 """Exact collision-free motion planner for two vehicles on a junction of 3 to 8 legs.
 
 Implements Baldi, *Collision-Free Motion Planning Algorithm in a Y-Graph*,
-with the conventions of ``ALGORITHM.md``: on a Y the configuration space
+with the conventions of docs/planner.md: on a Y the configuration space
 deforms onto a circle, so two continuous instructions suffice (topological
 complexity 2). With four to eight legs it deforms onto the graph ``G_k`` and
-the planner takes one of three instructions (``STAR-JUNCTIONS.md``).
+the planner takes one of three instructions (docs/star.md).
 
 Examples
 --------

@@ -1,4 +1,4 @@
-"""The oriented boundary cycle of the configuration space (ALGORITHM.md section 4).
+"""The oriented boundary cycle of the configuration space (docs/planner.md, 'The boundary 12-cycle').
 
 Twelve vertices alternating peaks (both vehicles at leg ends) and valleys (one
 at a leg end, the other at the junction); each edge moves one vehicle along
@@ -61,7 +61,7 @@ class BoundaryCycle:
         self.names = names
         self.lengths = lengths
         self.endpoints = self.legs.endpoints
-        # Counterclockwise successors (ALGORITHM.md section 4), starting at P(0, 1):
+        # Counterclockwise successors (docs/planner.md, 'The boundary 12-cycle'), starting at P(0, 1):
         # P(i, i+1) -> V2(i) -> P(i, i-1) -> V1(i-1) -> P(i+1, i-1).
         tuples: list[IndexedConfiguration] = []
         first, second = 0, 1

@@ -1,4 +1,4 @@
-"""Cells of the configuration space and the retraction onto the boundary (ALGORITHM.md sections 2-4).
+"""Cells of the configuration space and the retraction onto the boundary (docs/planner.md).
 
 The public functions take and return :class:`~topology.positions.Configuration`;
 the ``*_indexed`` variants work on the planner's indexed form
@@ -25,7 +25,7 @@ __all__ = [
     "retract_indexed",
 ]
 
-#: Relative tolerance (of the perimeter) of the antipodal test, ALGORITHM.md section 5.
+#: Relative tolerance (of the perimeter) of the antipodal test, docs/planner.md, 'The two instructions'.
 ANTIPODAL_TOLERANCE = 1e-9
 
 
@@ -64,7 +64,7 @@ def classify_indexed(c: IndexedConfiguration, lengths: tuple[float, ...]) -> Cel
 
 
 def retract_indexed(c: IndexedConfiguration, lengths: tuple[float, ...]) -> list[IndexedConfiguration]:
-    """Waypoints from ``c`` to its boundary image ``r(c)``, ``c`` first (ALGORITHM.md section 3)."""
+    """Waypoints from ``c`` to its boundary image ``r(c)``, ``c`` first (docs/planner.md, retraction)."""
     out = [c]
     l1, s1, l2, s2 = c
     if l1 == l2:  # triangle: the vehicle nearer O moves to O alone
@@ -179,7 +179,7 @@ def boundary_angle(graph: StarGraph, configuration: Configuration) -> float:
 def is_antipodal(graph: StarGraph, first: Configuration, second: Configuration) -> bool:
     """Whether two boundary configurations are half a perimeter apart on the cycle.
 
-    Uses the tolerance ``1e-9 * perimeter`` of ALGORITHM.md section 5.
+    Uses the tolerance ``1e-9 * perimeter`` of docs/planner.md, 'The two instructions'.
     """
     perimeter = graph.perimeter
     delta = (boundary_angle(graph, second) - boundary_angle(graph, first)) % perimeter

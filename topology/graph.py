@@ -1,6 +1,6 @@
 """Tracks: k legs of given lengths meeting at one junction (a star); the Y is k = 3.
 
-Conventions follow ``ALGORITHM.md`` section 1 and ``STAR-JUNCTIONS.md``: the
+Conventions follow docs/planner.md, 'The track and positions' and docs/star.md: the
 legs are listed in counterclockwise order around the junction ``O``.
 """
 
@@ -109,14 +109,14 @@ class StarGraph:
         Leg directions, degrees.
     cycle : BoundaryCycle or None
         For three legs, the oriented boundary cycle of the configuration space
-        (ALGORITHM.md section 4); ``None`` for four or more.
+        (docs/planner.md, 'The boundary 12-cycle'); ``None`` for four or more.
 
     Notes
     -----
     With three legs the configuration space deforms onto a circle and
     :func:`~topology.plan` is the paper's planner (two instructions); with
     four or more it deforms onto the graph ``G_k`` (:attr:`retract_graph`)
-    and the planner takes one of three instructions (``STAR-JUNCTIONS.md``).
+    and the planner takes one of three instructions (docs/star.md).
 
     Examples
     --------
@@ -249,7 +249,7 @@ class StarGraph:
     # -- the graph the configuration space deforms onto -------------------
     @property
     def retract_graph(self) -> RetractGraph:
-        """The retract graph ``G_k`` with its per-track tables, built on first use (STAR-JUNCTIONS.md)."""
+        """The retract graph ``G_k`` with its per-track tables, built on first use (docs/star.md)."""
         built = self._retract_graph
         if not built:
             built.append(RetractGraph(self.names, self.lengths))
@@ -313,7 +313,7 @@ class YGraph(StarGraph):
     Notes
     -----
     A :class:`StarGraph` of three legs; :attr:`cycle` is the oriented boundary
-    cycle of the configuration space (ALGORITHM.md section 4).
+    cycle of the configuration space (docs/planner.md, 'The boundary 12-cycle').
     """
 
     def __init__(self, legs, *, angles_deg: Mapping[str, float] | None = None) -> None:

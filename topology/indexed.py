@@ -5,7 +5,7 @@ rather than named positions: a configuration is the tuple ``(leg1, s1, leg2,
 s2)`` of leg indices (0, 1, 2 in the track's counterclockwise order, or
 :data:`JUNCTION_INDEX` at the junction) and distances from the junction in
 metres; a region is a :class:`RegionKey`. The definitions are those of
-ALGORITHM.md sections 1, 3 and 6.
+docs/planner.md.
 """
 
 from __future__ import annotations
@@ -38,7 +38,7 @@ IndexedConfiguration = tuple[int, float, int, float]
 
 
 class RegionKey(NamedTuple):
-    """A region of ALGORITHM.md section 6 by leg indices.
+    """A region of docs/planner.md, 'Homotopy classes' by leg indices.
 
     ``Q(i, j)`` is ``RegionKey(i, j, 0)``; ``T(k, r)`` (both on leg ``k``,
     vehicle ``r`` nearer the junction) is ``RegionKey(k, k, r)``.

@@ -1,4 +1,4 @@
-"""Positions on the track and configurations of the two vehicles (ALGORITHM.md sections 1, 2).
+"""Positions on the track and configurations of the two vehicles (docs/planner.md).
 
 A position is ``(leg, s)`` with ``s`` metres from the junction ``O``; the
 junction itself has ``leg is None``.

@@ -1,4 +1,4 @@
-"""The retract graph ``G_k`` of a junction with k legs and its geodesic planner (STAR-JUNCTIONS.md).
+"""The retract graph ``G_k`` of a junction with k legs and its geodesic planner (docs/star.md).
 
 Baldi's retraction maps every configuration onto ``G_k``: the ``k (k - 1)``
 peaks ``P(i, j)`` (vehicle 1 at ``E_i``, vehicle 2 at ``E_j``), the ``2 k``
@@ -19,7 +19,7 @@ For k >= 4 each edge length is multiplied by ``1 + eta u`` (``eta`` =
 :data:`LENGTH_PERTURBATION`, ``u`` in [0, 1) seeded by k and the edge) and
 ``w`` is a seeded generic weight in [-1, 1] per edge, so that ties of three
 or more routes are isolated points and two tied routes differ by a cycle of
-non-zero ``w``-integral. For k = 3 ``G_3`` is the 12-cycle of ALGORITHM.md
+non-zero ``w``-integral. For k = 3 ``G_3`` is the 12-cycle of docs/planner.md
 section 4: lengths are exact and ``w`` is +1 counterclockwise round the
 cycle, so rule 2 is the paper's counterclockwise half turn.
 """
@@ -54,7 +54,7 @@ LENGTH_PERTURBATION = 1e-3
 #: Seed of the perturbations ``u`` and of the 1-form ``w`` (combined with k).
 PERTURBATION_SEED = 5050
 #: Two routes tie when their (perturbed) lengths differ by at most this fraction of the total
-#: length of ``G_k``: for k = 3, the antipodal tolerance of ALGORITHM.md section 5 (1e-9 of the
+#: length of ``G_k``: for k = 3, the antipodal tolerance of docs/planner.md (instructions; 1e-9 of the
 #: perimeter either side of half a turn).
 TIE_TOLERANCE = 2e-9
 
@@ -199,7 +199,7 @@ class RetractGraph:
             counterclockwise.append(1.0 if j == (i + 1) % count else -1.0)
         self.edges = tuple(edges)
         self.edge_lengths = _read_only(np.array(edge_lengths))
-        if count == 3:  # the circle: exact lengths, w counterclockwise (ALGORITHM.md section 5)
+        if count == 3:  # the circle: exact lengths, w counterclockwise (docs/planner.md)
             factors = np.ones(len(edges))
             weights = np.array(counterclockwise)
         else:

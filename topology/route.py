@@ -1,9 +1,9 @@
 """The motion planner and its result, the :class:`Route`.
 
-ALGORITHM.md sections 5 and 6 (three legs): retract the start onto the
+docs/planner.md, 'The two instructions' and 'Homotopy classes' (three legs): retract the start onto the
 boundary circle, go round the circle (shortest way, or counterclockwise half a
 turn when the goal is the start with the vehicles swapped), then undo the
-goal's retraction. STAR-JUNCTIONS.md (four to eight legs): the same
+goal's retraction. docs/star.md (four to eight legs): the same
 retractions, and between them a route on the retract graph ``G_k`` chosen by
 three rules (:mod:`topology.retract_graph`).
 """
@@ -43,7 +43,7 @@ class Instruction(Option):
 
     Three legs (topological complexity 2): ``SHORTEST`` and ``COUNTERCLOCKWISE``.
     Four to eight legs (topological complexity 3): ``SHORTEST``, ``TWO_TIED``
-    and ``MANY_TIED`` (STAR-JUNCTIONS.md section 3).
+    and ``MANY_TIED`` (docs/star.md, 'The three rules').
     """
 
     #: the unique shortest route (three legs: paper Instruction 2, the shorter way round)
@@ -70,7 +70,7 @@ _RULE_INSTRUCTION = {1: Instruction.SHORTEST, 2: Instruction.TWO_TIED, 3: Instru
 class Homotopy(Option):
     """Which of the two shortest homotopy classes :func:`plan` takes."""
 
-    PAPER = "paper"  #: the class of the planner's instruction (ALGORITHM.md section 5)
+    PAPER = "paper"  #: the class of the planner's instruction (docs/planner.md, 'The two instructions')
     #: three legs: the other way round the boundary circle; four or more: the shortest
     #: route on ``G_k`` in another class (the second-shortest simple route)
     OTHER = "other"
@@ -87,7 +87,7 @@ class WayRound(Option):
 
 @dataclass(frozen=True, slots=True)
 class Region:
-    """A contractible region of the configuration space (ALGORITHM.md section 6).
+    """A contractible region of the configuration space (docs/planner.md, 'Homotopy classes').
 
     ``Q(i, j)``: vehicle 1 on leg ``i``, vehicle 2 on another leg ``j``.
     ``T(k, r)``: both vehicles on leg ``k``, vehicle ``r`` (1 or 2) nearer the
@@ -263,7 +263,7 @@ class Route:
 
     @property
     def regions(self) -> tuple[Region, ...]:
-        """The homotopy class: reduced sequence of regions visited (ALGORITHM.md section 6).
+        """The homotopy class: reduced sequence of regions visited (docs/planner.md, 'Homotopy classes').
 
         Empty when the whole route stays on one ray (a vehicle parked at the
         junction while the other moves on one leg) or does not move.
@@ -316,8 +316,8 @@ def plan(
 ) -> Route:
     """Plan a collision-free route from ``start`` to ``goal``.
 
-    Three legs: the paper's planner (ALGORITHM.md section 5). Four to eight
-    legs: the three-rule geodesic planner on ``G_k`` (STAR-JUNCTIONS.md).
+    Three legs: the paper's planner (docs/planner.md, 'The two instructions'). Four to eight
+    legs: the three-rule geodesic planner on ``G_k`` (docs/star.md).
 
     Parameters
     ----------
@@ -427,7 +427,7 @@ def _route_round_circle(
     start: Configuration,
     goal: Configuration,
 ) -> tuple[Instruction, float, list[IndexedConfiguration]]:
-    """Instruction, signed arc length and cycle vertices passed, three legs (ALGORITHM.md section 5)."""
+    """Instruction, signed arc length and cycle vertices passed, three legs (docs/planner.md)."""
     cycle = graph.cycle
     origin = cycle.locate(origin_point)
     target = cycle.locate(target_point)
@@ -456,7 +456,7 @@ def _route_on_graph(
     start: Configuration,
     goal: Configuration,
 ) -> tuple[Instruction, float, list[IndexedConfiguration]]:
-    """Instruction, length and ``G_k`` vertices passed, four or more legs (STAR-JUNCTIONS.md section 3)."""
+    """Instruction, length and ``G_k`` vertices passed, four or more legs (docs/star.md, the rules)."""
     origin: GraphPoint = retract_graph.locate(origin_point)
     target: GraphPoint = retract_graph.locate(target_point)
     chosen: Geodesic = retract_graph.shortest(origin, target)

@@ -1,9 +1,9 @@
-"""What the ``trajgen`` commands share: exit codes, the argument parser, common options.
+"""The options several ``trajgen`` commands take, and reading them: the scenario, the method, CSV.
 
-Each command lives in its own module of :mod:`trajgen.cli` with a
-``register(commands)`` function that adds its sub-parser; the parser's
-``run`` default is the function that carries the command out and returns its
-exit status.
+The exit codes and the parser are in :mod:`trajgen.cli.parser`. Each command lives in its own
+module of :mod:`trajgen.cli` with a ``register(commands)`` function that adds its sub-parser and
+uses the ``add_*`` functions here; the parser's ``run`` default is the function that carries the
+command out and returns its exit status.
 """
 
 from __future__ import annotations

@@ -40,7 +40,7 @@ def class_travel(route: Route, min_separation: float) -> tuple[float, float]:
     """Least distance each vehicle drives on any motion in the route's homotopy class, metres.
 
     Every motion in the class passes the route's reduced region sequence in
-    order (ALGORITHM.md section 6). Between two consecutive regions one vehicle
+    order (docs/planner.md, 'Homotopy classes'). Between two consecutive regions one vehicle
     crosses the junction while the other stays on its leg at least
     ``min_separation`` from it. Per vehicle, these checkpoints in order (at the
     junction; at least ``min_separation`` out on a leg), from its start to its

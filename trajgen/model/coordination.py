@@ -7,7 +7,7 @@ pair of path segments the track distance between the vehicles is affine in
 obstacle region ``{(p1, p2): distance < d}`` is a union of convex polygons.
 Its connected parts are the **conflicts**. The plan passes each conflict on one
 side: the vehicle that passes first is the conflict's **leader**, the other its
-**follower** (``ONLINE-EXECUTION.md`` section 2; docs/online.md).
+**follower** (docs/online.md, 'The executor').
 
 A follower may not come to rest where it would meet a position at which its
 leader could still come to rest: the leader's **earliest rest point**

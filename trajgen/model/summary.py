@@ -3,7 +3,7 @@
 A route's homotopy class is named for people by :func:`class_name`: on a Y
 (three legs) the way round the boundary circle of the configuration space;
 on a junction of four to eight legs, which route on the retract graph
-``G_k`` it is (STAR-JUNCTIONS.md): the planner's shortest route (its
+``G_k`` it is (docs/star.md): the planner's shortest route (its
 instruction), or the second-shortest, in another class.
 """
 

@@ -5,7 +5,7 @@ The picture itself, ``configuration.png``, is drawn by
 configuration, region and motion of it lies in the flat drawing, so that can be
 checked without looking at pixels.
 
-The space of the paper (section 5.2; ALGORITHM.md sections 2-4) is a base of six
+The space of the paper (section 5.2; docs/planner.md) is a base of six
 quadrangles ``Q(i, j)`` (vehicle 1 on leg ``i``, vehicle 2 on leg ``j``) around
 the deleted point where both vehicles would be at the junction, and six
 triangles ``T(k, r)`` (both on leg ``k``, vehicle ``r`` nearer the junction),
@@ -24,7 +24,7 @@ The flat drawing:
 - ``Q(i, j)`` is the kite origin - ``V2(i)`` - ``P(i, j)`` - ``V1(j)``. A
   configuration with ``u = s1 / L_i``, ``v = s2 / L_j`` is drawn at ``m b`` where
   ``m = max(u, v)`` and ``b`` is its retraction ``(u / m, v / m)`` on the kite's
-  outer edges: the retraction (ALGORITHM.md section 3, radial in ``(s1, s2)``)
+  outer edges: the retraction (docs/planner.md, 'Retraction onto the circle', radial in ``(s1, s2)``)
   is a straight line away from the deleted point, and the rays (one vehicle at
   the junction) are the straight lines from the origin to the valleys.
 - A triangle cannot lie flat in the base (three sheets meet along its ray), so
@@ -281,7 +281,7 @@ class ConfigurationLayout(ArrayValue):
         return self.boundary_point(cycle.theta(cycle.locate(retract_indexed(c, self.graph.lengths)[-1])))
 
     def retraction(self, c: IndexedConfiguration, region: RegionKey | None = None) -> np.ndarray:
-        """The retraction of ``c`` onto the boundary (ALGORITHM.md section 3) as drawn, shape (n, 2).
+        """The retraction of ``c`` onto the boundary (docs/planner.md) as drawn, shape (n, 2).
 
         Its waypoints, from ``c`` to its boundary image: a straight line away from the
         deleted point in a quadrangle; in a triangle, to the ray's copy, then along it to

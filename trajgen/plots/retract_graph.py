@@ -2,7 +2,7 @@
 
 With four or more legs the configuration space has no flat drawing like the
 Y's (:mod:`trajgen.plots.configuration`): it deforms onto the graph ``G_k``
-(STAR-JUNCTIONS.md section 2), which this module draws instead.
+(docs/star.md, 'The retract graph G_k'), which this module draws instead.
 
 The drawing (:class:`RetractGraphLayout`, pure geometry, no drawing) is a table
 of where each vehicle is, vehicle 1 down the rows, vehicle 2 across the
@@ -60,7 +60,7 @@ __all__ = [
     "vertex_name",
 ]
 
-#: What each of the planner's three instructions on ``G_k`` does (STAR-JUNCTIONS.md section 3).
+#: What each of the planner's three instructions on ``G_k`` does (docs/star.md, 'The three rules').
 RULE_WORDS = {
     Instruction.SHORTEST: "rule 1, the one shortest route",
     Instruction.TWO_TIED: "rule 2, two shortest routes tie: the larger ∫w wins",
@@ -274,8 +274,7 @@ _FOOTNOTE = (
     "end: vehicle 1",
     "along a column (blue), vehicle 2 along a row (orange).  O,O (both at the junction) is deleted; × (both "
     "at one leg's end)",
-    "is no configuration.  Every configuration retracts onto G_k (STAR-JUNCTIONS.md section 2): the route is "
-    "the start's",
+    "is no configuration.  Every configuration retracts onto G_k (docs/star.md): the route is the start's",
     "retraction, a route on G_k, the goal's retraction undone.  Edges are arcs, not to scale: one from row i "
     "up to O is L_i long,",
     "one from column j across to O is L_j long (the headers give the lengths).",

@@ -1,6 +1,6 @@
 """The ``optimal`` method: time-optimal jerk-limited schedules in the two shortest homotopy classes.
 
-Formulation (ALGORITHM.md section 6). The route's reduced region sequence
+Formulation (docs/planner.md, 'Homotopy classes'). The route's reduced region sequence
 ``R_1 ... R_P`` fixes the homotopy class. Phase ``p`` keeps the vehicles in
 region ``R_p``: each vehicle on a fixed leg, tracked by its distance ``s``
 from the junction, with state ``(s, v, a)`` and jerk as control, piecewise

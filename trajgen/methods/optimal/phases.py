@@ -1,7 +1,7 @@
 """Phases of the optimal-control problem and the stage layout of its transcription.
 
 Phase ``p`` keeps the vehicles in region ``R_p`` of the route's homotopy class
-(ALGORITHM.md section 6), taken from the route's own segment regions. Each
+(docs/planner.md, 'Homotopy classes'), taken from the route's own segment regions. Each
 phase has ``segments`` segments of free duration, each of ``nodes`` control
 intervals at fixed fractions of it (:func:`grid_fractions`). The stage
 sequence (:func:`stages`) is the one definition of the variable layout that
