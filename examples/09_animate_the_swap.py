@@ -25,7 +25,7 @@ import numpy as np
 
 from trajgen import Optimal, certify, load_scenario, make_schedule
 from trajgen.export import commit_files
-from trajgen.plots import animate, gif_bytes, plot_configuration, png_bytes
+from trajgen.plots import animate, encode_gif, plot_configuration, png_bytes
 from trajgen.plots.animation import frame_geometry, playback
 
 here = Path(__file__).resolve().parent
@@ -62,10 +62,8 @@ print(
 )
 
 # 4. The animation's frames as a GIF, the configuration's Figure as a PNG, written in one commit.
-animation = animate(verified, names=scenario.names)
-gif = gif_bytes(animation.frames(), delays_ms=animation.delays_ms, palette_samples=animation.palette_samples)
 files = {
-    output / "swap.gif": gif,
+    output / "swap.gif": encode_gif(animate(verified, names=scenario.names)),
     output / "configuration.png": png_bytes(plot_configuration(verified, names=scenario.names)),
 }
 for path in commit_files(files):

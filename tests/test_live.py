@@ -20,7 +20,7 @@ import time
 
 import pytest
 
-from tests.support.helpers import REPO, execution_plan
+from tests.support.helpers import REPO, execution_plan, scenario_vehicle
 from tests.support.vda5050_reference import schema_errors
 from topology import Configuration, Position
 from trajgen.cli import main
@@ -400,14 +400,7 @@ def _until(condition, seconds: float = 10.0) -> bool:
 
 def _first_vehicle(scenario, ids, settings: BrokerSettings, clock: RunClock, **options) -> SimulatedVehicle:
     """The scenario's first vehicle, simulated and started (``options``: of :class:`SimulatedVehicle`)."""
-    return SimulatedVehicle(
-        ids[0],
-        scenario.limits.vehicles[0],
-        position_xy(scenario.track, scenario.start.first),
-        broker=settings,
-        clock=clock,
-        **options,
-    ).start()
+    return scenario_vehicle(scenario, 0, ids[0], broker=settings, clock=clock, **options).start()
 
 
 def _watcher(settings: BrokerSettings, topic: str, take):

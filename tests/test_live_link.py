@@ -12,15 +12,14 @@ import time
 
 import pytest
 
-from tests.support.helpers import execution_plan
+from tests.support.helpers import execution_plan, scenario_vehicle
 from trajgen.live.broker import EmbeddedBroker, MosquittoBroker, mosquitto_available
 from trajgen.live.clock import RunClock
 from trajgen.live.link import RETRY_MAX_S, BrokerLink, LinkState
 from trajgen.live.master import LiveMaster
 from trajgen.live.mqtt import BrokerSettings, make_client
 from trajgen.live.outcome import LiveOutcome
-from trajgen.live.session import ClosestApproach, LiveDemo, identities, position_xy
-from trajgen.live.vehicle import SimulatedVehicle
+from trajgen.live.session import ClosestApproach, LiveDemo, identities
 
 #: The issue's longest gap between two starts, wall seconds.
 GAP_S = 15.0
@@ -114,16 +113,9 @@ def test_any_start_order_of_broker_master_and_vehicles_completes_the_run(order):
     clock = RunClock(25.0)
     ids = identities(scenario.names)
     approach = ClosestApproach(scenario.track)
-    starts = (scenario.start.first, scenario.start.second)
     vehicles = [
-        SimulatedVehicle(
-            ids[v],
-            scenario.limits.vehicles[v],
-            position_xy(scenario.track, starts[v]),
-            broker=settings,
-            clock=clock,
-            state_rate=2.0,
-            observer=approach.observer(v),
+        scenario_vehicle(
+            scenario, v, ids[v], broker=settings, clock=clock, state_rate=2.0, observer=approach.observer(v)
         )
         for v in (0, 1)
     ]

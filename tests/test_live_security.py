@@ -212,9 +212,9 @@ def test_tls_with_the_right_ca_connects(tls_broker, certificates):
 
 
 def test_an_acl_that_forbids_the_masters_orders_is_reported_within_seconds_naming_each_vehicle(tmp_path):
-    from tests.support.helpers import execution_plan
+    from tests.support.helpers import execution_plan, scenario_vehicle
     from trajgen.live.master import LiveMaster
-    from trajgen.live.session import identities, position_xy
+    from trajgen.live.session import identities
 
     passwords = tmp_path / "passwords"
     for number, user in enumerate(("master", "agv1", "agv2")):
@@ -236,15 +236,8 @@ def test_an_acl_that_forbids_the_masters_orders_is_reported_within_seconds_namin
         return BrokerSettings.from_url(url, username=user, password_file=password)
 
     clock = RunClock(1.0)
-    starts = (scenario.start.first, scenario.start.second)
     vehicles = [
-        SimulatedVehicle(
-            ids[v],
-            scenario.limits.vehicles[v],
-            position_xy(scenario.track, starts[v]),
-            broker=login(ids[v].serial_number),
-            clock=clock,
-        ).start()
+        scenario_vehicle(scenario, v, ids[v], broker=login(ids[v].serial_number), clock=clock).start()
         for v in (0, 1)
     ]
     master = LiveMaster(

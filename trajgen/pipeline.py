@@ -76,7 +76,7 @@ class Outputs:
     compare: tuple = METHODS.names
 
     def __post_init__(self) -> None:
-        if isinstance(self.compare, str) or not all(isinstance(name, str) for name in self.compare):
+        if not isinstance(self.compare, tuple | list) or not all(isinstance(n, str) for n in self.compare):
             raise InputError(f"compare must be a tuple of method names, got {self.compare!r}")
         object.__setattr__(self, "compare", tuple(METHODS.canonical(name) for name in self.compare))
         object.__setattr__(self, "csv_dir", _folder(self.csv_dir, "CSV output folder"))

@@ -44,9 +44,22 @@ def execution_plan(name: str, method: str):
 
 def animation_gif(verified, **options) -> bytes:
     """The GIF the command line writes of ``animate(verified, **options)``."""
-    from trajgen.plots import animate, gif_bytes
+    from trajgen.plots import animate, encode_gif
 
-    animation = animate(verified, **options)
-    return gif_bytes(
-        animation.frames(), delays_ms=animation.delays_ms, palette_samples=animation.palette_samples
+    return encode_gif(animate(verified, **options))
+
+
+def scenario_vehicle(scenario, v: int, identity, *, broker, clock, **options):
+    """Vehicle ``v`` of ``scenario`` simulated at its start, not started (``options``: SimulatedVehicle's)."""
+    from trajgen.live.session import position_xy
+    from trajgen.live.vehicle import SimulatedVehicle
+
+    start = (scenario.start.first, scenario.start.second)[v]
+    return SimulatedVehicle(
+        identity,
+        scenario.limits.vehicles[v],
+        position_xy(scenario.track, start),
+        broker=broker,
+        clock=clock,
+        **options,
     )

@@ -45,13 +45,11 @@ def _command_animate(args: argparse.Namespace) -> int:
     playback(0.0, fps=args.fps, max_frames=args.max_frames)  # bad options are refused before computing
     from trajgen.pipeline import run
     from trajgen.plots.animation_drawing import animate
-    from trajgen.plots.gif import gif_bytes
+    from trajgen.plots.gif import encode_gif
 
     scenario = scenario_from(args.scenario)
     verified = run(scenario, method=method_from(args)).verified
-    animation = animate(verified, names=scenario.names, fps=args.fps, max_frames=args.max_frames)
-    samples = animation.palette_samples
-    gif = gif_bytes(animation.frames(), delays_ms=animation.delays_ms, palette_samples=samples)
+    gif = encode_gif(animate(verified, names=scenario.names, fps=args.fps, max_frames=args.max_frames))
     (written,) = commit_files({path: gif})
     play = playback(verified.schedule.duration, fps=args.fps, max_frames=args.max_frames)
     print(

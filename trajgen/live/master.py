@@ -43,7 +43,7 @@ from trajgen.live.clock import RunClock
 from trajgen.live.geometry import track_position
 from trajgen.live.link import BrokerLink
 from trajgen.live.mqtt import BrokerSettings, Topic, VehicleIdentity, make_client
-from trajgen.live.orders import NODE_DEVIATION, horizon_length, order_message, path_elements
+from trajgen.live.orders import horizon_length, order_message, path_elements
 from trajgen.live.outcome import LiveOutcome, LiveRun
 from trajgen.live.runlog import RunLog
 from trajgen.live.view import (
@@ -62,7 +62,7 @@ from trajgen.model.summary import provenance
 from trajgen.online.goals import goal_refusal, plan_from_rest
 from trajgen.verification import VerifiedSchedule, require_verified
 
-__all__ = ["NODE_DEVIATION", "RELEASE_SPACING", "LiveMaster", "LiveOutcome", "LiveRun"]
+__all__ = ["RELEASE_SPACING", "LiveMaster", "LiveOutcome", "LiveRun"]
 
 logger = logging.getLogger(__name__)
 

@@ -1,7 +1,7 @@
 """Plots of verified schedules and runs: each draws into an ``ax`` or ``figure`` and returns the Figure.
 
 Nothing here writes files: the pipeline and the command line turn Figures into PNG bytes
-(:func:`png_bytes`) and an :class:`Animation`'s frames into a GIF (:func:`gif_bytes`). A notebook
+(:func:`png_bytes`) and an :class:`Animation` into a GIF (:func:`encode_gif`). A notebook
 composes and restyles them as it likes (``docs/plots.md``). Only :mod:`trajgen.plots.figure`
 imports matplotlib, and only when a plot is drawn; each plot is imported from its module when
 first used. The ``render_*`` functions of 0.6 (bytes) are deprecated shims for one release.
@@ -25,7 +25,7 @@ if TYPE_CHECKING:
         render_speed,
     )
     from trajgen.plots.figure import png_bytes
-    from trajgen.plots.gif import gif_bytes
+    from trajgen.plots.gif import encode_gif, gif_bytes
     from trajgen.plots.live_run import plot_live_run
     from trajgen.plots.separation import plot_separation
     from trajgen.plots.simulation import plot_simulation
@@ -35,6 +35,7 @@ __all__ = [
     "METHOD_COLOURS",
     "Animation",
     "animate",
+    "encode_gif",
     "gif_bytes",
     "plot_configuration",
     "plot_coordination",
@@ -56,6 +57,7 @@ _SOURCES = {
     "METHOD_COLOURS": "trajgen.plots.coordination",
     "Animation": "trajgen.plots.animation_drawing",
     "animate": "trajgen.plots.animation_drawing",
+    "encode_gif": "trajgen.plots.gif",
     "gif_bytes": "trajgen.plots.gif",
     "plot_configuration": "trajgen.plots.configuration_drawing",
     "plot_coordination": "trajgen.plots.coordination",

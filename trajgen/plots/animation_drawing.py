@@ -298,8 +298,7 @@ class Animation:
     """A schedule played on the track seen from above: its frames, made one at a time when asked.
 
     Made by :func:`animate`. The GIF is made at the edge (the command line):
-    ``gif_bytes(animation.frames(), delays_ms=animation.delays_ms,
-    palette_samples=animation.palette_samples)``.
+    :func:`~trajgen.plots.gif.encode_gif`.
 
     Attributes
     ----------

@@ -83,10 +83,7 @@ def render_live_run(run, *, names) -> bytes:
 def render_animation(verified, *, names=("vehicle 1", "vehicle 2"), fps=10, max_frames=300) -> bytes:
     """Deprecated: the GIF of ``animate(verified, ...)`` (see :func:`~trajgen.plots.gif.gif_bytes`)."""
     from trajgen.plots.animation_drawing import animate
-    from trajgen.plots.gif import gif_bytes
+    from trajgen.plots.gif import encode_gif
 
     _warn("render_animation", "animate")
-    animation = animate(verified, names=names, fps=fps, max_frames=max_frames)
-    return gif_bytes(
-        animation.frames(), delays_ms=animation.delays_ms, palette_samples=animation.palette_samples
-    )
+    return encode_gif(animate(verified, names=names, fps=fps, max_frames=max_frames))

@@ -23,7 +23,7 @@ from trajgen.errors import InputError
 if TYPE_CHECKING:  # Pillow is imported when a GIF is made, not with the package
     from PIL import Image
 
-__all__ = ["GIF_DELAY_UNIT_MS", "gif_bytes"]
+__all__ = ["GIF_DELAY_UNIT_MS", "encode_gif", "gif_bytes"]
 
 #: GIF frame delays are whole hundredths of a second.
 GIF_DELAY_UNIT_MS = 10
@@ -178,3 +178,10 @@ def gif_bytes(
         raise InputError("a GIF needs at least one frame, got none")
     out.write(b"\x3b")
     return out.getvalue()
+
+
+def encode_gif(animation) -> bytes:
+    """An :class:`~trajgen.plots.animation_drawing.Animation` as a looping GIF, a frame drawn at a time."""
+    return gif_bytes(
+        animation.frames(), delays_ms=animation.delays_ms, palette_samples=animation.palette_samples
+    )
