@@ -63,11 +63,6 @@ _PROBE_CONNECT = bytes((0x10, 12, 0, 4)) + b"MQTT" + bytes((4, 0x02, 0, 10, 0, 0
 _PROBE_CONNACK = bytes((0x20, 2, 0, 0))
 _PROBE_DISCONNECT = bytes((0xE0, 0))
 
-#: Ports handed out by this process, never handed out twice (a broker may not be listening yet).
-_PORTS_GIVEN: set[int] = set()
-_PORTS_LOCK = threading.Lock()
-
-
 #: Debian's and Homebrew's folders of mosquitto, looked in after the ``PATH`` (which often lacks them).
 MOSQUITTO_FOLDERS = ("/usr/sbin", "/usr/local/sbin", "/opt/homebrew/sbin")
 
@@ -77,16 +72,16 @@ def mosquitto_available() -> bool:
     return MosquittoBroker.executable() is not None
 
 
-def _free_port() -> int:
-    """A TCP port of :data:`HOST` that nothing listens on, and that this process gave no broker yet."""
-    with _PORTS_LOCK:
-        while True:
-            with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as probe:
-                probe.bind((HOST, 0))
-                port = probe.getsockname()[1]
-            if port not in _PORTS_GIVEN:
-                _PORTS_GIVEN.add(port)
-                return port
+def _reserved_port() -> socket.socket:
+    """A socket bound to a free port of :data:`HOST`, not listening: it holds the port for a broker.
+
+    Only sockets with ``SO_REUSEADDR`` (the brokers') may bind the port then, and no client gets it as
+    its own port: one dialling it before the broker listens could otherwise connect to itself.
+    """
+    reservation = socket.socket(socket.AF_INET, socket.SOCK_STREAM)
+    reservation.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
+    reservation.bind((HOST, 0))
+    return reservation
 
 
 def _wait_until_bindable(port: int, what: str) -> None:
@@ -147,7 +142,11 @@ class _Broker:
             raise InputError(
                 f"broker port {short_repr(port)} is out of range: expected 1 to 65535 (None: a free port)"
             )
-        self._port = _free_port() if port is None else port
+        if port is None:
+            reservation = _reserved_port()
+            port = reservation.getsockname()[1]
+            weakref.finalize(self, reservation.close)
+        self._port = port
         self._lock = threading.RLock()
 
     @property
