@@ -32,8 +32,8 @@ from limits import Limits
 from topology import plan
 from trajgen import Optimal, SolverCache, verify
 from trajgen.errors import InputError
+from trajgen.execution.goals import execution_margin
 from trajgen.methods.optimal import Outcome
-from trajgen.online.goals import execution_margin
 from trajgen.progress import progress
 from trajgen.scenario.sampling import campaign_scenarios, online_campaign, reference_sets
 

@@ -36,7 +36,7 @@ def main() -> None:
     longest = (0.0, "")
     scenarios = campaign_scenarios(args.scenarios, seed=args.seed)
     for scenario in progress(scenarios, description="scenarios"):
-        route = scenario.plan()
+        route = scenario.route()
         for method in methods:
             began = time.perf_counter()
             schedule = make_schedule(route, scenario.limits, method=method)

@@ -88,13 +88,13 @@ def main() -> None:
     args = parser.parse_args()
     cache = SolverCache(maxsize=256)
     fastest = Optimal(nodes=args.nodes, cache=cache)
-    paper = Optimal(nodes=args.nodes, homotopy="paper", cache=cache)
+    paper = Optimal(nodes=args.nodes, homotopy="planned", cache=cache)
     reference = Optimal(
         nodes=64,
         refinements=12,
         refinement_tolerance=1e-5,
         time_limit=120.0,
-        homotopy="paper",
+        homotopy="planned",
         cache=SolverCache(maxsize=256),
     )
     print(

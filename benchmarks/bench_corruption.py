@@ -67,7 +67,7 @@ def main() -> None:
     for scenario, path in SCENARIOS.items():
         loaded = load_scenario(path)
         for name, method in methods.items():
-            schedule = method.schedule(loaded.plan(), loaded.limits)
+            schedule = method.schedule(loaded.route(), loaded.limits)
             if schedule.fallback_reason is not None:
                 raise SystemExit(f"{scenario} {name}: fell back to exact ({schedule.fallback_reason.value})")
             original = exported(schedule)

@@ -20,8 +20,8 @@ from limits import ILLUSTRATIVE_LIMITS
 from topology import YGraph
 from trajgen import Exact, Optimal, certify, default_scenario, make_schedule, run
 from trajgen.errors import OutputLimitError, VerificationError
-from trajgen.export.dialects import DIALECTS, TableDialect
 from trajgen.export.plc import plc_tables
+from trajgen.export.plc.dialects import DIALECTS, TableDialect
 from trajgen.progress import progress
 from trajgen.scenario.sampling import random_scenarios
 
@@ -57,7 +57,7 @@ def campaign(count: int, seed: int) -> None:
     outcomes = {(d.name.value, m): [] for d in dialects for m in ("exact", "optimal")}
     times = []
     for scenario in progress(scenarios, description="scenarios"):
-        route = scenario.plan()
+        route = scenario.route()
         for label, method in (("exact", Exact()), ("optimal", Optimal())):
             verified = certify(make_schedule(route, scenario.limits, method=method))
             for dialect in dialects:

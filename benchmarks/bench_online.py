@@ -1,6 +1,6 @@
 """Figures of the order-keeping online executor: cycle cost, and the fault campaign.
 
-1. Per-cycle cost of :meth:`trajgen.online.Executor.step` for both vehicles (the executor only: the
+1. Per-cycle cost of :meth:`trajgen.execution.Executor.step` for both vehicles (the executor only: the
    simulated plant and the bookkeeping are not timed), over the first ``--timed`` campaign scenarios
    run one at a time in this process: median, 99th percentile, worst, in microseconds. The cycles
    that re-plan for a new goal (planner, timing method, verifier), and those during which Python's
@@ -30,9 +30,9 @@ import multiprocessing
 import statistics
 import time
 
-from trajgen.online import Executor
-from trajgen.online.goals import execution_margin, plan_for_execution
-from trajgen.online.simulation import parse_faults, simulate
+from trajgen.execution import Executor
+from trajgen.execution.goals import execution_margin, schedule_for_execution
+from trajgen.execution.simulation import parse_faults, simulate
 from trajgen.progress import progress
 from trajgen.scenario.sampling import campaign_faults, online_campaign
 
@@ -42,7 +42,7 @@ def run_case(args: tuple[int, int, str | None, bool]) -> dict:
     k, seed, method, fault_free = args
     logging.disable(logging.WARNING)
     scenario = online_campaign(k + 1, seed=seed)[k]
-    verified = plan_for_execution(scenario, method=method)
+    verified = schedule_for_execution(scenario, method=method)
     margin = execution_margin(scenario, 0.05)
     specs = campaign_faults(scenario, verified.schedule.duration, seed=1000 + k, margin=margin)
     try:

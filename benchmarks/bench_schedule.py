@@ -31,7 +31,7 @@ def scenarios(count: int, seed: int):
 
 def timed(scenario, method: TimingMethod):
     begin = time.perf_counter()
-    route = scenario.plan()
+    route = scenario.route()
     schedule = make_schedule(route, scenario.limits, method=method)
     elapsed = time.perf_counter() - begin
     begin = time.perf_counter()

@@ -24,7 +24,7 @@ kept = os.environ.get("TRAJGEN_EXAMPLE_OUTPUT")
 scratch = None if kept else tempfile.TemporaryDirectory(prefix="trajgen-example-")
 output = Path(kept or scratch.name).resolve()
 
-route = scenario.plan()
+route = scenario.route()
 print(
     f"route: {route.instruction}, {len(route.waypoints)} waypoints, regions {[str(r) for r in route.regions]}"
 )

@@ -26,7 +26,7 @@ kept = os.environ.get("TRAJGEN_EXAMPLE_OUTPUT")
 scratch = None if kept else tempfile.TemporaryDirectory(prefix="trajgen-example-")
 output = Path(kept or scratch.name).resolve()
 
-route = scenario.plan()
+route = scenario.route()
 print("homotopy class:", " -> ".join(str(region) for region in route.regions))
 
 # Every registered method, each schedule certified by the verifier (it raises if one fails).

@@ -21,9 +21,9 @@ from pathlib import Path
 import numpy as np
 
 from trajgen import load_scenario
+from trajgen.execution import schedule_for_execution
+from trajgen.execution.simulation import parse_faults, simulate
 from trajgen.export import commit_files
-from trajgen.online import plan_for_execution
-from trajgen.online.simulation import parse_faults, simulate
 from trajgen.plots import plot_simulation, png_bytes
 
 here = Path(__file__).resolve().parent
@@ -35,7 +35,7 @@ scratch = None if kept else tempfile.TemporaryDirectory(prefix="trajgen-example-
 output = Path(kept or scratch.name).resolve()
 
 # The plan the executor plays: the optimal swap, planned with room for the executor's margins.
-plan = plan_for_execution(scenario)
+plan = schedule_for_execution(scenario)
 schedule = plan.schedule
 print(f"planned swap: {schedule.duration:.2f} s, verified {plan.report.passed}")
 

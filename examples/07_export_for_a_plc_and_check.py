@@ -14,7 +14,7 @@ import tempfile
 from pathlib import Path
 
 from trajgen import Outputs, load_scenario, run
-from trajgen.export.check import check_profiles
+from trajgen.export.plc.check import check_profiles
 
 here = Path(__file__).resolve().parent
 scenario = load_scenario(here / "swap.toml")

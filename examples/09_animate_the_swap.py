@@ -26,7 +26,7 @@ import numpy as np
 from trajgen import Optimal, certify, load_scenario, make_schedule
 from trajgen.export import commit_files
 from trajgen.plots import animate, encode_gif, plot_configuration, png_bytes
-from trajgen.plots.animation import frame_geometry, playback
+from trajgen.plots.animation_layout import frame_geometry, playback
 
 here = Path(__file__).resolve().parent
 scenario = load_scenario(here / "swap.toml")
@@ -37,7 +37,7 @@ scratch = None if kept else tempfile.TemporaryDirectory(prefix="trajgen-example-
 output = Path(kept or scratch.name).resolve()
 
 # 1. The schedule to show: the optimal swap, certified (plots accept nothing else).
-route = scenario.plan()
+route = scenario.route()
 verified = certify(make_schedule(route, scenario.limits, method=Optimal()))
 duration = verified.schedule.duration
 print(f"optimal swap: {duration:.2f} s, class {verified.schedule.route.way_round.value}")

@@ -26,7 +26,7 @@ print(f"G_{track.leg_count}: {vertices} vertices, {edges} edges, {cycles} indepe
 print(f"instructions on this track: {', '.join(i.value for i in Instruction.of_track(track))}")
 
 # Head-on: the planner's route, one vehicle moving at a time between waypoints.
-route = scenario.plan()
+route = scenario.route()
 print(f"head-on route ({route.instruction.value}), {route.length:.1f} m of travel:")
 for waypoint in route.waypoints:
     print(f"  agv1 {waypoint.first!s:>6}   agv2 {waypoint.second!s:>6}")

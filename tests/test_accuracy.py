@@ -14,9 +14,9 @@ from limits import Limits
 from tests.conftest import REPO
 from topology import plan
 from trajgen import Optimal, verify
+from trajgen.execution.goals import execution_margin
 from trajgen.methods.optimal import Outcome
 from trajgen.methods.optimal.solve import abandoned_solver_calls
-from trajgen.online.goals import execution_margin
 from trajgen.scenario.sampling import online_campaign, reference_sets
 
 pytestmark = pytest.mark.accuracy

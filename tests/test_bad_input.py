@@ -132,7 +132,7 @@ def test_wrong_types_in_the_api_are_type_or_value_errors(value):
     from trajgen.plots import plot_coordination
 
     scenario = default_scenario()
-    route = scenario.plan()
+    route = scenario.route()
     calls = [
         lambda: make_schedule(value, LIMITS),
         lambda: make_schedule(route, value),

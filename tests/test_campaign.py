@@ -34,7 +34,7 @@ def test_the_campaign_spans_the_whole_range():
 @pytest.mark.parametrize("method", [Exact(), Toppra()], ids=["exact", "toppra"])
 def test_every_exact_and_toppra_schedule_verifies(method, index):
     scenario = SCENARIOS[index]
-    schedule = make_schedule(scenario.plan(), scenario.limits, method=method)
+    schedule = make_schedule(scenario.route(), scenario.limits, method=method)
     certify(schedule)  # raises VerificationError, naming every failure, if one does not verify
     # neither falls back on these seeded scenarios (toppra may, flagged and verified, on others)
     assert schedule.fallback_reason is None
@@ -48,7 +48,7 @@ def optimal():
 @pytest.mark.parametrize("index", range(0, len(SCENARIOS), OPTIMAL_EVERY), ids=lambda k: f"scenario-{k}")
 def test_the_optimal_schedule_verifies_and_is_no_slower_than_exact(optimal, index):
     scenario = SCENARIOS[index]
-    route = scenario.plan()
+    route = scenario.route()
     schedule = certify(make_schedule(route, scenario.limits, method=optimal)).schedule
     # solved: the effort is fixed by iterations, not by the clock, so a fallback (a solver failure, or
     # one that did not come back within the time limit) on these seeded scenarios is a regression

@@ -44,7 +44,7 @@ def test_the_faster_class_wins_the_issue_swaps(legs, vehicles, baseline, before)
     limits = Limits(vehicles, 1.5)
     route = swap_route(legs)
     fastest = Optimal().schedule(route, limits)
-    paper = Optimal(homotopy="paper").schedule(route, limits)
+    paper = Optimal(homotopy="planned").schedule(route, limits)
     report = verify(fastest)
     assert report.passed, report.failures
     assert report.regions_match  # the regions of the class it says it took
@@ -53,13 +53,13 @@ def test_the_faster_class_wins_the_issue_swaps(legs, vehicles, baseline, before)
     assert fastest.route.homotopy is Homotopy.OTHER
     assert fastest.route.way_round is WayRound.CLOCKWISE  # a swap's paper class is counterclockwise
     assert fastest.route.regions != route.regions
-    assert paper.route.homotopy is Homotopy.PAPER
+    assert paper.route.homotopy is Homotopy.PLANNED
     assert paper.route.regions == route.regions
     assert fastest.duration <= baseline * (1 + 1e-4)  # never slower than the issue's prioritized baseline
     assert fastest.duration < 0.93 * paper.duration
     assert paper.duration < before  # the paper's class is faster too than with the fixed grid
     classes = fastest.info.classes
-    assert [(c.homotopy, c.chosen) for c in classes] == [(Homotopy.PAPER, False), (Homotopy.OTHER, True)]
+    assert [(c.homotopy, c.chosen) for c in classes] == [(Homotopy.PLANNED, False), (Homotopy.OTHER, True)]
     assert classes[1].makespan == pytest.approx(fastest.duration, rel=1e-12)
     assert classes[0].makespan == pytest.approx(paper.duration, rel=2e-3)
     assert all(c.lower_bound <= c.makespan * (1 + 1e-9) for c in classes)
@@ -78,12 +78,12 @@ def test_the_four_times_faster_swap_reaches_its_closed_form_lower_bound():
 
 @pytest.mark.parametrize("scenario", RANDOM, ids=[s.source for s in RANDOM])
 def test_the_class_lower_bound_holds_in_both_classes(scenario):
-    paper = scenario.plan()
+    paper = scenario.route()
     if paper.arc_length == 0.0:
         pytest.skip("start and goal retract to one boundary point: one class only")
     other = plan(paper.graph, paper.start, paper.goal, min_separation=paper.min_separation, homotopy="other")
     for route in (paper, other):
-        schedule = Optimal(homotopy="paper").schedule(route, scenario.limits)  # the route's own class
+        schedule = Optimal(homotopy="planned").schedule(route, scenario.limits)  # the route's own class
         assert schedule.route.regions == route.regions
         assert verify(schedule).passed
         bound = class_lower_bound(route, scenario.limits)
@@ -93,9 +93,9 @@ def test_the_class_lower_bound_holds_in_both_classes(scenario):
 #: Converged solves (stored reference values): makespan of each class, seconds, the faster first, from
 #: ``Optimal(nodes=64, refinements=12, refinement_tolerance=1e-5)`` (trajgen 0.7).
 CONVERGED = {
-    "into-one-leg": ((13.500020756816056, Homotopy.PAPER), (21.68482261852551, Homotopy.OTHER)),
-    "swap-CA-mixed": ((41.15476274144109, Homotopy.PAPER), (47.47637861555721, Homotopy.OTHER)),
-    "2-30-5-swap": ((64.09144697338594, Homotopy.PAPER), (64.09150030677102, Homotopy.OTHER)),
+    "into-one-leg": ((13.500020756816056, Homotopy.PLANNED), (21.68482261852551, Homotopy.OTHER)),
+    "swap-CA-mixed": ((41.15476274144109, Homotopy.PLANNED), (47.47637861555721, Homotopy.OTHER)),
+    "2-30-5-swap": ((64.09144697338594, Homotopy.PLANNED), (64.09150030677102, Homotopy.OTHER)),
 }
 
 
@@ -153,8 +153,8 @@ def test_the_converged_references_are_what_a_converged_solve_gives():
 def test_mesh_refinement_makes_a_long_track_accurate():
     # issue 10: on 200/120/80 m the fixed 32-node grid was 1.1 % over the converged 404.00 s
     route = swap_route((200.0, 120.0, 80.0))
-    refined = Optimal(homotopy="paper").schedule(route, LIMITS)
-    first_grid = Optimal(homotopy="paper", refinements=0).schedule(route, LIMITS)
+    refined = Optimal(homotopy="planned").schedule(route, LIMITS)
+    first_grid = Optimal(homotopy="planned", refinements=0).schedule(route, LIMITS)
     assert verify(refined).passed
     assert refined.info.refinements >= 1
     assert refined.info.source is Source.NLP
@@ -218,7 +218,7 @@ goal = "A:12"
     ("options", "homotopy", "way_round"),
     [
         pytest.param([], "other", "clockwise", id="default-fastest"),
-        pytest.param(["--homotopy", "paper"], "paper", "counterclockwise", id="paper"),
+        pytest.param(["--homotopy", "planned"], "planned", "counterclockwise", id="planned"),
         pytest.param(["--homotopy", "FASTEST"], "other", "clockwise", id="fastest-any-case"),
     ],
 )
@@ -230,11 +230,11 @@ def test_cli_reports_the_class_and_keeps_the_papers_on_request(
     assert main(["schedule", str(scenario), "--json", *options]) == EXIT_OK
     summary = json.loads(capsys.readouterr().out)
     assert summary["route"]["homotopy"] == homotopy
-    assert summary["route"]["paper_class"] is (homotopy == "paper")
+    assert summary["route"]["planned_class"] is (homotopy == "planned")
     assert summary["route"]["way_round"] == way_round
     assert summary["verified"] is True
     classes = summary["solver"]["classes"]
-    if options[1:] == ["paper"]:
+    if options[1:] == ["planned"]:
         assert classes == []
     else:
         assert [c["chosen"] for c in classes] == [False, True]
@@ -242,7 +242,7 @@ def test_cli_reports_the_class_and_keeps_the_papers_on_request(
         assert classes[1]["makespan_s"] < classes[0]["makespan_s"]
     main(["schedule", str(scenario), *options])
     human = capsys.readouterr().out
-    expected = "the paper's instruction" if homotopy == "paper" else "not the paper's: faster"
+    expected = "the paper's instruction" if homotopy == "planned" else "not the paper's: faster"
     assert f"homotopy class: {way_round} ({expected})" in human
 
 
@@ -251,12 +251,12 @@ def test_cli_reports_the_class_and_keeps_the_papers_on_request(
     [
         pytest.param(
             ["--homotopy", "both"],
-            r"homotopy choice 'both' is unknown: expected one of \['fastest', 'paper'\]",
+            r"homotopy choice 'both' is unknown: expected one of \['fastest', 'planned'\]",
             id="unknown",
         ),
         pytest.param(
-            ["--homotopy", "paper", "--method", "exact"],
-            "--homotopy 'paper' applies to the method 'optimal' only, got --method 'exact'",
+            ["--homotopy", "planned", "--method", "exact"],
+            "--homotopy 'planned' applies to the method 'optimal' only, got --method 'exact'",
             id="not-optimal",
         ),
     ],
@@ -284,7 +284,7 @@ def test_a_class_that_fails_is_reported_and_the_other_class_is_returned(monkeypa
     route = swap_route((12.0, 8.0, 15.0))
     schedule = Optimal().schedule(route, MIXED)
     assert schedule.fallback_reason is None
-    assert schedule.route.homotopy is Homotopy.PAPER  # the slower class, but the only one solved
+    assert schedule.route.homotopy is Homotopy.PLANNED  # the slower class, but the only one solved
     assert verify(schedule).passed
     paper, other = schedule.info.classes
     assert (paper.chosen, paper.failure) == (True, None)
@@ -301,7 +301,7 @@ def test_a_refinement_that_raises_keeps_the_passes_solved_before(monkeypatch, ca
 
     monkeypatch.setattr(optimal_method, "refine", broken)
     route = swap_route((12.0, 8.0, 15.0))
-    schedule = Optimal(homotopy="paper").schedule(route, LIMITS)
+    schedule = Optimal(homotopy="planned").schedule(route, LIMITS)
     assert schedule.fallback_reason is None
     assert schedule.info.refinements == 0
     assert "pass 1 of 1" in schedule.notes[0]

@@ -122,7 +122,7 @@ def test_the_scan_reads_every_kind_of_file():
         "tests/conftest.py",
         "tests/support/vda5050_reference.py",
         "benchmarks/bench_continuity.py",
-        "trajgen/export/vda5050.py",
+        "trajgen/export/vda5050/files.py",
         "topology/__init__.py",
         "limits/__init__.py",
     ):

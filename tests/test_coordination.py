@@ -24,7 +24,7 @@ from trajgen import Exact, Optimal, certify, load_scenario, verify
 from trajgen.model.coordination import (
     CoordinationDiagram,
     earliest_rest,
-    plan_paths,
+    schedule_paths,
     stopping_distance,
     stopping_distances,
 )
@@ -94,13 +94,13 @@ def test_the_earliest_rest_point_counts_only_forward_speed():
 @pytest.fixture(scope="module")
 def swap_plan():
     scenario = load_scenario(SWAP)
-    return scenario, Exact().schedule(scenario.plan(), scenario.limits)
+    return scenario, Exact().schedule(scenario.route(), scenario.limits)
 
 
 def test_the_swap_has_two_conflicts_at_the_junction_each_led_by_the_vehicle_the_plan_sends_first(swap_plan):
     """Legs of 10 m, d = 1.5 m: agv2 dodges into C first, then agv1 passes to B, then agv2 to A."""
     scenario, schedule = swap_plan
-    paths, times, _ = plan_paths(schedule)
+    paths, times, _ = schedule_paths(schedule)
     d = scenario.limits.min_separation
     diagram = CoordinationDiagram(paths, d, schedule, times)
     assert [round(path.length, 9) for path in paths] == [20.0, 40.0]
@@ -119,7 +119,7 @@ def test_the_swap_has_two_conflicts_at_the_junction_each_led_by_the_vehicle_the_
 
 def test_the_frontier_in_closed_form_on_the_swap(swap_plan):
     _scenario, schedule = swap_plan
-    paths, times, _ = plan_paths(schedule)
+    paths, times, _ = schedule_paths(schedule)
     diagram = CoordinationDiagram(paths, 1.5, schedule, times)
     # agv1 follows at the first crossing: until agv2 can no longer stop short of the junction's
     # surroundings, agv1 stops 1.5 m before the junction
@@ -138,8 +138,8 @@ def test_the_frontier_in_closed_form_on_the_swap(swap_plan):
 @given(st.lists(st.floats(0.0, 45.0), min_size=2, max_size=20))
 def test_a_frontier_never_moves_back_as_the_leaders_earliest_rest_moves_on(earliest):
     scenario = load_scenario(SWAP)
-    schedule = Exact().schedule(scenario.plan(), scenario.limits)
-    paths, times, _ = plan_paths(schedule)
+    schedule = Exact().schedule(scenario.route(), scenario.limits)
+    paths, times, _ = schedule_paths(schedule)
     diagram = CoordinationDiagram(paths, 1.5, schedule, times)
     for follower in (0, 1):
         values = [diagram.frontier(follower, e) for e in sorted(earliest)]
@@ -157,7 +157,7 @@ def test_a_plan_without_clearance_runs_between_two_conflicts_that_touch_at_a_poi
     track = YGraph({"A": 10.0, "B": 10.0, "C": 1.5})
     route = plan(track, conf("A:10", "B:10"), conf("B:10", "A:10"), min_separation=1.5)
     schedule = Exact().schedule(route, Limits((AGV, AGV), 1.5))
-    paths, times, _ = plan_paths(schedule)
+    paths, times, _ = schedule_paths(schedule)
     diagram = CoordinationDiagram(paths, 1.5, schedule, times)
     leaders = sorted(c.leader for c in diagram.conflicts)
     assert leaders == [0, 1]
@@ -177,7 +177,7 @@ def test_every_methods_plan_for_execution_obeys_the_braking_rule(name, method):
 @pytest.fixture(scope="module")
 def optimal_swap():
     scenario = load_scenario(SWAP)
-    return scenario, Optimal(braking_rule=True).schedule(scenario.plan(), scenario.limits)
+    return scenario, Optimal(braking_rule=True).schedule(scenario.route(), scenario.limits)
 
 
 def test_the_rule_binds_the_optimal_swap_two_centimetres_more_is_refused(optimal_swap):
@@ -198,7 +198,7 @@ def test_verify_refuses_a_plan_that_breaks_the_rule_naming_when_and_where(optima
     scenario = load_scenario(SWAP)
     # the time-optimal swap without the rule in the NLP, claimed to be a plan for execution:
     # agv2 follows agv1 through the junction closer than its service braking can keep
-    unruled = Optimal().schedule(scenario.plan(), scenario.limits)
+    unruled = Optimal().schedule(scenario.route(), scenario.limits)
     assert unruled.fallback_reason is None
     assert verify(unruled).passed  # a timed profile: safe as long as it is followed to the letter
     claimed = dataclasses.replace(unruled, method=Optimal(braking_rule=True))

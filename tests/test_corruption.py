@@ -34,7 +34,7 @@ SEED = 2026
 @functools.cache
 def schedule_of(scenario: str, method: str):
     loaded = load_scenario(SCENARIOS[scenario])
-    schedule = METHODS[method].schedule(loaded.plan(), loaded.limits)
+    schedule = METHODS[method].schedule(loaded.route(), loaded.limits)
     assert schedule.fallback_reason is None, schedule.notes
     return schedule
 

@@ -16,12 +16,12 @@ from trajgen import Exact, Optimal, Toppra, certify, default_scenario, make_sche
 from trajgen.cli import EXIT_BAD_INPUT, EXIT_FAILURE, EXIT_OK, main
 from trajgen.errors import InputError, OptionError, OutputLimitError, ProfileFileError, VerificationError
 from trajgen.export import CsvOptions, write_profiles
-from trajgen.export.check import check_profiles
-from trajgen.export.dialects import DIALECTS, TableDialect
 from trajgen.export.plc import plc_tables
-from trajgen.export.resample import resample
-from trajgen.export.table_check import check_tables
-from trajgen.export.tables import Interpolation, ProfileTable, divided_differences
+from trajgen.export.plc.check import check_profiles
+from trajgen.export.plc.dialects import DIALECTS, TableDialect
+from trajgen.export.plc.resample import resample
+from trajgen.export.plc.table_check import check_tables
+from trajgen.export.plc.tables import Interpolation, ProfileTable, divided_differences
 from trajgen.pipeline import Outputs
 
 SWAP = str(REPO / "examples" / "swap.toml")
@@ -245,7 +245,7 @@ def test_too_few_points_for_the_starts_and_stops_are_refused(swap):
 
 
 def test_tables_that_fail_as_interpolated_are_never_written(tmp_path, monkeypatch):
-    from trajgen.export import plc
+    from trajgen.export.plc import files as plc
 
     def too_far(tables, route, limits, *, jerk):  # the tables read back, judged with 12 m separation
         return check_tables(tables, route, type(limits)(limits.vehicles, min_separation=12.0), jerk=jerk)
@@ -324,7 +324,7 @@ def test_tables_along_the_wrong_class_fail(swap):
     from topology import Homotopy, plan
 
     scenario = default_scenario()
-    other = Homotopy.OTHER if swap.schedule.route.homotopy is Homotopy.PAPER else Homotopy.PAPER
+    other = Homotopy.OTHER if swap.schedule.route.homotopy is Homotopy.PLANNED else Homotopy.PLANNED
     wrong = plan(scenario.track, scenario.start, scenario.goal, min_separation=1.5, homotopy=other)
     resampled = resample(swap, interpolation="linear", max_points=2000)
     assert check_tables(resampled.tables, swap.schedule.route, scenario.limits).passed

@@ -12,8 +12,8 @@ import pytest
 
 from tests.conftest import REPO
 from trajgen import default_scenario, run
-from trajgen.export.dialects import DIALECTS, TableDialect
 from trajgen.export.plc import plc_tables
+from trajgen.export.plc.dialects import DIALECTS, TableDialect
 
 DOCS = REPO / "docs"
 TABLE_DIALECTS = [d for d in DIALECTS if isinstance(d, TableDialect)]
@@ -70,7 +70,7 @@ def test_the_timing_page_quotes_example_06s_swap_in_both_classes(capsys):
     """Example 06's swap (legs 12/8/15 m, a fast vehicle and a slow one), as the example computes it."""
     example = runpy.run_path(str(REPO / "examples" / "06_two_different_vehicles.py"))
     capsys.readouterr()
-    paper = example["in_paper_class"].schedule.duration
+    paper = example["in_planned_class"].schedule.duration
     fastest = example["fastest"].schedule.duration
     text = _text("timing.md")
     assert f"it takes {fastest:.2f} s against {paper:.2f} s in the paper's class" in text

@@ -25,7 +25,7 @@ from tests.support.vda5050_reference import schema_errors
 from topology import Configuration, Position
 from trajgen.cli import main
 from trajgen.errors import InputError, LiveError
-from trajgen.export.vda5050_release import BaseRelease, plan_orders
+from trajgen.export.vda5050.release import BaseRelease, order_releases
 from trajgen.live.broker import EmbeddedBroker, MosquittoBroker, mosquitto_available
 from trajgen.live.clock import LEAD, RunClock
 from trajgen.live.master import LiveMaster, LiveOutcome
@@ -330,7 +330,7 @@ def _master_and_fakes(scenario, verified, **options):
 
 def _releasing_vehicle(verified, spacing: float) -> int:
     """A vehicle whose arrival at its first decision point releases base (by the master's own rule)."""
-    plan = plan_orders(verified, spacing=spacing)
+    plan = order_releases(verified, spacing=spacing)
     for v in (0, 1):
         rule = BaseRelease(plan.paths, verified.schedule.limits.min_separation)
         if rule.reach(v, rule.released[v]):

@@ -24,13 +24,13 @@ from topology import JUNCTION_INDEX, Configuration, Position, StarGraph, YGraph
 from topology.indexed import separation as indexed_separation
 from trajgen import certify, default_scenario, load_scenario, make_schedule
 from trajgen.errors import InputError, UnverifiedScheduleError
+from trajgen.execution import BrakingCheck, Executor, Mode, PathState, VehicleState
+from trajgen.execution.braking_check import emergency_position
+from trajgen.execution.goals import execution_margin, schedule_for_execution
+from trajgen.execution.messages import Command, Setpoint, checked_state
+from trajgen.execution.plant import Plant
+from trajgen.execution.simulation import parse_faults, simulate
 from trajgen.model.paths import VehiclePath
-from trajgen.online import BrakingCheck, Executor, Mode, PathState, VehicleState
-from trajgen.online.braking import emergency_position
-from trajgen.online.goals import execution_margin, plan_for_execution
-from trajgen.online.messages import Command, Setpoint, checked_state
-from trajgen.online.plant import Plant
-from trajgen.online.simulation import parse_faults, simulate
 from trajgen.scenario import Scenario
 from trajgen.scenario.sampling import campaign_faults, online_campaign, random_scenarios
 
@@ -57,7 +57,7 @@ def swap():
 
 def test_the_swap_paths_follow_the_route():
     scenario = default_scenario()
-    route = scenario.plan()
+    route = scenario.route()
     for v in (0, 1):
         path = VehiclePath.from_route(route, v)
         assert path.length == pytest.approx(route.travel[v], abs=1e-12)
@@ -78,7 +78,7 @@ def test_the_swap_paths_follow_the_route():
 @settings(max_examples=200, derandomize=True, deadline=None)
 @given(fraction=st.floats(0.0, 1.0), vehicle=st.sampled_from([0, 1]))
 def test_project_undoes_locate(fraction, vehicle):
-    route = default_scenario().plan()
+    route = default_scenario().route()
     path = VehiclePath.from_route(route, vehicle)
     p = fraction * path.length
     leg, s = path.locate(p)
@@ -144,7 +144,7 @@ def test_sweep_covers_exactly_the_track_passed_over(stops, ends):
 @settings(max_examples=200, derandomize=True, deadline=None)
 @given(fraction=st.floats(-0.1, 1.1), vehicle=st.sampled_from([0, 1]))
 def test_place_agrees_with_the_separate_lookups(fraction, vehicle):
-    route = default_scenario().plan()
+    route = default_scenario().route()
     path = VehiclePath.from_route(route, vehicle)
     p = fraction * path.length
     leg, s, heading, axis, branch = path.place(p)
@@ -254,7 +254,7 @@ def track_distance(paths, first: np.ndarray, second: np.ndarray) -> np.ndarray:
 
 
 def test_the_vectorized_track_distance_agrees_with_the_planners():
-    route = default_scenario().plan()
+    route = default_scenario().route()
     paths = tuple(VehiclePath.from_route(route, v) for v in (0, 1))
     rng = np.random.default_rng(5)
     one, two = rng.uniform(-1.0, paths[0].length + 1.0, 500), rng.uniform(-1.0, paths[1].length + 1.0, 500)
@@ -283,7 +283,7 @@ def test_what_the_check_certifies_holds_under_every_braking_of_both(
     Also for the check of a hold, whose unclear intervals are halved.
     """
     scenario = default_scenario()
-    route = scenario.plan()
+    route = scenario.route()
     paths = tuple(VehiclePath.from_route(route, v) for v in (0, 1))
     first = fraction * paths[0].length
     second = data.draw(st.floats(0.0, paths[1].length))
@@ -397,7 +397,7 @@ def random_plans(kind: str, count: int):
         else:
             track = YGraph({name: rng.uniform(4.0, 16.0) for name in "ABC"})
         (scenario,) = random_scenarios(1, seed=500 + k, track=track, limits=ILLUSTRATIVE_LIMITS)
-        out.append((scenario, plan_for_execution(scenario, method=rng.choice(["exact", "toppra"]))))
+        out.append((scenario, schedule_for_execution(scenario, method=rng.choice(["exact", "toppra"]))))
     return out
 
 
@@ -563,7 +563,7 @@ def test_campaign_scenarios_that_failed_reach_their_goals_safely(k, method):
     junction vertex timed 3e-15 m up its leg; 132: a re-plan's 7 um first move read as its goal).
     """
     scenario = online_campaign(k + 1, seed=CAMPAIGN_SEED)[k]
-    verified = plan_for_execution(scenario, method=method)
+    verified = schedule_for_execution(scenario, method=method)
     margin = execution_margin(scenario, 0.05)
     specs = campaign_faults(scenario, verified.schedule.duration, seed=1000 + k, margin=margin)
     result, _ = simulate(scenario, parse_faults(scenario, specs), verified=verified)
@@ -587,7 +587,7 @@ SEED_12_REGRESSIONS = {
 @pytest.mark.parametrize("k", sorted(SEED_12_REGRESSIONS), ids=lambda k: f"scenario-{k}")
 def test_seed_12_campaign_scenarios_that_deadlocked_reach_their_goals_safely(k):
     scenario = online_campaign(k + 1, seed=12)[k]
-    verified = plan_for_execution(scenario, method="exact")
+    verified = schedule_for_execution(scenario, method="exact")
     margin = execution_margin(scenario, 0.05)
     specs = campaign_faults(scenario, verified.schedule.duration, seed=1000 + k, margin=margin)
     assert any(spec.startswith("goal:") for spec in specs), specs  # each failed after a new goal
@@ -611,7 +611,7 @@ def test_seed_12_campaign_scenarios_that_braked_hard_keep_the_braking_invariant(
     the goal); new motion keeps the coarse check, whose pessimism is the holds' room.
     """
     scenario = online_campaign(k + 1, seed=12)[k]
-    verified = plan_for_execution(scenario, method="exact")
+    verified = schedule_for_execution(scenario, method="exact")
     margin = execution_margin(scenario, 0.05)
     specs = campaign_faults(scenario, verified.schedule.duration, seed=1000 + k, margin=margin)
     result, _ = simulate(scenario, parse_faults(scenario, specs), verified=verified)
@@ -631,7 +631,7 @@ def test_a_re_plan_continues_each_vehicles_axis_from_where_it_stands():
     waited for: a deadlock.
     """
     scenario = load_scenario(SWAP)
-    verified = plan_for_execution(scenario, method="exact")
+    verified = schedule_for_execution(scenario, method="exact")
     executor = Executor(verified, min_separation=scenario.limits.min_separation)
     short = 0.004  # metres: inside the position tolerance, so still on the setpoints
     states = []
@@ -655,7 +655,7 @@ def test_a_vehicle_at_rest_at_the_junction_leaves_it_onto_the_leg_its_setpoint_n
     junction along the leg it came from, the wrong one, or not at all.
     """
     scenario = load_scenario(SWAP)
-    verified = plan_for_execution(scenario, method="exact")
+    verified = schedule_for_execution(scenario, method="exact")
     plant = Plant(Executor(verified, min_separation=scenario.limits.min_separation), (), 0.01)
     body = plant.bodies[0]
     body.s = 0.0
@@ -712,7 +712,7 @@ def test_bad_executor_options(swap, options, match):
 
 def test_the_executor_takes_only_verified_schedules():
     scenario = default_scenario()
-    schedule = make_schedule(scenario.plan(), scenario.limits, method="exact")
+    schedule = make_schedule(scenario.route(), scenario.limits, method="exact")
     with pytest.raises(UnverifiedScheduleError, match="Executor"):
         Executor(schedule)
     assert Executor(certify(schedule)).mode is Mode.FOLLOWING

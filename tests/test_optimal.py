@@ -108,7 +108,7 @@ def test_slower_vehicle_sets_the_time_when_it_moves_alone():
 
 @pytest.mark.parametrize("scenario", RANDOM, ids=[s.source for s in RANDOM])
 def test_lower_bound_optimal_exact_order_and_verification(scenario):
-    route = scenario.plan()
+    route = scenario.route()
     schedule = optimal_schedule(route, scenario.limits)
     exact = exact_schedule(route, scenario.limits)
     report = verify(schedule)
@@ -203,7 +203,7 @@ def test_forced_solver_failure_falls_back_to_exact_and_logs(caplog):
 def test_backup_solvers_reach_fatrops_optimum(fatrop_iterations, solved_by):
     route = route_of(UNEQUAL, ("A:12", "B:8"), ("B:8", "A:12"))
     # the chain on one class and one grid (no refinement), so that each attempt is one solver's
-    single = {"homotopy": "paper", "refinements": 0}
+    single = {"homotopy": "planned", "refinements": 0}
     reference = optimal_schedule(route, LIMITS, **single)
     assert reference.info.solver is Solver.FATROP
     # a fresh NLP whose fatrop stops early: the chain must carry on to the same optimum
@@ -284,7 +284,7 @@ def test_make_schedule_dispatches_optimal():
         ),
         pytest.param(
             {"homotopy": "both"},
-            r"homotopy choice 'both' is unknown: expected one of \['fastest', 'paper'\]",
+            r"homotopy choice 'both' is unknown: expected one of \['fastest', 'planned'\]",
             id="homotopy",
         ),
     ],
@@ -433,7 +433,7 @@ def test_a_time_limit_reached_after_the_first_pass_keeps_that_pass_and_says_so(m
     late_clock = types.SimpleNamespace(perf_counter=lambda: real_clock() + (1e6 if solved else 0.0))
     monkeypatch.setattr(optimal_method, "solve", solve_once_then_late)
     monkeypatch.setattr(optimal_method, "time", late_clock)
-    schedule = Optimal(homotopy="paper", cache=SolverCache()).schedule(route, LIMITS)
+    schedule = Optimal(homotopy="planned", cache=SolverCache()).schedule(route, LIMITS)
     assert len(solved) == 1  # no refinement pass started after the limit
     assert schedule.fallback_reason is None  # the first pass is kept, verified
     assert verify(schedule).passed

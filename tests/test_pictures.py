@@ -21,7 +21,7 @@ from trajgen.cli import EXIT_BAD_INPUT, EXIT_OK, main
 from trajgen.errors import OptionError, UnverifiedScheduleError
 from trajgen.pipeline import PLOT_NAMES
 from trajgen.plots import plot_configuration, png_bytes
-from trajgen.plots.animation import (
+from trajgen.plots.animation_layout import (
     DEFAULT_MAX_FRAMES,
     END_HOLD_MS,
     FRAME_HEIGHT_PX,
@@ -33,7 +33,7 @@ from trajgen.plots.animation import (
     playback,
     speed_text,
 )
-from trajgen.plots.configuration import ConfigurationLayout, route_samples, schedule_samples
+from trajgen.plots.configuration_layout import ConfigurationLayout, route_samples, schedule_samples
 from trajgen.plots.gif import gif_bytes
 from trajgen.plots.speed import VEHICLE_COLOURS
 
@@ -97,7 +97,7 @@ def _in_region(point: np.ndarray, polygon: np.ndarray) -> bool:
 @pytest.fixture(scope="module")
 def swap():
     scenario = default_scenario()
-    return scenario, certify(make_schedule(scenario.plan(), scenario.limits, method=Exact()))
+    return scenario, certify(make_schedule(scenario.route(), scenario.limits, method=Exact()))
 
 
 @pytest.fixture(scope="module")
@@ -500,7 +500,7 @@ def test_animate_writes_the_gif(tmp_path, capsys):
         pytest.param("ok.gif", ["--fps", "0"], "fps .* from 1 to 50", id="bad-fps"),
         pytest.param("ok.gif", ["--max-frames", "1"], "max_frames .* from 2", id="bad-max-frames"),
         pytest.param(
-            "ok.gif", ["--method", "toppra", "--homotopy", "paper"], "--homotopy", id="bad-homotopy"
+            "ok.gif", ["--method", "toppra", "--homotopy", "planned"], "--homotopy", id="bad-homotopy"
         ),
     ],
 )
@@ -531,14 +531,14 @@ def swap_by_method():
     from trajgen.methods import METHODS
 
     scenario = default_scenario()
-    route = scenario.plan()
+    route = scenario.route()
     return {cls.name: certify(make_schedule(route, scenario.limits, method=cls())) for cls in METHODS}
 
 
 def test_the_coordination_plot_draws_the_too_close_region_as_the_diagrams_exact_polygons(swap_by_method):
     from matplotlib.patches import Polygon
 
-    from trajgen.model.coordination import CoordinationDiagram, plan_paths
+    from trajgen.model.coordination import CoordinationDiagram, schedule_paths
     from trajgen.plots import plot_coordination
 
     exact = swap_by_method["exact"].schedule
@@ -547,7 +547,7 @@ def test_the_coordination_plot_draws_the_too_close_region_as_the_diagrams_exact_
     drawn = sorted(
         tuple(map(tuple, np.round(p.get_xy()[:-1], 9))) for p in axis.patches if isinstance(p, Polygon)
     )
-    paths, times, _ = plan_paths(exact)
+    paths, times, _ = schedule_paths(exact)
     diagram = CoordinationDiagram(paths, exact.limits.min_separation, exact, times)
     expected = sorted(
         tuple(tuple(np.round(v, 9)) for v in polygon) for c in diagram.conflicts for polygon in c.polygons

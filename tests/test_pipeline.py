@@ -217,7 +217,7 @@ def test_cli_help_lists_one_line_per_method(capsys):
         main(["schedule", "--help"])
     out = capsys.readouterr().out
     for cls in METHODS:
-        assert any(line.strip().startswith(f"{cls.name}: {cls.summary}") for line in out.splitlines()), (
+        assert any(line.strip().startswith(f"{cls.name}: {cls.description}") for line in out.splitlines()), (
             cls.name
         )
 

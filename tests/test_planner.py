@@ -281,7 +281,7 @@ def test_route_properties(query):
     graph, start, goal, separation = query
     route = plan(graph, start, goal, min_separation=separation)
     check_route(graph, start, goal, separation, route)
-    assert route.homotopy is Homotopy.PAPER
+    assert route.homotopy is Homotopy.PLANNED
     assert abs(route.arc_length) <= graph.perimeter / 2 * (1 + 1e-9)
 
 
@@ -331,7 +331,7 @@ def test_the_other_class_of_a_query_that_stays_at_one_boundary_point_is_refused(
     with pytest.raises(OptionError, match=same_point):
         plan(tiny, near, far, homotopy="other")
     with pytest.raises(
-        OptionError, match=r"homotopy 'both' is unknown: expected one of \['paper', 'other'\]"
+        OptionError, match=r"homotopy 'both' is unknown: expected one of \['planned', 'other'\]"
     ):
         plan(graph, start, goal, homotopy="both")
 

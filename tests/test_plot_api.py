@@ -17,7 +17,7 @@ from matplotlib.figure import Figure
 from tests.conftest import REPO
 from tests.support.helpers import animation_gif
 from trajgen import Exact, certify, default_scenario, make_schedule
-from trajgen.online.simulation import parse_faults, simulate
+from trajgen.execution.simulation import parse_faults, simulate
 from trajgen.plots import (
     animate,
     plot_configuration,
@@ -42,7 +42,7 @@ NAMES = ("agv1", "agv2")
 @pytest.fixture(scope="module")
 def subjects():
     scenario = default_scenario()
-    verified = certify(make_schedule(scenario.plan(), scenario.limits, method=Exact()))
+    verified = certify(make_schedule(scenario.route(), scenario.limits, method=Exact()))
     result, _ = simulate(scenario, parse_faults(scenario, ["stop:agv1@3+2"]), method="exact")
     run = {
         "states": {name: [(float(t), 0.5 * t, True) for t in np.linspace(0.0, 10.0, 20)] for name in NAMES},

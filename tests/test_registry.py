@@ -37,7 +37,7 @@ class Cautious(TimingMethod):
     """A method that is not built in: exact at a fraction of the limits' speed, as a user might add."""
 
     name: ClassVar[str] = "cautious"
-    summary: ClassVar[str] = "exact, twice as long"
+    description: ClassVar[str] = "exact, twice as long"
 
     @property
     def jerk_limited(self) -> bool:
@@ -52,7 +52,7 @@ def test_the_registry_lists_the_methods_in_order_with_a_default():
     assert METHODS.names == ("exact", "toppra", "optimal")
     assert METHODS.default == "optimal"
     assert list(METHODS) == [Exact, Toppra, Optimal]
-    assert all(cls.summary in METHODS.help() for cls in METHODS)
+    assert all(cls.description in METHODS.help() for cls in METHODS)
     assert METHODS.create() == Optimal()
     assert METHODS.create(" Toppra ") == Toppra()
     options = Optimal(nodes=16)
@@ -141,7 +141,7 @@ def test_a_registered_source_whose_class_has_drifted_is_refused_when_loaded(sour
 
 
 def test_the_built_in_sources_name_and_summarize_their_classes():
-    assert [(cls.name, cls.summary) for cls in METHODS] == [
+    assert [(cls.name, cls.description) for cls in METHODS] == [
         (name, line.split(": ", 1)[1].removesuffix(" (default)"))
         for name, line in zip(METHODS.names, METHODS.help().splitlines(), strict=True)
     ]

@@ -54,7 +54,7 @@ def test_vehicles_stop_where_the_direction_changes_and_reverse_with_negative_vel
 
 @pytest.mark.parametrize("scenario", RANDOM, ids=[s.source for s in RANDOM])
 def test_exact_and_toppra_pass_the_verifier_and_toppra_is_never_slower(scenario):
-    route = scenario.plan()
+    route = scenario.route()
     exact = exact_schedule(route, scenario.limits)
     timed = toppra_schedule(route, scenario.limits)
     no_jerk = exact_schedule(route, scenario.limits, jerk=False)
@@ -76,7 +76,7 @@ STRESS = random_scenarios(300, seed=2026, track=TRACK, limits=MIXED)
 @pytest.mark.parametrize("index", [90, 241], ids=["stress-90", "stress-241"])
 def test_toppra_velocity_peaks_between_grid_points_are_within_limits(index):
     scenario = STRESS[index]
-    timed = toppra_schedule(scenario.plan(), scenario.limits)
+    timed = toppra_schedule(scenario.route(), scenario.limits)
     report = verify(timed)
     assert report.passed, report.failures
 
@@ -84,7 +84,7 @@ def test_toppra_velocity_peaks_between_grid_points_are_within_limits(index):
 @pytest.mark.parametrize("index", [90, 241, 0, 1, 2], ids=lambda i: f"stress-{i}")
 def test_closed_form_velocity_peaks_agree_with_dense_sampling(index):
     scenario = STRESS[index]
-    timed = toppra_schedule(scenario.plan(), scenario.limits)
+    timed = toppra_schedule(scenario.route(), scenario.limits)
     sections = [s.kinematics for s in timed.sections if isinstance(s.kinematics, ToppraKinematics)]
     assert sections
     for kinematics in sections:
@@ -213,7 +213,7 @@ def test_the_last_sample_is_the_goal_at_rest_with_no_jerk(method, period):
 def test_the_closed_form_verifier_agrees_with_the_sampled_second_opinion(scenario, method):
     from tests.support.sampled_verifier import sampled_verify
 
-    schedule = make_schedule(scenario.plan(), scenario.limits, method=method)
+    schedule = make_schedule(scenario.route(), scenario.limits, method=method)
     certified, sampled = verify(schedule), sampled_verify(schedule)
     assert certified.passed, certified.failures
     assert sampled.passed, sampled.failures
@@ -291,7 +291,7 @@ def test_the_csv_leg_column_is_the_states_leg_plus_one_and_leg_names_read_both(t
     from trajgen import certify, default_scenario, write_profiles
 
     scenario = default_scenario()
-    verified = certify(make_schedule(scenario.plan(), scenario.limits, method="exact"))
+    verified = certify(make_schedule(scenario.route(), scenario.limits, method="exact"))
     first, _ = write_profiles(verified, scenario.names, tmp_path)
     rows = [line.split(";") for line in first.read_text().splitlines()[1:]]
     t = np.array([float(row[0]) for row in rows])

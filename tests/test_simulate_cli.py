@@ -11,16 +11,16 @@ import re
 import numpy as np
 import pytest
 
-import trajgen.closed_loop
+import trajgen.simulation_pipeline
 from tests.conftest import REPO
 from trajgen.cli import EXIT_BAD_INPUT, EXIT_FAILURE, EXIT_OK, main
-from trajgen.closed_loop import format_simulation, run_simulation
 from trajgen.errors import InputError
-from trajgen.online.faults import FaultError
-from trajgen.online.goals import plan_for_execution
-from trajgen.online.simulation import parse_faults, simulate
+from trajgen.execution.faults import FaultError
+from trajgen.execution.goals import schedule_for_execution
+from trajgen.execution.simulation import parse_faults, simulate
 from trajgen.plots import plot_simulation, png_bytes
 from trajgen.scenario import load_scenario
+from trajgen.simulation_pipeline import format_simulation, run_simulation
 
 
 def simulation_png(*arguments, **options) -> bytes:
@@ -94,7 +94,7 @@ def stopped_run(tmp_path_factory):
         contextlib.redirect_stdout(out),
         contextlib.redirect_stderr(err),
     ):
-        patch.setattr(trajgen.closed_loop, "simulate", recording)
+        patch.setattr(trajgen.simulation_pipeline, "simulate", recording)
         status = main(argv)
     assert len(results) == 1
     return Run(status, out.getvalue(), err.getvalue(), results[0], trace, plot)
@@ -162,7 +162,7 @@ def test_a_failed_run_exits_1_and_still_writes_its_evidence(
     stopped_run, tmp_path, capsys, monkeypatch, change, message
 ):
     failed = dataclasses.replace(stopped_run.result, **change)
-    monkeypatch.setattr(trajgen.closed_loop, "simulate", lambda *args, **kwargs: (failed, None))
+    monkeypatch.setattr(trajgen.simulation_pipeline, "simulate", lambda *args, **kwargs: (failed, None))
     plot = tmp_path / "plot"
     assert main(["simulate", SWAP, "--plot", str(plot)]) == EXIT_FAILURE
     captured = capsys.readouterr()
@@ -207,7 +207,7 @@ def nothing_computed(monkeypatch):
     def refuse(*args, **kwargs):
         raise AssertionError("simulate ran although the input was bad")
 
-    monkeypatch.setattr(trajgen.closed_loop, "simulate", refuse)
+    monkeypatch.setattr(trajgen.simulation_pipeline, "simulate", refuse)
 
 
 @pytest.mark.usefixtures("nothing_computed")
@@ -297,7 +297,7 @@ def test_render_simulation_refuses_bad_arguments(stopped_run, result, min_separa
 def test_the_plot_data_hold_each_vehicles_frontier_and_no_vehicle_passes_it(method):
     """What the plot draws as each vehicle's frontier: finite where a conflict binds, never overrun."""
     scenario = load_scenario(SWAP)
-    verified = plan_for_execution(scenario, method=method)
+    verified = schedule_for_execution(scenario, method=method)
     result, _ = simulate(scenario, parse_faults(scenario, ["stop:agv1@8+3"]), verified=verified)
     plot = result.plot
     t, travel, frontier = plot["t"], plot["travel"], plot["frontier"]
@@ -337,7 +337,7 @@ def test_events_name_the_vehicles_by_their_names(capsys):
 
 
 def test_a_run_of_repeated_events_prints_as_one_line_with_its_count():
-    from trajgen.closed_loop import format_simulation
+    from trajgen.simulation_pipeline import format_simulation
 
     events = [
         {"t_s": 10.0 + 0.01 * k, "kind": "retime", "detail": "agv2 holds: the braking check"}
@@ -376,7 +376,7 @@ def test_a_run_of_repeated_events_prints_as_one_line_with_its_count():
 
 def test_run_simulation_returns_a_named_result_with_its_files(tmp_path):
     from trajgen import Exact
-    from trajgen.closed_loop import SimulationRun
+    from trajgen.simulation_pipeline import SimulationRun
 
     run = run_simulation(load_scenario(SWAP), ["stop:agv1@8+3"], method=Exact(), trace_dir=tmp_path)
     assert isinstance(run, SimulationRun)

@@ -411,7 +411,7 @@ def check_valid_route(graph: StarGraph, start, goal, separation: float, route) -
         list(itertools.accumulate(steps, initial=0.0)), rel=1e-12, abs=1e-12
     )
     assert route.instruction in Instruction.of_track(graph)
-    assert route.homotopy is Homotopy.PAPER or route.homotopy is Homotopy.OTHER
+    assert route.homotopy is Homotopy.PLANNED or route.homotopy is Homotopy.OTHER
 
 
 # -- 1. k = 3: the geodesic machinery of G_3 is the cycle planner ------------------------------------------
@@ -443,7 +443,7 @@ def test_a_star_of_three_legs_plans_exactly_as_the_y(query):
     star = StarGraph(graph.legs)
     assert star.cycle is not None
     assert star.angles_deg == graph.angles_deg
-    for homotopy in ("paper", "other"):
+    for homotopy in ("planned", "other"):
         try:
             expected = plan(graph, start, goal, min_separation=separation, homotopy=homotopy)
         except OptionError:
@@ -467,9 +467,9 @@ def test_every_route_on_a_star_is_valid(query):
     graph, start, goal, separation = query
     route = plan(graph, start, goal, min_separation=separation)
     check_valid_route(graph, start, goal, separation, route)
-    assert route.homotopy is Homotopy.PAPER
+    assert route.homotopy is Homotopy.PLANNED
     assert route.instruction in Instruction.of_track(graph)
-    assert route.way_round is (WayRound.GRAPH if route.arc_length > 0 else WayRound.NONE)
+    assert route.way_round is (WayRound.NOT_APPLICABLE if route.arc_length > 0 else WayRound.NONE)
 
 
 # -- 3. shortest on G_k up to the perturbation -------------------------------------------------------------

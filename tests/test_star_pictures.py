@@ -20,9 +20,16 @@ from trajgen.errors import InputError, UnverifiedScheduleError
 from trajgen.model.summary import class_label, class_name
 from trajgen.pipeline import PLOT_NAMES
 from trajgen.plots import plot_configuration, png_bytes
-from trajgen.plots.animation import FRAME_HEIGHT_PX, FRAME_WIDTH_PX, frame_geometry, frame_layout, playback
-from trajgen.plots.configuration import ConfigurationLayout
-from trajgen.plots.retract_graph import (
+from trajgen.plots.animation_layout import (
+    FRAME_HEIGHT_PX,
+    FRAME_WIDTH_PX,
+    frame_geometry,
+    frame_layout,
+    playback,
+)
+from trajgen.plots.configuration_layout import ConfigurationLayout
+from trajgen.plots.speed import VEHICLE_COLOURS
+from trajgen.plots.star_configuration import (
     BOW,
     RULE_WORDS,
     RetractGraphLayout,
@@ -31,7 +38,6 @@ from trajgen.plots.retract_graph import (
     route_points,
     schedule_points,
 )
-from trajgen.plots.speed import VEHICLE_COLOURS
 
 
 def configuration_png(*arguments, **options) -> bytes:

@@ -42,10 +42,10 @@ from trajgen import (
 )
 from trajgen.cli import EXIT_BAD_INPUT, EXIT_FAILURE, EXIT_OK, main
 from trajgen.errors import InputError, ScenarioError
-from trajgen.export.check import check_profiles
-from trajgen.export.dialects import DIALECTS, TableDialect
+from trajgen.execution.executor import Executor, VehicleState
+from trajgen.export.plc.check import check_profiles
+from trajgen.export.plc.dialects import DIALECTS, TableDialect
 from trajgen.model.summary import class_label
-from trajgen.online.executor import Executor, VehicleState
 from trajgen.scenario.sampling import online_campaign, random_scenarios, random_track
 
 CROSSING = REPO / "trajgen" / "data" / "crossing.toml"
@@ -127,7 +127,7 @@ def star_scenario(k: int):
 @functools.cache
 def star_schedule(k: int, method: str):
     scenario = star_scenario(k)
-    return make_schedule(scenario.plan(), scenario.limits, method=METHODS[method]())
+    return make_schedule(scenario.route(), scenario.limits, method=METHODS[method]())
 
 
 def leg_index(scenario, position) -> int:
@@ -192,7 +192,7 @@ def test_every_method_verifies_on_k_legs(k, method):
         homotopy=route.homotopy,
     )
     assert route.region_keys == planned.region_keys
-    assert route.way_round is WayRound.GRAPH
+    assert route.way_round is WayRound.NOT_APPLICABLE
     # a second opinion from samples: legs in range, separation, limits, class
     second = sampled_verify(schedule, period=2e-3)
     assert second.passed, second.failures
@@ -319,7 +319,7 @@ def test_plan_names_the_class_on_g4(capsys):
     summary = json.loads(capsys.readouterr().out)
     assert summary["legs"] == 4
     assert summary["class"] == "shortest route on G_4"
-    assert summary["way_round"] == "graph"
+    assert summary["way_round"] == "not-applicable"
     assert summary["arc_length_m"] == 60.0
     assert summary["regions"] == ["Q(N,S)", "Q(E,S)", "Q(E,N)", "Q(S,N)"]
     assert summary["waypoints"][2] == [{"leg": "E", "s_m": 10.0}, {"leg": "S", "s_m": 10.0}]
@@ -503,14 +503,14 @@ def test_optimal_fastest_on_a_crossing_takes_the_faster_of_two_classes(capsys):
     # fast vehicle 2 dodges, which is much faster
     scenario = builtin_scenario("crossing")
     limits = Limits((QUARTER, FAST), 1.5)
-    route = scenario.plan()
+    route = scenario.route()
     fastest = Optimal().schedule(route, limits)
     report = verify(fastest)
     assert report.passed, report.failures
     assert report.regions_match
     assert fastest.fallback_reason is None
     classes = fastest.info.classes
-    assert [(c.homotopy, c.chosen) for c in classes] == [(Homotopy.PAPER, False), (Homotopy.OTHER, True)]
+    assert [(c.homotopy, c.chosen) for c in classes] == [(Homotopy.PLANNED, False), (Homotopy.OTHER, True)]
     assert [c.summary()["class"] for c in classes] == [
         "shortest route on G_4",
         "second-shortest route on G_4",
@@ -568,7 +568,7 @@ def test_simulate_under_faults_on_a_crossing_keeps_the_separation(tmp_path, caps
 
 def test_the_executor_on_a_crossing_checks_legs_by_count():
     scenario = builtin_scenario("crossing")
-    verified = certify(make_schedule(scenario.plan(), scenario.limits, method="exact"))
+    verified = certify(make_schedule(scenario.route(), scenario.limits, method="exact"))
     executor = Executor(verified)
     with pytest.raises(
         InputError,
@@ -589,7 +589,7 @@ def test_random_scenarios_on_k_legs_plan_and_verify(k):
     assert [s.source for s in scenarios] == [f"<online k={k} 13:{n}>" for n in range(3)]
     track = scenarios[0].track
     for scenario in [*scenarios, *random_scenarios(3, seed=2, track=track, limits=scenarios[0].limits)]:
-        schedule = make_schedule(scenario.plan(), scenario.limits, method="exact")
+        schedule = make_schedule(scenario.route(), scenario.limits, method="exact")
         assert verify(schedule).passed
 
 

@@ -65,7 +65,7 @@ def test_an_exact_schedule_on_the_command_line_loads_no_solver_spline_plot_or_ru
         name
         for name in modules
         if name.startswith(
-            ("trajgen.plots", "trajgen.online", "trajgen.closed_loop", "trajgen.export.vda5050")
+            ("trajgen.plots", "trajgen.execution", "trajgen.simulation_pipeline", "trajgen.export.vda5050")
         )
         or name in ("trajgen.cli.animate", "trajgen.cli.check", "trajgen.cli.simulate", "trajgen.cli.vda5050")
     )
@@ -96,7 +96,7 @@ def test_a_method_is_imported_when_it_is_first_created_not_when_it_is_named():
 
 def test_the_check_sees_a_heavy_import():
     assert "scipy" in _modules_after(
-        "import trajgen.export.tables as t; t.ProfileTable  # noqa\nimport scipy"
+        "import trajgen.export.plc.tables as t; t.ProfileTable  # noqa\nimport scipy"
     )
 
 

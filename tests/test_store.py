@@ -78,14 +78,14 @@ def test_the_shared_cache_stores_what_it_builds_and_a_new_process_loads_it(tmp_p
 def test_a_damaged_file_is_deleted_and_the_shape_built_again(tmp_path, caplog):
     route = route_of(*SWAP)
     store = NlpStore(tmp_path)
-    Optimal(homotopy="paper", cache=SolverCache(store=store)).warm_up(route)
+    Optimal(homotopy="planned", cache=SolverCache(store=store)).warm_up(route)
     assert store.flush(timeout=120)
     (path,) = store.files()
     data = bytearray(path.read_bytes())
     data[-100] ^= 0xFF  # one flipped byte in the payload
     path.write_bytes(bytes(data))
     with caplog.at_level(logging.WARNING, logger="trajgen.methods.optimal"):
-        schedule = Optimal(homotopy="paper", cache=SolverCache(store=store)).schedule(route, LIMITS)
+        schedule = Optimal(homotopy="planned", cache=SolverCache(store=store)).schedule(route, LIMITS)
     assert any("is damaged (checksum mismatch); it is built again" in r.message for r in caplog.records)
     assert schedule.info.built is True
     assert verify(schedule).passed
@@ -170,12 +170,12 @@ def test_the_long_track_is_solved_in_its_units_within_its_bound_and_agrees_with_
     limits = MIXED
     bound = lower_bound(route, limits)
     assert bound == pytest.approx(1502.5833, abs=1e-3)
-    scaled = Optimal(homotopy="paper", cache=SolverCache()).schedule(route, limits)
+    scaled = Optimal(homotopy="planned", cache=SolverCache()).schedule(route, limits)
     assert verify(scaled).passed
     assert scaled.fallback_reason is None
     assert bound <= scaled.duration <= bound * 1.002  # the issue: within 0.2 % of the S-curve bound
     # the same class in seconds and metres (an independent solve): the same optimum, more iterations
-    shape = Optimal(homotopy="paper").shape(route)
+    shape = Optimal(homotopy="planned").shape(route)
     compiled = CompiledNlp(shape)
     guess, parameters = _problem(route, limits, shape, compiled.size)
     plain = solve(compiled, guess, parameters, units=ProblemUnits(1.0, 1.0))

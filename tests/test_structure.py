@@ -255,10 +255,10 @@ FLOW = (
     ("trajgen.verification",),
     ("trajgen.methods",),
     ("trajgen.export",),
-    ("trajgen.online",),
+    ("trajgen.execution", "trajgen.online"),  # trajgen.online: the deprecated name, one release
     ("trajgen.live",),
     ("trajgen.plots",),
-    ("trajgen.pipeline", "trajgen.closed_loop"),
+    ("trajgen.pipeline", "trajgen.simulation_pipeline", "trajgen.closed_loop"),  # closed_loop: deprecated
     ("trajgen.cli",),
     ("trajgen", "trajgen.__main__"),
 )

@@ -33,7 +33,7 @@ from trajgen.export.vda5050 import (
     Vda5050Options,
     node_id,
     order_paths,
-    plan_orders,
+    order_releases,
     render_manifest,
     render_orders,
     write_orders,
@@ -66,7 +66,7 @@ CASES = {
     "swap-exact": (None, Exact()),
     "swap-toppra": (None, Toppra()),
     "unequal-other-class": (UNEQUAL, Optimal()),
-    "unequal-paper-class": (UNEQUAL, Optimal(homotopy="paper")),
+    "unequal-paper-class": (UNEQUAL, Optimal(homotopy="planned")),
     "angled-shared-leg": (
         scenario_data(
             (9.0, 6.0, 11.0),
@@ -98,9 +98,9 @@ def case(name: str):
     data, method = CASES[name]
     scenario = load_scenario(SWAP) if data is None else parse_scenario(data, source=name)
     verified = run(scenario, method=method).verified
-    plan = plan_orders(verified)
-    messages = render_orders(verified, scenario.names, options=OPTIONS, plan=plan)
-    manifest = json.loads(render_manifest(verified, scenario.names, messages, options=OPTIONS, plan=plan))
+    plan = order_releases(verified)
+    messages = render_orders(verified, scenario.names, options=OPTIONS, releases=plan)
+    manifest = json.loads(render_manifest(verified, scenario.names, messages, options=OPTIONS, releases=plan))
     return scenario, verified, plan, messages, manifest
 
 
@@ -617,7 +617,7 @@ def test_the_other_class_is_exported_on_its_own_route():
     _, verified, plan, _, _ = case("unequal-other-class")
     assert verified.schedule.route.homotopy is Homotopy.OTHER
     paper = case("unequal-paper-class")[1]
-    assert paper.schedule.route.homotopy is Homotopy.PAPER
+    assert paper.schedule.route.homotopy is Homotopy.PLANNED
     other_nodes = [n.leg for n in plan.paths[1].nodes]
     paper_nodes = [n.leg for n in case("unequal-paper-class")[2].paths[1].nodes]
     assert other_nodes != paper_nodes
@@ -702,7 +702,7 @@ def test_options_shape_the_header():
         first_header_id=41,
     )
     _, verified, plan, _, _ = case("swap-exact")
-    messages = render_orders(verified, ("agv1", "agv2"), options=options, plan=plan)
+    messages = render_orders(verified, ("agv1", "agv2"), options=options, releases=plan)
     first = json.loads(messages[0].data)
     assert first["timestamp"] == "2025-05-01T08:00:00.000Z"  # in UTC
     assert (first["serialNumber"], first["orderId"], first["headerId"]) == ("SN-1", "job7-agv1", 41)
@@ -712,7 +712,7 @@ def test_options_shape_the_header():
 def test_renderers_take_only_verified_schedules():
     schedule = case("swap-exact")[1].schedule
     with pytest.raises(UnverifiedScheduleError):
-        plan_orders(schedule)
+        order_releases(schedule)
     with pytest.raises(UnverifiedScheduleError):
         render_orders(schedule, ("agv1", "agv2"), options=OPTIONS)
 
@@ -988,7 +988,7 @@ def test_the_command_with_a_factsheet(tmp_path, capsys):
         (["--start-time", "tomorrow"], "is not an ISO 8601 time"),
         (["--serial-number", "agv9=X"], "names no vehicle of the scenario"),
         (["--map-id", ""], "map_id must be a non-empty"),
-        (["--homotopy", "paper", "--method", "exact"], "applies to the method 'optimal' only"),
+        (["--homotopy", "planned", "--method", "exact"], "applies to the method 'optimal' only"),
         (["--serial-number", "SN1"], "names no vehicle: expected NAME=SERIAL"),
         (["--start-time", "9999-12-31T23:59:59Z"], "is out of range"),
     ],
@@ -1026,12 +1026,12 @@ def test_an_output_path_that_is_a_file_exits_2_before_computing(tmp_path, capsys
 
 
 def test_an_internal_failure_exits_1_and_writes_nothing(tmp_path, capsys, monkeypatch):
-    import trajgen.export.vda5050
+    import trajgen.export.vda5050.files
 
     def broken(*args, **kwargs):
         raise RuntimeError("renderer broke")
 
-    monkeypatch.setattr(trajgen.export.vda5050, "order_files", broken)
+    monkeypatch.setattr(trajgen.export.vda5050.files, "order_files", broken)
     out = tmp_path / "orders"
     assert main(["export-vda5050", str(SWAP), "--out", str(out), "--method", "exact"]) == EXIT_FAILURE
     assert "internal failure: RuntimeError: renderer broke" in capsys.readouterr().err
@@ -1041,7 +1041,7 @@ def test_an_internal_failure_exits_1_and_writes_nothing(tmp_path, capsys, monkey
 def test_schedules_of_every_method_can_be_certified_and_exported():
     scenario = load_scenario(SWAP)
     for method in (Exact(jerk=False), Toppra(grid_points=60)):
-        verified = certify(make_schedule(scenario.plan(), scenario.limits, method=method))
+        verified = certify(make_schedule(scenario.route(), scenario.limits, method=method))
         messages = render_orders(verified, scenario.names, options=OPTIONS)
         for message in messages:
             document = json.loads(message.data)

@@ -144,7 +144,7 @@ def test_a_verified_schedule_and_its_report_print_as_one_short_line():
     from trajgen import Exact, VerificationReport, certify, default_scenario, make_schedule
 
     scenario = default_scenario()
-    verified = certify(make_schedule(scenario.plan(), scenario.limits, method=Exact()))
+    verified = certify(make_schedule(scenario.route(), scenario.limits, method=Exact()))
     for value in (verified, verified.schedule, verified.report):
         text = repr(value)
         assert "\n" not in text

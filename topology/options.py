@@ -4,10 +4,19 @@ from __future__ import annotations
 
 import enum
 import re
+import warnings
 
 from topology.errors import OptionError
 
-__all__ = ["Option"]
+__all__ = ["Option", "rename_values"]
+
+#: Each option class's renamed values: old value -> (new value, the release that renamed it).
+_RENAMED: dict[type, dict[str, tuple[str, str]]] = {}
+
+
+def rename_values(option: type[Option], renamed: dict[str, str], version: str) -> None:
+    """Let ``option`` take each old value of ``renamed`` (old -> new) for one release, with a warning."""
+    _RENAMED.setdefault(option, {}).update({old: (new, version) for old, new in renamed.items()})
 
 
 class Option(enum.StrEnum):
@@ -17,6 +26,19 @@ class Option(enum.StrEnum):
     def label(cls) -> str:
         """The quantity's name in messages: the class name in words (``HomotopyChoice``: homotopy choice)."""
         return re.sub(r"(?<!^)(?=[A-Z])", " ", cls.__name__).lower()
+
+    @classmethod
+    def _missing_(cls, value: object):
+        """An old value of :func:`rename_values`: its new member, with a ``DeprecationWarning``."""
+        new, version = _RENAMED.get(cls, {}).get(value, (None, None))
+        if new is None:
+            return None
+        warnings.warn(
+            f"{cls.label()} {value!r} is deprecated since trajgen {version}: use {new!r}",
+            DeprecationWarning,
+            stacklevel=3,
+        )
+        return cls(new)
 
     @classmethod
     def lookup(cls, name: object):

@@ -30,7 +30,7 @@ from topology.indexed import (
     separation,
     step,
 )
-from topology.options import Option
+from topology.options import Option, rename_values
 from topology.positions import Configuration
 from topology.retract_graph import Geodesic, GraphPoint, RetractGraph
 from topology.validation import finite_real
@@ -70,10 +70,11 @@ _RULE_INSTRUCTION = {1: Instruction.SHORTEST, 2: Instruction.TWO_TIED, 3: Instru
 class Homotopy(Option):
     """Which of the two shortest homotopy classes :func:`plan` takes."""
 
-    PAPER = "paper"  #: the class of the planner's instruction (docs/planner.md, 'The two instructions')
+    PLANNED = "planned"  #: the class of the planner's instruction (docs/planner.md, 'The two instructions')
     #: three legs: the other way round the boundary circle; four or more: the shortest
     #: route on ``G_k`` in another class (the second-shortest simple route)
     OTHER = "other"
+    PAPER = "planned"  #: deprecated name of :attr:`PLANNED` (0.7)
 
 
 class WayRound(Option):
@@ -82,7 +83,14 @@ class WayRound(Option):
     COUNTERCLOCKWISE = "counterclockwise"
     CLOCKWISE = "clockwise"
     NONE = "none"  #: start and goal retract to the same boundary point
-    GRAPH = "graph"  #: four or more legs: along the retract graph ``G_k``, which is no circle
+    #: four or more legs: the configuration space deforms onto a graph (``G_k``), not a circle, so a
+    #: route goes round nothing; :func:`trajgen.model.summary.class_name` names its class
+    NOT_APPLICABLE = "not-applicable"
+    GRAPH = "not-applicable"  #: deprecated name of :attr:`NOT_APPLICABLE` (0.7)
+
+
+rename_values(Homotopy, {"paper": "planned"}, "0.7")
+rename_values(WayRound, {"graph": "not-applicable"}, "0.7")
 
 
 @dataclass(frozen=True, slots=True)
@@ -175,7 +183,7 @@ class Route:
     cumulative_travel : tuple of float
         Travel ``|ds1| + |ds2|`` from the start to each waypoint, metres, shape (n,).
     homotopy : Homotopy
-        ``PAPER`` if the route takes the class of the planner's instruction, ``OTHER`` for the
+        ``PLANNED`` if the route takes the class of the planner's instruction, ``OTHER`` for the
         second class (``plan(..., homotopy=Homotopy.OTHER)``).
     """
 
@@ -186,7 +194,7 @@ class Route:
     arc_length: float
     indexed_waypoints: tuple[IndexedConfiguration, ...] = field(repr=False)
     cumulative_travel: tuple[float, ...] = field(repr=False)
-    homotopy: Homotopy = Homotopy.PAPER
+    homotopy: Homotopy = Homotopy.PLANNED
 
     def __post_init__(self) -> None:
         count = len(self.waypoints)
@@ -204,7 +212,7 @@ class Route:
         ``GRAPH`` for four or more legs, unless the route stays at one point of ``G_k``.
         """
         if self.graph.cycle is None:
-            return WayRound.GRAPH if self.arc_length > 0.0 else WayRound.NONE
+            return WayRound.NOT_APPLICABLE if self.arc_length > 0.0 else WayRound.NONE
         if self.arc_length > 0.0:
             return WayRound.COUNTERCLOCKWISE
         if self.arc_length < 0.0:
@@ -312,7 +320,7 @@ def plan(
     goal: Configuration,
     *,
     min_separation: float = 0.0,
-    homotopy: Homotopy | str = Homotopy.PAPER,
+    homotopy: Homotopy | str = Homotopy.PLANNED,
 ) -> Route:
     """Plan a collision-free route from ``start`` to ``goal``.
 
@@ -330,7 +338,8 @@ def plan(
         ``0 <= min_separation <= shortest leg``. ``0`` means only "not the
         same point".
     homotopy : Homotopy or str, optional
-        ``"paper"`` (default): the class the planner's instruction takes.
+        ``"planned"`` (default): the class the planner's instruction takes (``"paper"``, its
+        name before 0.7, still works with a ``DeprecationWarning``).
         ``"other"``: the same retractions, but the other way round the
         boundary circle (three legs), or the shortest route on ``G_k`` in
         another class (four or more legs). ``Route.instruction`` names the

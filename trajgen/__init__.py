@@ -9,7 +9,7 @@ Examples
 --------
 >>> from trajgen import default_scenario, make_schedule, certify, Exact
 >>> scenario = default_scenario()
->>> verified = certify(make_schedule(scenario.plan(), scenario.limits, method=Exact()))
+>>> verified = certify(make_schedule(scenario.route(), scenario.limits, method=Exact()))
 >>> verified.report.passed, round(verified.schedule.duration, 1)
 (True, 67.5)
 """

@@ -16,8 +16,8 @@ from topology import Route
 from trajgen.errors import InputError, VerificationError
 from trajgen.export.atomic import check_output_paths, commit_files
 from trajgen.export.csv import CsvOptions, check_row_limit, profile_chunk_pair, profile_paths
-from trajgen.export.dialects import DIALECTS, Dialect, TableDialect
-from trajgen.export.plc import PlcTables, check_dialect_method, plc_tables, table_paths
+from trajgen.export.plc.dialects import DIALECTS, Dialect, TableDialect
+from trajgen.export.plc.files import PlcTables, check_dialect_method, plc_tables, table_paths
 from trajgen.methods import METHODS, make_schedule
 from trajgen.model.analysis import lower_bound
 from trajgen.model.schedule import TimingMethod
@@ -59,7 +59,7 @@ class Outputs:
         Format of the ``generic`` CSV profiles.
     dialect : Dialect or str
         The PLC dialect of the profile files (default ``generic``;
-        :data:`~trajgen.export.dialects.DIALECTS`).
+        :data:`~trajgen.export.plc.dialects.DIALECTS`).
     max_points : int or None
         Points per table of a table dialect (default: the dialect's limit).
     compare : tuple of str
@@ -210,7 +210,7 @@ def run(
     tabled = outputs.csv_dir is not None and isinstance(outputs.dialect, TableDialect)
     if tabled:
         check_dialect_method(outputs.dialect, chosen.jerk_limited)
-    route = scenario.plan()
+    route = scenario.route()
     if outputs.csv_dir is not None and not tabled:  # refuse a profile too long before computing one
         check_row_limit(lower_bound(route, scenario.limits), outputs.csv, lower_bound=True)
     verified = certify(make_schedule(route, scenario.limits, method=chosen))

@@ -25,9 +25,9 @@ from limits import Limits, VehicleLimits
 from tests.conftest import REPO
 from topology import Configuration, Position, YGraph, plan
 from trajgen import Exact, Toppra, certify, load_scenario, make_schedule
-from trajgen.closed_loop import run_simulation
 from trajgen.export.csv import CsvOptions, Units, profile_chunks, render_profile
 from trajgen.export.plc import plc_tables
+from trajgen.simulation_pipeline import run_simulation
 from trajgen.verification import VerifiedSchedule
 
 GOLDEN = REPO / "tests" / "data" / "golden"
@@ -44,7 +44,7 @@ _METHODS = {"exact": Exact, "toppra": Toppra}
 def example_schedule(scenario: str, method: str) -> VerifiedSchedule:
     """``examples/<scenario>.toml`` timed by ``method`` (``exact`` or ``toppra``), verified."""
     loaded = load_scenario(REPO / "examples" / f"{scenario}.toml")
-    return certify(make_schedule(loaded.plan(), loaded.limits, method=_METHODS[method]()))
+    return certify(make_schedule(loaded.route(), loaded.limits, method=_METHODS[method]()))
 
 
 @functools.cache

@@ -8,7 +8,7 @@ from limits import Limits, VehicleLimits
 from tests.conftest import REPO
 from topology import Configuration, Position, YGraph, plan
 from trajgen import Optimal, Schedule, load_scenario
-from trajgen.online.goals import plan_for_execution
+from trajgen.execution.goals import schedule_for_execution
 
 SLOW = VehicleLimits(max_velocity=0.7, max_acceleration=0.35, max_jerk=0.6)
 AGV = VehicleLimits(max_velocity=1.0, max_acceleration=0.5, max_jerk=1.0)
@@ -33,13 +33,13 @@ def too_close(schedule: Schedule, separation: float = 10.5) -> Schedule:
 
 @functools.cache
 def execution_plan(name: str, method: str):
-    """``(scenario, plan_for_execution(scenario))`` of ``examples/NAME.toml``, once per test process.
+    """``(scenario, schedule_for_execution(scenario))`` of ``examples/NAME.toml``, once per test process.
 
     Several modules test the same plans; solved once, each worker shares them.
     """
     scenario = load_scenario(REPO / "examples" / f"{name}.toml")
     chosen = Optimal() if method == "optimal" else method
-    return scenario, plan_for_execution(scenario, method=chosen)
+    return scenario, schedule_for_execution(scenario, method=chosen)
 
 
 def animation_gif(verified, **options) -> bytes:

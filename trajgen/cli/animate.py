@@ -10,7 +10,7 @@ from trajgen.cli.options import add_method, method_from, scenario_from
 from trajgen.cli.parser import EXIT_OK
 from trajgen.errors import OutputError
 from trajgen.export.atomic import check_output_paths, commit_files
-from trajgen.plots.animation import (
+from trajgen.plots.animation_layout import (
     DEFAULT_FPS,
     DEFAULT_MAX_FRAMES,
     FRAME_HEIGHT_PX,
@@ -44,7 +44,7 @@ def _command_animate(args: argparse.Namespace) -> int:
     path = gif_path(args.out)
     playback(0.0, fps=args.fps, max_frames=args.max_frames)  # bad options are refused before computing
     from trajgen.pipeline import run
-    from trajgen.plots.animation_drawing import animate
+    from trajgen.plots.animation import animate
     from trajgen.plots.gif import encode_gif
 
     scenario = scenario_from(args.scenario)

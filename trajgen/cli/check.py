@@ -15,7 +15,7 @@ SHOWN_FAILURES = 10
 
 
 def _command_check(args: argparse.Namespace) -> int:
-    from trajgen.export.check import check_profiles
+    from trajgen.export.plc.check import check_profiles
 
     scenario = scenario_from(args.scenario)
     verdict = check_profiles(

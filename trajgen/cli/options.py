@@ -13,7 +13,7 @@ import dataclasses
 
 from trajgen.errors import OptionError
 from trajgen.export import DEFAULT_MAX_ROWS, CsvOptions, Units
-from trajgen.export.dialects import DIALECTS
+from trajgen.export.plc.dialects import DIALECTS
 from trajgen.methods import METHODS
 from trajgen.methods.optimal.choice import HomotopyChoice
 from trajgen.model.schedule import TimingMethod
@@ -100,7 +100,7 @@ def add_method(
         metavar="|".join(c.value for c in HomotopyChoice),
         help="optimal only: 'fastest' (default) solves two homotopy classes and keeps the faster:\n"
         "on a Y both ways round the configuration circle, on 4 to 8 legs the shortest and\n"
-        "the second-shortest route on the retract graph G_k; 'paper' keeps the class of\n"
+        "the second-shortest route on the retract graph G_k; 'planned' keeps the class of\n"
         "the planner's instruction (the paper's on a Y)",
     )
 

@@ -15,7 +15,7 @@ __all__ = ["register"]
 
 
 def _command_plan(args: argparse.Namespace) -> int:
-    route = scenario_from(args.scenario).plan()
+    route = scenario_from(args.scenario).route()
     print(json.dumps(route_summary(route), indent=2) if args.json else format_route(route))
     return EXIT_OK
 

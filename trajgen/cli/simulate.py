@@ -13,8 +13,8 @@ __all__ = ["register"]
 
 
 def _command_simulate(args: argparse.Namespace) -> int:
-    from trajgen.closed_loop import format_simulation, run_simulation  # the executor and its Ruckig
     from trajgen.export.csv import CsvOptions
+    from trajgen.simulation_pipeline import format_simulation, run_simulation  # the executor and its Ruckig
 
     scenario = scenario_from(args.scenario)
     run = run_simulation(

@@ -11,7 +11,7 @@ from trajgen.cli.options import add_method, method_from, scenario_from
 from trajgen.cli.parser import EXIT_OK
 from trajgen.errors import OptionError
 from trajgen.export.atomic import check_output_paths, commit_files
-from trajgen.export.vda5050_options import MANIFEST_NAME, Vda5050Options
+from trajgen.export.vda5050.options import MANIFEST_NAME, Vda5050Options
 
 __all__ = ["parse_start_time", "register"]
 
@@ -89,7 +89,7 @@ def _format(summary: dict) -> str:
 
 
 def _command_export(args: argparse.Namespace) -> int:
-    from trajgen.export.vda5050 import order_files, order_paths
+    from trajgen.export.vda5050.files import order_files, order_paths
     from trajgen.model.summary import provenance
     from trajgen.pipeline import run
 

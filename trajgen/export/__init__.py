@@ -14,32 +14,34 @@ from trajgen.lazy import lazy_attributes
 
 if TYPE_CHECKING:
     from trajgen.export.atomic import commit_files
-    from trajgen.export.check import check_profiles
     from trajgen.export.csv import DEFAULT_MAX_ROWS, CsvOptions, Units, render_profile, write_profiles
-    from trajgen.export.dialects import DIALECTS, Dialect, DialectName, TableDialect
-    from trajgen.export.plc import PlcTables, plc_tables, write_tables
-    from trajgen.export.vda5050 import Vda5050Options, render_manifest, render_orders, write_orders
+    from trajgen.export.plc.check import check_profiles
+    from trajgen.export.plc.dialects import DIALECTS, Dialect, DialectName, TableDialect
+    from trajgen.export.plc.files import PlcTables, plc_tables, write_tables
+    from trajgen.export.vda5050.files import write_orders
+    from trajgen.export.vda5050.messages import render_manifest, render_orders
+    from trajgen.export.vda5050.options import Vda5050Options
 
 #: Where each name lives: importing one exporter does not import the others.
 _SOURCES = {
     "DEFAULT_MAX_ROWS": "trajgen.export.csv",
-    "DIALECTS": "trajgen.export.dialects",
+    "DIALECTS": "trajgen.export.plc.dialects",
     "CsvOptions": "trajgen.export.csv",
-    "Dialect": "trajgen.export.dialects",
-    "DialectName": "trajgen.export.dialects",
-    "PlcTables": "trajgen.export.plc",
-    "TableDialect": "trajgen.export.dialects",
+    "Dialect": "trajgen.export.plc.dialects",
+    "DialectName": "trajgen.export.plc.dialects",
+    "PlcTables": "trajgen.export.plc.files",
+    "TableDialect": "trajgen.export.plc.dialects",
     "Units": "trajgen.export.csv",
-    "Vda5050Options": "trajgen.export.vda5050",
-    "check_profiles": "trajgen.export.check",
+    "Vda5050Options": "trajgen.export.vda5050.options",
+    "check_profiles": "trajgen.export.plc.check",
     "commit_files": "trajgen.export.atomic",
-    "plc_tables": "trajgen.export.plc",
-    "render_manifest": "trajgen.export.vda5050",
-    "render_orders": "trajgen.export.vda5050",
+    "plc_tables": "trajgen.export.plc.files",
+    "render_manifest": "trajgen.export.vda5050.messages",
+    "render_orders": "trajgen.export.vda5050.messages",
     "render_profile": "trajgen.export.csv",
-    "write_orders": "trajgen.export.vda5050",
+    "write_orders": "trajgen.export.vda5050.files",
     "write_profiles": "trajgen.export.csv",
-    "write_tables": "trajgen.export.plc",
+    "write_tables": "trajgen.export.plc.files",
 }
 
 __all__ = [

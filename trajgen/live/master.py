@@ -5,7 +5,7 @@ base up to its frontier (the last released node) and a short horizon past it
 (:mod:`trajgen.live.orders`). Then it follows the vehicles' states; a vehicle
 whose states keep showing it lacks its order ends the run (``ORDER_NOT_TAKEN``).
 When a vehicle reports a node reached, the release rule
-(:class:`~trajgen.export.vda5050_release.BaseRelease`) may let the base of
+(:class:`~trajgen.export.vda5050.release.BaseRelease`) may let the base of
 either vehicle grow; each growth is an order update (same ``orderId``,
 ``orderUpdateId`` + 1, stitched at the previous decision point).
 
@@ -37,8 +37,9 @@ import numpy as np
 
 from topology import Configuration
 from trajgen.errors import InputError
-from trajgen.export.vda5050_messages import node_id
-from trajgen.export.vda5050_release import BaseRelease, plan_orders
+from trajgen.execution.goals import goal_refusal, schedule_from_rest
+from trajgen.export.vda5050.messages import node_id
+from trajgen.export.vda5050.release import BaseRelease, order_releases
 from trajgen.live.clock import RunClock
 from trajgen.live.geometry import track_position
 from trajgen.live.link import BrokerLink
@@ -59,7 +60,6 @@ from trajgen.live.view import (
 )
 from trajgen.methods import METHODS
 from trajgen.model.summary import provenance
-from trajgen.online.goals import goal_refusal, plan_from_rest
 from trajgen.verification import VerifiedSchedule, require_verified
 
 __all__ = ["RELEASE_SPACING", "LiveMaster", "LiveOutcome", "LiveRun"]
@@ -157,7 +157,7 @@ class LiveMaster:
     def _adopt(self, verified: VerifiedSchedule, *, first: bool) -> None:
         """Take a new plan: paths, release rule, and (after a goal change) the stitch offsets."""
         self._plan_goal = verified.schedule.route.goal
-        plan = plan_orders(verified, spacing=self.spacing)
+        plan = order_releases(verified, spacing=self.spacing)
         rule = BaseRelease(plan.paths, verified.schedule.limits.min_separation)
         for v, view in enumerate(self._views):
             if not first:
@@ -501,7 +501,7 @@ class LiveMaster:
         for view in views:
             view.restart = None
         goal, self._goal = self._goal, None
-        verified = plan_from_rest(self.graph, self.limits, start, goal, method=self.method, margin=0.0)
+        verified = schedule_from_rest(self.graph, self.limits, start, goal, method=self.method, margin=0.0)
         self._counts["replans"] += 1
         self.log.write({"t": self._now(), "event": "replan", "goal": str(goal)})
         self._adopt(verified, first=False)

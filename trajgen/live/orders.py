@@ -12,7 +12,7 @@ from __future__ import annotations
 import bisect
 
 from limits import VehicleLimits
-from trajgen.export.vda5050_messages import VDA5050_VERSION, order_elements
+from trajgen.export.vda5050.messages import VDA5050_VERSION, order_elements
 from trajgen.live.view import VehicleView
 from trajgen.model.coordination import stopping_distance
 

@@ -30,7 +30,7 @@ class LiveRun:
         Seconds of the run from the first order to both vehicles at their goals (or to the time out).
     planned : float
         When the first plan's releases bring both vehicles to their goals, seconds
-        (:attr:`~trajgen.export.vda5050_release.OrderPlan.planned_duration`).
+        (:attr:`~trajgen.export.vda5050.release.OrderReleases.planned_duration`).
     orders : int
         Orders and order updates published, re-sends included.
     resent : int

@@ -18,13 +18,13 @@ from dataclasses import dataclass
 
 from topology import StarGraph
 from trajgen.errors import InputError
+from trajgen.execution.goals import schedule_for_execution
 from trajgen.live.clock import RunClock
 from trajgen.live.geometry import position_xy, track_position
 from trajgen.live.master import RELEASE_SPACING, LiveMaster, LiveRun
 from trajgen.live.mqtt import DEFAULT_INTERFACE, DEFAULT_VERSION, BrokerSettings, VehicleIdentity
 from trajgen.live.runlog import RunLog
 from trajgen.live.vehicle import SimulatedVehicle, StopFault, VehicleSnapshot
-from trajgen.online.goals import plan_for_execution
 from trajgen.verification import VerifiedSchedule
 
 __all__ = [
@@ -48,11 +48,11 @@ DEFAULT_MANUFACTURER = "unspecified"
 def live_plan(scenario, *, method=None) -> VerifiedSchedule:
     """The verified plan of ``scenario`` for a live run: the online executor's plan.
 
-    The same plan :func:`~trajgen.online.goals.plan_for_execution` gives (``optimal`` with the
+    The same plan :func:`~trajgen.execution.goals.schedule_for_execution` gives (``optimal`` with the
     braking rule in its problem, a position margin on the separation): what is planned is what
     both the executor and the live master carry out.
     """
-    return plan_for_execution(scenario, method=method)
+    return schedule_for_execution(scenario, method=method)
 
 
 def identities(

@@ -36,12 +36,12 @@ class Exact(TimingMethod):
     --------
     >>> from trajgen.scenario import default_scenario
     >>> scenario = default_scenario()
-    >>> round(Exact().schedule(scenario.plan(), scenario.limits).duration, 3)
+    >>> round(Exact().schedule(scenario.route(), scenario.limits).duration, 3)
     67.5
     """
 
     name: ClassVar[str] = "exact"
-    summary: ClassVar[str] = "the route exactly, one straight piece at a time, jerk-limited S-curves"
+    description: ClassVar[str] = "the route exactly, one straight piece at a time, jerk-limited S-curves"
 
     jerk: bool = True
 

@@ -25,8 +25,8 @@ class MethodSource:
     ----------
     name : str
         The method's name, as its class's ``name``.
-    summary : str
-        One line for help texts, as its class's ``summary``.
+    description : str
+        One line for help texts, as its class's ``description``.
     module : str
         Dotted name of the module that defines the class.
     class_name : str
@@ -34,23 +34,23 @@ class MethodSource:
     """
 
     name: str
-    summary: str
+    description: str
     module: str
     class_name: str
 
     def load(self) -> type[TimingMethod]:
-        """The class, imported; its ``name`` and ``summary`` must be the registered ones.
+        """The class, imported; its ``name`` and ``description`` must be the registered ones.
 
         Raises
         ------
         RuntimeError
-            The class's ``name`` or ``summary`` differs from the registered one.
+            The class's ``name`` or ``description`` differs from the registered one.
         """
         method = getattr(importlib.import_module(self.module), self.class_name)
-        if (method.name, method.summary) != (self.name, self.summary):
+        if (method.name, method.description) != (self.name, self.description):
             raise RuntimeError(
                 f"timing method {self.module}.{self.class_name} is named {method.name!r} "
-                f"({method.summary!r}), registered as {self.name!r} ({self.summary!r})"
+                f"({method.description!r}), registered as {self.name!r} ({self.description!r})"
             )
         return method
 
@@ -75,7 +75,7 @@ class MethodRegistry:
     Exact(jerk=True)
     """
 
-    __slots__ = ("_by_name", "_summaries", "default")
+    __slots__ = ("_by_name", "_descriptions", "default")
 
     def __init__(self, methods: Sequence[type[TimingMethod] | MethodSource], *, default: str) -> None:
         self._by_name: dict[str, type[TimingMethod] | MethodSource] = {}
@@ -85,7 +85,7 @@ class MethodRegistry:
             self._by_name[method.name] = method
         if default not in self._by_name:
             raise ValueError(f"default method {default!r} is not among {list(self._by_name)!r}")
-        self._summaries = {name: method.summary for name, method in self._by_name.items()}
+        self._descriptions = {name: method.description for name, method in self._by_name.items()}
         #: Name of the default method.
         self.default = default
 
@@ -137,10 +137,10 @@ class MethodRegistry:
         return self.lookup(self.default if method is None else method)()
 
     def help(self) -> str:
-        """One line per method for help texts: ``name: summary``."""
+        """One line per method for help texts: ``name: description``."""
         return "\n".join(
-            f"{name}: {summary}" + (" (default)" if name == self.default else "")
-            for name, summary in self._summaries.items()
+            f"{name}: {description}" + (" (default)" if name == self.default else "")
+            for name, description in self._descriptions.items()
         )
 
     def schedule(self, route: Route, limits: Limits, *, method: TimingMethod | str | None = None) -> Schedule:

@@ -243,7 +243,7 @@ class Toppra(TimingMethod):
     """
 
     name: ClassVar[str] = "toppra"
-    summary: ClassVar[str] = (
+    description: ClassVar[str] = (
         "rounded corners where safe, TOPPRA velocity/acceleration timing (jerk not limited)"
     )
 

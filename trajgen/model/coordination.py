@@ -34,7 +34,7 @@ __all__ = [
     "CoordinationDiagram",
     "Polygon",
     "earliest_rest",
-    "plan_paths",
+    "schedule_paths",
     "schedule_times",
     "schedule_waypoints",
     "stopping_distance",
@@ -491,7 +491,7 @@ def schedule_waypoints(schedule, times: np.ndarray | None = None) -> list[tuple[
     ]
 
 
-def plan_paths(
+def schedule_paths(
     schedule, pieces: Pieces | None = None
 ) -> tuple[tuple[VehiclePath, VehiclePath], np.ndarray, np.ndarray]:
     """Both vehicles' paths of a schedule, the instants of :func:`schedule_times`, and the travel there.

@@ -12,7 +12,8 @@ from __future__ import annotations
 
 import abc
 import enum
-from dataclasses import dataclass, field
+import warnings
+from dataclasses import InitVar, dataclass, field
 from typing import ClassVar
 
 import numpy as np
@@ -21,6 +22,7 @@ from limits import Limits
 from topology import JUNCTION_INDEX, JUNCTION_NAME, Configuration, Position, Route, StarGraph
 from topology.validation import finite_real
 from trajgen.errors import InputError
+from trajgen.lazy import RenamedAttribute
 from trajgen.model.profiles import PiecewiseCubic
 from trajgen.model.values import ArrayValue, frozen, readonly
 
@@ -120,7 +122,9 @@ class TimingMethod(abc.ABC):
     #: Name of the method (``--method NAME`` on the command line).
     name: ClassVar[str]
     #: One line for the help texts.
-    summary: ClassVar[str]
+    description: ClassVar[str]
+    #: Deprecated name of ``description`` (0.7).
+    summary = RenamedAttribute("description", "0.7")
 
     @property
     @abc.abstractmethod
@@ -317,7 +321,7 @@ class ScheduleState(ArrayValue):
         --------
         >>> from trajgen import default_scenario, make_schedule
         >>> scenario = default_scenario()
-        >>> schedule = make_schedule(scenario.plan(), scenario.limits, method="exact")
+        >>> schedule = make_schedule(scenario.route(), scenario.limits, method="exact")
         >>> state = schedule.state([0.0, schedule.duration])
         >>> state.leg_names(scenario.track).tolist(), state.leg.tolist()
         ([['A', 'B'], ['B', 'A']], [[0, 1], [1, 0]])
@@ -349,10 +353,11 @@ class Schedule:
         ``exact`` schedule in its place; ``notes`` say more.
     info : MethodInfo or None
         Method diagnostics (e.g. :class:`trajgen.methods.optimal.OptimalInfo`).
-    continuity : int or None
+    smoothness : int or None
         How many derivatives of position are continuous and zero at the start
         and goal (0: position only, as a linearly interpolated table; 1: also
-        velocity; 2: also acceleration). ``None``: 2 if ``jerk_limited``, else 1.
+        velocity; 2: also acceleration). ``None``: 2 if ``jerk_limited``, else 1;
+        the attribute is always the number.
     end_tolerance : float or None
         How far from the route's start and goal the motion may begin and end,
         and past a leg's end it may reach, metres (``None``: the verifier's
@@ -364,7 +369,7 @@ class Schedule:
         How many derivatives (1: velocity, 2: acceleration, 3: jerk) the
         verifier checks against the limits in closed form. ``None``: velocity
         and acceleration, and jerk if ``jerk_limited``; a table read back
-        defines fewer (:mod:`trajgen.export.tables` checks the rest from its points).
+        defines fewer (:mod:`trajgen.export.plc.tables` checks the rest from its points).
     """
 
     route: Route
@@ -375,20 +380,23 @@ class Schedule:
     notes: tuple[str, ...] = ()
     fallback_reason: FallbackReason | None = None
     info: MethodInfo | None = field(default=None, compare=False)
-    continuity: int | None = None
+    smoothness: int | None = None
     end_tolerance: float | None = None
     checked_limits: int | None = None
+    continuity: InitVar[int | None] = None
 
-    def __post_init__(self) -> None:
+    def __post_init__(self, continuity: int | None) -> None:
         object.__setattr__(self, "sections", tuple(self.sections))
         object.__setattr__(self, "notes", tuple(self.notes))
-
-    @property
-    def smoothness(self) -> int:
-        """Derivatives of position that are continuous (see ``continuity``): 0, 1 or 2."""
-        if self.continuity is not None:
-            return self.continuity
-        return 2 if self.jerk_limited else 1
+        if continuity is not None:
+            warnings.warn(
+                "Schedule(continuity=...) is deprecated since trajgen 0.7: use smoothness=",
+                DeprecationWarning,
+                stacklevel=3,
+            )
+            object.__setattr__(self, "smoothness", continuity)
+        if self.smoothness is None:
+            object.__setattr__(self, "smoothness", 2 if self.jerk_limited else 1)
 
     def __repr__(self) -> str:
         """One line: method, makespan, sections, jerk, class (the arrays stay out of it)."""

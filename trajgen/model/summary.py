@@ -57,7 +57,7 @@ def class_name(route: Route) -> str:
 
 def class_label(route: Route) -> str:
     """The route's homotopy class for people: :func:`class_name` and whether it is the planner's."""
-    return _class_text(class_name(route), route.homotopy is Homotopy.PAPER, route.graph.cycle is not None)
+    return _class_text(class_name(route), route.homotopy is Homotopy.PLANNED, route.graph.cycle is not None)
 
 
 def _class_makespan(comparison: dict) -> str:
@@ -85,7 +85,7 @@ def route_summary(route: Route) -> dict:
         "waypoints": [[{"leg": p.leg, "s_m": p.s} for p in (w.first, w.second)] for w in route.waypoints],
         "regions": [str(r) for r in route.regions],
         "homotopy": route.homotopy.value,
-        "paper_class": route.homotopy is Homotopy.PAPER,
+        "planned_class": route.homotopy is Homotopy.PLANNED,
         "way_round": route.way_round.value,
         "arc_length_m": route.arc_length,
         "travel_m": list(route.travel),
@@ -124,7 +124,7 @@ def format_route(route: Route) -> str:
 def _route_class_text(route: dict) -> str:
     """The class line of a run's route summary (:func:`route_summary`)."""
     circle = "class" not in route
-    return _class_text(route["way_round"] if circle else route["class"], route["paper_class"], circle)
+    return _class_text(route["way_round"] if circle else route["class"], route["planned_class"], circle)
 
 
 def _chosen_mark(comparison: dict, *, fallback: bool) -> str:

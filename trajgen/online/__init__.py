@@ -1,19 +1,36 @@
-"""Online execution: a verified plan played in closed loop, keeping its order at every conflict.
+"""Deprecated: :mod:`trajgen.execution` (trajgen 0.7 renamed ``trajgen.online``); kept for one release.
 
-:class:`Executor` is stepped once per control cycle with the measured states
-of both vehicles and returns their setpoints: each vehicle follows the plan
-while it is on time, else Ruckig re-times it towards its frontier (where its
-leader at each conflict could still come to rest), under an independent
-braking check. :func:`~trajgen.online.goals.plan_for_execution` makes the plan
-it plays; :func:`~trajgen.online.simulation.simulate` runs it against a
-simulated plant with faults (:mod:`trajgen.online.faults`). The argument is
-in docs/online.md. The model types it uses (``VehiclePath``, ``CoordinationDiagram``,
-``Conflict``) have one import path, :mod:`trajgen.model`.
+Importing it warns (``DeprecationWarning``); every name is :mod:`trajgen.execution`'s, and
+``plan_for_execution`` is :func:`~trajgen.execution.schedule_for_execution`.
 """
 
-from trajgen.online.braking import BrakingCheck, PathState
-from trajgen.online.executor import Command, Event, Executor, GoalDecision, Mode, Setpoint, VehicleState
-from trajgen.online.goals import execution_margin, plan_for_execution
+import warnings
+
+from trajgen.lazy import lazy_attributes
+
+warnings.warn(
+    "trajgen.online is deprecated: import from trajgen.execution (plan_for_execution is now "
+    "schedule_for_execution)",
+    DeprecationWarning,
+    stacklevel=2,
+)
+
+_SOURCES = {
+    name: "trajgen.execution"
+    for name in (
+        "BrakingCheck",
+        "Command",
+        "Event",
+        "Executor",
+        "GoalDecision",
+        "Mode",
+        "PathState",
+        "Setpoint",
+        "VehicleState",
+        "execution_margin",
+        "schedule_for_execution",
+    )
+}
 
 __all__ = [
     "BrakingCheck",
@@ -27,4 +44,13 @@ __all__ = [
     "VehicleState",
     "execution_margin",
     "plan_for_execution",
+    "schedule_for_execution",
 ]
+
+_attribute, __dir__ = lazy_attributes(__name__, globals(), _SOURCES)
+
+
+def __getattr__(name: str) -> object:
+    if name == "plan_for_execution":
+        return _attribute("schedule_for_execution")
+    return _attribute(name)

@@ -12,8 +12,8 @@ from typing import TYPE_CHECKING
 from trajgen.lazy import lazy_attributes
 
 if TYPE_CHECKING:
-    from trajgen.plots.animation_drawing import Animation, animate
-    from trajgen.plots.configuration_drawing import plot_configuration
+    from trajgen.plots.animation import Animation, animate
+    from trajgen.plots.configuration import plot_configuration
     from trajgen.plots.coordination import METHOD_COLOURS, plot_coordination
     from trajgen.plots.deprecated import (
         render_animation,
@@ -55,11 +55,11 @@ __all__ = [
 
 _SOURCES = {
     "METHOD_COLOURS": "trajgen.plots.coordination",
-    "Animation": "trajgen.plots.animation_drawing",
-    "animate": "trajgen.plots.animation_drawing",
+    "Animation": "trajgen.plots.animation",
+    "animate": "trajgen.plots.animation",
     "encode_gif": "trajgen.plots.gif",
     "gif_bytes": "trajgen.plots.gif",
-    "plot_configuration": "trajgen.plots.configuration_drawing",
+    "plot_configuration": "trajgen.plots.configuration",
     "plot_coordination": "trajgen.plots.coordination",
     "plot_live_run": "trajgen.plots.live_run",
     "plot_separation": "trajgen.plots.separation",

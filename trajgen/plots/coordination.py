@@ -9,7 +9,7 @@ import numpy as np
 from trajgen.errors import InputError
 from trajgen.methods import METHODS
 from trajgen.model.analysis import travelled
-from trajgen.model.coordination import CoordinationDiagram, plan_paths
+from trajgen.model.coordination import CoordinationDiagram, schedule_paths
 from trajgen.model.summary import class_label
 from trajgen.plots.figure import drawing_area, finished, polygon_patch
 from trajgen.plots.speed import VEHICLE_COLOURS, plot_period
@@ -60,7 +60,7 @@ def plot_coordination(verified: Mapping[str, VerifiedSchedule], *, figure=None):
     for axis, names in zip(panels, groups.values(), strict=True):
         reference = schedules[names[0]]
         required = max(reference.limits.min_separation, reference.route.min_separation)
-        paths, times, _ = plan_paths(reference)
+        paths, times, _ = schedule_paths(reference)
         diagram = CoordinationDiagram(paths, required, reference, times)
         labelled: set[int] = set()
         for conflict in diagram.conflicts:  # exact: convex polygons, in the colour of who passes first

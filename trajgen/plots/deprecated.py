@@ -58,7 +58,7 @@ def render_coordination(verified) -> bytes:
 
 def render_configuration(subject, *, names=None) -> bytes:
     """Deprecated: ``png_bytes(plot_configuration(subject, names=names))``."""
-    from trajgen.plots.configuration_drawing import plot_configuration
+    from trajgen.plots.configuration import plot_configuration
 
     _warn("render_configuration", "plot_configuration")
     return png_bytes(plot_configuration(subject, names=names))
@@ -82,7 +82,7 @@ def render_live_run(run, *, names) -> bytes:
 
 def render_animation(verified, *, names=("vehicle 1", "vehicle 2"), fps=10, max_frames=300) -> bytes:
     """Deprecated: the GIF of ``animate(verified, ...)`` (see :func:`~trajgen.plots.gif.gif_bytes`)."""
-    from trajgen.plots.animation_drawing import animate
+    from trajgen.plots.animation import animate
     from trajgen.plots.gif import encode_gif
 
     _warn("render_animation", "animate")

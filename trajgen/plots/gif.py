@@ -181,7 +181,7 @@ def gif_bytes(
 
 
 def encode_gif(animation) -> bytes:
-    """An :class:`~trajgen.plots.animation_drawing.Animation` as a looping GIF, a frame drawn at a time."""
+    """An :class:`~trajgen.plots.animation.Animation` as a looping GIF, a frame drawn at a time."""
     return gif_bytes(
         animation.frames(), delays_ms=animation.delays_ms, palette_samples=animation.palette_samples
     )

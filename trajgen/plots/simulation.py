@@ -50,10 +50,10 @@ def _progress(axis, result, names) -> None:
 
 def _coordination(axis, result, names, min_separation: float) -> None:
     """The plan's conflicts in the plane of both vehicles' travel, the plan's curve and the executed one."""
-    from trajgen.model.coordination import CoordinationDiagram, plan_paths
+    from trajgen.model.coordination import CoordinationDiagram, schedule_paths
 
     schedule = result.schedule.schedule
-    paths, times, travel = plan_paths(schedule)
+    paths, times, travel = schedule_paths(schedule)
     diagram = CoordinationDiagram(paths, min_separation + result.position_margin, schedule, times)
     for conflict in diagram.conflicts:
         colour = VEHICLE_COLOURS[conflict.leader]
@@ -104,7 +104,7 @@ def plot_simulation(result, *, names: tuple[str, str], min_separation: float, fi
     Parameters
     ----------
     result : SimulationResult
-        From :func:`trajgen.online.simulation.simulate`.
+        From :func:`trajgen.execution.simulation.simulate`.
     names : pair of str
         Legend labels of the vehicles.
     min_separation : float
@@ -122,7 +122,7 @@ def plot_simulation(result, *, names: tuple[str, str], min_separation: float, fi
         ``result`` is not a SimulationResult, or ``min_separation`` is not a finite number >= 0.
     """
     # imported here: importing the plots must not load the online executor (and Ruckig)
-    from trajgen.online.simulation import SimulationResult
+    from trajgen.execution.simulation import SimulationResult
 
     if not isinstance(result, SimulationResult):
         raise InputError(f"plot_simulation expects a SimulationResult, got {type(result).__name__}")

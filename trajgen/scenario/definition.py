@@ -33,6 +33,7 @@ folder; see :mod:`trajgen.scenario.factsheet`); it still gives ``max_jerk``.
 from __future__ import annotations
 
 import tomllib
+import warnings
 from dataclasses import dataclass
 from importlib import resources
 from pathlib import Path
@@ -155,7 +156,7 @@ class Scenario:
     ...     start=start,
     ...     goal=start.swapped(),
     ... )
-    >>> scenario.names, scenario.source, len(scenario.plan().waypoints)
+    >>> scenario.names, scenario.source, len(scenario.route().waypoints)
     (('agv1', 'agv2'), '<python>', 7)
     """
 
@@ -176,9 +177,14 @@ class Scenario:
         for k, vehicle in enumerate(self.limits.vehicles, start=1):
             _check_plausible_vehicle(vehicle, f"vehicle {k}")
 
-    def plan(self) -> Route:
+    def route(self) -> Route:
         """The planner's route from start to goal, keeping the scenario's minimum separation."""
         return plan(self.track, self.start, self.goal, min_separation=self.limits.min_separation)
+
+    def plan(self) -> Route:
+        """Deprecated name of :meth:`route` (trajgen 0.6), kept for one release."""
+        warnings.warn("Scenario.plan() is deprecated: use Scenario.route()", DeprecationWarning, stacklevel=2)
+        return self.route()
 
 
 def _check_plausible_track(track: StarGraph) -> None:

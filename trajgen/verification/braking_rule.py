@@ -29,7 +29,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from limits import VehicleLimits
-from trajgen.model.coordination import CoordinationDiagram, plan_paths, stopping_distances
+from trajgen.model.coordination import CoordinationDiagram, schedule_paths, stopping_distances
 from trajgen.model.pieces import Pieces
 from trajgen.model.schedule import Schedule
 from trajgen.model.values import sorted_unique
@@ -122,7 +122,7 @@ def braking_rule_failures(
     separation = schedule.limits.min_separation if separation is None else separation
     if schedule.duration <= 0.0:
         return []
-    paths, times, travel = plan_paths(schedule, pieces)
+    paths, times, travel = schedule_paths(schedule, pieces)
     diagram = CoordinationDiagram(paths, separation, schedule, times)
     if not diagram.conflicts:
         return []

@@ -19,7 +19,7 @@ from limits import Limits
 from topology import Homotopy, OptionError, Route, plan
 from trajgen.errors import InputError, SolverError
 from trajgen.methods.exact import Exact
-from trajgen.methods.optimal.braking import BRAKING_CURVATURE, BRAKING_MARGIN
+from trajgen.methods.optimal.braking_constraints import BRAKING_CURVATURE, BRAKING_MARGIN
 from trajgen.methods.optimal.choice import HomotopyChoice
 from trajgen.methods.optimal.classes import ClassRace, ClassSolve
 from trajgen.methods.optimal.compiled import NlpOrigin, SolverCache
@@ -130,10 +130,10 @@ class Optimal(TimingMethod):
         schedule gets).
     braking_rule : bool, optional
         State the braking rule (:mod:`trajgen.verification.braking_rule`) in the problem (default
-        ``False``), so that the plan can be executed by the order-keeping :class:`~trajgen.online.Executor`
+        ``False``), so that the plan can be executed by the order-keeping :class:`~trajgen.execution.Executor`
         without holds; verify then checks it. Slower (its NLP takes 1.2 s to build, 0.2 s to
         load from the disk store, and about 0.25 s a solve); the executor's
-        :func:`~trajgen.online.plan_for_execution` turns it on.
+        :func:`~trajgen.execution.schedule_for_execution` turns it on.
     refinements : int, optional
         Most mesh-refinement passes after the first solve (default 6): the grid's nodes move to the
         jerk switches of the previous pass and the same compiled NLP is solved again (see
@@ -146,7 +146,7 @@ class Optimal(TimingMethod):
     homotopy : HomotopyChoice or str, optional
         ``"fastest"`` (default): solve the route's class and the other one, return the faster:
         the other way round the boundary circle (three legs), or the second-shortest route on
-        ``G_k`` (four to eight legs, ``plan(..., homotopy="other")``). ``"paper"``: the route's
+        ``G_k`` (four to eight legs, ``plan(..., homotopy="other")``). ``"planned"``: the route's
         class only.
     cache : SolverCache or None, optional
         Where compiled NLPs are kept; ``None`` (default) uses the process-wide
@@ -154,7 +154,7 @@ class Optimal(TimingMethod):
     """
 
     name: ClassVar[str] = "optimal"
-    summary: ClassVar[str] = (
+    description: ClassVar[str] = (
         "time-optimal jerk-limited schedule, faster of the two shortest homotopy classes (CasADi)"
     )
     _shared: ClassVar[list[SolverCache]] = []
@@ -262,12 +262,12 @@ class Optimal(TimingMethod):
 
         The other is the other way round the boundary circle (three legs) or the other of the
         planner's shortest and second-shortest routes on ``G_k`` (four to eight legs). With
-        ``homotopy="paper"``, or where start and goal retract to one boundary point (the other
+        ``homotopy="planned"``, or where start and goal retract to one boundary point (the other
         way would be a full turn), only ``route``.
         """
-        if self.homotopy is HomotopyChoice.PAPER or route.arc_length == 0.0:
+        if self.homotopy is HomotopyChoice.PLANNED or route.arc_length == 0.0:
             return [route]
-        other = Homotopy.OTHER if route.homotopy is Homotopy.PAPER else Homotopy.PAPER
+        other = Homotopy.OTHER if route.homotopy is Homotopy.PLANNED else Homotopy.PLANNED
         graph, start, goal, separation = route.graph, route.start, route.goal, route.min_separation
         try:
             return [route, plan(graph, start, goal, min_separation=separation, homotopy=other)]

@@ -26,7 +26,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from trajgen.methods.optimal.braking import BRAKING_SAMPLES, VehicleSymbols, braking_terms
+from trajgen.methods.optimal.braking_constraints import BRAKING_SAMPLES, VehicleSymbols, braking_terms
 from trajgen.methods.optimal.phases import DEPTH, DURATION, STATE_SIZE, NlpShape, PhaseKind, Stage, stages
 
 __all__ = ["ParameterLayout", "Transcription", "transcribe"]

@@ -3,21 +3,21 @@
 Each control cycle :meth:`Executor.step` takes both vehicles' measured states
 and returns their setpoints for the end of the cycle. What the plan fixes is
 kept: each vehicle's path (:mod:`trajgen.model.paths`) and, at every conflict of
-the coordination diagram, who passes first (:mod:`trajgen.online.conflicts`).
+the coordination diagram, who passes first (:mod:`trajgen.execution.conflicts`).
 Time is free:
 
 * **Frontier.** Each cycle each vehicle gets the farthest travel it may come
   to rest at: short of every conflict it follows, where its leader could still
   come to rest (from the leader's earliest rest point on).
-* **Motion** (:mod:`trajgen.online.motion`). A vehicle on time follows the plan
+* **Motion** (:mod:`trajgen.execution.motion`). A vehicle on time follows the plan
   while its service braking ends before its frontier; once it departs (a stop,
   a slow drive, a lag, a jump, a frontier that binds), Ruckig drives it
   time-optimally to rest at its next reversal or its frontier, recomputed every
   cycle, so a waiting follower starts the moment its leader moves on.
-* **Safety** (:mod:`trajgen.online.safety`). The braking invariant is checked
+* **Safety** (:mod:`trajgen.execution.safety_guard`). The braking invariant is checked
   every cycle, independently: a follower holds where its next setpoint would
   break it, and if nothing can be certified both brake hard (reported).
-* **Only a goal change re-plans** (:mod:`trajgen.online.goals`): both brake to
+* **Only a goal change re-plans** (:mod:`trajgen.execution.goals`): both brake to
   rest, then the planner plans from where they stand.
 
 The argument (separation, no deadlock, what a stop costs) is in docs/online.md.
@@ -33,18 +33,9 @@ import math
 from limits import Limits
 from topology import JUNCTION_INDEX, Configuration, Position, Route
 from trajgen.errors import InputError, ScheduleError, TrajgenError
-from trajgen.model.coordination import (
-    CoordinationDiagram,
-    earliest_rest,
-    schedule_times,
-    schedule_waypoints,
-    stopping_distance,
-)
-from trajgen.model.paths import VehiclePath
-from trajgen.model.summary import class_name
-from trajgen.online.braking import PathState
-from trajgen.online.goals import goal_refusal, plan_from_rest
-from trajgen.online.messages import (
+from trajgen.execution.braking_check import PathState
+from trajgen.execution.goals import goal_refusal, schedule_from_rest
+from trajgen.execution.messages import (
     PERIOD_RANGE,
     Command,
     Event,
@@ -57,8 +48,17 @@ from trajgen.online.messages import (
     checked_period,
     checked_state,
 )
-from trajgen.online.motion import AT_REST, PlanPlayer, VehicleMotion
-from trajgen.online.safety import SafetyGuard
+from trajgen.execution.motion import AT_REST, PlanPlayer, VehicleMotion
+from trajgen.execution.safety_guard import SafetyGuard
+from trajgen.model.coordination import (
+    CoordinationDiagram,
+    earliest_rest,
+    schedule_times,
+    schedule_waypoints,
+    stopping_distance,
+)
+from trajgen.model.paths import VehiclePath
+from trajgen.model.summary import class_name
 from trajgen.verification import VerifiedSchedule, require_verified
 from trajgen.verification.braking_rule import BRAKING_RULE_TOLERANCE
 
@@ -76,7 +76,7 @@ class Executor:
     Parameters
     ----------
     verified : VerifiedSchedule
-        The plan (from :func:`~trajgen.online.goals.plan_for_execution`, which keeps the clearance
+        The plan (from :func:`~trajgen.execution.goals.schedule_for_execution`, which keeps the clearance
         the margins need).
     period : float, optional
         Control period, seconds (0.002 to 0.1).
@@ -445,7 +445,7 @@ class Executor:
             goal, self._next_goal = self._next_goal, None
             start = Configuration(*(self._position(state) for state in measured))
             try:
-                verified = plan_from_rest(
+                verified = schedule_from_rest(
                     self.graph,
                     self.limits,
                     start,

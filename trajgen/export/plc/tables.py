@@ -4,7 +4,7 @@ A PLC does not play a schedule: it plays a table of points and interpolates
 between them (linearly, by a cubic spline, or a velocity linearly in time).
 :class:`ProfileTable` is one vehicle's table with the interpolation its
 controller applies (read along the route and verified by
-:mod:`trajgen.export.table_check`). What a table's interpolation leaves
+:mod:`trajgen.export.plc.table_check`). What a table's interpolation leaves
 undefined (the acceleration of a linear table, the jerk of a linear velocity
 table) is checked from divided differences of its points
 (:func:`divided_differences`), with rest before the first point and after the

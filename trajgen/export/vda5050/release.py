@@ -19,7 +19,7 @@ the base, not the schedule's timing, is what keeps the two vehicles apart here:
   so the vehicles pass the junction in the schedule's order, and the
   releases cannot deadlock. The releases are found by replaying both paths,
   node by node, in the order of the schedule's times, each vehicle waiting
-  at its decision point until released (:func:`plan_orders`).
+  at its decision point until released (:func:`order_releases`).
 
 Each update is triggered by the other vehicle reaching a node (its state's
 ``lastNodeId`` and ``lastNodeSequenceId``); ``send_at`` is the time of that
@@ -27,7 +27,7 @@ event in the replay (the schedule's time plus the waits before it). A vehicle
 released after it reaches its decision point waits there (``wait``): VDA 5050
 cannot express a schedule in which both vehicles are near the junction at
 once, so a schedule that does so (``optimal``) is executed a few seconds
-slower (:attr:`OrderPlan.planned_duration`).
+slower (:attr:`OrderReleases.planned_duration`).
 """
 
 from __future__ import annotations
@@ -38,11 +38,11 @@ from dataclasses import dataclass
 from topology import JUNCTION_INDEX
 from topology.validation import short_repr
 from trajgen.errors import InputError, ScheduleError
-from trajgen.export.vda5050_path import OrderPath, vehicle_path
+from trajgen.export.vda5050.path import OrderPath, vehicle_path
 from trajgen.model.pieces import schedule_pieces
 from trajgen.verification import POSITION_TOLERANCE, VerifiedSchedule, require_verified
 
-__all__ = ["BaseRelease", "OrderPlan", "Release", "plan_orders"]
+__all__ = ["BaseRelease", "OrderReleases", "Release", "order_releases"]
 
 
 @dataclass(frozen=True, slots=True)
@@ -81,7 +81,7 @@ class Release:
 
 
 @dataclass(frozen=True, slots=True)
-class OrderPlan:
+class OrderReleases:
     """Both vehicles' paths and every release, in the order they are sent.
 
     Attributes
@@ -306,7 +306,7 @@ class _Replay:
         return releases, finish
 
 
-def plan_orders(verified: VerifiedSchedule, *, spacing: float | None = None) -> OrderPlan:
+def order_releases(verified: VerifiedSchedule, *, spacing: float | None = None) -> OrderReleases:
     """Both vehicles' VDA 5050 paths and the releases of their bases (see the module's description).
 
     Parameters
@@ -319,7 +319,7 @@ def plan_orders(verified: VerifiedSchedule, *, spacing: float | None = None) -> 
 
     Returns
     -------
-    OrderPlan
+    OrderReleases
 
     Raises
     ------
@@ -329,11 +329,11 @@ def plan_orders(verified: VerifiedSchedule, *, spacing: float | None = None) -> 
         No order of the two paths' edges keeps the separation node by node (not seen on any
         schedule: 220 random scenarios of the three methods, and the tests' cases).
     """
-    schedule = require_verified(verified, "plan_orders").schedule
+    schedule = require_verified(verified, "order_releases").schedule
     pieces = schedule_pieces(schedule)
     usable = isinstance(spacing, int | float) and not isinstance(spacing, bool) and math.isfinite(spacing)
     if spacing is not None and not (usable and spacing > 0):
         raise InputError(f"release spacing {short_repr(spacing)} m is not allowed: expected a number > 0")
     paths = tuple(vehicle_path(schedule, pieces, v, spacing=spacing) for v in (0, 1))
     releases, finish = _Replay(paths, schedule.limits.min_separation).run()
-    return OrderPlan(paths, tuple(releases), max(finish, schedule.duration))
+    return OrderReleases(paths, tuple(releases), max(finish, schedule.duration))

@@ -21,7 +21,7 @@ import numpy as np
 
 from topology.indexed import track_distance
 from trajgen.errors import InputError, OutputLimitError
-from trajgen.export.tables import Interpolation, ProfileTable, divided_differences, limit_ratios, slowdown
+from trajgen.export.plc.tables import Interpolation, ProfileTable, divided_differences, limit_ratios, slowdown
 from trajgen.model.pieces import schedule_pieces
 from trajgen.model.schedule import Schedule
 from trajgen.model.values import sorted_unique

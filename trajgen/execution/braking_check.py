@@ -66,7 +66,7 @@ class ServiceBraking:
         self._input.target_acceleration = [0.0]
         self._trajectory = Trajectory(1)
 
-    def plan(self, state: PathState) -> Trajectory:
+    def trajectory(self, state: PathState) -> Trajectory:
         """Braking from ``state``; the returned trajectory is reused by the next call."""
         self._input.current_position = [state.p]
         self._input.current_velocity = [state.v]
@@ -139,7 +139,9 @@ class BrakingCheck:
             must not be refused for the intervals' pessimism. New motion is certified without, and
             that pessimism is the room a later hold has.
         """
-        trajectories = [braking.plan(state) for braking, state in zip(self._braking, commanded, strict=True)]
+        trajectories = [
+            braking.trajectory(state) for braking, state in zip(self._braking, commanded, strict=True)
+        ]
         durations = [t.duration for t in trajectories]
         ends = [t.at_time(d)[0][0] for t, d in zip(trajectories, durations, strict=True)]
         horizon = max(

@@ -19,9 +19,9 @@ from ruckig import ControlInterface, InputParameter, Result, Ruckig, Trajectory
 from limits import VehicleLimits
 from topology import JUNCTION_INDEX
 from trajgen.errors import ScheduleError
+from trajgen.execution.braking_check import PathState
 from trajgen.model.paths import VehiclePath
 from trajgen.model.pieces import schedule_pieces
-from trajgen.online.braking import PathState
 from trajgen.verification import VerifiedSchedule
 
 __all__ = ["AT_REST", "PlanPlayer", "VehicleMotion", "ruckig_jerk", "travel_state"]

@@ -1,7 +1,7 @@
 """Closed-loop simulation: the executor drives a simulated plant that applies faults.
 
-The plant (:mod:`trajgen.online.plant`) moves each vehicle after its setpoints;
-faults (:mod:`trajgen.online.faults`) act on the plant only, and the executor
+The plant (:mod:`trajgen.execution.plant`) moves each vehicle after its setpoints;
+faults (:mod:`trajgen.execution.faults`) act on the plant only, and the executor
 sees their effects through the measurements, and goal requests.
 
 Every cycle the simulation checks the *true* positions against the minimum
@@ -9,7 +9,7 @@ separation, certified between cycles too (track distance is 1-Lipschitz in
 each vehicle's position, so between two cycles it is at least the mean of the
 two distances less half the distance both vehicles drove), and the commanded
 setpoints against the vehicle limits. Memory does not grow with the simulated
-time (:mod:`trajgen.online.trace`).
+time (:mod:`trajgen.execution.trace`).
 """
 
 from __future__ import annotations
@@ -26,16 +26,16 @@ from topology import StarGraph
 from topology.indexed import leg_travel
 from topology.indexed import separation as indexed_separation
 from trajgen.errors import InputError
+from trajgen.execution.executor import Executor
+from trajgen.execution.faults import Fault, FaultError, FaultKind, parse_fault
+from trajgen.execution.goals import execution_margin, for_execution, schedule_for_execution
+from trajgen.execution.messages import Command, Event, Mode, VehicleState
+from trajgen.execution.plant import Plant
+from trajgen.execution.trace import PLOT_SAMPLES, Decimated, Trace
 from trajgen.export.csv import CsvOptions
 from trajgen.model.schedule import TimingMethod
 from trajgen.model.summary import provenance
 from trajgen.model.values import frozen
-from trajgen.online.executor import Executor
-from trajgen.online.faults import Fault, FaultError, FaultKind, parse_fault
-from trajgen.online.goals import execution_margin, for_execution, plan_for_execution
-from trajgen.online.messages import Command, Event, Mode, VehicleState
-from trajgen.online.plant import Plant
-from trajgen.online.trace import PLOT_SAMPLES, Decimated, Trace
 from trajgen.scenario import Scenario
 from trajgen.verification import VerifiedSchedule
 
@@ -157,10 +157,10 @@ class SimulationResult:
 def parse_faults(
     scenario: Scenario, specs: Sequence[str], *, position_margin: float = 0.05
 ) -> tuple[Fault, ...]:
-    """Parse ``--fault`` specs against a scenario (see :func:`~trajgen.online.faults.parse_fault`).
+    """Parse ``--fault`` specs against a scenario (see :func:`~trajgen.execution.faults.parse_fault`).
 
     A jump may be as large as the position margin the executor keeps in this scenario
-    (:func:`~trajgen.online.executor.execution_margin`: at most ``position_margin``).
+    (:func:`~trajgen.execution.executor.execution_margin`: at most ``position_margin``).
     """
     margin = execution_margin(scenario, position_margin)
     return tuple(
@@ -252,7 +252,8 @@ def simulate(
     trace : CsvOptions, optional
         Spool the executed motion as CSV rows in this dialect (its sample period is ignored).
     verified : VerifiedSchedule, optional
-        The plan, if already computed for ``scenario`` (:func:`~trajgen.online.executor.plan_for_execution`).
+        The plan, if already computed for ``scenario``
+        (:func:`~trajgen.execution.goals.schedule_for_execution`).
     observer : callable, optional
         Called every cycle with the executor, the measured states and the command (for tests and tools).
 
@@ -272,7 +273,7 @@ def simulate(
                 f"fault {fault.spec!r}: jump beyond the position margin {margin!r} m kept in this scenario"
             )
     if verified is None:
-        verified = plan_for_execution(scenario, method=method, position_margin=position_margin)
+        verified = schedule_for_execution(scenario, method=method, position_margin=position_margin)
     executor = Executor(
         verified,
         period=period,

@@ -1,20 +1,8 @@
-"""VDA 5050 2.1.0 orders of both vehicles as the files of a run; re-exports the ``vda5050_*`` modules.
+"""VDA 5050 2.1.0 orders of both vehicles as the files of a run, committed all or none.
 
-The work is split by job, and every public name of these modules is available
-from here:
-
-- :mod:`trajgen.export.vda5050_options`: the options of the messages and
-  their checks (:class:`Vda5050Options`);
-- :mod:`trajgen.export.vda5050_path`: the nodes and edges of each vehicle's
-  path, from its verified schedule;
-- :mod:`trajgen.export.vda5050_release`: which base each order and order
-  update releases, and when (:func:`plan_orders`);
-- :mod:`trajgen.export.vda5050_messages`: the bytes of each message and of
-  the manifest (:func:`render_orders`, :func:`render_manifest`).
-
-This module names the files of a run (``<vehicle name>/order-NNN.json`` and
-``manifest.json``); renderers return bytes, and :func:`write_orders` commits
-every file of a run together (:func:`~trajgen.export.atomic.commit_files`).
+The files are ``<vehicle name>/order-NNN.json`` and ``manifest.json``; the renderers
+(:mod:`trajgen.export.vda5050.messages`) return bytes, and :func:`write_orders` commits every
+file of a run together (:func:`~trajgen.export.atomic.commit_files`).
 """
 
 from __future__ import annotations
@@ -25,43 +13,13 @@ from pathlib import Path
 from topology.validation import short_repr
 from trajgen.errors import OptionError
 from trajgen.export.atomic import check_output_paths, commit_files
-from trajgen.export.vda5050_messages import (
-    VDA5050_VERSION,
-    OrderMessage,
-    edge_id,
-    node_id,
-    render_manifest,
-    render_orders,
-)
-from trajgen.export.vda5050_options import MANIFEST_NAME, MAX_FIRST_HEADER_ID, Vda5050Options
-from trajgen.export.vda5050_path import HOLD_MARGIN, NODE_TOLERANCE, NodeKind, OrderPath, PathEdge, PathNode
-from trajgen.export.vda5050_release import OrderPlan, Release, plan_orders
+from trajgen.export.vda5050.messages import render_manifest, render_orders
+from trajgen.export.vda5050.options import MANIFEST_NAME, Vda5050Options
+from trajgen.export.vda5050.release import order_releases
 from trajgen.scenario.naming import check_vehicle_names
 from trajgen.verification import VerifiedSchedule, require_verified
 
-__all__ = [
-    "HOLD_MARGIN",
-    "MANIFEST_NAME",
-    "MAX_FIRST_HEADER_ID",
-    "NODE_TOLERANCE",
-    "VDA5050_VERSION",
-    "NodeKind",
-    "OrderMessage",
-    "OrderPath",
-    "OrderPlan",
-    "PathEdge",
-    "PathNode",
-    "Release",
-    "Vda5050Options",
-    "edge_id",
-    "node_id",
-    "order_files",
-    "order_paths",
-    "plan_orders",
-    "render_manifest",
-    "render_orders",
-    "write_orders",
-]
+__all__ = ["order_files", "order_paths", "write_orders"]
 
 
 def order_paths(names: Sequence[str], directory: str | Path) -> tuple[Path, Path, Path]:
@@ -94,11 +52,13 @@ def order_files(
 ) -> dict[Path, bytes]:
     """Every file of a run, rendered: ``directory/<vehicle name>/order-NNN.json`` and ``manifest.json``."""
     order_paths(names, directory)
-    plan = plan_orders(require_verified(verified, "order_files"))
-    messages = render_orders(verified, names, options=options, plan=plan)
+    releases = order_releases(require_verified(verified, "order_files"))
+    messages = render_orders(verified, names, options=options, releases=releases)
     directory = Path(directory)
     files = {directory / message.path: message.data for message in messages}
-    files[directory / MANIFEST_NAME] = render_manifest(verified, names, messages, options=options, plan=plan)
+    files[directory / MANIFEST_NAME] = render_manifest(
+        verified, names, messages, options=options, releases=releases
+    )
     return files
 
 

@@ -1,12 +1,12 @@
 """Plans meant for execution, and the one thing that re-plans: a new goal.
 
 A plan for the executor keeps twice its position margin on top of the
-separation (:func:`plan_for_execution`): the executor's conflicts keep one
+separation (:func:`schedule_for_execution`): the executor's conflicts keep one
 margin (room for a position correction), the other is clearance between
 them, so no frontier stops a vehicle short of a reversal. Only a goal change
 re-plans: both vehicles brake to rest, the topological planner plans from
 where they stand, the timing method times it, the verifier certifies it
-(:func:`plan_from_rest`).
+(:func:`schedule_from_rest`).
 """
 
 from __future__ import annotations
@@ -17,13 +17,13 @@ from trajgen.methods import METHODS, make_schedule
 from trajgen.model.schedule import TimingMethod
 from trajgen.verification import VerifiedSchedule, certify
 
-__all__ = ["execution_margin", "goal_refusal", "plan_for_execution", "plan_from_rest"]
+__all__ = ["execution_margin", "goal_refusal", "schedule_for_execution", "schedule_from_rest"]
 
 
 def execution_margin(scenario, position_margin: float) -> float:
     """The position margin an executor can keep for ``scenario``, metres: at most ``position_margin``.
 
-    The plan needs twice the margin on top of the separation (:func:`plan_for_execution`), which must
+    The plan needs twice the margin on top of the separation (:func:`schedule_for_execution`), which must
     fit the shortest leg and the start and goal; where it does not, the margin shrinks (to 0 when the
     separation is the shortest leg).
     """
@@ -32,7 +32,7 @@ def execution_margin(scenario, position_margin: float) -> float:
     return max(0.0, min(position_margin, 0.5 * (room - scenario.limits.min_separation)))
 
 
-def plan_from_rest(
+def schedule_from_rest(
     graph: StarGraph,
     limits: Limits,
     start: Configuration,
@@ -61,17 +61,17 @@ def for_execution(method: TimingMethod | str | None) -> TimingMethod:
     return METHODS.create(method).for_execution()
 
 
-def plan_for_execution(
+def schedule_for_execution(
     scenario, *, method: TimingMethod | str | None = None, position_margin: float = 0.05
 ) -> VerifiedSchedule:
-    """The verified schedule an :class:`~trajgen.online.Executor` plays for ``scenario``.
+    """The verified schedule an :class:`~trajgen.execution.Executor` plays for ``scenario``.
 
     Planned for the separation ``min_separation + 2 * margin``, with the margin of
     :func:`execution_margin`: the executor's conflicts keep ``min_separation + margin``, and the
     second margin is the plan's clearance between them.
     """
     margin = execution_margin(scenario, position_margin)
-    return plan_from_rest(
+    return schedule_from_rest(
         scenario.track, scenario.limits, scenario.start, scenario.goal, method=method, margin=margin
     )
 

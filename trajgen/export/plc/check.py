@@ -2,7 +2,7 @@
 
 The files alone are read with their dialect's reader (a file that cannot be
 read is bad input) and verified as the controllers interpolate them
-(:func:`trajgen.export.table_check.check_tables`): the separation along the track
+(:func:`trajgen.export.plc.table_check.check_tables`): the separation along the track
 between the two vehicles, the limits, the start and goal, the homotopy class,
 plus what their format requires (line ends, header, point count). The files
 do not say which homotopy class they take, so both of the planner's classes
@@ -23,10 +23,10 @@ from topology import Homotopy, Route, plan
 from topology.indexed import track_distance
 from trajgen.errors import OptionError, ProfileFileError
 from trajgen.export.csv import profile_paths
-from trajgen.export.dialects import DIALECTS, Dialect, DialectName, TableDialect
-from trajgen.export.plc import table_paths
-from trajgen.export.table_check import TableCheck, check_tables
-from trajgen.export.tables import ProfileTable
+from trajgen.export.plc.dialects import DIALECTS, Dialect, DialectName, TableDialect
+from trajgen.export.plc.files import table_paths
+from trajgen.export.plc.table_check import TableCheck, check_tables
+from trajgen.export.plc.tables import ProfileTable
 from trajgen.model.summary import class_name
 from trajgen.scenario import Scenario
 from trajgen.scenario.reading import FileKind, file_label, read_bounded

@@ -1,6 +1,6 @@
 """What the executor exchanges with the vehicles and its callers: states, setpoints, commands, events.
 
-Plain frozen values; :class:`~trajgen.online.executor.Executor` takes
+Plain frozen values; :class:`~trajgen.execution.executor.Executor` takes
 :class:`VehicleState` s each cycle and returns a :class:`Command`.
 """
 

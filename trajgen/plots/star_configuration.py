@@ -1,7 +1,7 @@
 """``configuration.png`` for four to eight legs: the retract graph ``G_k`` drawn as a table, with the route.
 
 With four or more legs the configuration space has no flat drawing like the
-Y's (:mod:`trajgen.plots.configuration`): it deforms onto the graph ``G_k``
+Y's (:mod:`trajgen.plots.configuration_layout`): it deforms onto the graph ``G_k``
 (docs/star.md, 'The retract graph G_k'), which this module draws instead.
 
 The drawing (:class:`RetractGraphLayout`, pure geometry, no drawing) is a table

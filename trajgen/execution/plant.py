@@ -3,7 +3,7 @@
 Each vehicle moves along the track after its setpoints: it lands on each
 setpoint while it is on track, passes the junction onto the leg the setpoint
 names, and is stopped by the end of a leg. Faults
-(:mod:`trajgen.online.faults`) act here only; the executor sees their effects
+(:mod:`trajgen.execution.faults`) act here only; the executor sees their effects
 through the measurements. A stop (or the executor's emergency brake) brakes at
 the vehicle's emergency deceleration; a drive that is off its setpoint (after
 a jump, a stop) closes the gap gradually: its speed is the setpoint's plus
@@ -18,9 +18,9 @@ import math
 from collections.abc import Sequence
 
 from topology import JUNCTION_INDEX
-from trajgen.online.executor import Executor
-from trajgen.online.faults import Fault, FaultKind
-from trajgen.online.messages import Command, VehicleState
+from trajgen.execution.executor import Executor
+from trajgen.execution.faults import Fault, FaultKind
+from trajgen.execution.messages import Command, VehicleState
 
 __all__ = ["Body", "Plant"]
 

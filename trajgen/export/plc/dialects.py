@@ -30,7 +30,8 @@ from topology.validation import short_repr
 from trajgen.errors import OptionError, ProfileFileError
 from trajgen.export.csv import HEADER_NAMES, Units
 from trajgen.export.numbers import format_number_rows
-from trajgen.export.tables import Interpolation, ProfileTable
+from trajgen.export.plc.tables import Interpolation, ProfileTable
+from trajgen.lazy import RenamedAttribute
 
 __all__ = [
     "DIALECTS",
@@ -91,7 +92,9 @@ class Dialect(abc.ABC):
     #: ``--dialect NAME``.
     name: ClassVar[DialectName]
     #: One line for the help texts.
-    summary: ClassVar[str]
+    description: ClassVar[str]
+    #: Deprecated name of ``description`` (0.7).
+    summary = RenamedAttribute("description", "0.7")
     #: The file name suffix.
     suffix: ClassVar[str] = ".csv"
 
@@ -166,7 +169,7 @@ class TableDialect(Dialect):
     Parameters
     ----------
     name : DialectName
-    summary : str
+    description : str
     default_points : int
         Points per table unless ``--max-points`` says otherwise.
     most_points : int or None
@@ -183,7 +186,7 @@ class TableDialect(Dialect):
     """
 
     name: DialectName
-    summary: str
+    description: str
     default_points: int
     most_points: int | None
     table_interpolation: Interpolation
@@ -311,7 +314,7 @@ class GenericDialect(Dialect):
     """
 
     name: ClassVar[DialectName] = DialectName.GENERIC
-    summary: ClassVar[str] = "trajgen's CSV: t, axis, v, a, j, leg, s, x, y every sample period (default)"
+    description: ClassVar[str] = "trajgen's CSV: t, axis, v, a, j, leg, s, x, y every sample period (default)"
 
     @property
     def point_limit(self) -> None:
@@ -417,7 +420,7 @@ class DialectRegistry:
         lines = []
         for dialect in self:
             limit = "" if dialect.point_limit is None else f" [{dialect.point_limit:,} points]"
-            lines.append(f"{dialect.name.value}: {dialect.summary}{limit}")
+            lines.append(f"{dialect.name.value}: {dialect.description}{limit}")
         return "\n".join(lines)
 
 

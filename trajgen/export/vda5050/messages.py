@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import json
 import math
+import warnings
 from collections.abc import Sequence
 from dataclasses import dataclass
 from datetime import datetime, timedelta
@@ -17,9 +18,9 @@ from pathlib import PurePosixPath
 
 from topology import JUNCTION_INDEX, JUNCTION_NAME, StarGraph
 from trajgen.errors import OptionError
-from trajgen.export.vda5050_options import Vda5050Options
-from trajgen.export.vda5050_path import NodeKind, OrderPath, PathEdge, PathNode
-from trajgen.export.vda5050_release import OrderPlan, Release, plan_orders
+from trajgen.export.vda5050.options import Vda5050Options
+from trajgen.export.vda5050.path import NodeKind, OrderPath, PathEdge, PathNode
+from trajgen.export.vda5050.release import OrderReleases, Release, order_releases
 from trajgen.model.schedule import Schedule
 from trajgen.scenario.naming import check_vehicle_names
 from trajgen.verification import VerifiedSchedule, require_verified
@@ -259,12 +260,27 @@ def _checked(verified: object, names: Sequence[str], options: object, what: str)
     return schedule, names
 
 
+def _releases(
+    verified, releases: OrderReleases | None, plan: OrderReleases | None, caller: str
+) -> OrderReleases:
+    """``releases``, or the deprecated ``plan``, or computed from ``verified``."""
+    if plan is not None:
+        warnings.warn(
+            f"{caller}(plan=...) is deprecated: the keyword is now releases=",
+            DeprecationWarning,
+            stacklevel=3,
+        )
+        releases = plan if releases is None else releases
+    return order_releases(verified) if releases is None else releases
+
+
 def render_orders(
     verified: VerifiedSchedule,
     names: Sequence[str],
     *,
     options: Vda5050Options,
-    plan: OrderPlan | None = None,
+    releases: OrderReleases | None = None,
+    plan: OrderReleases | None = None,
 ) -> tuple[OrderMessage, ...]:
     """Every VDA 5050 order message of both vehicles, in the order they are sent.
 
@@ -274,8 +290,10 @@ def render_orders(
     names : sequence of 2 str
         Vehicle names (folder names, default serial numbers).
     options : Vda5050Options
-    plan : OrderPlan, optional
-        ``plan_orders(verified)``, if already computed.
+    releases : OrderReleases, optional
+        ``order_releases(verified)``, if already computed.
+    plan : OrderReleases, optional
+        Deprecated name of ``releases`` (trajgen 0.6).
 
     Returns
     -------
@@ -291,7 +309,7 @@ def render_orders(
     from vda5050.model.order import Order
 
     schedule, names = _checked(verified, names, options, "render_orders")
-    plan = plan_orders(verified) if plan is None else plan
+    plan = _releases(verified, releases, plan, "render_orders")
     graph = schedule.route.graph
     messages = []
     for release in plan.releases:
@@ -327,7 +345,7 @@ def render_orders(
     return tuple(messages)
 
 
-def _manifest(schedule: Schedule, plan: OrderPlan, messages, names, options: Vda5050Options) -> dict:
+def _manifest(schedule: Schedule, plan: OrderReleases, messages, names, options: Vda5050Options) -> dict:
     graph = schedule.route.graph
 
     def node_ref(vehicle: int, index: int) -> dict:
@@ -386,7 +404,8 @@ def render_manifest(
     messages: Sequence[OrderMessage],
     *,
     options: Vda5050Options,
-    plan: OrderPlan | None = None,
+    releases: OrderReleases | None = None,
+    plan: OrderReleases | None = None,
 ) -> bytes:
     """The index of a run's messages (``manifest.json``): each file, when and on which event to send it.
 
@@ -397,8 +416,10 @@ def render_manifest(
     messages : sequence of OrderMessage
         From :func:`render_orders` with the same arguments.
     options : Vda5050Options
-    plan : OrderPlan, optional
-        ``plan_orders(verified)``, if already computed.
+    releases : OrderReleases, optional
+        ``order_releases(verified)``, if already computed.
+    plan : OrderReleases, optional
+        Deprecated name of ``releases`` (trajgen 0.6).
 
     Returns
     -------
@@ -406,5 +427,5 @@ def render_manifest(
         JSON, UTF-8.
     """
     schedule, names = _checked(verified, names, options, "render_manifest")
-    plan = plan_orders(verified) if plan is None else plan
+    plan = _releases(verified, releases, plan, "render_manifest")
     return _dumps(_manifest(schedule, plan, messages, names, options))

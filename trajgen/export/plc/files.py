@@ -2,7 +2,7 @@
 
 What is verified is what is written: the rendered bytes are read back with the
 dialect's own reader and the two tables are checked along the schedule's route
-(:func:`trajgen.export.table_check.check_tables`) as the controllers interpolate them.
+(:func:`trajgen.export.plc.table_check.check_tables`) as the controllers interpolate them.
 A table set that fails is never returned.
 """
 
@@ -15,10 +15,10 @@ from pathlib import Path
 
 from trajgen.errors import OptionError, VerificationError
 from trajgen.export.atomic import check_output_paths, commit_files
-from trajgen.export.dialects import DIALECTS, TableDialect
-from trajgen.export.resample import Resampled, resample
-from trajgen.export.table_check import TableCheck, check_tables
-from trajgen.export.tables import Interpolation, limit_ratios, slowdown
+from trajgen.export.plc.dialects import DIALECTS, TableDialect
+from trajgen.export.plc.resample import Resampled, resample
+from trajgen.export.plc.table_check import TableCheck, check_tables
+from trajgen.export.plc.tables import Interpolation, limit_ratios, slowdown
 from trajgen.scenario.naming import check_vehicle_names
 from trajgen.verification import VerifiedSchedule, require_verified
 
@@ -95,7 +95,7 @@ def plc_tables(
     ----------
     verified : VerifiedSchedule
     dialect : TableDialect or str
-        A dialect other than ``generic`` (:data:`~trajgen.export.dialects.DIALECTS`).
+        A dialect other than ``generic`` (:data:`~trajgen.export.plc.dialects.DIALECTS`).
     max_points : int, optional
         Points per table (default: the dialect's limit).
 
@@ -168,7 +168,7 @@ def write_tables(
     directory : path
         Created if missing.
     dialect : TableDialect or str
-        A table dialect (:data:`~trajgen.export.dialects.DIALECTS`, not ``generic``: for it see
+        A table dialect (:data:`~trajgen.export.plc.dialects.DIALECTS`, not ``generic``: for it see
         :func:`~trajgen.export.csv.write_profiles`).
     max_points : int, optional
         Points per table (default: the dialect's limit).
@@ -190,7 +190,7 @@ def write_tables(
     >>> import tempfile
     >>> from trajgen import Exact, certify, default_scenario, make_schedule
     >>> scenario = default_scenario()
-    >>> verified = certify(make_schedule(scenario.plan(), scenario.limits, method=Exact()))
+    >>> verified = certify(make_schedule(scenario.route(), scenario.limits, method=Exact()))
     >>> with tempfile.TemporaryDirectory() as folder:
     ...     [p.name for p in write_tables(verified, scenario.names, folder, dialect="codesys-xy")]
     ['agv1.txt', 'agv2.txt']

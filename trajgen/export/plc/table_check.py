@@ -1,6 +1,6 @@
 """Profile tables read along the route as a schedule, and verified as the controllers will drive them.
 
-:class:`TableMotion` turns the two vehicles' :class:`~trajgen.export.tables.ProfileTable` into a
+:class:`TableMotion` turns the two vehicles' :class:`~trajgen.export.plc.tables.ProfileTable` into a
 :class:`~trajgen.model.schedule.Schedule` along the route, so the independent verifier
 (:mod:`trajgen.verification`) checks the separation, the track, the start and goal and the homotopy class
 of exactly what the controllers will drive, in closed form between the points too;
@@ -19,7 +19,7 @@ from limits import Limits
 from topology import JUNCTION_INDEX, Route
 from topology.validation import short_repr
 from trajgen.errors import InputError
-from trajgen.export.tables import (
+from trajgen.export.plc.tables import (
     CROSSING_TOLERANCE,
     END_TOLERANCES,
     Interpolation,
@@ -210,7 +210,7 @@ class TableMotion(TimingMethod):
             self,
             tuple(sections),
             jerk_limited=self.jerk,
-            continuity=smoothness,
+            smoothness=smoothness,
             end_tolerance=max(END_TOLERANCES[table.interpolation] for table in self.tables),
             checked_limits=min(table.interpolation.closed_form for table in self.tables),
         )

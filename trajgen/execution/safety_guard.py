@@ -1,7 +1,7 @@
 """The braking invariant, the executor's last defence: both vehicles can always stop apart.
 
 Every cycle, before a pair of setpoints is issued, :class:`SafetyGuard` asks the
-:class:`~trajgen.online.braking.BrakingCheck` whether both vehicles, braking at
+:class:`~trajgen.execution.braking_check.BrakingCheck` whether both vehicles, braking at
 once from here (each anywhere between its service braking from the commanded
 state and its emergency stop from the measured one), keep the separation until
 both are at rest, certified between its samples too. A follower whose next
@@ -18,9 +18,9 @@ import math
 from limits import Limits
 from topology import StarGraph
 from topology.indexed import separation as indexed_separation
+from trajgen.execution.braking_check import BrakingCheck, PathState
 from trajgen.model.coordination import stopping_distance
 from trajgen.model.paths import VehiclePath
-from trajgen.online.braking import BrakingCheck, PathState
 
 __all__ = ["SEPARATION_TOLERANCE", "SafetyGuard"]
 
@@ -74,7 +74,7 @@ class SafetyGuard:
 
         ``hold``: the setpoints hold vehicles (they brake as the last cycle certified), checked to the
         millimetre; new motion is certified with the check's coarser intervals, whose pessimism keeps
-        room for the holds that may follow (:meth:`~trajgen.online.braking.BrakingCheck.clearance`).
+        room for the holds that may follow (:meth:`~trajgen.execution.braking_check.BrakingCheck.clearance`).
 
         Vehicles far apart are certified at once: the track distance changes by at most the
         distance each vehicle drives, and none drives farther than its service stop from its
