@@ -29,6 +29,7 @@ from topology.cycle import (
     retract,
 )
 from topology.errors import (
+    InfeasibleError,
     InputError,
     OptionError,
     PositionError,
@@ -37,11 +38,13 @@ from topology.errors import (
     TrajgenError,
 )
 from topology.graph import MAX_LEGS, MIN_LEGS, StarGraph, YGraph
+from topology.graph_planner import GraphMove, GraphRoute, plan_graph
 from topology.indexed import JUNCTION_INDEX, RegionKey, reduce_regions
 from topology.options import Option
 from topology.positions import JUNCTION, JUNCTION_NAME, Configuration, Position
 from topology.retract_graph import Geodesic, GraphPoint, RetractGraph
 from topology.route import Homotopy, Instruction, Region, Route, WayRound, plan, region_sequence
+from topology.track_graph import EdgePoint, TrackEdge, TrackGraph
 
 __all__ = [
     "ANTIPODAL_TOLERANCE",
@@ -53,9 +56,13 @@ __all__ = [
     "BoundaryCycle",
     "Cell",
     "Configuration",
+    "EdgePoint",
     "Geodesic",
+    "GraphMove",
     "GraphPoint",
+    "GraphRoute",
     "Homotopy",
+    "InfeasibleError",
     "InputError",
     "Instruction",
     "Option",
@@ -68,7 +75,9 @@ __all__ = [
     "Route",
     "SeparationError",
     "StarGraph",
+    "TrackEdge",
     "TrackError",
+    "TrackGraph",
     "TrajgenError",
     "WayRound",
     "YGraph",
@@ -77,6 +86,7 @@ __all__ = [
     "classify",
     "is_antipodal",
     "plan",
+    "plan_graph",
     "reduce_regions",
     "region_sequence",
     "retract",

@@ -10,6 +10,7 @@ received and what was expected.
 from __future__ import annotations
 
 __all__ = [
+    "InfeasibleError",
     "InputError",
     "OptionError",
     "PositionError",
@@ -41,3 +42,11 @@ class SeparationError(InputError):
 
 class OptionError(InputError):
     """A string option is not one of the accepted names."""
+
+
+class InfeasibleError(InputError):
+    """No collision-free route exists: the vehicles cannot reach their goals keeping the separation.
+
+    An answer about the scenario, not a failure of the planner: raised before any timing, it is
+    bad input to the command line (exit 2).
+    """

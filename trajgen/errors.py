@@ -15,6 +15,7 @@ from __future__ import annotations
 
 from limits.errors import LimitsError
 from topology.errors import (
+    InfeasibleError,
     InputError,
     OptionError,
     PositionError,
@@ -24,6 +25,7 @@ from topology.errors import (
 )
 
 __all__ = [
+    "InfeasibleError",
     "InputError",
     "LimitsError",
     "LiveError",

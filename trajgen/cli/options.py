@@ -11,13 +11,13 @@ from __future__ import annotations
 import argparse
 import dataclasses
 
-from trajgen.errors import OptionError
+from trajgen.errors import OptionError, ScenarioError
 from trajgen.export import DEFAULT_MAX_ROWS, CsvOptions, Units
 from trajgen.export.plc.dialects import DIALECTS
 from trajgen.methods import METHODS
 from trajgen.methods.optimal.choice import HomotopyChoice
 from trajgen.model.schedule import TimingMethod
-from trajgen.scenario import Scenario, default_scenario, load_scenario
+from trajgen.scenario import GraphScenario, Scenario, default_scenario, load_scenario
 
 __all__ = [
     "add_csv_options",
@@ -30,9 +30,22 @@ __all__ = [
 ]
 
 
-def scenario_from(path: str | None) -> Scenario:
-    """The scenario of a file, or the built-in one for ``None``."""
-    return default_scenario() if path is None else load_scenario(path)
+def scenario_from(path: str | None, *, graph: bool = False) -> Scenario:
+    """The scenario of a file, or the built-in one for ``None``.
+
+    Raises
+    ------
+    ScenarioError
+        A track graph (``[track]`` with ``edges``) where the command takes junctions only
+        (``graph=False``): today only ``trajgen plan`` takes graphs.
+    """
+    scenario = default_scenario() if path is None else load_scenario(path)
+    if isinstance(scenario, GraphScenario) and not graph:
+        raise ScenarioError(
+            f"{scenario.source}: a track with edges (a track graph) is planned by 'trajgen plan'; this "
+            "command does not take one yet: expected a [track] with legs (docs/graphs.md)"
+        )
+    return scenario
 
 
 #: The generic CSV's options and their defaults (``None`` in the parser, so a given one is known).

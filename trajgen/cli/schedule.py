@@ -5,9 +5,16 @@ from __future__ import annotations
 import argparse
 import json
 
+from topology import GraphRoute
 from trajgen.cli.options import add_csv_options, add_method, csv_options, method_from, scenario_from
 from trajgen.cli.parser import EXIT_OK
-from trajgen.model.summary import format_route, format_run, route_summary
+from trajgen.model.summary import (
+    format_graph_route,
+    format_route,
+    format_run,
+    graph_route_summary,
+    route_summary,
+)
 from trajgen.pipeline import Outputs, run
 from trajgen.scenario import BuiltinScenario, builtin_scenario
 
@@ -15,8 +22,13 @@ __all__ = ["register"]
 
 
 def _command_plan(args: argparse.Namespace) -> int:
-    route = scenario_from(args.scenario).route()
-    print(json.dumps(route_summary(route), indent=2) if args.json else format_route(route))
+    scenario = scenario_from(args.scenario, graph=True)
+    route = scenario.route()
+    if isinstance(route, GraphRoute):
+        summary, text = graph_route_summary(route, scenario.names), format_graph_route(route, scenario.names)
+    else:
+        summary, text = route_summary(route), format_route(route)
+    print(json.dumps(summary, indent=2) if args.json else text)
     return EXIT_OK
 
 

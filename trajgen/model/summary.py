@@ -9,14 +9,16 @@ instruction), or the second-shortest, in another class.
 
 from __future__ import annotations
 
-from topology import Homotopy, Instruction, Route, WayRound
+from topology import GraphRoute, Homotopy, Instruction, Route, WayRound
 
 __all__ = [
     "class_label",
     "class_name",
+    "format_graph_route",
     "format_provenance",
     "format_route",
     "format_run",
+    "graph_route_summary",
     "provenance",
     "route_summary",
 ]
@@ -95,6 +97,55 @@ def route_summary(route: Route) -> dict:
         summary["legs"] = route.graph.leg_count
         summary["class"] = class_name(route)
     return summary
+
+
+def graph_route_summary(route: GraphRoute, names: tuple[str, str] = ("vehicle 1", "vehicle 2")) -> dict:
+    """A JSON-ready summary of a route on a track graph: each vehicle's travel and the moves.
+
+    Each move names the vehicle, where it starts and ends (``EDGE:s`` or a node), the nodes it
+    passes, the edges it runs along, its length and where the other vehicle stands meanwhile.
+    """
+    track = route.track
+    return {
+        "track": {"nodes": len(track.nodes), "edges": track.edge_count, "length_m": track.total_length},
+        "min_separation_m": route.min_separation,
+        "start": [track.name(p) for p in route.start],
+        "goal": [track.name(p) for p in route.goal],
+        "travel_m": list(route.travel),
+        "length_m": route.length,
+        "moves": [
+            {
+                "vehicle": names[move.vehicle],
+                "from": track.name(move.points[0]),
+                "to": track.name(move.points[-1]),
+                "via": [track.name(p) for p in move.points[1:-1]],
+                "edges": [track.edges[e].name for e in move.edges],
+                "length_m": move.length,
+                "other_at": track.name(move.standing),
+            }
+            for move in route.moves
+        ],
+        "critical_points": route.critical_points,
+        "searched": route.searched,
+    }
+
+
+def format_graph_route(route: GraphRoute, names: tuple[str, str] = ("vehicle 1", "vehicle 2")) -> str:
+    """Human-readable multi-line description of a route on a track graph."""
+    summary = graph_route_summary(route, names)
+    lines = [
+        f"track: {summary['track']['nodes']} nodes, {summary['track']['edges']} edges, "
+        f"{summary['track']['length_m']:g} m; minimum separation {route.min_separation:g} m",
+        f"travel: {names[0]} {route.travel[0]:g} m, {names[1]} {route.travel[1]:g} m "
+        f"({route.length:g} m in all, the least of any one-at-a-time route)",
+        f"moves ({len(route.moves)}):",
+    ]
+    for number, move in enumerate(summary["moves"], start=1):
+        lines.append(
+            f"  {number:2d}  {move['vehicle']}: {move['from']} -> {move['to']} along "
+            f"{', '.join(move['edges'])}, {move['length_m']:g} m (the other at {move['other_at']})"
+        )
+    return "\n".join(lines)
 
 
 def format_route(route: Route) -> str:

@@ -14,12 +14,14 @@ from trajgen.scenario.definition import (
     load_scenario,
     parse_scenario,
 )
+from trajgen.scenario.graph import GraphScenario
 
 __all__ = [
     "DEFAULT_SCENARIO_NAME",
     "MAX_SCENARIO_BYTES",
     "PLAUSIBLE",
     "BuiltinScenario",
+    "GraphScenario",
     "Scenario",
     "builtin_scenario",
     "default_scenario",

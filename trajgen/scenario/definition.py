@@ -34,15 +34,17 @@ from __future__ import annotations
 
 import tomllib
 import warnings
+from collections.abc import Callable
 from dataclasses import dataclass
 from importlib import resources
 from pathlib import Path
 
 from limits import Limits, VehicleLimits
-from topology import Configuration, Option, Position, Route, StarGraph, YGraph, plan
+from topology import Configuration, Option, Position, Route, StarGraph, TrackGraph, YGraph, plan
 from topology.validation import short_repr
 from trajgen.errors import InputError, OptionError, ScenarioError
 from trajgen.scenario.factsheet import read_factsheet
+from trajgen.scenario.graph import GraphScenario
 from trajgen.scenario.naming import check_vehicle_name, check_vehicle_names
 from trajgen.scenario.reading import FileKind, file_label, read_bounded
 
@@ -113,6 +115,8 @@ PLAUSIBLE = {
 }
 _TOP_KEYS = {"track": True, "safety": True, "vehicle": True}
 _TRACK_KEYS = {"legs": True, "angles_deg": False}
+_GRAPH_TRACK_KEYS = {"edges": True, "nodes": False}
+_EDGE_KEYS = {"from": True, "to": True, "length": False}
 _SAFETY_KEYS = {"min_separation": True}
 _VEHICLE_KEYS = {
     "name": True,
@@ -287,9 +291,14 @@ def _factsheet_limits(vehicle: dict, where: str, source: str, folder: Path | Non
 
 
 def _parse_vehicle(
-    vehicle: object, k: int, track: StarGraph, taken: list[str], source: str, folder: Path | None = None
+    vehicle: object,
+    k: int,
+    position: Callable[[str], object],
+    taken: list[str],
+    source: str,
+    folder: Path | None = None,
 ):
-    """Name, limits, start and goal of ``[[vehicle]]`` number ``k``."""
+    """Name, limits, start and goal of ``[[vehicle]]`` number ``k`` (``position`` reads a position)."""
     where = f"[[vehicle]] {k}"
     vehicle = _table(vehicle, where, source)
     _check_keys(vehicle, _VEHICLE_KEYS, where, source)
@@ -324,14 +333,19 @@ def _parse_vehicle(
                 f"got {type(text).__name__} {short_repr(text)}"
             )
         try:
-            ends.append(track.check(Position.parse(text)))
+            ends.append(position(text))
         except InputError as error:
             raise ScenarioError(f"{source}: {where} {key}: {error}") from None
     return name, limits, ends[0], ends[1]
 
 
-def parse_scenario(data: dict, *, source: str = "<scenario>", folder: str | Path | None = None) -> Scenario:
+def parse_scenario(
+    data: dict, *, source: str = "<scenario>", folder: str | Path | None = None
+) -> Scenario | GraphScenario:
     """Build a Scenario from parsed TOML data, naming ``source`` and the key in every error.
+
+    A ``[track]`` with ``legs`` is a junction (:class:`Scenario`); with ``edges``, a track graph
+    (:class:`~trajgen.scenario.graph.GraphScenario`, docs/graphs.md).
 
     ``folder`` is where relative ``factsheet`` paths are found (``None``: the
     current working directory).
@@ -343,6 +357,8 @@ def parse_scenario(data: dict, *, source: str = "<scenario>", folder: str | Path
         track, limits or separation, or vehicles closer than the separation.
     """
     _check_keys(_table(data, "the scenario", source), _TOP_KEYS, "the scenario", source)
+    if isinstance(data["track"], dict) and "edges" in data["track"]:
+        return _parse_graph_scenario(data, source, None if folder is None else Path(folder))
     track = _parse_track(data, source)
     safety = _table(data["safety"], "[safety]", source)
     _check_keys(safety, _SAFETY_KEYS, "[safety]", source)
@@ -354,8 +370,9 @@ def parse_scenario(data: dict, *, source: str = "<scenario>", folder: str | Path
     names: list[str] = []
     parsed = []
     for k, vehicle in enumerate(vehicles, start=1):
+        position = _star_position(track)
         parsed.append(
-            _parse_vehicle(vehicle, k, track, names, source, None if folder is None else Path(folder))
+            _parse_vehicle(vehicle, k, position, names, source, None if folder is None else Path(folder))
         )
         names.append(parsed[-1][0])
     try:
@@ -386,6 +403,78 @@ def parse_scenario(data: dict, *, source: str = "<scenario>", folder: str | Path
         raise ScenarioError(f"{source}: {error}") from None
 
 
+def _star_position(track: StarGraph) -> Callable[[str], Position]:
+    return lambda text: track.check(Position.parse(text))
+
+
+def _parse_graph_track(table: dict, source: str) -> TrackGraph:
+    """``[track]`` with ``edges`` (and optional ``nodes`` x/y) as a :class:`~topology.TrackGraph`."""
+    _check_keys(table, _GRAPH_TRACK_KEYS, "[track]", source)
+    coordinates = None
+    if "nodes" in table:
+        coordinates = {}
+        for name, xy in _table(table["nodes"], "[track] nodes", source).items():
+            where = f"[track] nodes.{short_repr(name)}"
+            if not isinstance(xy, list) or len(xy) != 2:
+                raise ScenarioError(f"{source}: {where} must be [x, y] in metres, got {short_repr(xy)}")
+            coordinates[name] = (_number(xy[0], where, source), _number(xy[1], where, source))
+    edges = {}
+    for name, edge in _table(table["edges"], "[track] edges", source).items():
+        where = f"[track] edges.{short_repr(name)}"
+        edge = _table(edge, where, source)
+        _check_keys(edge, _EDGE_KEYS, where, source)
+        ends = [edge[key] for key in ("from", "to")]
+        if not all(isinstance(end, str) for end in ends):
+            raise ScenarioError(f"{source}: {where} from and to must be node names, got {short_repr(ends)}")
+        length = _number(edge["length"], f"{where} length", source) if "length" in edge else None
+        edges[name] = (ends[0], ends[1], length)
+    try:
+        track = TrackGraph.from_edges(edges, coordinates=coordinates)
+    except InputError as error:
+        raise ScenarioError(f"{source}: [track]: {error}") from None
+    low, high = PLAUSIBLE["leg length"]
+    for edge in track.edges:
+        if not low <= edge.length <= high:
+            raise ScenarioError(
+                f"{source}: [track]: edge {edge.name!r} is {edge.length!r} m long: "
+                f"expected {low:g} to {high:g} m"
+            )
+    return track
+
+
+def _parse_graph_scenario(data: dict, source: str, folder: Path | None) -> GraphScenario:
+    track = _parse_graph_track(_table(data["track"], "[track]", source), source)
+    safety = _table(data["safety"], "[safety]", source)
+    _check_keys(safety, _SAFETY_KEYS, "[safety]", source)
+    separation = _number(safety["min_separation"], "[safety] min_separation", source)
+    vehicles = data["vehicle"]
+    if not isinstance(vehicles, list) or len(vehicles) != 2:
+        count = len(vehicles) if isinstance(vehicles, list) else type(vehicles).__name__
+        raise ScenarioError(f"{source}: expected exactly two [[vehicle]] tables, got {count}")
+    names: list[str] = []
+    parsed = []
+    for k, vehicle in enumerate(vehicles, start=1):
+        parsed.append(_parse_vehicle(vehicle, k, track.point, names, source, folder))
+        names.append(parsed[-1][0])
+    try:
+        limits = Limits(vehicles=(parsed[0][1], parsed[1][1]), min_separation=separation)
+    except InputError as error:
+        raise ScenarioError(f"{source}: [safety]: {error}") from None
+    start, goal = (parsed[0][2], parsed[1][2]), (parsed[0][3], parsed[1][3])
+    for label, pair in (("start", start), ("goal", goal)):
+        gap = track.distance(*pair)
+        if gap < separation or gap == 0.0:
+            raise ScenarioError(
+                f"{source}: the vehicles' {label} positions ({track.name(pair[0])}, {track.name(pair[1])}) "
+                f"are {gap!r} m apart along the track: expected at least [safety] min_separation "
+                f"{separation!r} m"
+            )
+    try:
+        return GraphScenario(track, limits, (names[0], names[1]), start, goal, source)
+    except InputError as error:
+        raise ScenarioError(f"{source}: {error}") from None
+
+
 def _read_scenario_file(path: Path, label: str) -> str:
     """The text of a scenario file: a regular file of at most :data:`MAX_SCENARIO_BYTES`, UTF-8."""
     data = read_bounded(path, label, SCENARIO_FILE)
@@ -398,7 +487,7 @@ def _read_scenario_file(path: Path, label: str) -> str:
         ) from None
 
 
-def load_scenario(path: str | Path) -> Scenario:
+def load_scenario(path: str | Path) -> Scenario | GraphScenario:
     """Read a scenario TOML file (UTF-8, at most :data:`MAX_SCENARIO_BYTES`).
 
     Raises
@@ -413,7 +502,7 @@ def load_scenario(path: str | Path) -> Scenario:
     return _parse_text(_read_scenario_file(path, label), label, path.parent)
 
 
-def _parse_text(text: str, source: str, folder: Path | None = None) -> Scenario:
+def _parse_text(text: str, source: str, folder: Path | None = None) -> Scenario | GraphScenario:
     try:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as error:
