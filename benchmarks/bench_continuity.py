@@ -4,9 +4,10 @@ Run: ``python benchmarks/bench_continuity.py [--cases N] [--seed S]``.
 
 For each kind of query (generic queries under rule 1, points along the tie
 sets of rule 2, retractions crossing a vertex of ``G_k``) and k = 4, 6, 8,
-builds ``--cases`` seeded cases exactly as ``tests/test_star.py`` does (which
-bounds them on seed 0), moves start and goal by ``DELTA`` metres, and prints
-over the comparable cases (both queries under one instruction and class):
+builds ``--cases`` seeded cases with ``tests/support/continuity.py``, as
+``tests/test_planner.py`` does (which bounds them on seed 0), moves start and
+goal by ``DELTA`` metres, and prints over the comparable cases (both queries
+under one instruction and class):
 
 - ratio: ``max over tau of d(route_a.at(tau), route_b.at(tau))`` divided by how
   far start and goal moved (``d`` is the track distance of vehicle 1 plus that
@@ -27,7 +28,7 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))  # the tests' construction
 
-from tests.test_star import CONTINUITY_BOUND, DELTA, continuity_cases
+from tests.support.continuity import CONTINUITY_BOUND, DELTA, continuity_cases
 
 
 def main() -> None:

@@ -1,14 +1,15 @@
 """``optimal`` over the two shortest homotopy classes, and its accuracy (issue 10).
 
-Closed-form and stored reference values (the issue's swaps and its long track),
-agreement with a converged solve, the class lower bound in both classes, and
-the ``homotopy`` option in Python and on the command line.
+Closed-form and stored reference values (the issue's swaps and its long track, the two classes
+of a 4-way crossing), agreement with a converged solve, the class lower bound in both classes,
+and the ``homotopy`` option in Python and on the command line.
 """
 
 from __future__ import annotations
 
 import json
 import logging
+import math
 import re
 
 import pytest
@@ -16,10 +17,11 @@ import pytest
 from limits import Limits, VehicleLimits
 from tests.support.helpers import AGV, LIMITS, MIXED, SLOW, route_of
 from topology import Homotopy, WayRound, plan
-from trajgen import FallbackReason, Optimal, SolverCache, lower_bound, verify
+from trajgen import FallbackReason, Optimal, SolverCache, builtin_scenario, lower_bound, verify
 from trajgen.cli import EXIT_BAD_INPUT, EXIT_OK, main
 from trajgen.methods.optimal import Solver, Source
 from trajgen.model.analysis import class_lower_bound
+from trajgen.model.summary import class_label
 from trajgen.scenario.sampling import random_scenarios
 
 FAST = VehicleLimits(2.0, 1.0, 2.0)
@@ -63,6 +65,32 @@ def test_the_faster_class_wins_the_issue_swaps(legs, vehicles, baseline, before)
     assert classes[1].makespan == pytest.approx(fastest.duration, rel=1e-12)
     assert classes[0].makespan == pytest.approx(paper.duration, rel=2e-3)
     assert all(c.lower_bound <= c.makespan * (1 + 1e-9) for c in classes)
+
+
+def test_optimal_fastest_on_a_crossing_takes_the_faster_of_two_classes(capsys):
+    # the slow vehicle 1 would dodge into a side leg in the planner's class; in the other class the
+    # fast vehicle 2 dodges, which is much faster
+    scenario = builtin_scenario("crossing")
+    limits = Limits((QUARTER, FAST), 1.5)
+    route = scenario.route()
+    fastest = Optimal().schedule(route, limits)
+    report = verify(fastest)
+    assert report.passed, report.failures
+    assert report.regions_match
+    assert fastest.fallback_reason is None
+    classes = fastest.info.classes
+    assert [(c.homotopy, c.chosen) for c in classes] == [(Homotopy.PLANNED, False), (Homotopy.OTHER, True)]
+    assert [c.summary()["class"] for c in classes] == [
+        "shortest route on G_4",
+        "second-shortest route on G_4",
+    ]
+    assert classes[1].makespan == pytest.approx(fastest.duration, rel=1e-12)
+    assert classes[0].makespan is None or classes[0].makespan > 1.05 * classes[1].makespan
+    assert all(c.lower_bound <= (c.makespan or math.inf) * (1 + 1e-9) for c in classes)
+    other = plan(scenario.track, scenario.start, scenario.goal, min_separation=1.5, homotopy="other")
+    assert fastest.route.region_keys == other.region_keys
+    assert fastest.route.travel == (20.0, 40.0)  # the fast vehicle 2 drives the detour
+    assert class_label(fastest.route) == "second-shortest route on G_4 (not the planner's: faster)"
 
 
 @pytest.mark.accuracy

@@ -1,4 +1,7 @@
-"""PLC dialects: resampled tables, their files, and ``trajgen check`` on them and on edited files."""
+"""PLC dialects: resampled tables, their files, and ``trajgen check`` on them and on edited files.
+
+On the demo swap, and on the built-in 4-way crossing (its legs numbered 1 to 4).
+"""
 
 from __future__ import annotations
 
@@ -12,7 +15,8 @@ from hypothesis import strategies as st
 
 from tests.conftest import REPO
 from tests.support.helpers import LIMITS, MIXED, route_of
-from trajgen import Exact, Optimal, Toppra, certify, default_scenario, make_schedule, run
+from tests.support.star_scenarios import CROSSING
+from trajgen import Exact, Optimal, Toppra, certify, default_scenario, load_scenario, make_schedule, run
 from trajgen.cli import EXIT_BAD_INPUT, EXIT_FAILURE, EXIT_OK, main
 from trajgen.errors import InputError, OptionError, OutputLimitError, ProfileFileError, VerificationError
 from trajgen.export import CsvOptions, write_profiles
@@ -408,6 +412,26 @@ def test_every_column_of_a_generic_file_is_checked(exported, tmp_path, column, c
     assert any(re.search(match, f) for f in verdict.failures), verdict.failures
 
 
+def test_check_rejects_a_leg_the_crossing_lacks(tmp_path, capsys):
+    out = tmp_path / "csv"
+    assert main(["schedule", str(CROSSING), "--method", "exact", "--csv", str(out)]) == EXIT_OK
+    capsys.readouterr()
+    path = out / "agv1.csv"
+    lines = path.read_bytes().decode("ascii").split("\r\n")
+    fields = lines[1].split(";")
+    assert fields[5] == "1"  # agv1 starts on N, the first leg
+    fields[5] = "5"
+    lines[1] = ";".join(fields)
+    path.write_bytes("\r\n".join(lines).encode("ascii"))
+    assert main(["check", str(CROSSING), "--csv", str(out), "--json"]) == EXIT_FAILURE
+    verdict = json.loads(capsys.readouterr().out)
+    assert not verdict["passed"]
+    assert any(
+        "leg 5 is not on the track: expected 0 (the junction) or a leg 1 to 4 (1-based, 4 legs)" in f
+        for f in verdict["failures"]
+    ), verdict["failures"]
+
+
 def test_a_table_whose_axis_runs_backwards_fails(exported, tmp_path):
     dialect = DIALECTS.lookup("siemens-xy")
     parsed = [
@@ -520,3 +544,19 @@ def test_an_api_error_names_the_apis_remedy_and_the_flag(swap, tmp_path, call, r
         call(swap, tmp_path / "out")
     assert remedy in str(raised.value)
     assert not (tmp_path / "out").exists()
+
+
+# -- the table dialects on a 4-way crossing ----------------------------------------------------------------
+
+
+@pytest.mark.parametrize("dialect", [d.name.value for d in TABLE_DIALECTS])
+def test_table_dialects_on_a_crossing(tmp_path, capsys, dialect):
+    out = tmp_path / dialect
+    argv = ["schedule", str(CROSSING), "--method", "exact", "--csv", str(out), "--dialect", dialect, "--json"]
+    assert main(argv) == EXIT_OK
+    summary = json.loads(capsys.readouterr().out)
+    assert summary["export"]["dialect"] == dialect
+    assert summary["export"]["min_separation_m"] >= 1.5 - 1e-9
+    verdict = check_profiles(load_scenario(CROSSING), out, dialect=dialect)
+    assert verdict.passed, verdict.failures
+    assert verdict.check.route.graph.leg_count == 4

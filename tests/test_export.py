@@ -1,4 +1,4 @@
-"""CSV profiles: format, round trip re-verified from the file, options, atomicity."""
+"""CSV profiles: format, round trip re-verified from the file, options, atomicity, legs up to k."""
 
 from __future__ import annotations
 
@@ -6,11 +6,14 @@ import numpy as np
 import pytest
 
 from tests.support.helpers import LIMITS, MIXED, route_of, too_close
-from trajgen import Exact, Schedule, Toppra, certify
+from tests.support.star_scenarios import STAR_SCENARIOS, leg_index, read_csv, toml_text
+from trajgen import Exact, Schedule, Toppra, certify, load_scenario
+from trajgen.cli import EXIT_OK, main
 from trajgen.errors import OptionError, UnverifiedScheduleError, VerificationError
 from trajgen.export import CsvOptions, Units, commit_files, write_profiles
 from trajgen.export import csv as csv_export
 from trajgen.export.csv import format_block, format_rows, profile_chunk_pair, render_profile
+from trajgen.export.plc.check import check_profiles
 
 SWAP = ((10.0, 10.0, 10.0), ("A:10", "B:10"), ("B:10", "A:10"))
 NAMES = ("agv1", "agv2")
@@ -189,3 +192,36 @@ def test_commit_files_takes_a_chunk_of_each_file_in_turn(tmp_path):
     )
     assert taken == ["a0", "c0", "a1", "a2"]
     assert [path.read_bytes() for path in paths] == [b"a0;a1;a2;", b"whole", b"c0;"]
+
+
+# -- a junction of 8 legs: legs 1-based up to 8, x and y from the angles --------------------------------
+
+
+def test_csv_legs_are_one_based_up_to_k_and_xy_follow_the_angles(tmp_path, capsys):
+    data = STAR_SCENARIOS[8]
+    path = tmp_path / "eight.toml"
+    path.write_text(toml_text(data), encoding="utf-8")
+    scenario = load_scenario(path)
+    assert main(["schedule", str(path), "--method", "exact", "--csv", str(tmp_path / "csv")]) == EXIT_OK
+    capsys.readouterr()
+    angles = np.radians(np.array(scenario.track.angles_deg))
+    seen: set[int] = set()
+    for vehicle, name in enumerate(scenario.names):
+        columns = read_csv(tmp_path / "csv" / f"{name}.csv")
+        legs = columns["leg"].astype(int)
+        assert np.all(legs == columns["leg"])  # integers
+        assert np.all((legs >= 0) & (legs <= 8))
+        seen |= set(legs.tolist())
+        on_leg = legs > 0
+        angle = angles[np.where(on_leg, legs - 1, 0)]
+        s = columns["s_m"]
+        np.testing.assert_allclose(columns["x_m"], np.where(on_leg, s * np.cos(angle), 0.0), atol=2e-9)
+        np.testing.assert_allclose(columns["y_m"], np.where(on_leg, s * np.sin(angle), 0.0), atol=2e-9)
+        # the first and last rows: the scenario's start and goal, by 1-based index
+        for row, position in ((0, scenario.start[vehicle]), (-1, scenario.goal[vehicle])):
+            assert legs[row] == leg_index(scenario, position) + 1
+            assert s[row] == pytest.approx(position.s, abs=1e-9)
+    assert 8 in seen  # the 8th leg, H, is leg 8
+    assert scenario.start[0].leg == "H"
+    assert scenario.track.index("H") == 7
+    assert check_profiles(scenario, tmp_path / "csv").passed

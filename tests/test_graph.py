@@ -1,4 +1,4 @@
-"""Value objects of the track: positions, configurations, distances, and their errors."""
+"""Value objects of the track (3 to 8 legs): positions, configurations, distances, and their errors."""
 
 from __future__ import annotations
 
@@ -6,12 +6,15 @@ import math
 
 import pytest
 
+from tests.support.helpers import legs_id
+from tests.support.star_spec import LEGS4
 from topology import (
     JUNCTION,
     Configuration,
     Position,
     PositionError,
     SeparationError,
+    StarGraph,
     TrackError,
     YGraph,
     plan,
@@ -59,6 +62,27 @@ def test_xy_uses_leg_angles():
     assert TRACK.xy(Position("A", 10.0)) == pytest.approx((0.0, 10.0))  # default A points at 90 degrees
 
 
+@pytest.mark.parametrize("k", range(3, 9), ids=legs_id)
+def test_a_star_spreads_its_legs_evenly_by_default(k):
+    names = [f"leg{j}" for j in range(k)]
+    star = StarGraph({name: 1.0 + j for j, name in enumerate(names)})
+    assert star.leg_count == k
+    assert star.names == tuple(names)
+    assert star.lengths == tuple(1.0 + j for j in range(k))
+    assert star.angles_deg == pytest.approx([(90.0 + 360.0 * j / k) % 360.0 for j in range(k)])
+    assert (star.cycle is None) == (k > 3)
+    assert star.boundary_length == pytest.approx(2 * (k - 1) * sum(star.lengths))
+    # the planar layout follows the angles
+    x, y = star.xy(Position(names[-1], 2.0))
+    angle = math.radians(90.0 + 360.0 * (k - 1) / k)
+    assert (x, y) == pytest.approx((2.0 * math.cos(angle), 2.0 * math.sin(angle)))
+
+
+def test_counterclockwise_angles_may_start_anywhere():
+    star = StarGraph(LEGS4, angles_deg={"N": 300, "W": 10, "S": 100, "E": 200})
+    assert star.angles_deg == (300.0, 10.0, 100.0, 200.0)
+
+
 def test_legs_accept_pairs_and_keep_order():
     track = YGraph([("x", 1.0), ("y", 2.0), ("z", 3.0)])
     assert track.names == ("x", "y", "z")
@@ -69,6 +93,8 @@ def test_legs_accept_pairs_and_keep_order():
 
 START = Configuration(Position("A", 10.0), Position("B", 8.0))
 GOAL = START.swapped()
+#: A swap on the 4-way crossing :data:`LEGS4` (whose shortest leg is 2 m).
+CROSSING_START = Configuration(Position("N", 10.0), Position("W", 10.0))
 
 
 @pytest.mark.parametrize(
@@ -192,6 +218,59 @@ GOAL = START.swapped()
             SeparationError,
             "min_separation.*must be finite",
             id="nan-separation",
+        ),
+        # junctions of 3 to 8 legs
+        pytest.param(
+            lambda: StarGraph({"A": 1.0, "B": 1.0}),
+            TrackError,
+            r"a track has 3 to 8 legs, got 2",
+            id="star-of-two-legs",
+        ),
+        pytest.param(
+            lambda: StarGraph({f"l{j}": 1.0 for j in range(9)}),
+            TrackError,
+            r"a track has 3 to 8 legs, got 9",
+            id="star-of-nine-legs",
+        ),
+        pytest.param(
+            lambda: StarGraph(LEGS4, angles_deg={"N": 90, "W": 270, "S": 180, "E": 0}),
+            TrackError,
+            r"not distinct and counterclockwise in the order of the legs \['N', 'W', 'S', 'E'\]",
+            id="clockwise-angles-legs4",
+        ),
+        pytest.param(
+            lambda: StarGraph(LEGS4, angles_deg={"N": 90, "W": 180, "S": 180, "E": 0}),
+            TrackError,
+            r"not distinct and counterclockwise",
+            id="repeated-angle-legs4",
+        ),
+        pytest.param(
+            lambda: StarGraph(LEGS4, angles_deg={"N": 90, "W": 180, "S": 270}),
+            TrackError,
+            r"angles_deg must give exactly the legs \['N', 'W', 'S', 'E'\]",
+            id="missing-angle-legs4",
+        ),
+        pytest.param(
+            lambda: YGraph(LEGS4), TrackError, r"a Y-track has exactly 3 legs, got 4", id="y-with-four-legs"
+        ),
+        pytest.param(
+            lambda: plan(StarGraph(LEGS4), CROSSING_START, CROSSING_START.swapped(), min_separation=2.5),
+            SeparationError,
+            r"between 0 m and the shortest leg 2\.0 m, got 2\.5 m: legs 'S' \(2\.0 m\) would be too short "
+            r"to serve as sidings",
+            id="separation-beyond-one-leg-legs4",
+        ),
+        pytest.param(
+            lambda: plan(StarGraph(LEGS4), CROSSING_START, CROSSING_START.swapped(), min_separation=3.5),
+            SeparationError,
+            r"legs 'S' \(2\.0 m\), 'E' \(3\.0 m\) would be too short",
+            id="separation-beyond-two-legs-legs4",
+        ),
+        pytest.param(
+            lambda: plan(StarGraph(LEGS4), CROSSING_START, CROSSING_START.swapped(), min_separation=-0.5),
+            SeparationError,
+            r"between 0 m and the shortest leg 2\.0 m, got -0\.5 m$",
+            id="negative-separation-legs4",
         ),
     ],
 )

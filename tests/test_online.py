@@ -22,7 +22,7 @@ from tests.conftest import REPO
 from tests.support.helpers import execution_plan
 from topology import JUNCTION_INDEX, Configuration, Position, StarGraph, YGraph
 from topology.indexed import separation as indexed_separation
-from trajgen import certify, default_scenario, load_scenario, make_schedule
+from trajgen import builtin_scenario, certify, default_scenario, load_scenario, make_schedule
 from trajgen.errors import InputError, UnverifiedScheduleError
 from trajgen.execution import BrakingCheck, Executor, Mode, PathState, VehicleState
 from trajgen.execution.braking_check import emergency_position
@@ -694,6 +694,19 @@ def test_bad_input_to_the_executor(swap, call, match):
     executor = Executor(swap[1], min_separation=1.5)
     with pytest.raises(InputError, match=match):
         call(executor)
+
+
+def test_the_executor_on_a_crossing_checks_legs_by_count():
+    scenario = builtin_scenario("crossing")
+    verified = certify(make_schedule(scenario.route(), scenario.limits, method="exact"))
+    executor = Executor(verified)
+    with pytest.raises(
+        InputError,
+        match=r"measured leg must be a leg index 0 to 3 of the 4 legs or -1 \(the junction\), got 4",
+    ):
+        executor.step(VehicleState(4, 1.0), VehicleState(2, 10.0))
+    command = executor.step(VehicleState(0, 10.0), VehicleState(2, 10.0))  # leg 3 (E) is known: no error
+    assert len(command.setpoints) == 2
 
 
 @pytest.mark.parametrize(

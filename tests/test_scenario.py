@@ -1,28 +1,68 @@
-"""Scenario TOML files: the shipped swap, and every bad-file case."""
+"""Scenarios: the shipped swap and crossing, random scenarios of 3 to 8 legs, and every bad-file case."""
 
 from __future__ import annotations
 
+import random
+from importlib import resources
+
 import pytest
 
+from limits import Limits
 from tests.conftest import REPO
-from topology import Position
-from trajgen.errors import ScenarioError
+from tests.support.helpers import AGV, legs_id
+from tests.support.star_scenarios import STAR_SCENARIOS
+from topology import Position, StarGraph
+from trajgen import BuiltinScenario, builtin_scenario, make_schedule, parse_scenario, verify
+from trajgen.errors import InputError, ScenarioError
 from trajgen.scenario import default_scenario, load_scenario
+from trajgen.scenario.sampling import online_campaign, random_scenarios, random_track
 
 SWAP_FILE = REPO / "examples" / "swap.toml"
 GOOD = SWAP_FILE.read_text()
 
+#: The built-in scenarios by number of legs: the swap on a Y (the default) and the 4-way crossing.
+BUILT_IN = {3: BuiltinScenario.SWAP, 4: BuiltinScenario.CROSSING}
 
-def test_example_file_is_the_built_in_default():
-    assert (REPO / "trajgen" / "data" / "swap.toml").read_text() == GOOD
-    shipped = default_scenario()
-    from_file = load_scenario(SWAP_FILE)
+
+@pytest.mark.parametrize("legs", sorted(BUILT_IN), ids=legs_id)
+def test_example_file_is_the_built_in_scenario_and_ships_as_package_data(legs):
+    name = BUILT_IN[legs]
+    example = REPO / "examples" / f"{name.value}.toml"
+    packaged = resources.files("trajgen").joinpath("data", f"{name.value}.toml")
+    assert packaged.is_file()
+    assert (REPO / "trajgen" / "data" / f"{name.value}.toml").read_text() == example.read_text()
+    shipped = builtin_scenario(name)
+    assert shipped.track.leg_count == legs
+    if legs == 3:
+        assert example == SWAP_FILE
+        default = default_scenario()  # the default
+        assert (default.track, default.limits, default.start, default.goal) == (
+            shipped.track,
+            shipped.limits,
+            shipped.start,
+            shipped.goal,
+        )
+    else:
+        assert shipped.track.legs == {"N": 10.0, "W": 10.0, "S": 10.0, "E": 10.0}
+        assert shipped.track.angles_deg == (90.0, 180.0, 270.0, 0.0)
+        assert shipped.limits == Limits((AGV, AGV), 1.5)
+        assert (str(shipped.start), str(shipped.goal)) == ("(N:10, S:10)", "(S:10, N:10)")
+    from_file = load_scenario(example)
     assert (shipped.track, shipped.limits, shipped.start, shipped.goal) == (
         from_file.track,
         from_file.limits,
         from_file.start,
         from_file.goal,
     )
+    pyproject = (REPO / "pyproject.toml").read_text(encoding="utf-8")
+    assert 'trajgen = ["data/*.toml"]' in pyproject  # setuptools package-data: every packaged scenario
+
+
+def test_builtin_scenario_refuses_an_unknown_name():
+    with pytest.raises(
+        InputError, match=r"built-in scenario 'ring' is unknown: expected one of \['swap', 'crossing'\]"
+    ):
+        builtin_scenario("ring")
 
 
 def test_swap_scenario_contents():
@@ -195,3 +235,60 @@ def test_exactly_two_vehicles(tmp_path):
 def test_missing_file_is_a_scenario_error(tmp_path):
     with pytest.raises(ScenarioError, match="cannot read the scenario file"):
         load_scenario(tmp_path / "absent.toml")
+
+
+# -- junctions of 4 to 8 legs: the scenario refuses what a junction cannot be --------------------------------
+
+
+def test_the_scenario_refuses_nine_legs():
+    data = STAR_SCENARIOS[8]
+    legs = {**data["track"]["legs"], "I": 10.0}
+    bad = {**data, "track": {"legs": legs}}
+    with pytest.raises(
+        ScenarioError, match=r"<nine>: \[track\]: a track has 3 to 8 legs, got 9: \['A', .*'I'\]"
+    ):
+        parse_scenario(bad, source="<nine>")
+
+
+@pytest.mark.parametrize(
+    ("short", "named"),
+    [({"W": 1.0}, r"\['W'\]"), ({"W": 1.0, "E": 1.2}, r"\['W', 'E'\]")],
+    ids=["one-short-leg", "two-short-legs"],
+)
+def test_the_scenario_refuses_a_separation_longer_than_legs_naming_them(short, named):
+    data = STAR_SCENARIOS[4]
+    bad = {**data, "track": {"legs": {**data["track"]["legs"], **short}}}
+    with pytest.raises(
+        ScenarioError,
+        match=rf"min_separation 1.5 m exceeds the shortest leg 1.0 m: legs {named} could not serve",
+    ):
+        parse_scenario(bad, source="<short legs>")
+
+
+# -- random scenarios of 3 to 8 legs -------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("k", [4, 6, 8], ids=legs_id)
+def test_random_scenarios_on_k_legs_plan_and_verify(k):
+    scenarios = online_campaign(3, seed=13, leg_count=k)
+    assert all(s.track.leg_count == k and s.track.names == tuple("ABCDEFGH"[:k]) for s in scenarios)
+    assert [s.source for s in scenarios] == [f"<online k={k} 13:{n}>" for n in range(3)]
+    track = scenarios[0].track
+    for scenario in [*scenarios, *random_scenarios(3, seed=2, track=track, limits=scenarios[0].limits)]:
+        schedule = make_schedule(scenario.route(), scenario.limits, method="exact")
+        assert verify(schedule).passed
+
+
+@pytest.mark.parametrize("count", [2, 9, True], ids=["two", "nine", "bool"])
+def test_random_track_refuses_a_leg_count_out_of_range(count):
+    with pytest.raises(
+        InputError, match=rf"leg_count \(number of legs\) must be an integer from 3 to 8, got {count!r}"
+    ):
+        random_track(random.Random(0), leg_count=count)
+
+
+def test_random_three_leg_tracks_are_ygraphs_as_before():
+    track = random_track(random.Random(3))
+    assert track.names == ("A", "B", "C")
+    assert track.cycle is not None
+    assert isinstance(random_track(random.Random(3), leg_count=5), StarGraph)

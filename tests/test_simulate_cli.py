@@ -1,4 +1,7 @@
-"""``trajgen simulate``: fault specs refused before anything runs, the trace, the plot and the exit status."""
+"""``trajgen simulate``: fault specs refused before anything runs, the trace, the plot and the exit status.
+
+On the demo swap, and under faults on the built-in 4-way crossing.
+"""
 
 from __future__ import annotations
 
@@ -13,6 +16,8 @@ import pytest
 
 import trajgen.simulation_pipeline
 from tests.conftest import REPO
+from tests.support.star_scenarios import CROSSING, read_csv
+from topology import JUNCTION_INDEX
 from trajgen.cli import EXIT_BAD_INPUT, EXIT_FAILURE, EXIT_OK, main
 from trajgen.errors import InputError
 from trajgen.execution.faults import FaultError
@@ -384,3 +389,45 @@ def test_run_simulation_returns_a_named_result_with_its_files(tmp_path):
     assert run.files == (tmp_path / "agv1.csv", tmp_path / "agv2.csv")
     assert run.summary()["files"] == [str(tmp_path / "agv1.csv"), str(tmp_path / "agv2.csv")]
     assert run.summary()["makespan_s"] == round(run.result.makespan_s, 6)
+
+
+# -- faults on a 4-way crossing ------------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize(
+    ("method", "faults"),
+    [
+        ("optimal", ["stop:agv2@6+4"]),
+        ("optimal", ["stop:agv1@10+5"]),
+        ("exact", ["stop:agv2@20+10", "goal:agv1@30=W:10"]),
+    ],
+    ids=["optimal-stop-agv2", "optimal-stop-agv1", "exact-stop-and-new-goal-on-W"],
+)
+def test_simulate_under_faults_on_a_crossing_keeps_the_separation(tmp_path, capsys, method, faults):
+    argv = ["simulate", str(CROSSING), "--method", method, "--trace", str(tmp_path), "--json"]
+    for fault in faults:
+        argv += ["--fault", fault]
+    assert main(argv) == EXIT_OK
+    summary = json.loads(capsys.readouterr().out)
+    assert summary["reached_goal"] is True
+    assert summary["violations"] == 0
+    assert summary["min_separation_m"] >= 1.5
+    assert summary["certified_separation_m"] >= 1.5
+    # the plan's order is kept: only a new goal re-plans, a stop never does
+    new_goals = sum(f.startswith("goal:") for f in faults)
+    assert summary["replans"] == new_goals
+    # the executed motion, traced: legs 1-based up to 4, never closer than the separation
+    traces = [read_csv(tmp_path / f"{name}.csv") for name in ("agv1", "agv2")]
+    for columns in traces:
+        assert set(columns["leg"].astype(int).tolist()) <= {0, 1, 2, 3, 4}
+    legs = [c["leg"].astype(int) - 1 for c in traces]
+    same = (legs[0] == legs[1]) & (legs[0] != JUNCTION_INDEX)
+    gap = np.where(same, np.abs(traces[0]["s_m"] - traces[1]["s_m"]), traces[0]["s_m"] + traces[1]["s_m"])
+    assert gap.min() >= 1.5
+    if any(f.startswith("goal:") for f in faults):
+        assert traces[0]["leg"][-1] == 2  # W:10
+        assert traces[0]["s_m"][-1] == pytest.approx(10.0, abs=1e-3)
+        replan = next(
+            e["detail"] for e in summary["events"] if "new goal" in e["detail"] and e["kind"] == "replan"
+        )
+        assert "route on G_4" in replan

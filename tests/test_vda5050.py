@@ -1,5 +1,7 @@
 """VDA 5050 orders: valid and accepted messages, paths on the route, safe releases, factsheet limits, CLI.
 
+On Y tracks, and through the command on junctions of 4 to 8 legs (nodes placed by the leg angles).
+
 The messages are checked against references of the ``vda5050-sdk`` package
 (:mod:`tests.support.vda5050_reference`): the official schemas, the sdk's pydantic models, and its
 order acceptance (VDA 5050 figure 8).
@@ -22,6 +24,7 @@ from pydantic import ValidationError
 from vda5050.domain.order import AcceptanceDecision
 
 from tests.conftest import REPO
+from tests.support.star_scenarios import CROSSING, STAR_SCENARIOS, toml_text
 from tests.support.vda5050_reference import SimulatedVehicle, parse_order, schema_errors
 from topology import JUNCTION_INDEX, Homotopy
 from trajgen import Exact, Optimal, Toppra, certify, make_schedule, parse_scenario, run
@@ -225,14 +228,19 @@ def test_the_sdk_model_check_is_not_vacuous(mutate, error, match):
         parse_order(mutate(document))
 
 
-def start_point(name: str, vehicle: str) -> tuple[float, float]:
-    """Where ``vehicle`` of case ``name`` stands before its first order (m), from the scenario."""
-    scenario = case(name)[0]
-    position = scenario.start[scenario.names.index(vehicle)]
+def start_xy(scenario, vehicle: int) -> tuple[float, float]:
+    """Where vehicle ``vehicle`` (0 or 1) stands before its first order (m), from the leg angles."""
+    position = scenario.start[vehicle]
     if position.leg is None:
         return 0.0, 0.0
     angle = math.radians(scenario.track.angles_deg[scenario.track.index(position.leg)])
     return position.s * math.cos(angle), position.s * math.sin(angle)
+
+
+def start_point(name: str, vehicle: str) -> tuple[float, float]:
+    """Where ``vehicle`` of case ``name`` stands before its first order (m), from the scenario."""
+    scenario = case(name)[0]
+    return start_xy(scenario, scenario.names.index(vehicle))
 
 
 def decisions(name: str, vehicle: str, messages: list[dict]) -> list[AcceptanceDecision]:
@@ -1036,6 +1044,74 @@ def test_an_internal_failure_exits_1_and_writes_nothing(tmp_path, capsys, monkey
     assert main(["export-vda5050", str(SWAP), "--out", str(out), "--method", "exact"]) == EXIT_FAILURE
     assert "internal failure: RuntimeError: renderer broke" in capsys.readouterr().err
     assert not out.exists()
+
+
+# ---- the command on junctions of 4 to 8 legs ---------------------------------------------------------------
+
+#: export-vda5050's default --map-id (docs/formats/vda5050.md): the map the vehicles have
+DEFAULT_MAP_ID = "trajgen"
+
+
+def assert_each_vehicle_accepts_its_orders(scenario, folder) -> None:
+    """The sdk's acceptance takes each vehicle's first order as new and each update as stitched."""
+    for vehicle, name in enumerate(scenario.names):
+        paths = sorted((folder / name).glob("order-*.json"))
+        messages = [json.loads(path.read_text(encoding="utf-8")) for path in paths]
+        receiver = SimulatedVehicle(messages[0], *start_xy(scenario, vehicle), map_id=DEFAULT_MAP_ID)
+        got = [receiver.receive(message).decision for message in messages]
+        expected = [AcceptanceDecision.ACCEPT_NEW] + [AcceptanceDecision.ACCEPT_UPDATE] * (len(paths) - 1)
+        assert got == expected, name
+
+
+def test_export_vda5050_on_k_legs_validates_and_places_nodes_by_angle(tmp_path, capsys):
+    data = STAR_SCENARIOS[5]
+    path = tmp_path / "five.toml"
+    path.write_text(toml_text(data), encoding="utf-8")
+    scenario = load_scenario(path)
+    out = tmp_path / "vda"
+    argv = ["export-vda5050", str(path), "--out", str(out), "--method", "exact"]
+    assert main([*argv, "--start-time", "2025-05-01T08:00:00Z"]) == EXIT_OK
+    capsys.readouterr()
+    orders = sorted(out.glob("*/order-*.json"))
+    assert {p.parent.name for p in orders} == set(scenario.names)
+    legs_seen = set()
+    for order_path in orders:
+        order = json.loads(order_path.read_text(encoding="utf-8"))
+        assert schema_errors(order) == []
+        parse_order(order)
+        for node in order["nodes"]:
+            position = node["nodePosition"]
+            if node["nodeId"] == "O":
+                assert (position["x"], position["y"]) == (0.0, 0.0)
+                continue
+            leg, s = node["nodeId"].split(":")
+            legs_seen.add(leg)
+            angle = math.radians(scenario.track.angles_deg[scenario.track.index(leg)])
+            assert position["x"] == pytest.approx(float(s) * math.cos(angle), abs=1e-6)
+            assert position["y"] == pytest.approx(float(s) * math.sin(angle), abs=1e-6)
+            assert 0.0 < float(s) <= scenario.track.length(leg)
+        for edge in order["edges"]:
+            if "direction" in edge:
+                assert edge["direction"] in scenario.track.names
+    assert {"A", "D"} <= legs_seen <= set(scenario.track.names)
+    assert_each_vehicle_accepts_its_orders(scenario, out)
+    manifest = json.loads((out / "manifest.json").read_text(encoding="utf-8"))
+    assert manifest  # written with the orders
+
+
+def test_export_vda5050_on_a_crossing_with_optimal(tmp_path, capsys):
+    out = tmp_path / "vda"
+    argv = ["export-vda5050", str(CROSSING), "--out", str(out), "--start-time", "2025-05-01T08:00:00Z"]
+    assert main(argv) == EXIT_OK
+    capsys.readouterr()
+    orders = sorted(out.glob("*/order-*.json"))
+    assert len(orders) >= 4  # each vehicle's first order and at least one update each
+    for order_path in orders:
+        order = json.loads(order_path.read_text(encoding="utf-8"))
+        assert schema_errors(order) == []
+        parse_order(order)
+        assert {n["nodeId"].split(":")[0] for n in order["nodes"]} <= {"O", "N", "W", "S", "E"}
+    assert_each_vehicle_accepts_its_orders(load_scenario(CROSSING), out)
 
 
 def test_schedules_of_every_method_can_be_certified_and_exported():

@@ -16,6 +16,11 @@ LIMITS = Limits(vehicles=(AGV, AGV), min_separation=1.5)
 MIXED = Limits(vehicles=(AGV, SLOW), min_separation=1.5)
 
 
+def legs_id(legs: int) -> str:
+    """The id of a test case on a junction of ``legs`` legs: ``legs3`` (a Y), ``legs4`` ... ``legs8``."""
+    return f"legs{legs}"
+
+
 def conf(first: str, second: str) -> Configuration:
     return Configuration(Position.parse(first), Position.parse(second))
 
