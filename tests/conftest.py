@@ -54,6 +54,7 @@ SLOW_FILES = {
     "test_commit_processes.py",
 }
 SLOW_TESTS = {
+    "test_graph_planner.py::test_the_planner_equals_a_grid_oracle_on_random_trees_and_graphs_with_loops",
     "test_online.py::test_campaign_scenarios_that_failed_reach_their_goals_safely",
     "test_online.py::test_a_new_goal_mid_run_is_reached_with_no_violation",
     "test_online.py::test_a_lagging_drive_never_moves_a_frontier_back",
