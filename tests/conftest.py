@@ -3,16 +3,10 @@
 from __future__ import annotations
 
 import os
-import sys
 from pathlib import Path
 
-# The test run caches bytecode, also where none is written by default (PYTHONDONTWRITEBYTECODE):
-# pytest's rewrite of hypothesis (a pytest plugin's modules, 2 s) is then done once, here, before the
-# workers start, and they read it; the packages are compiled once for every process (pytest_configure).
-sys.dont_write_bytecode = False
-
-import pytest  # noqa: E402
-from hypothesis import HealthCheck, settings  # noqa: E402  (with the bytecode cached)
+import pytest
+from hypothesis import HealthCheck, settings
 
 # "seeded" (the default): what CI runs. "thorough": twenty times the examples, for a release or a
 # change to the planner (HYPOTHESIS_PROFILE=thorough); tests that set max_examples keep theirs.
@@ -121,12 +115,7 @@ SLOW_LEGS = {
 
 
 def pytest_configure(config) -> None:
-    """Compile the packages once, and give the run its own store of compiled NLPs.
-
-    Runs in the process that starts the others, before they import the packages. The
-    pytest-xdist workers, and the command-line, example and documentation runs the tests start,
-    all import the packages of this checkout; where no bytecode is written
-    (``PYTHONDONTWRITEBYTECODE``), each would compile them again (0.5 s a process).
+    """Give the run its own store of compiled NLPs (in the process that starts the others).
 
     The optimal method keeps the NLPs it builds in a disk store (``$TRAJGEN_CACHE_DIR``, else the
     user's cache folder). The run points it at a new temporary folder, which every worker and
@@ -135,11 +124,8 @@ def pytest_configure(config) -> None:
     """
     if hasattr(config, "workerinput"):
         return
-    import compileall
     import tempfile
 
-    for package in ("trajgen", "topology", "limits"):
-        compileall.compile_dir(REPO / package, quiet=1)
     store = tempfile.TemporaryDirectory(prefix="trajgen-test-nlp-")
     config._trajgen_store = store  # kept alive until pytest_unconfigure
     os.environ["TRAJGEN_CACHE_DIR"] = store.name
