@@ -4,10 +4,14 @@ from __future__ import annotations
 
 import argparse
 import json
+import os
+from pathlib import Path
 
 from topology import GraphRoute
 from trajgen.cli.options import add_csv_options, add_method, csv_options, method_from, scenario_from
 from trajgen.cli.parser import EXIT_OK
+from trajgen.errors import OutputError
+from trajgen.export.atomic import check_output_paths, commit_files
 from trajgen.model.summary import (
     format_graph_route,
     format_route,
@@ -22,14 +26,37 @@ __all__ = ["register"]
 
 
 def _command_plan(args: argparse.Namespace) -> int:
+    picture = None
+    if args.plot is not None:
+        picture = Path(args.plot)
+        if picture.suffix.lower() != ".png" or args.plot.endswith(("/", os.sep)):
+            raise OutputError(
+                f"--plot {args.plot!r} does not name a .png file: expected a file name ending in .png"
+            )
+        check_output_paths([picture])  # before planning: a bad path is refused at once
     scenario = scenario_from(args.scenario, graph=True)
     route = scenario.route()
+    if picture is not None:
+        commit_files({picture: _route_picture(route, scenario.names)})
     if isinstance(route, GraphRoute):
         summary, text = graph_route_summary(route, scenario.names), format_graph_route(route, scenario.names)
     else:
         summary, text = route_summary(route), format_route(route)
     print(json.dumps(summary, indent=2) if args.json else text)
     return EXIT_OK
+
+
+def _route_picture(route, names) -> bytes:
+    """The PNG of a route: the track graph from above with the moves, or a junction's configurations."""
+    from trajgen.plots import png_bytes  # matplotlib only when a picture is asked for
+
+    if isinstance(route, GraphRoute):
+        from trajgen.plots.graph_route import plot_graph_route
+
+        return png_bytes(plot_graph_route(route, names=names))
+    from trajgen.plots import plot_configuration
+
+    return png_bytes(plot_configuration(route, names=names))
 
 
 def _command_schedule(args: argparse.Namespace) -> int:
@@ -113,6 +140,12 @@ def register(commands) -> None:
     plan_parser = commands.add_parser("plan")
     plan_parser.add_argument("scenario", help="scenario TOML file")
     plan_parser.add_argument("--json", action="store_true", help="print a machine-readable summary")
+    plan_parser.add_argument(
+        "--plot",
+        metavar="FILE.png",
+        help="draw the route into FILE.png: a track graph from above with the numbered moves, or "
+        "a junction's configuration space with the route",
+    )
     plan_parser.set_defaults(run=_command_plan)
 
     schedule = commands.add_parser(

@@ -1,4 +1,4 @@
-"""Plots of verified schedules and runs: each draws into an ``ax`` or ``figure`` and returns the Figure.
+"""Plots of schedules, runs and routes: each draws into an ``ax`` or ``figure`` and returns the Figure.
 
 Nothing here writes files: the pipeline and the command line turn Figures into PNG bytes
 (:func:`png_bytes`) and an :class:`Animation` into a GIF (:func:`encode_gif`). A notebook
@@ -26,6 +26,7 @@ if TYPE_CHECKING:
     )
     from trajgen.plots.figure import png_bytes
     from trajgen.plots.gif import encode_gif, gif_bytes
+    from trajgen.plots.graph_route import plot_graph_route
     from trajgen.plots.live_run import plot_live_run
     from trajgen.plots.separation import plot_separation
     from trajgen.plots.simulation import plot_simulation
@@ -39,6 +40,7 @@ __all__ = [
     "gif_bytes",
     "plot_configuration",
     "plot_coordination",
+    "plot_graph_route",
     "plot_live_run",
     "plot_separation",
     "plot_simulation",
@@ -61,6 +63,7 @@ _SOURCES = {
     "gif_bytes": "trajgen.plots.gif",
     "plot_configuration": "trajgen.plots.configuration",
     "plot_coordination": "trajgen.plots.coordination",
+    "plot_graph_route": "trajgen.plots.graph_route",
     "plot_live_run": "trajgen.plots.live_run",
     "plot_separation": "trajgen.plots.separation",
     "plot_simulation": "trajgen.plots.simulation",
