@@ -42,6 +42,8 @@ FIGURES = {
     "10_four_way_crossing": (r"head-on optimal / exact = ([0-9.]+)", 0.4076, 0.0005),
     # released node by node (a node every metre): at closest, one stands at a node 1.61 m from the other
     "11_live_over_mqtt": (r"closest approach on the true positions: ([0-9.]+) m", 1.610, 0.002),
+    # head-on on a line with a passing loop: agv2 takes the loop (11.5 m against the main's 10 m)
+    "12_plan_a_track_graph": (r"agv2 drives ([0-9.]+) m", 30.5, 1e-9),
 }
 
 
