@@ -7,9 +7,11 @@ forms; each bad track is refused with a message naming the culprit.
 
 from __future__ import annotations
 
+import dataclasses
 import itertools
 import math
 import random
+import re
 
 import pytest
 
@@ -17,6 +19,7 @@ from tests.support.grid_oracle import GRID, GridTrack, random_case, shortest_rou
 from topology import (
     Configuration,
     EdgePoint,
+    GraphMove,
     InfeasibleError,
     Position,
     PositionError,
@@ -27,6 +30,7 @@ from topology import (
     plan,
     plan_graph,
 )
+from trajgen.verification.graph_route import verify_graph_route
 
 #: Seeded random cases per kind (the issue asks for at least 500 of each), in chunks run in parallel.
 CASES = 500
@@ -55,6 +59,9 @@ def _compare(loops: bool, count: int, first_seed: int) -> tuple[int, int]:
         route = plan_graph(track, start, goal, min_separation=separation)
         assert route.length == pytest.approx(expected, abs=1e-9), (seed, edges, start, goal, separation)
         _check_moves(route, grid, edges)
+        report = verify_graph_route(route)
+        assert report.passed, report.failures
+        assert report.closest >= separation - 1e-9
         feasible += 1
     return feasible, infeasible
 
@@ -243,3 +250,68 @@ def test_bad_positions_are_refused(start, error, match):
     track = TrackGraph.from_edges({"a": ("J", "A", 6.0), "b": ("J", "B", 6.0), "c": ("J", "C", 6.0)})
     with pytest.raises(error, match=match):
         plan_graph(track, start, ("A", "B"), min_separation=1.5)
+
+
+def _swap_route():
+    track = TrackGraph.from_edges({"a": ("J", "A", 6.0), "b": ("J", "B", 6.0), "c": ("J", "C", 6.0)})
+    return plan_graph(track, ("A", "B"), ("B", "A"), min_separation=1.5)
+
+
+def test_the_verifier_passes_the_planners_route_with_its_closest_approach():
+    report = verify_graph_route(_swap_route())
+    assert report.passed, report.failures
+    assert report.closest == pytest.approx(1.5)  # the waiting vehicle stands exactly 1.5 m into c
+
+
+@pytest.mark.parametrize(
+    ("tamper", "match"),
+    [
+        (
+            lambda r: dataclasses.replace(r, min_separation=3.0),
+            r"come 1.5 m apart: expected at least the minimum separation 3 m",
+        ),
+        (
+            lambda r: dataclasses.replace(r, moves=r.moves[::-1]),
+            r"move 1 \(c:1.5 -> B\): starts at c:1.5, but the vehicle is at A",
+        ),
+        (
+            lambda r: dataclasses.replace(r, moves=r.moves[:2]),
+            r"vehicle 1 ends at c:1.5: expected its goal B",
+        ),
+        (
+            lambda r: dataclasses.replace(r, travel=(15.0, 11.0)),
+            r"vehicle 2 travels 12.0 m by its moves: the route says 11.0 m",
+        ),
+        (
+            lambda r: dataclasses.replace(
+                r, moves=(dataclasses.replace(r.moves[0], standing=r.track.point("c:1")), *r.moves[1:])
+            ),
+            r"the other vehicle is said to stand at c:1, but it is at B",
+        ),
+        (
+            lambda r: dataclasses.replace(
+                r, moves=(dataclasses.replace(r.moves[0], length=math.nan), *r.moves[1:])
+            ),
+            r"move 1 \(A -> c:1.5\): a number is not finite",
+        ),
+    ],
+    ids=["separation", "order", "short", "travel", "standing", "nan"],
+)
+def test_the_verifier_refuses_a_route_that_is_not_what_its_moves_do(tamper, match):
+    report = verify_graph_route(tamper(_swap_route()))
+    assert not report.passed
+    assert any(re.search(match, failure) for failure in report.failures), report.failures
+
+
+def test_a_move_through_the_standing_vehicle_is_caught_between_the_points():
+    """Both ends of the move are far from the standing vehicle; it passes through it in between."""
+    track = TrackGraph.from_edges({"line": ("W", "E", 20.0)})
+    route = plan_graph(track, ("line:2", "line:10"), ("line:2", "line:10"), min_separation=1.5)
+    moved = GraphMove(0, (track.point("line:2"), track.point("line:18")), (0,), 16.0, track.point("line:10"))
+    forged = dataclasses.replace(
+        route, moves=(moved,), goal=(track.point("line:18"), route.goal[1]), travel=(16.0, 0.0)
+    )
+    report = verify_graph_route(forged)
+    assert not report.passed
+    assert report.closest == 0.0
+    assert "along 'line' the vehicles come 0 m apart" in report.failures[0]

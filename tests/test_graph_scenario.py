@@ -61,6 +61,8 @@ def test_each_example_plans_the_grid_oracles_shortest_route(name, capsys):
     summary = json.loads(capsys.readouterr().out)
     assert len(summary["travel_m"]) == 2
     assert summary["length_m"] == pytest.approx(sum(summary["travel_m"]))
+    assert summary["verified"] is True
+    assert summary["closest_approach_m"] >= scenario.limits.min_separation - 1e-9
     assert {move["vehicle"] for move in summary["moves"]} <= set(scenario.names)
     edges = {edge.name: (edge.start, edge.end, edge.length) for edge in scenario.track.edges}
     grid = GridTrack(edges)
@@ -71,6 +73,7 @@ def test_each_example_plans_the_grid_oracles_shortest_route(name, capsys):
     text = capsys.readouterr().out
     assert f"travel: {scenario.names[0]} {summary['travel_m'][0]:g} m" in text
     assert text.count(" -> ") == len(summary["moves"])
+    assert f"verified: every move keeps {scenario.limits.min_separation:g} m" in text
 
 
 def _grid_point(track: TrackGraph, grid: GridTrack, point) -> int:

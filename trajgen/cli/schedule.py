@@ -10,7 +10,7 @@ from pathlib import Path
 from topology import GraphRoute
 from trajgen.cli.options import add_csv_options, add_method, csv_options, method_from, scenario_from
 from trajgen.cli.parser import EXIT_OK
-from trajgen.errors import OutputError
+from trajgen.errors import OutputError, VerificationError
 from trajgen.export.atomic import check_output_paths, commit_files
 from trajgen.model.summary import (
     format_graph_route,
@@ -21,6 +21,7 @@ from trajgen.model.summary import (
 )
 from trajgen.pipeline import Outputs, run
 from trajgen.scenario import BuiltinScenario, builtin_scenario
+from trajgen.verification.graph_route import verify_graph_route
 
 __all__ = ["register"]
 
@@ -36,12 +37,20 @@ def _command_plan(args: argparse.Namespace) -> int:
         check_output_paths([picture])  # before planning: a bad path is refused at once
     scenario = scenario_from(args.scenario, graph=True)
     route = scenario.route()
-    if picture is not None:
-        commit_files({picture: _route_picture(route, scenario.names)})
     if isinstance(route, GraphRoute):
-        summary, text = graph_route_summary(route, scenario.names), format_graph_route(route, scenario.names)
+        report = verify_graph_route(route)
+        if not report.passed:  # neither printed nor drawn: the planner's route failed the verifier
+            raise VerificationError(f"the planner's route fails the verifier: {'; '.join(report.failures)}")
+        summary = graph_route_summary(route, scenario.names)
+        summary |= {"verified": True, "closest_approach_m": report.closest}
+        text = format_graph_route(route, scenario.names) + (
+            f"\nverified: every move keeps {route.min_separation:g} m; "
+            f"closest approach {report.closest:.4f} m"
+        )
     else:
         summary, text = route_summary(route), format_route(route)
+    if picture is not None:
+        commit_files({picture: _route_picture(route, scenario.names)})
     print(json.dumps(summary, indent=2) if args.json else text)
     return EXIT_OK
 

@@ -1,0 +1,196 @@
+"""The verifier's check of a route on a track graph: every move keeps the separation, in closed form.
+
+Independent of the planner's code: the node-to-node track distances come from this module's own
+Dijkstra over the track's edges, and the distance from a standing vehicle to a moving one is taken
+per edge the mover runs along. Along an edge, the track distance from a fixed point ``q`` is the
+minimum of two affine functions of the position (through either end of the edge), and, on ``q``'s
+own edge, of ``|s - s_q|``; so its minimum over a stretch is at the stretch's ends, or 0 where the
+stretch passes ``q``. Nothing is sampled.
+
+Also checked: each vehicle starts and ends where the route says, each move starts where its vehicle
+is, the standing vehicle is where the other one is, the travel adds up, every number is finite.
+"""
+
+from __future__ import annotations
+
+import heapq
+import itertools
+import math
+from dataclasses import dataclass
+
+from topology import EdgePoint, GraphRoute, TrackGraph
+from trajgen.errors import InputError
+
+__all__ = ["GraphRouteReport", "verify_graph_route"]
+
+#: Metres of round-off allowed: below the separation, off a point, in the travel's sum.
+ROUTE_TOLERANCE = 1e-9
+
+
+@dataclass(frozen=True, slots=True)
+class GraphRouteReport:
+    """What the verifier found on a route on a track graph.
+
+    Attributes
+    ----------
+    passed : bool
+    closest : float
+        The least track distance between the vehicles over the whole route, metres.
+    closest_move : int or None
+        The move (0-based) where it is least; ``None`` for a route without moves.
+    failures : tuple of str
+        Each failed check, naming the move and the quantity.
+    """
+
+    passed: bool
+    closest: float
+    closest_move: int | None
+    failures: tuple[str, ...]
+
+
+def _node_distances(track: TrackGraph) -> list[list[float]]:
+    """Shortest track distance between every two nodes: a Dijkstra from each node over the edges."""
+    index = {name: number for number, name in enumerate(track.nodes)}
+    links: list[list[tuple[int, float]]] = [[] for _ in track.nodes]
+    for edge in track.edges:
+        a, b = index[edge.start], index[edge.end]
+        links[a].append((b, float(edge.length)))
+        links[b].append((a, float(edge.length)))
+    table = []
+    for origin in range(len(track.nodes)):
+        best = [math.inf] * len(track.nodes)
+        best[origin] = 0.0
+        heap = [(0.0, origin)]
+        while heap:
+            here_distance, here = heapq.heappop(heap)
+            if here_distance > best[here]:
+                continue
+            for there, length in links[here]:
+                if here_distance + length < best[there]:
+                    best[there] = here_distance + length
+                    heapq.heappush(heap, (best[there], there))
+        table.append(best)
+    return table
+
+
+class _Distances:
+    """Track distances of the verifier's own, between points ``(edge, s)`` of one track."""
+
+    def __init__(self, track: TrackGraph) -> None:
+        index = {name: number for number, name in enumerate(track.nodes)}
+        self.ends = [(index[e.start], index[e.end]) for e in track.edges]
+        self.lengths = [float(e.length) for e in track.edges]
+        self.nodes = _node_distances(track)
+
+    def to_node(self, edge: int, s: float, node: int) -> float:
+        start, end = self.ends[edge]
+        return min(self.nodes[start][node] + s, self.nodes[end][node] + self.lengths[edge] - s)
+
+    def between(self, a: EdgePoint, b: EdgePoint) -> float:
+        """The track distance between two points."""
+        return self.least_along(a, b.edge, b.s, b.s)
+
+    def least_along(self, fixed: EdgePoint, edge: int, low: float, high: float) -> float:
+        """The least track distance from ``fixed`` to the points of ``edge`` from ``low`` to ``high`` m."""
+        start, end = self.ends[edge]
+        through_start = self.to_node(fixed.edge, fixed.s, start)
+        through_end = self.to_node(fixed.edge, fixed.s, end)
+        rest = self.lengths[edge]
+        least = min(through_start + low, through_end + rest - high)  # each affine: least at an end
+        if fixed.edge == edge:
+            least = min(
+                least, 0.0 if low <= fixed.s <= high else min(abs(fixed.s - low), abs(fixed.s - high))
+            )
+        return least
+
+
+def _on(track: TrackGraph, point: EdgePoint, edge: int) -> float | None:
+    """``point``'s metres along ``edge``, or ``None`` if it is not on that edge."""
+    if point.edge == edge:
+        return point.s
+    node = track.node_at(point)
+    if node is None:
+        return None
+    start, end = track.ends(edge)
+    if node == start:
+        return 0.0
+    if node == end:
+        return track.length(edge)
+    return None
+
+
+def verify_graph_route(route: GraphRoute) -> GraphRouteReport:
+    """Check every move of ``route`` against the separation, and that the moves make the route.
+
+    Raises
+    ------
+    InputError
+        ``route`` is not a GraphRoute.
+    """
+    if not isinstance(route, GraphRoute):
+        raise InputError(f"verify_graph_route takes a GraphRoute, got {type(route).__name__}")
+    track, separation = route.track, route.min_separation
+    distances = _Distances(track)
+    failures: list[str] = []
+    where = list(route.start)
+    travel = [0.0, 0.0]
+    closest, closest_move = distances.between(where[0], where[1]), None
+    for number, move in enumerate(route.moves):
+        label = f"move {number + 1} ({track.name(move.points[0])} -> {track.name(move.points[-1])})"
+        numbers = [move.length, move.standing.s, *(p.s for p in move.points)]
+        if not all(math.isfinite(value) for value in numbers):
+            failures.append(f"{label}: a number is not finite: expected finite metres")
+            break
+        if move.vehicle not in (0, 1) or len(move.edges) != len(move.points) - 1:
+            failures.append(
+                f"{label}: vehicle {move.vehicle!r} or {len(move.edges)} edges for "
+                f"{len(move.points)} points: expected vehicle 0 or 1 and one edge per step"
+            )
+            break
+        if distances.between(where[move.vehicle], move.points[0]) > ROUTE_TOLERANCE:
+            failures.append(
+                f"{label}: starts at {track.name(move.points[0])}, but the vehicle is at "
+                f"{track.name(where[move.vehicle])}"
+            )
+        standing = where[1 - move.vehicle]
+        if distances.between(standing, move.standing) > ROUTE_TOLERANCE:
+            failures.append(
+                f"{label}: the other vehicle is said to stand at {track.name(move.standing)}, but "
+                f"it is at {track.name(standing)}"
+            )
+        length = 0.0
+        for (a, b), edge in zip(itertools.pairwise(move.points), move.edges, strict=True):
+            s_a, s_b = _on(track, a, edge), _on(track, b, edge)
+            if s_a is None or s_b is None:
+                failures.append(
+                    f"{label}: {track.name(a)} -> {track.name(b)} is not along edge "
+                    f"{track.edges[edge].name!r}"
+                )
+                continue
+            length += abs(s_b - s_a)
+            least = distances.least_along(standing, edge, min(s_a, s_b), max(s_a, s_b))
+            if least < closest:
+                closest, closest_move = least, number
+            if least < separation - ROUTE_TOLERANCE:
+                failures.append(
+                    f"{label}: along {track.edges[edge].name!r} the vehicles come {least:.6g} m apart: "
+                    f"expected at least the minimum separation {separation:g} m"
+                )
+        if abs(length - move.length) > ROUTE_TOLERANCE * max(1.0, length):
+            failures.append(f"{label}: its length is {move.length!r} m, its edges add up to {length!r} m")
+        travel[move.vehicle] += length
+        where[move.vehicle] = move.points[-1]
+    for vehicle in (0, 1):
+        if distances.between(where[vehicle], route.goal[vehicle]) > ROUTE_TOLERANCE:
+            failures.append(
+                f"vehicle {vehicle + 1} ends at {track.name(where[vehicle])}: expected its goal "
+                f"{track.name(route.goal[vehicle])}"
+            )
+        if abs(travel[vehicle] - route.travel[vehicle]) > ROUTE_TOLERANCE * max(1.0, travel[vehicle]):
+            failures.append(
+                f"vehicle {vehicle + 1} travels {travel[vehicle]!r} m by its moves: the route "
+                f"says {route.travel[vehicle]!r} m"
+            )
+    if closest < separation - ROUTE_TOLERANCE and closest_move is None:
+        failures.append(f"the vehicles start {closest:.6g} m apart: expected at least {separation:g} m")
+    return GraphRouteReport(not failures, closest, closest_move, tuple(failures))
