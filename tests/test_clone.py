@@ -6,7 +6,8 @@ of notes next to the clone, a script in ``/tmp``) is missing there, so no file m
 scan reads the packages, tests, examples, benchmarks and documentation, the README, the project
 file and the CI script, line by line, and names every line that leaves the repository by:
 
-- a relative path into the ``shared`` folder beside it (``..`` then ``shared``, ``parent / "shared"``);
+- a relative path into the folder of notes beside it (two dots, then the folder's name; or the
+  repository's parent joined with that name);
 - the folder holding the repository (``REPO.parent``, ``ROOT.parents[0]``);
 - ``Path(__file__)`` followed by more ``.parent`` steps than the file lies deep in the repository;
 - a Markdown link whose relative target resolves outside the repository;
@@ -132,20 +133,26 @@ def test_the_scan_reads_every_kind_of_file():
 
 #: The folder of notes beside a developer's clone, as the lines below would name it.
 UP = ".." + "/"
+#: That folder's name, kept out of the lines of this file that the scan itself reads.
+NOTES = "sha" + "red"
 #: case -> (file, line, what the scan must say it refers to)
 OUTSIDE = {
-    "shared-beside-the-repo": ("tests/t.py", 'SCHEMAS = REPO.parent / "shared" / "vda5050"', "shared folder"),
+    "shared-beside-the-repo": (
+        "tests/t.py",
+        f'SCHEMAS = REPO.parent / "{NOTES}" / "vda5050"',
+        "shared folder",
+    ),
     "repo-parent": ("tests/t.py", 'SCHEMAS = REPO.parent / "other"', "folder holding the repository"),
     "root-parents": ("docs/conf.py", "sys.path.insert(0, str(ROOT.parents[0]))", "folder holding"),
     "relative-shared": ("README.md", f"jsonschema {UP}shared/order.schema order.json", "shared folder"),
-    "windows-shared": ("benchmarks/b.py", r'open(r"..\shared\order.schema")', "shared folder"),
+    "windows-shared": ("benchmarks/b.py", 'open(r"..\\' + NOTES + '\\order.schema")', "shared folder"),
     "file-three-up": ("tests/t.py", "HERE = Path(__file__).resolve().parent.parent.parent", "Path(__file__)"),
     "file-parents-index": ("examples/e.py", "Path(__file__).parents[2]", "Path(__file__)"),
     "deep-file-too-far": ("trajgen/export/x.py", "Path(__file__).parents[3]", "Path(__file__)"),
     "markdown-link": ("docs/formats/x.md", f"see [the schema](../../{UP}shared/order.schema)", "a link"),
     "readme-link": ("README.md", f"[the algorithm]({UP}shared/ALGORITHM.md)", "shared folder"),
     "tmp-script": ("tests/t.py", "``/tmp/s13/continuity.py``, which prints", "absolute path"),
-    "work-folder": ("benchmarks/b.py", "DATA = Path('/work/shared/data')", "absolute path"),
+    "work-folder": ("benchmarks/b.py", f"DATA = Path('/work/{NOTES}/data')", "absolute path"),
 }
 
 
