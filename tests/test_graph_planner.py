@@ -18,7 +18,6 @@ import pytest
 from tests.support.grid_oracle import GRID, GridTrack, random_case, shortest_route
 from topology import (
     Configuration,
-    EdgePoint,
     GraphMove,
     InfeasibleError,
     Position,
@@ -76,23 +75,15 @@ def _check_moves(route, grid: GridTrack, edges) -> None:
         assert len(move.edges) == len(move.points) - 1
         for (a, b), edge in zip(itertools.pairwise(move.points), move.edges, strict=True):
             name = track.edges[edge].name
-            s_a, s_b = _along(track, a, edge), _along(track, b, edge)
+            s_a, s_b = track.position_on(a, edge), track.position_on(b, edge)
+            assert s_a is not None
+            assert s_b is not None
             standing = grid.index(track.edges[move.standing.edge].name, move.standing.s)
             for k in range(round(min(s_a, s_b) / GRID), round(max(s_a, s_b) / GRID) + 1):
                 gap = grid.steps[standing, grid.point_of[(name, k)]] * GRID
                 assert gap >= route.min_separation - 1e-9, (move, k)
         position[move.vehicle] = move.points[-1]
     assert tuple(position) == route.goal
-
-
-def _along(track: TrackGraph, point: EdgePoint, edge: int) -> float:
-    """``point``'s metres along ``edge`` (a node is 0 or the edge's length there)."""
-    if point.edge == edge:
-        return point.s
-    node = track.node_at(point)
-    start, end = track.ends(edge)
-    assert node in (start, end)
-    return 0.0 if node == start else track.length(edge)
 
 
 @pytest.mark.parametrize("chunk", range(CHUNKS))

@@ -279,6 +279,18 @@ class TrackGraph:
             return int(end)
         return None
 
+    def position_on(self, point: EdgePoint, edge: int) -> float | None:
+        """``point``'s metres along ``edge`` (a node is 0 or the edge's length there), or ``None``."""
+        if point.edge == edge:
+            return point.s
+        node = self.node_at(point)
+        start, end = self.ends(edge)
+        if node is not None and node == start:
+            return 0.0
+        if node is not None and node == end:
+            return self.length(edge)
+        return None
+
     def point(self, text: str | EdgePoint) -> EdgePoint:
         """The point written ``"EDGE:s"`` (metres from the edge's ``from`` node) or ``"NODE"``.
 

@@ -15,9 +15,9 @@ warnings.warn(
     stacklevel=2,
 )
 
-_SOURCES = {
-    name: "trajgen.execution"
-    for name in (
+#: Every name of trajgen.execution's face, found there when first used.
+_SOURCES = dict.fromkeys(
+    (
         "BrakingCheck",
         "Command",
         "Event",
@@ -29,23 +29,11 @@ _SOURCES = {
         "VehicleState",
         "execution_margin",
         "schedule_for_execution",
-    )
-}
+    ),
+    "trajgen.execution",
+)
 
-__all__ = [
-    "BrakingCheck",
-    "Command",
-    "Event",
-    "Executor",
-    "GoalDecision",
-    "Mode",
-    "PathState",
-    "Setpoint",
-    "VehicleState",
-    "execution_margin",
-    "plan_for_execution",
-    "schedule_for_execution",
-]
+__all__ = [*_SOURCES, "plan_for_execution"]
 
 _attribute, __dir__ = lazy_attributes(__name__, globals(), _SOURCES)
 

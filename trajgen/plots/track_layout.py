@@ -86,7 +86,7 @@ class TrackLayout:
         move = route.moves[number]
         pieces = []
         for (a, b), edge in zip(zip(move.points, move.points[1:], strict=False), move.edges, strict=True):
-            pieces.append(self.along(edge, _on(self.track, a, edge), _on(self.track, b, edge)))
+            pieces.append(self.along(edge, self.track.position_on(a, edge), self.track.position_on(b, edge)))
         return np.vstack(pieces)
 
     @property
@@ -94,13 +94,6 @@ class TrackLayout:
         """The larger side of the drawing's bounding box, metres (at least 1)."""
         every = np.vstack([self.nodes, *self.edges])
         return max(float(np.ptp(every[:, 0])), float(np.ptp(every[:, 1])), 1.0)
-
-
-def _on(track: TrackGraph, point: EdgePoint, edge: int) -> float:
-    """``point``'s metres along ``edge``: its own ``s``, or the edge's end it is the node of."""
-    if point.edge == edge:
-        return point.s
-    return 0.0 if track.node_at(point) == track.ends(edge)[0] else track.length(edge)
 
 
 def _scaled(distances: np.ndarray) -> np.ndarray:

@@ -339,6 +339,31 @@ def _parse_vehicle(
     return name, limits, ends[0], ends[1]
 
 
+def _parse_vehicles(data: dict, position: Callable[[str], object], source: str, folder: Path | None):
+    """``[safety]`` and the two ``[[vehicle]]`` tables: separation, limits, names, (starts, goals).
+
+    ``position`` reads a position of the track (``"A:10.0"`` on a junction, ``"EDGE:s"`` on a graph).
+    """
+    safety = _table(data["safety"], "[safety]", source)
+    _check_keys(safety, _SAFETY_KEYS, "[safety]", source)
+    separation = _number(safety["min_separation"], "[safety] min_separation", source)
+    vehicles = data["vehicle"]
+    if not isinstance(vehicles, list) or len(vehicles) != 2:
+        count = len(vehicles) if isinstance(vehicles, list) else type(vehicles).__name__
+        raise ScenarioError(f"{source}: expected exactly two [[vehicle]] tables, got {count}")
+    names: list[str] = []
+    parsed = []
+    for k, vehicle in enumerate(vehicles, start=1):
+        parsed.append(_parse_vehicle(vehicle, k, position, names, source, folder))
+        names.append(parsed[-1][0])
+    try:
+        limits = Limits(vehicles=(parsed[0][1], parsed[1][1]), min_separation=separation)
+    except InputError as error:
+        raise ScenarioError(f"{source}: [safety]: {error}") from None
+    ends = ((parsed[0][2], parsed[1][2]), (parsed[0][3], parsed[1][3]))
+    return separation, limits, (names[0], names[1]), ends
+
+
 def parse_scenario(
     data: dict, *, source: str = "<scenario>", folder: str | Path | None = None
 ) -> Scenario | GraphScenario:
@@ -360,27 +385,10 @@ def parse_scenario(
     if isinstance(data["track"], dict) and "edges" in data["track"]:
         return _parse_graph_scenario(data, source, None if folder is None else Path(folder))
     track = _parse_track(data, source)
-    safety = _table(data["safety"], "[safety]", source)
-    _check_keys(safety, _SAFETY_KEYS, "[safety]", source)
-    separation = _number(safety["min_separation"], "[safety] min_separation", source)
-    vehicles = data["vehicle"]
-    if not isinstance(vehicles, list) or len(vehicles) != 2:
-        count = len(vehicles) if isinstance(vehicles, list) else type(vehicles).__name__
-        raise ScenarioError(f"{source}: expected exactly two [[vehicle]] tables, got {count}")
-    names: list[str] = []
-    parsed = []
-    for k, vehicle in enumerate(vehicles, start=1):
-        position = _star_position(track)
-        parsed.append(
-            _parse_vehicle(vehicle, k, position, names, source, None if folder is None else Path(folder))
-        )
-        names.append(parsed[-1][0])
-    try:
-        limits = Limits(vehicles=(parsed[0][1], parsed[1][1]), min_separation=separation)
-    except InputError as error:
-        raise ScenarioError(f"{source}: [safety]: {error}") from None
-    start = Configuration(parsed[0][2], parsed[1][2])
-    goal = Configuration(parsed[0][3], parsed[1][3])
+    separation, limits, names, ends = _parse_vehicles(
+        data, _star_position(track), source, None if folder is None else Path(folder)
+    )
+    start, goal = Configuration(*ends[0]), Configuration(*ends[1])
     shortest = track.shortest_leg
     if separation > shortest:
         too_short = [
@@ -398,7 +406,7 @@ def parse_scenario(
                 f"expected at least [safety] min_separation {separation!r} m"
             )
     try:
-        return Scenario(track, limits, (names[0], names[1]), start, goal, source)
+        return Scenario(track, limits, names, start, goal, source)
     except InputError as error:
         raise ScenarioError(f"{source}: {error}") from None
 
@@ -444,23 +452,7 @@ def _parse_graph_track(table: dict, source: str) -> TrackGraph:
 
 def _parse_graph_scenario(data: dict, source: str, folder: Path | None) -> GraphScenario:
     track = _parse_graph_track(_table(data["track"], "[track]", source), source)
-    safety = _table(data["safety"], "[safety]", source)
-    _check_keys(safety, _SAFETY_KEYS, "[safety]", source)
-    separation = _number(safety["min_separation"], "[safety] min_separation", source)
-    vehicles = data["vehicle"]
-    if not isinstance(vehicles, list) or len(vehicles) != 2:
-        count = len(vehicles) if isinstance(vehicles, list) else type(vehicles).__name__
-        raise ScenarioError(f"{source}: expected exactly two [[vehicle]] tables, got {count}")
-    names: list[str] = []
-    parsed = []
-    for k, vehicle in enumerate(vehicles, start=1):
-        parsed.append(_parse_vehicle(vehicle, k, track.point, names, source, folder))
-        names.append(parsed[-1][0])
-    try:
-        limits = Limits(vehicles=(parsed[0][1], parsed[1][1]), min_separation=separation)
-    except InputError as error:
-        raise ScenarioError(f"{source}: [safety]: {error}") from None
-    start, goal = (parsed[0][2], parsed[1][2]), (parsed[0][3], parsed[1][3])
+    separation, limits, names, (start, goal) = _parse_vehicles(data, track.point, source, folder)
     for label, pair in (("start", start), ("goal", goal)):
         gap = track.distance(*pair)
         if gap < separation or gap == 0.0:
@@ -470,7 +462,7 @@ def _parse_graph_scenario(data: dict, source: str, folder: Path | None) -> Graph
                 f"{separation!r} m"
             )
     try:
-        return GraphScenario(track, limits, (names[0], names[1]), start, goal, source)
+        return GraphScenario(track, limits, names, start, goal, source)
     except InputError as error:
         raise ScenarioError(f"{source}: {error}") from None
 

@@ -104,21 +104,6 @@ class _Distances:
         return least
 
 
-def _on(track: TrackGraph, point: EdgePoint, edge: int) -> float | None:
-    """``point``'s metres along ``edge``, or ``None`` if it is not on that edge."""
-    if point.edge == edge:
-        return point.s
-    node = track.node_at(point)
-    if node is None:
-        return None
-    start, end = track.ends(edge)
-    if node == start:
-        return 0.0
-    if node == end:
-        return track.length(edge)
-    return None
-
-
 def verify_graph_route(route: GraphRoute) -> GraphRouteReport:
     """Check every move of ``route`` against the separation, and that the moves make the route.
 
@@ -160,7 +145,7 @@ def verify_graph_route(route: GraphRoute) -> GraphRouteReport:
             )
         length = 0.0
         for (a, b), edge in zip(itertools.pairwise(move.points), move.edges, strict=True):
-            s_a, s_b = _on(track, a, edge), _on(track, b, edge)
+            s_a, s_b = track.position_on(a, edge), track.position_on(b, edge)
             if s_a is None or s_b is None:
                 failures.append(
                     f"{label}: {track.name(a)} -> {track.name(b)} is not along edge "
