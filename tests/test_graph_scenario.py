@@ -164,8 +164,11 @@ def test_a_bad_graph_scenario_is_refused_naming_the_key(track, positions, match)
 
 
 @pytest.mark.parametrize(
-    "command", [["schedule"], ["export-vda5050", "--out", "x"], ["simulate"], ["animate", "--out", "x.gif"]]
+    "command", [["export-vda5050", "--out", "x"], ["simulate"], ["animate", "--out", "x.gif"]]
 )
 def test_commands_that_do_not_take_a_graph_yet_refuse_it_plainly(command, capsys):
     assert main([command[0], str(EXAMPLES / "h.toml"), *command[1:]]) == 2
-    assert "a track with edges (a track graph) is planned by 'trajgen plan'" in capsys.readouterr().err
+    assert (
+        "a track with edges (a track graph) is planned by 'trajgen plan' and timed by 'trajgen schedule'"
+        in capsys.readouterr().err
+    )

@@ -161,7 +161,7 @@ def test_a_compared_method_that_fails_verification_is_left_out_of_the_plot(tmp_p
 
 
 def test_run_refuses_what_is_not_a_scenario():
-    with pytest.raises(InputError, match="run expects a Scenario, got str"):
+    with pytest.raises(InputError, match="run expects a Scenario or a GraphScenario, got str"):
         run("examples/swap.toml")  # type: ignore[arg-type]
 
 

@@ -59,7 +59,7 @@ def test_a_failing_report_cannot_make_a_certificate():
         certify(broken)
     with pytest.raises(UnverifiedScheduleError, match=r"made by trajgen\.certify\(schedule\) alone"):
         VerifiedSchedule(broken, report)
-    with pytest.raises(InputError, match="verify expects a Schedule, got str"):
+    with pytest.raises(InputError, match="verify expects a Schedule or a GraphSchedule, got str"):
         verify("schedule")  # type: ignore[arg-type]
 
 

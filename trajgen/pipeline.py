@@ -12,7 +12,7 @@ import logging
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from topology import Route
+from topology import GraphRoute, Route
 from trajgen.errors import InputError, VerificationError
 from trajgen.export.atomic import check_output_paths, commit_files
 from trajgen.export.csv import CsvOptions, check_row_limit, profile_chunk_pair, profile_paths
@@ -21,8 +21,8 @@ from trajgen.export.plc.files import PlcTables, check_dialect_method, plc_tables
 from trajgen.methods import METHODS, make_schedule
 from trajgen.model.analysis import lower_bound
 from trajgen.model.schedule import TimingMethod
-from trajgen.model.summary import provenance, route_summary
-from trajgen.scenario import Scenario
+from trajgen.model.summary import graph_route_summary, provenance, route_summary
+from trajgen.scenario import GraphScenario, Scenario
 from trajgen.verification import VerifiedSchedule, certify
 
 __all__ = ["LONG_SCHEDULE_S", "PLOT_NAMES", "Outputs", "RunResult", "run"]
@@ -125,9 +125,9 @@ class RunResult:
         The PLC tables written, for a table dialect.
     """
 
-    scenario: Scenario
+    scenario: Scenario | GraphScenario
     method: TimingMethod
-    route: Route
+    route: Route | GraphRoute
     verified: VerifiedSchedule
     files: tuple[Path, ...]
     notes: tuple[str, ...] = ()
@@ -145,7 +145,11 @@ class RunResult:
             "worst_margins": report.summary(),
             "notes": [*schedule.notes, *self.notes],
             "solver": None if schedule.info is None else schedule.info.summary(),
-            "route": route_summary(self.route),
+            "route": (
+                graph_route_summary(self.route, self.scenario.names)
+                if isinstance(self.route, GraphRoute)
+                else route_summary(self.route)
+            ),
             "export": None if self.tables is None else self.tables.summary(),
             "files": [str(path) for path in self.files],
         }
@@ -175,16 +179,34 @@ def _comparison(
     return verified, notes
 
 
+def _check_graph_outputs(outputs: Outputs) -> None:
+    """Refuse, before computing, what a track graph's schedule cannot be written as yet."""
+    if outputs.csv_dir is not None and isinstance(outputs.dialect, TableDialect):
+        raise InputError(
+            f"dialect '{outputs.dialect.name.value}' is not written for a track graph yet: expected the "
+            "generic CSV (docs/graphs.md)"
+        )
+    if outputs.plot_dir is not None:
+        raise InputError(
+            "the plots of a track graph's schedule are not drawn yet: expected no plot folder "
+            "('trajgen plan SCENARIO --plot FILE.png' draws the route; docs/graphs.md)"
+        )
+
+
 def run(
-    scenario: Scenario, *, method: TimingMethod | str | None = None, outputs: Outputs | None = None
+    scenario: Scenario | GraphScenario,
+    *,
+    method: TimingMethod | str | None = None,
+    outputs: Outputs | None = None,
 ) -> RunResult:
     """Plan, schedule, verify, render and commit: the whole job.
 
     Parameters
     ----------
-    scenario : Scenario
+    scenario : Scenario or GraphScenario
     method : TimingMethod or str, optional
-        A method object with its options, a registered name, or ``None`` for the default.
+        A method object with its options, a registered name, or ``None`` for the default
+        (on a track graph: ``exact``, the method that times graphs today).
     outputs : Outputs, optional
         Files to write; none by default.
 
@@ -203,9 +225,12 @@ def run(
     outputs = outputs if outputs is not None else Outputs()
     if not isinstance(outputs, Outputs):
         raise InputError(f"outputs must be Outputs, got {type(outputs).__name__}")
-    if not isinstance(scenario, Scenario):
-        raise InputError(f"run expects a Scenario, got {type(scenario).__name__}")
-    chosen = METHODS.create(method)
+    if not isinstance(scenario, Scenario | GraphScenario):
+        raise InputError(f"run expects a Scenario or a GraphScenario, got {type(scenario).__name__}")
+    graph = isinstance(scenario, GraphScenario)
+    chosen = METHODS.create("exact" if graph and method is None else method)
+    if graph:
+        _check_graph_outputs(outputs)
     check_output_paths(outputs.paths(scenario.names))
     tabled = outputs.csv_dir is not None and isinstance(outputs.dialect, TableDialect)
     if tabled:

@@ -37,13 +37,14 @@ def scenario_from(path: str | None, *, graph: bool = False) -> Scenario:
     ------
     ScenarioError
         A track graph (``[track]`` with ``edges``) where the command takes junctions only
-        (``graph=False``): today only ``trajgen plan`` takes graphs.
+        (``graph=False``): today ``trajgen plan`` and ``trajgen schedule`` take graphs.
     """
     scenario = default_scenario() if path is None else load_scenario(path)
     if isinstance(scenario, GraphScenario) and not graph:
         raise ScenarioError(
-            f"{scenario.source}: a track with edges (a track graph) is planned by 'trajgen plan'; this "
-            "command does not take one yet: expected a [track] with legs (docs/graphs.md)"
+            f"{scenario.source}: a track with edges (a track graph) is planned by 'trajgen plan' and timed "
+            "by 'trajgen schedule'; this command does not take one yet: expected a [track] with legs "
+            "(docs/graphs.md)"
         )
     return scenario
 
@@ -102,9 +103,9 @@ def add_method(
     """``--method`` (and, with ``homotopy``, ``--homotopy``)."""
     parser.add_argument(
         "--method",
-        default=METHODS.default,
+        default=None,
         metavar="|".join(METHODS.names),
-        help=f"{what}, one of:\n{METHODS.help()}",
+        help=f"{what}, one of:\n{METHODS.help()}\n(a track graph is timed by exact, its default there)",
     )
     if not homotopy:
         return

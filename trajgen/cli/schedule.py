@@ -20,7 +20,7 @@ from trajgen.model.summary import (
     route_summary,
 )
 from trajgen.pipeline import Outputs, run
-from trajgen.scenario import BuiltinScenario, builtin_scenario
+from trajgen.scenario import BuiltinScenario, GraphScenario, builtin_scenario
 from trajgen.verification.graph_route import verify_graph_route
 
 __all__ = ["register"]
@@ -69,7 +69,7 @@ def _route_picture(route, names) -> bytes:
 
 
 def _command_schedule(args: argparse.Namespace) -> int:
-    scenario = scenario_from(args.scenario)
+    scenario = scenario_from(args.scenario, graph=True)
     outputs = Outputs(
         csv_dir=args.csv,
         plot_dir=args.plot,
@@ -77,7 +77,9 @@ def _command_schedule(args: argparse.Namespace) -> int:
         dialect=args.dialect,
         max_points=args.max_points,
     )
-    summary = run(scenario, method=method_from(args), outputs=outputs).summary()
+    graph_default = isinstance(scenario, GraphScenario) and args.method is None and args.homotopy is None
+    method = None if graph_default else method_from(args)  # None: the pipeline's default for the track
+    summary = run(scenario, method=method, outputs=outputs).summary()
     print(json.dumps(summary, indent=2) if args.json else format_run(summary))
     return EXIT_OK
 

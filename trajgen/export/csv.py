@@ -19,7 +19,9 @@ from topology import JUNCTION_INDEX, Option, StarGraph
 from topology.validation import short_repr
 from trajgen.errors import InputError, OptionError, OutputLimitError
 from trajgen.export.atomic import commit_files
+from trajgen.export.graph_rows import check_edge_names, format_graph_block, graph_header
 from trajgen.export.numbers import format_number_rows
+from trajgen.model.graph_schedule import GraphSchedule
 from trajgen.model.schedule import Schedule, ScheduleState, check_period, sample_block, sample_rows
 from trajgen.scenario.naming import check_vehicle_names
 from trajgen.verification import VerifiedSchedule, require_verified
@@ -251,12 +253,28 @@ def _checked(
     options = CsvOptions() if options is None else options
     if not isinstance(options, CsvOptions):
         raise OptionError(f"CSV options must be CsvOptions, got {type(options).__name__}")
+    if isinstance(schedule, GraphSchedule):
+        check_edge_names(schedule.track, options.delimiter)
     return schedule, options
 
 
 def _chunks(
-    schedule: Schedule, vehicle: int, options: CsvOptions, rows: int, blocks: _SampledBlocks
+    schedule: Schedule | GraphSchedule, vehicle: int, options: CsvOptions, rows: int, blocks: _SampledBlocks
 ) -> Iterator[bytes]:
+    if isinstance(schedule, GraphSchedule):  # the edge by name, x/y only with node coordinates
+        header = graph_header(schedule.track, options.units.value)
+        yield (options.delimiter.join(header) + "\r\n").encode("ascii")
+        for first in range(0, rows, ROWS_PER_CHUNK):
+            yield format_graph_block(
+                schedule.track,
+                blocks.block(first),  # type: ignore[arg-type]
+                vehicle,
+                delimiter=options.delimiter,
+                decimal=options.decimal,
+                scale=options.units.scale,
+                decimals=options.units.decimals,
+            )
+        return
     yield (options.delimiter.join(HEADER_NAMES[options.units]) + "\r\n").encode("ascii")
     for first in range(0, rows, ROWS_PER_CHUNK):
         yield format_block(schedule.route.graph, blocks.block(first), vehicle, options)

@@ -16,6 +16,7 @@ import numpy as np
 from limits import Limits
 from topology import Route
 from trajgen.errors import InputError
+from trajgen.methods.graph_timing import moves_one_at_a_time
 from trajgen.model.axes import piece_maps, piece_profiles, route_axes, straight_pieces
 from trajgen.model.schedule import CubicKinematics, Schedule, Section, TimingMethod, check_request
 
@@ -67,6 +68,10 @@ class Exact(TimingMethod):
             sections.append(section)
             clock += section.duration
         return Schedule(route, limits, self, tuple(sections), jerk_limited=self.jerk)
+
+    def schedule_graph(self, route, limits: Limits):
+        """The exact schedule of a route on a track graph: its moves one after the other, rest to rest."""
+        return moves_one_at_a_time(route, limits, self, jerk=self.jerk)
 
     def waypoint_times(self, schedule: Schedule) -> np.ndarray:
         """Time at which an exact schedule of this method passes each route waypoint, seconds, shape (n,).

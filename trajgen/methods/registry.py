@@ -7,8 +7,9 @@ from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
 
 from limits import Limits
-from topology import Route
+from topology import GraphRoute, Route
 from trajgen.errors import OptionError
+from trajgen.model.graph_schedule import GraphSchedule
 from trajgen.model.schedule import Schedule, TimingMethod
 
 __all__ = ["MethodRegistry", "MethodSource"]
@@ -143,7 +144,9 @@ class MethodRegistry:
             for name, description in self._descriptions.items()
         )
 
-    def schedule(self, route: Route, limits: Limits, *, method: TimingMethod | str | None = None) -> Schedule:
+    def schedule(
+        self, route: Route | GraphRoute, limits: Limits, *, method: TimingMethod | str | None = None
+    ) -> Schedule | GraphSchedule:
         """Time-parameterize ``route`` with ``method`` (unverified; see :func:`trajgen.verification.certify`).
 
         Raises
@@ -155,4 +158,6 @@ class MethodRegistry:
             smaller separation than ``limits`` asks.
         """
         chosen = self.create(method)
+        if isinstance(route, GraphRoute):
+            return chosen.schedule_graph(route, limits)
         return chosen.schedule(route, limits)

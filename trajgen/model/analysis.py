@@ -7,7 +7,7 @@ import itertools
 import numpy as np
 
 from limits import Limits
-from topology import Route
+from topology import GraphRoute, Route
 from topology.indexed import JUNCTION_INDEX, track_distance
 from trajgen.model.profiles import rest_to_rest_time
 from trajgen.model.schedule import Schedule
@@ -21,7 +21,7 @@ def lower_bound(route: Route, limits: Limits) -> float:
     Ignores the other vehicle entirely, so no schedule from the route's start
     to its goal can be faster.
     """
-    graph = route.graph
+    graph = route.track if isinstance(route, GraphRoute) else route.graph
     times = []
     for vehicle, (start, goal) in enumerate(zip(route.start, route.goal, strict=True)):
         vehicle_limits = limits.vehicles[vehicle]

@@ -19,7 +19,16 @@ from trajgen.model.polynomials import evaluate, root_in
 from trajgen.model.schedule import AxisMap, CubicKinematics, Schedule, Section
 from trajgen.model.values import ArrayValue, readonly, sorted_unique
 
-__all__ = ["DEGREE", "Pieces", "UncheckableKinematicsError", "motion_arrays", "schedule_pieces", "shift"]
+__all__ = [
+    "DEGREE",
+    "Pieces",
+    "UncheckableKinematicsError",
+    "cubic_pieces",
+    "motion_arrays",
+    "schedule_pieces",
+    "shift",
+    "split_at_values",
+]
 
 #: Highest power of the axis polynomials (TOPPRA sections: a quadratic path of a quadratic s(t)).
 DEGREE = 4
@@ -100,7 +109,7 @@ def shift(c: np.ndarray, delta: np.ndarray) -> np.ndarray:
     return out
 
 
-def _cubic_section(kinematics: CubicKinematics) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def cubic_pieces(kinematics: CubicKinematics) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Breakpoints (m + 1,), axis polynomials (2, m, DEGREE + 1), knot intervals (2, m): a cubic section."""
     duration = kinematics.duration
     times = sorted_unique(
@@ -158,7 +167,7 @@ def _section_polynomials(section: Section) -> tuple[np.ndarray, np.ndarray, np.n
     kinematics = section.kinematics
     # exact types only: a subclass could evaluate (and so export) something else than this form
     if type(kinematics) is CubicKinematics:
-        return _cubic_section(kinematics)
+        return cubic_pieces(kinematics)
     if type(kinematics) is ToppraKinematics:
         return _toppra_section(kinematics)
     raise UncheckableKinematicsError(
@@ -192,25 +201,43 @@ def motion_arrays(schedule: Schedule, section: int, vehicle: int, interval: int 
     return f"{arrays}{at}, sections[{section}].maps[{vehicle}].{{axis_start,axis_end,s_start}}"
 
 
-def _split_at_map_boundaries(
-    times: np.ndarray, axis: np.ndarray, intervals: np.ndarray, maps: tuple[AxisMap, AxisMap]
+def split_at_values(
+    times: np.ndarray, axis: np.ndarray, intervals: np.ndarray, values: tuple, *, margin: float = 0.0
 ):
-    """Split pieces where an axis crosses from one sub-range of its map to the next."""
+    """Split pieces where a vehicle's axis polynomial passes one of its ``values``.
+
+    Parameters
+    ----------
+    times : ndarray, shape (m + 1,)
+        Breakpoints, seconds.
+    axis : ndarray, shape (2, m, DEGREE + 1)
+        Both vehicles' polynomials on each piece (time since the piece's start).
+    intervals : ndarray of int, shape (2, m)
+    values : tuple of 2 sequences of float
+        Per vehicle, the axis values to split at.
+    margin : float, optional
+        A piece that reaches a value within ``margin`` at one of its ends is not split (it passes the
+        value at its knot; a root near a knot where the motion comes to rest is round-off).
+
+    Returns
+    -------
+    (starts, lengths, axis, intervals)
+        The pieces after splitting, shapes (n,), (n,), (2, n, DEGREE + 1), (2, n).
+    """
     splits = [[] for _ in range(times.size - 1)]
-    for vehicle, axis_map in enumerate(maps):
-        if axis_map.legs.size < 2:
-            continue
-        bounds = sorted_unique(np.concatenate([axis_map.axis_start, axis_map.axis_end]))[1:-1]
-        h = np.diff(times)
+    h = np.diff(times)
+    for vehicle, bounds in enumerate(values):
         for value in bounds:
             c = axis[vehicle].copy()
             c[:, 0] -= value
             roots = root_in(c, np.zeros_like(h), h)
             inside = np.isfinite(roots) & (roots > 0.0) & (roots < h)
+            if margin > 0.0:
+                inside &= (np.abs(c[:, 0]) > margin) & (np.abs(evaluate(c, h)) > margin)
             for k in np.nonzero(inside)[0]:
                 splits[k].append(float(roots[k]))
     if not any(splits):
-        return times[:-1], np.diff(times), axis, intervals
+        return times[:-1], h, axis, intervals
     starts, lengths, rows = [], [], []
     for k, points in enumerate(splits):
         cuts = [0.0, *sorted(points), float(times[k + 1] - times[k])]
@@ -222,6 +249,17 @@ def _split_at_map_boundaries(
     index = np.array([r[0] for r in rows])
     offset = np.array([r[1] for r in rows])
     return np.array(starts), np.array(lengths), shift(axis[:, index], offset[None, :]), intervals[:, index]
+
+
+def _split_at_map_boundaries(
+    times: np.ndarray, axis: np.ndarray, intervals: np.ndarray, maps: tuple[AxisMap, AxisMap]
+):
+    """Split pieces where an axis crosses from one sub-range of its map to the next."""
+    values = tuple(
+        sorted_unique(np.concatenate([m.axis_start, m.axis_end]))[1:-1] if m.legs.size >= 2 else ()
+        for m in maps
+    )
+    return split_at_values(times, axis, intervals, values)
 
 
 def _map_of(axis_map: AxisMap, middle: np.ndarray):

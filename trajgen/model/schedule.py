@@ -135,6 +135,21 @@ class TimingMethod(abc.ABC):
     def schedule(self, route: Route, limits: Limits) -> Schedule:
         """Time-parameterize ``route`` under ``limits`` (unverified: see :func:`trajgen.certify`)."""
 
+    def schedule_graph(self, route, limits: Limits):
+        """Time-parameterize a route on a track graph (:class:`topology.GraphRoute`) under ``limits``.
+
+        Returns a :class:`~trajgen.model.graph_schedule.GraphSchedule` (unverified: see
+        :func:`trajgen.certify`).
+
+        Raises
+        ------
+        InputError
+            The method does not time track graphs yet.
+        """
+        raise InputError(
+            f"method {self.name!r} does not time a track graph yet: expected --method exact (docs/graphs.md)"
+        )
+
     @property
     def plans_for_execution(self) -> bool:
         """Whether its schedules obey the braking rule (:mod:`~trajgen.verification.braking_rule`).

@@ -178,6 +178,12 @@ def _route_class_text(route: dict) -> str:
     return _class_text(route["way_round"] if circle else route["class"], route["planned_class"], circle)
 
 
+def _graph_class_text(route: dict) -> str:
+    """The class line of a route on a track graph: its moves in order (who goes where, who waits)."""
+    moves = "; ".join(f"{m['vehicle']} {m['from']} -> {m['to']}" for m in route["moves"]) or "no move"
+    return f"the planned route's, every conflict passed in its order ({moves})"
+
+
 def _chosen_mark(comparison: dict, *, fallback: bool) -> str:
     """`` <- chosen`` for the class whose solution was returned; nothing for a class that failed."""
     if not comparison["chosen"]:
@@ -227,9 +233,12 @@ def format_run(summary: dict) -> str:
         f"method: {format_provenance(summary)}  duration: {summary['duration_s']:.3f} s  "
         f"verified: {summary['verified']}",
         f"worst margins: separation {margins['min_separation_m']:.4f} m "
-        f"(margin {margins['separation_margin_m']:.4f} m), |v|/limit {max(margins['velocity_ratio']):.6f}, "
+        f"(margin {round(margins['separation_margin_m'], 4) + 0.0:.4f} m), "
+        f"|v|/limit {max(margins['velocity_ratio']):.6f}, "
         f"|a|/limit {max(margins['acceleration_ratio']):.6f}{jerk}",
-        f"homotopy class: {_route_class_text(summary['route'])}",
+        f"homotopy class: {_route_class_text(summary['route'])}"
+        if "moves" not in summary["route"]
+        else f"class: {_graph_class_text(summary['route'])}",
     ]
     if summary["solver"] is not None:
         lines += [

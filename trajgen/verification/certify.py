@@ -46,9 +46,11 @@ from topology import Region, reduce_regions
 from topology.indexed import JUNCTION_INDEX, track_distance
 from trajgen.errors import InputError, UnverifiedScheduleError
 from trajgen.model import polynomials
+from trajgen.model.graph_schedule import GraphSchedule
 from trajgen.model.pieces import Pieces, UncheckableKinematicsError, schedule_pieces
 from trajgen.model.schedule import Schedule
 from trajgen.verification.braking_rule import BRAKING_RULE_TOLERANCE, braking_rule_failures
+from trajgen.verification.graph_schedule import verify_graph_schedule
 from trajgen.verification.integrity import array_failures
 from trajgen.verification.piecewise import (
     allowance,
@@ -118,10 +120,10 @@ def verify(schedule: Schedule) -> VerificationReport:
     InputError
         ``schedule`` is not a Schedule.
     """
-    if not isinstance(schedule, Schedule):
-        raise InputError(f"verify expects a Schedule, got {type(schedule).__name__}")
+    if not isinstance(schedule, Schedule | GraphSchedule):
+        raise InputError(f"verify expects a Schedule or a GraphSchedule, got {type(schedule).__name__}")
     began = time.perf_counter()
-    report = _verify(schedule)
+    report = verify_graph_schedule(schedule) if isinstance(schedule, GraphSchedule) else _verify(schedule)
     logger.debug(
         "verified a %s schedule (%d pieces) in %.1f ms: %s",
         schedule.method,

@@ -21,7 +21,7 @@ from dataclasses import dataclass
 from topology import EdgePoint, GraphRoute, TrackGraph
 from trajgen.errors import InputError
 
-__all__ = ["GraphRouteReport", "verify_graph_route"]
+__all__ = ["GraphRouteReport", "TrackDistances", "verify_graph_route"]
 
 #: Metres of round-off allowed: below the separation, off a point, in the travel's sum.
 ROUTE_TOLERANCE = 1e-9
@@ -73,7 +73,7 @@ def _node_distances(track: TrackGraph) -> list[list[float]]:
     return table
 
 
-class _Distances:
+class TrackDistances:
     """Track distances of the verifier's own, between points ``(edge, s)`` of one track."""
 
     def __init__(self, track: TrackGraph) -> None:
@@ -83,8 +83,20 @@ class _Distances:
         self.nodes = _node_distances(track)
 
     def to_node(self, edge: int, s: float, node: int) -> float:
+        """The track distance from the point ``(edge, s)`` to node number ``node``."""
         start, end = self.ends[edge]
         return min(self.nodes[start][node] + s, self.nodes[end][node] + self.lengths[edge] - s)
+
+    def along(self, point: EdgePoint, edge: int) -> float:
+        """``point``'s metres from the ``from`` node of ``edge`` (a node at its ends: 0 or its length)."""
+        if point.edge == edge:
+            return point.s
+        start, end = self.ends[edge]
+        if self.to_node(point.edge, point.s, start) <= ROUTE_TOLERANCE:
+            return 0.0
+        if self.to_node(point.edge, point.s, end) <= ROUTE_TOLERANCE:
+            return self.lengths[edge]
+        return math.nan
 
     def between(self, a: EdgePoint, b: EdgePoint) -> float:
         """The track distance between two points."""
@@ -115,7 +127,7 @@ def verify_graph_route(route: GraphRoute) -> GraphRouteReport:
     if not isinstance(route, GraphRoute):
         raise InputError(f"verify_graph_route takes a GraphRoute, got {type(route).__name__}")
     track, separation = route.track, route.min_separation
-    distances = _Distances(track)
+    distances = TrackDistances(track)
     failures: list[str] = []
     where = list(route.start)
     travel = [0.0, 0.0]
