@@ -19,9 +19,9 @@ from trajgen.errors import InputError, OptionError, VerificationError
 from trajgen.export.csv import CsvOptions, profile_chunk_pair
 from trajgen.methods import make_schedule
 from trajgen.methods.exact import Exact
-from trajgen.model.graph_schedule import GraphSchedule
+from trajgen.model.graph_schedule import GraphSchedule, GraphSection
 from trajgen.model.profiles import PiecewiseCubic, rest_to_rest_time, scurve_phases
-from trajgen.model.schedule import CubicKinematics
+from trajgen.model.schedule import CubicKinematics, TimingMethod
 from trajgen.pipeline import Outputs, run
 from trajgen.scenario import load_scenario
 from trajgen.verification import verify
@@ -101,7 +101,7 @@ def _together(route, limits) -> GraphSchedule:
             for d, j in scurve_phases(path.length, v.max_velocity, v.max_acceleration, v.max_jerk)
         ]
         profiles.append(PiecewiseCubic.from_phases(0.0, phases, end=path.length))
-    return dataclasses.replace(schedule, kinematics=CubicKinematics(tuple(profiles)))
+    return dataclasses.replace(schedule, sections=(GraphSection(0.0, CubicKinematics(tuple(profiles))),))
 
 
 def test_the_verifier_finds_two_vehicles_too_close_between_samples():
@@ -119,7 +119,7 @@ def test_the_verifier_finds_a_vehicle_that_turns_back_without_stopping():
     assert schedule.paths[0].cusps.size == 1
     merged = _together(scenario.route(), scenario.limits)  # one S-curve through the cusp
     with pytest.raises(
-        VerificationError, match=r"vehicle 1 turns back at 15.5 m of travel .* expected at rest"
+        VerificationError, match=r"vehicle 1 turns back at 15.5 m of travel .* m/s: expected at rest"
     ):
         certify(merged)
     del schedule
@@ -158,8 +158,6 @@ def test_a_graph_run_writes_both_csv_files_and_refuses_what_it_cannot_draw_yet(t
         run(scenario, outputs=Outputs(plot_dir=tmp_path / "plots"))
     with pytest.raises(InputError, match="dialect 'siemens-xy' is not written for a track graph yet"):
         run(scenario, outputs=Outputs(csv_dir=tmp_path / "t", dialect="siemens-xy"))
-    with pytest.raises(InputError, match="method 'optimal' does not time a track graph yet"):
-        run(scenario, method="optimal")
     assert not (tmp_path / "plots").exists()
     assert not (tmp_path / "t").exists()
 
@@ -198,11 +196,15 @@ def test_an_edge_name_holding_the_delimiter_is_refused_naming_it():
     assert _csv_texts(verified, CsvOptions(delimiter=","))[0].count("a;1") > 0
 
 
-def test_the_other_methods_say_they_do_not_time_graphs_yet():
+def test_a_method_that_does_not_time_graphs_says_so_naming_itself():
     route, limits = _crossing()
-    for name in ("toppra", "optimal"):
-        with pytest.raises(InputError, match=f"method '{name}' does not time a track graph yet"):
-            make_schedule(route, limits, method=name)
+
+    class Junctions(Exact):
+        name = "junctions-only"
+        schedule_graph = TimingMethod.schedule_graph
+
+    with pytest.raises(InputError, match="method 'junctions-only' does not time a track graph yet"):
+        make_schedule(route, limits, method=Junctions())
 
 
 def test_seeded_random_graphs_are_timed_and_verified_with_the_rows_safe(tmp_path):

@@ -38,7 +38,7 @@ from topology.errors import (
     TrajgenError,
 )
 from topology.graph import MAX_LEGS, MIN_LEGS, StarGraph, YGraph
-from topology.graph_planner import GraphMove, GraphRoute, plan_graph
+from topology.graph_planner import GraphMove, GraphRoute, class_signature, plan_graph, plan_graph_classes
 from topology.indexed import JUNCTION_INDEX, RegionKey, reduce_regions
 from topology.options import Option
 from topology.positions import JUNCTION, JUNCTION_NAME, Configuration, Position
@@ -83,10 +83,12 @@ __all__ = [
     "YGraph",
     "as_indexed",
     "boundary_angle",
+    "class_signature",
     "classify",
     "is_antipodal",
     "plan",
     "plan_graph",
+    "plan_graph_classes",
     "reduce_regions",
     "region_sequence",
     "retract",

@@ -40,7 +40,10 @@ from topology.errors import InfeasibleError, SeparationError
 from topology.track_graph import EdgePoint, TrackGraph
 from topology.validation import finite_real, short_repr
 
-__all__ = ["GraphMove", "GraphRoute", "plan_graph"]
+__all__ = ["CLASS_WEIGHT", "GraphMove", "GraphRoute", "class_signature", "plan_graph", "plan_graph_classes"]
+
+#: Weight of the yielding-free vehicle's metres in the alternative classes of :func:`plan_graph_classes`.
+CLASS_WEIGHT = 4.0
 
 #: Metres by which a distance may fall short of the separation and still count as apart (round-off),
 #: and within which two critical points of an edge are one.
@@ -94,6 +97,8 @@ class GraphRoute:
         stands as it reaches them.
     searched : int
         Pairs of critical points the search expanded (how hard the planning was).
+    names : tuple of 2 str
+        The vehicles' names the planner was given (for messages and summaries).
     """
 
     track: TrackGraph
@@ -104,6 +109,7 @@ class GraphRoute:
     travel: tuple[float, float]
     critical_points: int
     searched: int
+    names: tuple[str, str] = ("vehicle 1", "vehicle 2")
 
     @property
     def length(self) -> float:
@@ -118,6 +124,7 @@ def plan_graph(
     *,
     min_separation: float,
     names: Sequence[str] = ("vehicle 1", "vehicle 2"),
+    weights: tuple[float, float] = (1.0, 1.0),
 ) -> GraphRoute:
     """The shortest collision-free route of two vehicles on ``track``, one moving at a time.
 
@@ -131,11 +138,15 @@ def plan_graph(
         Metres of track distance the vehicles keep at all times, positive.
     names : sequence of 2 str
         The vehicles' names, for messages.
+    weights : tuple of 2 float
+        What a metre of each vehicle's travel costs (default ``(1, 1)``: the sum of both travels is
+        minimised). A larger weight makes that vehicle's detours dearer, so the other one yields:
+        :func:`plan_graph_classes` plans the alternative classes so.
 
     Returns
     -------
     GraphRoute
-        The route that minimises the sum of both vehicles' travel (of those, the fewest moves).
+        The route that minimises the (weighted) sum of both vehicles' travel (of those, the fewest moves).
 
     Raises
     ------
@@ -155,6 +166,8 @@ def plan_graph(
             f"expected a start, a goal and a name for each of two vehicles, got {short_repr(start)}, "
             f"{short_repr(goal)}, {short_repr(names)}"
         )
+    if len(weights) != 2 or not all(finite_real(w, "route weight", SeparationError) > 0.0 for w in weights):
+        raise SeparationError(f"route weights {short_repr(weights)}: expected two positive numbers")
     starts = (track.point(start[0]), track.point(start[1]))
     goals = (track.point(goal[0]), track.point(goal[1]))
     for what, pair in (("start", starts), ("goal", goals)):
@@ -165,7 +178,47 @@ def plan_graph(
                 f"{gap:.6g} m apart along the track: expected at least the minimum separation "
                 f"{separation:g} m"
             )
-    return _Search(track, separation, starts, goals, tuple(names)).run()
+    search = _Search(track, separation, starts, goals, tuple(names))
+    search.weights = (float(weights[0]), float(weights[1]))
+    return search.run()
+
+
+def class_signature(route: GraphRoute) -> tuple:
+    """What makes a route's class: each move's vehicle and the edges it runs along, in order.
+
+    Two routes whose moves run the same edges in the same order (parking in the same siding,
+    passing a loop on the same side) differ only in how deep a vehicle waits: one class.
+    """
+    return tuple((move.vehicle, move.edges) for move in route.moves)
+
+
+def plan_graph_classes(
+    track: TrackGraph,
+    start: Sequence[str | EdgePoint],
+    goal: Sequence[str | EdgePoint],
+    *,
+    min_separation: float,
+    names: Sequence[str] = ("vehicle 1", "vehicle 2"),
+) -> tuple[GraphRoute, ...]:
+    """The shortest route and up to two more of other classes: where either vehicle yields instead.
+
+    The alternatives are the shortest routes when one vehicle's metres cost :data:`CLASS_WEIGHT`
+    times the other's (so the other one makes the detours: parks, or takes the other side of a
+    loop). Distinct classes (:func:`class_signature`) only, the shortest (``plan_graph``'s) first,
+    then by the sum of both travels.
+
+    Raises
+    ------
+    InfeasibleError, PositionError, SeparationError
+        As :func:`plan_graph`.
+    """
+    shortest = plan_graph(track, start, goal, min_separation=min_separation, names=names)
+    routes = {class_signature(shortest): shortest}
+    for weights in ((1.0, CLASS_WEIGHT), (CLASS_WEIGHT, 1.0)):
+        other = plan_graph(track, start, goal, min_separation=min_separation, names=names, weights=weights)
+        routes.setdefault(class_signature(other), other)
+    alternatives = sorted(list(routes.values())[1:], key=lambda r: (round(r.length, 9), len(r.moves)))
+    return (shortest, *alternatives)
 
 
 class _Search:
@@ -189,6 +242,7 @@ class _Search:
         self.node_points = [track.node_point(n) for n in range(len(track.nodes))]
         self.cuts = self._static_cuts()
         self.keys: dict[EdgePoint, tuple[int, float]] = {}
+        self.weights = (1.0, 1.0)
 
     # -- geometry ---------------------------------------------------------------------------------
 
@@ -319,7 +373,7 @@ class _Search:
                 known = to_goal[vehicle].get(pair[vehicle])
                 if known is None:
                     known = to_goal[vehicle][pair[vehicle]] = self._distance(pair[vehicle], goals[vehicle])
-                total += known
+                total += self.weights[vehicle] * known
             return total
 
         start = (self._key(self.starts[0]), self._key(self.starts[1]), 2)
@@ -348,7 +402,7 @@ class _Search:
                     key = (self._key(following[0]), self._key(following[1]), vehicle)
                     if key in done:
                         continue
-                    total = cost + step
+                    total = cost + self.weights[vehicle] * step
                     known = best.get(key)
                     if known is None or (round(total, 9), more) < (round(known[0], 9), known[1]):
                         best[key] = (total, more)
@@ -397,6 +451,7 @@ class _Search:
             (travel[0], travel[1]),
             self._critical_points(),
             searched,
+            self.names,
         )
 
     def _critical_points(self) -> int:

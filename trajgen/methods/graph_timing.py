@@ -1,24 +1,42 @@
 """Timing a route on a track graph (docs/graphs.md).
 
-The planner's route on a track graph moves one vehicle at a time. ``exact`` times it as it is: each
-move rest to rest with the time-optimal S-curve (closed form) of its vehicle's limits, the other
-vehicle standing; ``exact`` without jerk takes the trapezoids instead. Each vehicle's travel over
-time is one piecewise cubic (:class:`~trajgen.model.graph_schedule.GraphSchedule`).
+The planner's route on a track graph moves one vehicle at a time: in the plane of both vehicles'
+travel (metres driven along their paths) it is a staircase, each move a step along one axis.
+
+- ``exact`` times it as it is: each move rest to rest with the time-optimal S-curve of its vehicle's
+  limits (closed form), the other vehicle standing; without jerk, the trapezoids.
+- ``toppra`` overlaps the moves: where one vehicle's move hands over to the other's, the corner of
+  the staircase is replaced by a quadratic Bézier blend (both vehicles drive at once), as large as
+  half of each adjacent move, shrunk until the whole triangle of the corner keeps the separation (so
+  the blend keeps it and passes every conflict in the route's order). Between stops (a corner that
+  cannot be rounded, or a vehicle turning back) TOPPRA gives the time-optimal velocity- and
+  acceleration-limited timing; a section TOPPRA would make slower than the trapezoids keeps them.
 """
 
 from __future__ import annotations
 
-import math
+import logging
+
+import numpy as np
 
 from limits import Limits
-from topology import GraphRoute
-from trajgen.errors import InputError
-from trajgen.model.graph_paths import graph_paths
-from trajgen.model.graph_schedule import GraphSchedule
-from trajgen.model.profiles import PiecewiseCubic, scurve_phases, trapezoid_phases
+from topology import GraphRoute, TrackGraph
+from trajgen.errors import InputError, SolverError
+from trajgen.methods.toppra_timing import toppra_kinematics
+from trajgen.model.axes import piece_profiles
+from trajgen.model.blended import Blend, BlendedPath
+from trajgen.model.graph_paths import GraphPath, graph_paths
+from trajgen.model.graph_schedule import GraphSchedule, GraphSection
 from trajgen.model.schedule import CubicKinematics
 
-__all__ = ["check_graph_request", "moves_one_at_a_time"]
+__all__ = ["check_graph_request", "moves_one_at_a_time", "overlapped_moves", "travel_corners"]
+
+logger = logging.getLogger(__name__)
+
+#: Blend sizes tried, as fractions of the largest possible one.
+_BLEND_FRACTIONS = (1.0, 0.5, 0.25, 0.125, 0.0625)
+#: Samples per side of the corner's triangle when checking a blend.
+_TRIANGLE_SAMPLES = 48
 
 
 def check_graph_request(route: object, limits: object) -> tuple[GraphRoute, Limits]:
@@ -36,6 +54,24 @@ def check_graph_request(route: object, limits: object) -> tuple[GraphRoute, Limi
     return route, limits
 
 
+def travel_corners(route: GraphRoute) -> tuple[np.ndarray, np.ndarray]:
+    """The route as a staircase in the plane of both travels.
+
+    Returns
+    -------
+    corners : ndarray, shape (m + 1, 2)
+        Both vehicles' travel before the first move and after each, metres.
+    movers : ndarray of int, shape (m,)
+        The vehicle each move moves.
+    """
+    moves = [move for move in route.moves if move.length > 0.0]
+    corners = np.zeros((len(moves) + 1, 2))
+    for k, move in enumerate(moves):
+        corners[k + 1] = corners[k]
+        corners[k + 1, move.vehicle] += move.length
+    return corners, np.array([move.vehicle for move in moves], dtype=int)
+
+
 def moves_one_at_a_time(route: GraphRoute, limits: Limits, method, *, jerk: bool) -> GraphSchedule:
     """The route's moves one after the other, each rest to rest and time-optimal for its vehicle.
 
@@ -49,32 +85,111 @@ def moves_one_at_a_time(route: GraphRoute, limits: Limits, method, *, jerk: bool
         S-curves (jerk-limited) if True, else trapezoids.
     """
     check_graph_request(route, limits)
+    corners, _ = travel_corners(route)
+    sections = []
+    clock = 0.0
+    for k in range(max(len(corners) - 1, 1)):
+        end = corners[min(k + 1, len(corners) - 1)]
+        section = GraphSection(clock, CubicKinematics(piece_profiles(corners[k], end, limits, jerk=jerk)))
+        sections.append(section)
+        clock += section.duration
+    return GraphSchedule(route, limits, method, graph_paths(route), tuple(sections), jerk_limited=jerk)
+
+
+def _distances(track: TrackGraph, paths: tuple[GraphPath, GraphPath], points: np.ndarray) -> np.ndarray:
+    """Track distance between the vehicles at travel points ``points``, shape (n, 2) -> (n,)."""
+    edge_1, s_1 = paths[0].locate(points[:, 0])
+    edge_2, s_2 = paths[1].locate(points[:, 1])
+    return track.distances(edge_1, s_1, edge_2, s_2)
+
+
+def _safe_blend(
+    corners: np.ndarray, corner: int, track: TrackGraph, paths: tuple[GraphPath, GraphPath], required: float
+) -> Blend | None:
+    """The largest blend at ``corners[corner]`` whose whole triangle keeps ``required`` metres, or None.
+
+    The track distance changes by at most ``|dp1| + |dp2|`` between two points of the travel plane,
+    so a grid of the triangle with spacing ``h`` per axis that keeps ``required + h`` keeps
+    ``required`` everywhere in it; the blend and the corner both lie in the triangle, which then holds
+    no part of a conflict, so the blend passes every conflict on the route's side.
+    """
+    before, point, after = corners[corner - 1], corners[corner], corners[corner + 1]
+    incoming, outgoing = point - before, after - point
+    length_in, length_out = float(np.linalg.norm(incoming)), float(np.linalg.norm(outgoing))
+    u = np.linspace(0.0, 1.0, _TRIANGLE_SAMPLES + 1)
+    a, b = np.meshgrid(u, u)
+    inside = a + b <= 1.0
+    a, b = a[inside], b[inside]
+    for fraction in _BLEND_FRACTIONS:
+        r = 0.5 * fraction * min(length_in, length_out)
+        start, end = point - r * incoming / length_in, point + r * outgoing / length_out
+        # the triangle (start, point, end): point + a (start - point) + b (end - point)
+        grid = point + np.outer(a, start - point) + np.outer(b, end - point)
+        spacing = r / _TRIANGLE_SAMPLES
+        if np.min(_distances(track, paths, grid)) >= required + 2.0 * spacing:
+            return Blend(start, point, end)
+    return None
+
+
+def overlapped_moves(route: GraphRoute, limits: Limits, method, *, grid_points: int) -> GraphSchedule:
+    """The ``toppra`` schedule of a route on a track graph: corners rounded where safe, TOPPRA between stops.
+
+    Raises
+    ------
+    InputError
+        A bad route or limits.
+    """
+    check_graph_request(route, limits)
+    corners, movers = travel_corners(route)
     paths = graph_paths(route)
-    phases: tuple[list, list] = ([], [])
-    for move in route.moves:
-        if move.length <= 0.0:
-            continue
-        vehicle = limits.vehicles[move.vehicle]
-        if jerk:
-            moving = [
-                (d, math.nan, value)
-                for d, value in scurve_phases(
-                    move.length, vehicle.max_velocity, vehicle.max_acceleration, vehicle.max_jerk
+    if movers.size == 0:
+        exact = moves_one_at_a_time(route, limits, method, jerk=False)
+        return exact
+    required = max(limits.min_separation, route.min_separation)
+    blends: list[Blend | None] = [None]
+    for corner in range(1, movers.size):
+        same_vehicle = movers[corner] == movers[corner - 1]  # it turned back: at rest there
+        blends.append(None if same_vehicle else _safe_blend(corners, corner, route.track, paths, required))
+    groups, start = [], 0
+    for corner in range(1, movers.size):
+        if blends[corner] is None:
+            groups.append((start, corner))
+            start = corner
+    groups.append((start, movers.size))
+    sections: list[GraphSection] = []
+    clock = 0.0
+    rounded = timed_sections = 0
+    failed: list[str] = []
+    for first, stop in groups:
+        trapezoids = [
+            CubicKinematics(piece_profiles(corners[k], corners[k + 1], limits, jerk=False))
+            for k in range(first, stop)
+        ]
+        timed = None
+        if stop - first > 1:
+            path = BlendedPath(corners[first : stop + 1], (None, *blends[first + 1 : stop], None))
+            try:
+                timed = toppra_kinematics(path, limits, grid_points)
+            except SolverError as error:
+                logger.warning(
+                    "TOPPRA failed on a section of a graph route, its corners are stops: %s", error
                 )
-            ]
-        else:
-            moving = [
-                (d, value, 0.0)
-                for d, value in trapezoid_phases(move.length, vehicle.max_velocity, vehicle.max_acceleration)
-            ]
-        phases[move.vehicle].extend(moving)
-        phases[1 - move.vehicle].append((sum(d for d, _, _ in moving), 0.0, 0.0))  # the other stands
-    profiles = tuple(PiecewiseCubic.from_phases(0.0, phases[v], end=paths[v].length) for v in range(2))
-    return GraphSchedule(
-        route,
-        limits,
-        method,
-        paths,
-        CubicKinematics(profiles),
-        jerk_limited=jerk,  # type: ignore[arg-type]
+                failed.append(str(error))
+            if timed is not None and timed.duration >= sum(k.duration for k in trapezoids):
+                timed = None
+        if timed is not None:
+            sections.append(GraphSection(clock, timed))
+            clock += timed.duration
+            rounded += stop - first - 1
+            timed_sections += 1
+            continue
+        for kinematics in trapezoids:
+            sections.append(GraphSection(clock, kinematics))
+            clock += kinematics.duration
+    notes = (
+        f"{rounded} of {movers.size - 1} hand-overs between the vehicles overlapped; "
+        f"{timed_sections} section(s) timed by TOPPRA",
+        "jerk is not limited by this method",
+        *(f"TOPPRA failed on a section ({reason}); its corners are stops" for reason in failed),
     )
+    return GraphSchedule(route, limits, method, paths, tuple(sections), jerk_limited=False, notes=notes)

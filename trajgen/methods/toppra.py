@@ -33,8 +33,10 @@ from topology import Route, reduce_regions
 from topology.indexed import region_keys, track_distance
 from trajgen.errors import InputError, SolverError
 from trajgen.methods.exact import Exact
+from trajgen.methods.graph_timing import check_graph_request, overlapped_moves
+from trajgen.methods.toppra_timing import HEADROOM, toppra_kinematics
 from trajgen.model.axes import RouteAxes, piece_maps, piece_profiles, route_axes, straight_pieces
-from trajgen.model.blended import Blend, BlendedPath, ToppraKinematics
+from trajgen.model.blended import Blend, BlendedPath
 from trajgen.model.schedule import (
     AxisMap,
     CubicKinematics,
@@ -44,15 +46,12 @@ from trajgen.model.schedule import (
     TimingMethod,
     check_request,
 )
-from trajgen.model.values import sorted_unique
 from trajgen.verification import verify
 
 __all__ = ["HEADROOM", "Toppra"]
 
 logger = logging.getLogger(__name__)
 
-#: Fraction of the velocity and acceleration limits TOPPRA plans with.
-HEADROOM = 1.0 - 1e-4
 #: Blend sizes tried, as fractions of the largest possible one.
 _BLEND_FRACTIONS = (1.0, 0.5, 0.25, 0.125)
 _BLEND_SAMPLES = 256
@@ -101,36 +100,6 @@ def _safe_blend(axes: RouteAxes, pieces: list[tuple[int, int]], corner: int, req
     return None
 
 
-def _toppra_section(path: BlendedPath, limits: Limits, grid_points: int) -> ToppraKinematics:
-    import toppra
-    import toppra.algorithm
-    import toppra.constraint
-
-    v = np.array([vehicle.max_velocity for vehicle in limits.vehicles]) * HEADROOM
-    a = np.array([vehicle.max_acceleration for vehicle in limits.vehicles]) * HEADROOM
-    velocity = toppra.constraint.JointVelocityConstraint(np.column_stack([-v, v]))
-    acceleration = toppra.constraint.JointAccelerationConstraint(
-        np.column_stack([-a, a]), discretization_scheme=toppra.constraint.DiscretizationType.Interpolation
-    )
-    grid = sorted_unique(np.concatenate([np.linspace(0.0, path.length, grid_points), path.breakpoints]))
-    instance = toppra.algorithm.TOPPRA(
-        [velocity, acceleration], path, gridpoints=grid, parametrizer="ParametrizeConstAccel"
-    )
-    instance.compute_parameterization(0.0, 0.0)
-    data = instance.problem_data
-    speed = None if data.sd_vec is None else np.asarray(data.sd_vec, dtype=float)
-    if speed is None or not np.all(np.isfinite(speed)):
-        raise SolverError(f"TOPPRA could not parameterize a section: return code {data.return_code}")
-    grid = np.asarray(data.gridpoints, dtype=float)
-    speed = np.maximum(speed, 0.0)
-    speed[0] = speed[-1] = 0.0
-    mean = 0.5 * (speed[1:] + speed[:-1])
-    if np.any(mean <= 0.0):
-        raise SolverError("TOPPRA returned a zero path velocity inside a section")
-    times = np.concatenate([[0.0], np.cumsum(np.diff(grid) / mean)])
-    return _fit_to_limits(ToppraKinematics(path, grid, speed, times), limits)
-
-
 def _groups(axes: RouteAxes, pieces: list[tuple[int, int]], blends: list[Blend | None]):
     """Runs of pieces joined by rounded corners, as (first piece, end piece) index ranges.
 
@@ -149,34 +118,6 @@ def _groups(axes: RouteAxes, pieces: list[tuple[int, int]], blends: list[Blend |
         else:
             heading = np.where(heading == 0, step, heading)
     yield start, len(pieces)
-
-
-def _fit_to_limits(kinematics: ToppraKinematics, limits: Limits) -> ToppraKinematics:
-    """Stretch a TOPPRA section uniformly in time until it meets the limits between grid points too.
-
-    Scaling time by ``c >= 1`` divides velocities by ``c`` and accelerations by ``c**2`` exactly.
-    """
-    # acceleration is linear in s within a grid interval: its extremes are at the interval ends,
-    # which are sampled as one-sided limits (ends nudged inside)
-    fine = np.array([0.0, 1.0 - 1e-9])
-    times = (kinematics.times[:-1, None] + np.diff(kinematics.times)[:, None] * fine).ravel()
-    values = kinematics.evaluate(times)
-    peaks = kinematics.interior_velocity_peaks()
-    ratio = 1.0
-    for vehicle, vehicle_limits in enumerate(limits.vehicles):
-        fastest = max(float(np.max(np.abs(values[vehicle, 1]))), float(peaks[vehicle]))
-        ratio = max(
-            ratio,
-            fastest / vehicle_limits.max_velocity,
-            float(np.sqrt(np.max(np.abs(values[vehicle, 2])) / vehicle_limits.max_acceleration)),
-        )
-    if ratio <= 1.0:
-        return kinematics
-    stretch = ratio * (1.0 + 1e-7)  # the dense samples bound the maxima to well within this
-    logger.debug("TOPPRA section stretched in time by %.3g to meet the limits between grid points", stretch)
-    return ToppraKinematics(
-        kinematics.path, kinematics.grid, kinematics.speed / stretch, kinematics.times * stretch
-    )
 
 
 def _toppra_schedule(method: Toppra, route: Route, limits: Limits) -> Schedule:
@@ -205,7 +146,7 @@ def _toppra_schedule(method: Toppra, route: Route, limits: Limits) -> Schedule:
             vertices = axes.axes[[group[0][0]] + [b for _, b in group]]
             path = BlendedPath(vertices, (None, *blends[start + 1 : stop], None))
             try:
-                timed = _toppra_section(path, limits, grid_points)
+                timed = toppra_kinematics(path, limits, grid_points)
             except SolverError as error:  # keep this section's stops, flagged in the notes
                 logger.warning("TOPPRA failed on a section, its corners are stops: %s", error)
                 failed.append(str(error))
@@ -280,6 +221,40 @@ class Toppra(TimingMethod):
         if not report.passed:
             return _fallback(route, limits, FallbackReason.VERIFICATION_FAILED, "; ".join(report.failures))
         return schedule
+
+    def schedule_graph(self, route, limits: Limits):
+        """The TOPPRA schedule of a route on a track graph: hand-overs overlapped where safe, verified.
+
+        A result that cannot be computed or fails the verifier is replaced by the exact schedule
+        without jerk limits, with ``fallback_reason`` set (as on a junction).
+        """
+        check_graph_request(route, limits)
+        try:
+            schedule = overlapped_moves(route, limits, self, grid_points=self.grid_points)
+        except InputError:
+            raise
+        except Exception as error:  # TOPPRA's own failures must not leave the library as a crash
+            return _graph_fallback(
+                route, limits, FallbackReason.SOLVER_FAILED, f"{type(error).__name__}: {error}"
+            )
+        report = verify(schedule)
+        if not report.passed:
+            return _graph_fallback(
+                route, limits, FallbackReason.VERIFICATION_FAILED, "; ".join(report.failures)
+            )
+        return schedule
+
+
+def _graph_fallback(route, limits: Limits, reason: FallbackReason, detail: str):
+    logger.warning(
+        "toppra schedule of a graph fell back to exact without jerk (%s): %s", reason.value, detail
+    )
+    exact = Exact(jerk=False).schedule_graph(route, limits)
+    return dataclasses.replace(
+        exact,
+        notes=(f"fallback to exact without jerk limits ({reason.value}): {detail}",),
+        fallback_reason=reason,
+    )
 
 
 def _fallback(route: Route, limits: Limits, reason: FallbackReason, detail: str) -> Schedule:

@@ -1,7 +1,9 @@
 """Schedules on a track graph: both vehicles' travel over time along their paths (the data model).
 
 A :class:`GraphSchedule` holds each vehicle's path (:class:`~trajgen.model.graph_paths.GraphPath`)
-and its travel ``p(t)`` as a piecewise cubic (:class:`~trajgen.model.schedule.CubicKinematics`).
+and both vehicles' travel ``p(t)`` as consecutive :class:`GraphSection` s, each piecewise cubic
+(:class:`~trajgen.model.schedule.CubicKinematics`) or a TOPPRA section
+(:class:`~trajgen.model.blended.ToppraKinematics`) in the plane of both travels.
 The signed axis, velocity, acceleration and jerk a controller reads are the travel's, signed by the
 path's heading (which flips only where the vehicle is at rest). Made by the timing methods'
 :meth:`~trajgen.model.schedule.TimingMethod.schedule_graph`; checked by
@@ -16,10 +18,12 @@ import numpy as np
 
 from limits import Limits
 from topology import GraphRoute, TrackGraph
+from topology.validation import finite_real
+from trajgen.errors import InputError
 from trajgen.model.graph_paths import GraphPath
 from trajgen.model.schedule import (
-    CubicKinematics,
     FallbackReason,
+    Kinematics,
     MethodInfo,
     check_period,
     sample_block,
@@ -27,7 +31,31 @@ from trajgen.model.schedule import (
 )
 from trajgen.model.values import ArrayValue, frozen
 
-__all__ = ["GraphSchedule", "GraphState"]
+__all__ = ["GraphSchedule", "GraphSection", "GraphState"]
+
+
+@dataclass(frozen=True, slots=True)
+class GraphSection:
+    """A stretch of a schedule on a track graph: both vehicles' travel over the section's local time.
+
+    Attributes
+    ----------
+    start_time : float
+        Seconds from the start of the schedule.
+    kinematics : Kinematics
+        Travel of both vehicles (metres along their paths), its velocity, acceleration and jerk.
+    """
+
+    start_time: float
+    kinematics: Kinematics
+
+    def __post_init__(self) -> None:
+        finite_real(self.start_time, "section start_time (seconds)", InputError)
+
+    @property
+    def duration(self) -> float:
+        """Seconds."""
+        return self.kinematics.duration
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -92,8 +120,8 @@ class GraphSchedule:
         The method, with its options, that computed the motion.
     paths : tuple of 2 GraphPath
         Each vehicle's path along the route.
-    kinematics : CubicKinematics
-        Each vehicle's travel over time, metres (from 0 to its path's length).
+    sections : tuple of GraphSection
+        Consecutive in time, the first at t = 0: each vehicle's travel from 0 to its path's length.
     jerk_limited : bool
     notes : tuple of str
     fallback_reason : FallbackReason or None
@@ -105,11 +133,17 @@ class GraphSchedule:
     limits: Limits
     method: object
     paths: tuple[GraphPath, GraphPath]
-    kinematics: CubicKinematics
+    sections: tuple[GraphSection, ...]
     jerk_limited: bool
     notes: tuple[str, ...] = ()
     fallback_reason: FallbackReason | None = None
     info: MethodInfo | None = None
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "sections", tuple(self.sections))
+        object.__setattr__(self, "notes", tuple(self.notes))
+        if not self.sections:
+            raise InputError("a graph schedule needs at least one section: expected one at t = 0")
 
     def __repr__(self) -> str:
         """One line: method, makespan, moves, jerk."""
@@ -138,12 +172,31 @@ class GraphSchedule:
     @property
     def duration(self) -> float:
         """Makespan: time until both vehicles are at rest at their goals, seconds."""
-        return self.kinematics.duration
+        last = self.sections[-1]
+        return last.start_time + last.duration
+
+    def travel(self, t) -> np.ndarray:
+        """Both vehicles' travel (m), its velocity, acceleration and jerk at times ``t``, shape (2, 4, n).
+
+        Travel never decreases; :meth:`state` signs its derivatives by each path's heading.
+        """
+        t = np.clip(np.atleast_1d(np.asarray(t, dtype=float)), 0.0, self.duration)
+        starts = np.array([section.start_time for section in self.sections])
+        index = np.clip(np.searchsorted(starts, t, side="right") - 1, 0, len(self.sections) - 1)
+        values = np.zeros((2, 4, t.size))  # travel, its velocity, acceleration, jerk
+        for k, section in enumerate(self.sections):
+            mask = index == k
+            if mask.any():
+                local = np.clip(t[mask] - section.start_time, 0.0, section.duration)
+                if k == len(self.sections) - 1:
+                    local[t[mask] >= self.duration] = section.duration
+                values[:, :, mask] = section.kinematics.evaluate(local)
+        return values
 
     def state(self, t) -> GraphState:
         """States of both vehicles at times ``t`` (seconds, clipped to [0, duration])."""
         t = np.clip(np.atleast_1d(np.asarray(t, dtype=float)), 0.0, self.duration)
-        values = self.kinematics.evaluate(t)  # (2, 4, n): travel, its velocity, acceleration, jerk
+        values = self.travel(t)
         travel = values[:, 0]
         axis, heading = np.zeros_like(travel), np.zeros_like(travel)
         edge = np.zeros(travel.shape, dtype=int)

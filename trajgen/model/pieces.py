@@ -16,7 +16,7 @@ import numpy as np
 from topology import JUNCTION_INDEX
 from trajgen.model.blended import ToppraKinematics
 from trajgen.model.polynomials import evaluate, root_in
-from trajgen.model.schedule import AxisMap, CubicKinematics, Schedule, Section
+from trajgen.model.schedule import AxisMap, CubicKinematics, Schedule
 from trajgen.model.values import ArrayValue, readonly, sorted_unique
 
 __all__ = [
@@ -24,10 +24,12 @@ __all__ = [
     "Pieces",
     "UncheckableKinematicsError",
     "cubic_pieces",
+    "kinematics_polynomials",
     "motion_arrays",
     "schedule_pieces",
     "shift",
     "split_at_values",
+    "toppra_pieces",
 ]
 
 #: Highest power of the axis polynomials (TOPPRA sections: a quadratic path of a quadratic s(t)).
@@ -138,7 +140,7 @@ def cubic_pieces(kinematics: CubicKinematics) -> tuple[np.ndarray, np.ndarray, n
     return times, coefficients, intervals
 
 
-def _toppra_section(kinematics) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def toppra_pieces(kinematics) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Breakpoints, axis polynomials and grid intervals of a TOPPRA section: q(s(t)), quadratic in time."""
     grid, speed, times, path = kinematics.grid, kinematics.speed, kinematics.times, kinematics.path
     width = np.diff(grid)
@@ -163,13 +165,19 @@ def _toppra_section(kinematics) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     return np.asarray(times, dtype=float), coefficients, intervals
 
 
-def _section_polynomials(section: Section) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    kinematics = section.kinematics
+def kinematics_polynomials(kinematics) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Breakpoints (m + 1,), both vehicles' polynomials (2, m, DEGREE + 1) and intervals (2, m) of a section.
+
+    Raises
+    ------
+    UncheckableKinematicsError
+        The kinematics are neither piecewise cubic nor TOPPRA's.
+    """
     # exact types only: a subclass could evaluate (and so export) something else than this form
     if type(kinematics) is CubicKinematics:
         return cubic_pieces(kinematics)
     if type(kinematics) is ToppraKinematics:
-        return _toppra_section(kinematics)
+        return toppra_pieces(kinematics)
     raise UncheckableKinematicsError(
         f"section kinematics {type(kinematics).__name__} have no polynomial form the verifier knows"
     )
@@ -291,7 +299,7 @@ def schedule_pieces(schedule: Schedule) -> Pieces:
     """
     parts = []
     for index, section in enumerate(schedule.sections):
-        times, axis, intervals = _section_polynomials(section)
+        times, axis, intervals = kinematics_polynomials(section.kinematics)
         starts, lengths, axis, intervals = _split_at_map_boundaries(times, axis, intervals, section.maps)
         keep = lengths > 0.0
         starts, lengths, axis, intervals = starts[keep], lengths[keep], axis[:, keep], intervals[:, keep]

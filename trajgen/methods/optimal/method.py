@@ -19,6 +19,7 @@ from limits import Limits
 from topology import Homotopy, OptionError, Route, plan
 from trajgen.errors import InputError, SolverError
 from trajgen.methods.exact import Exact
+from trajgen.methods.graph_classes import solve_graph
 from trajgen.methods.optimal.braking_constraints import BRAKING_CURVATURE, BRAKING_MARGIN
 from trajgen.methods.optimal.choice import HomotopyChoice
 from trajgen.methods.optimal.classes import ClassRace, ClassSolve
@@ -115,7 +116,7 @@ class Optimal(TimingMethod):
         scratch converges in 40-150 iterations where it converges (benchmark and campaign sets),
         and 500 of them take 2-10 s.
     fatrop_iterations : int, optional
-        Iteration limit of fatrop (default 500; it converges in < 150 when it converges).
+        Iteration limit of fatrop (default 500; < 150 where it converges).
     time_limit : float, optional
         A safety stop, seconds (default :data:`DEFAULT_TIME_LIMIT`, 30 s, about 20 times the
         slowest usual solve; the one-time build or load of an NLP is not counted). The effort is
@@ -126,8 +127,7 @@ class Optimal(TimingMethod):
         ``fallback_reason`` ``time-limit`` if no class was solved, else
         ``info.time_limit_reached`` and a note (the passes solved before it are kept).
     time_budget : float, optional
-        Deprecated name of ``time_limit`` (0.7: it no longer decides how much of the optimum a
-        schedule gets).
+        Deprecated name of ``time_limit`` (0.7).
     braking_rule : bool, optional
         State the braking rule (:mod:`trajgen.verification.braking_rule`) in the problem (default
         ``False``), so that the plan can be executed by the order-keeping :class:`~trajgen.execution.Executor`
@@ -149,8 +149,9 @@ class Optimal(TimingMethod):
         ``G_k`` (four to eight legs, ``plan(..., homotopy="other")``). ``"planned"``: the route's
         class only.
     cache : SolverCache or None, optional
-        Where compiled NLPs are kept; ``None`` (default) uses the process-wide
-        :meth:`shared_cache`, backed by the user's disk store (:mod:`~.store`).
+        Where compiled NLPs are kept; ``None`` (default): the process-wide :meth:`shared_cache`.
+
+    On a track graph the problem is :mod:`trajgen.methods.graph_optimal`'s.
     """
 
     name: ClassVar[str] = "optimal"
@@ -273,6 +274,10 @@ class Optimal(TimingMethod):
             return [route, plan(graph, start, goal, min_separation=separation, homotopy=other)]
         except OptionError:  # start and goal retract to one boundary point up to round-off
             return [route]
+
+    def schedule_graph(self, route, limits: Limits):
+        """The optimal schedule of a route on a track graph (verified), or the flagged ``exact`` one."""
+        return solve_graph(self, route, limits)
 
     def schedule(self, route: Route, limits: Limits) -> Schedule:
         """The optimal schedule from ``route``'s start to its goal (verified), or the flagged ``exact`` one.
