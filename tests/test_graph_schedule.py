@@ -147,18 +147,15 @@ def test_the_verifier_finds_a_path_that_is_not_the_routes():
         certify(dataclasses.replace(schedule, route=other))
 
 
-def test_a_graph_run_writes_both_csv_files_and_refuses_what_it_cannot_draw_yet(tmp_path):
+def test_a_graph_run_writes_both_csv_files_and_refuses_what_it_cannot_write_yet(tmp_path):
     scenario = load_scenario(EXAMPLES / "passing-loop.toml")
     result = run(scenario, outputs=Outputs(csv_dir=tmp_path / "csv"))
     assert result.method.name == "exact"
     assert result.verified.report.passed
     assert sorted(p.name for p in result.files) == ["agv1.csv", "agv2.csv"]
     assert result.summary()["route"]["travel_m"] == list(result.route.travel)
-    with pytest.raises(InputError, match="plots of a track graph's schedule are not drawn yet"):
-        run(scenario, outputs=Outputs(plot_dir=tmp_path / "plots"))
     with pytest.raises(InputError, match="dialect 'siemens-xy' is not written for a track graph yet"):
         run(scenario, outputs=Outputs(csv_dir=tmp_path / "t", dialect="siemens-xy"))
-    assert not (tmp_path / "plots").exists()
     assert not (tmp_path / "t").exists()
 
 

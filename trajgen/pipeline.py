@@ -186,11 +186,6 @@ def _check_graph_outputs(outputs: Outputs) -> None:
             f"dialect '{outputs.dialect.name.value}' is not written for a track graph yet: expected the "
             "generic CSV (docs/graphs.md)"
         )
-    if outputs.plot_dir is not None:
-        raise InputError(
-            "the plots of a track graph's schedule are not drawn yet: expected no plot folder "
-            "('trajgen plan SCENARIO --plot FILE.png' draws the route; docs/graphs.md)"
-        )
 
 
 def run(
@@ -274,7 +269,12 @@ def run(
         files[speed] = png_bytes(plot_speed(verified, names=scenario.names))
         files[separation] = png_bytes(plot_separation(verified))
         files[coordination] = png_bytes(plot_coordination(compared))
-        files[configuration] = png_bytes(plot_configuration(verified, names=scenario.names))
+        if graph:  # the track from above with both vehicles' paths, move by move
+            from trajgen.plots import plot_graph_route
+
+            files[configuration] = png_bytes(plot_graph_route(verified.schedule.route, names=scenario.names))
+        else:
+            files[configuration] = png_bytes(plot_configuration(verified, names=scenario.names))
     written = commit_files(files) if files else ()
     # the schedule's route: optimal may have taken the other homotopy class
     return RunResult(scenario, chosen, verified.schedule.route, verified, written, tuple(notes), tables)

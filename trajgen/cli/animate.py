@@ -6,7 +6,7 @@ import argparse
 import os
 from pathlib import Path
 
-from trajgen.cli.options import add_method, method_from, scenario_from
+from trajgen.cli.options import add_method, scenario_from, scenario_method
 from trajgen.cli.parser import EXIT_OK
 from trajgen.errors import OutputError
 from trajgen.export.atomic import check_output_paths, commit_files
@@ -47,8 +47,8 @@ def _command_animate(args: argparse.Namespace) -> int:
     from trajgen.plots.animation import animate
     from trajgen.plots.gif import encode_gif
 
-    scenario = scenario_from(args.scenario)
-    verified = run(scenario, method=method_from(args)).verified
+    scenario = scenario_from(args.scenario, graph=True)
+    verified = run(scenario, method=scenario_method(args, scenario)).verified
     gif = encode_gif(animate(verified, names=scenario.names, fps=args.fps, max_frames=args.max_frames))
     (written,) = commit_files({path: gif})
     play = playback(verified.schedule.duration, fps=args.fps, max_frames=args.max_frames)

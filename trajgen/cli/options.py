@@ -119,6 +119,17 @@ def add_method(
     )
 
 
+def scenario_method(args: argparse.Namespace, scenario) -> TimingMethod | None:
+    """``--method`` for ``scenario``: ``None`` (the pipeline's default) on a track graph given none."""
+    if (
+        isinstance(scenario, GraphScenario)
+        and args.method is None
+        and getattr(args, "homotopy", None) is None
+    ):
+        return None
+    return method_from(args)
+
+
 def method_from(args: argparse.Namespace) -> TimingMethod:
     """The method object of ``--method`` with ``--homotopy`` applied."""
     method = METHODS.create(args.method)

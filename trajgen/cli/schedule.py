@@ -8,7 +8,14 @@ import os
 from pathlib import Path
 
 from topology import GraphRoute
-from trajgen.cli.options import add_csv_options, add_method, csv_options, method_from, scenario_from
+from trajgen.cli.options import (
+    add_csv_options,
+    add_method,
+    csv_options,
+    method_from,
+    scenario_from,
+    scenario_method,
+)
 from trajgen.cli.parser import EXIT_OK
 from trajgen.errors import OutputError, VerificationError
 from trajgen.export.atomic import check_output_paths, commit_files
@@ -20,7 +27,7 @@ from trajgen.model.summary import (
     route_summary,
 )
 from trajgen.pipeline import Outputs, run
-from trajgen.scenario import BuiltinScenario, GraphScenario, builtin_scenario
+from trajgen.scenario import BuiltinScenario, builtin_scenario
 from trajgen.verification.graph_route import verify_graph_route
 
 __all__ = ["register"]
@@ -77,9 +84,7 @@ def _command_schedule(args: argparse.Namespace) -> int:
         dialect=args.dialect,
         max_points=args.max_points,
     )
-    graph_default = isinstance(scenario, GraphScenario) and args.method is None and args.homotopy is None
-    method = None if graph_default else method_from(args)  # None: the pipeline's default for the track
-    summary = run(scenario, method=method, outputs=outputs).summary()
+    summary = run(scenario, method=scenario_method(args, scenario), outputs=outputs).summary()
     print(json.dumps(summary, indent=2) if args.json else format_run(summary))
     return EXIT_OK
 

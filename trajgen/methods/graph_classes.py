@@ -20,9 +20,10 @@ from trajgen.methods.graph_timing import check_graph_request
 from trajgen.model.analysis import lower_bound
 from trajgen.model.graph_schedule import GraphSchedule
 from trajgen.model.schedule import FallbackReason, MethodInfo
+from trajgen.model.summary import graph_class_label
 from trajgen.verification import verify
 
-__all__ = ["GraphClassResult", "GraphOptimalInfo", "class_label", "graph_fallback", "solve_graph"]
+__all__ = ["GraphClassResult", "GraphOptimalInfo", "graph_fallback", "solve_graph"]
 
 logger = logging.getLogger(__name__)
 
@@ -98,17 +99,6 @@ class GraphOptimalInfo(MethodInfo):
         }
 
 
-def class_label(route: GraphRoute) -> str:
-    """A route's class in words: its moves in order, by the vehicles' names."""
-    track, names = route.track, route.names
-    return (
-        "; ".join(
-            f"{names[m.vehicle]} {track.name(m.points[0])} -> {track.name(m.points[-1])}" for m in route.moves
-        )
-        or "no move"
-    )
-
-
 def _one_class(method, route: GraphRoute, limits: Limits) -> tuple[GraphSchedule | None, str | None]:
     """The verified optimal schedule of one class, or ``None`` and why not."""
     try:
@@ -150,7 +140,7 @@ def solve_graph(method, route: GraphRoute, limits: Limits) -> GraphSchedule:
     chosen = min(made, key=lambda item: (round(item[1].duration, 9), item[0]))[0] if made else 0
     classes = tuple(
         GraphClassResult(
-            class_label(r),
+            graph_class_label(r),
             k == 0,
             bound,
             None if schedule is None else schedule.duration,

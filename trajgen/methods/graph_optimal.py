@@ -33,6 +33,7 @@ import numpy as np
 from limits import Limits
 from topology import GraphRoute
 from trajgen.methods.graph_timing import check_graph_request, moves_one_at_a_time, overlapped_moves
+from trajgen.model.graph_cells import cell_ways
 from trajgen.model.graph_paths import GraphPath
 from trajgen.model.graph_schedule import GraphSchedule, GraphSection
 from trajgen.model.profiles import PiecewiseCubic
@@ -108,36 +109,18 @@ def _cells(guess: GraphSchedule) -> list[_Cell]:
     return cells
 
 
-def _on_cell(path: GraphPath, segment: int) -> tuple[int, float, float]:
-    """Edge, ``sign``, ``offset`` of ``s = offset + sign * p`` on a segment (never moving: its home)."""
-    if path.edges.size == 0:
-        return path.home.edge, 0.0, path.home.s
-    sign = float(np.sign(path.s_to[segment] - path.s_from[segment]))
-    return int(path.edges[segment]), sign, float(path.s_from[segment]) - sign * float(path.starts[segment])
+def _ways(route: GraphRoute, paths: tuple[GraphPath, GraphPath], cell: _Cell) -> list:
+    """The safe part of a cell as rows ``(c1, c2, c0)``: ``c1 p1 + c2 p2 + c0 >= d`` for each.
 
-
-def _ways(route: GraphRoute, paths: tuple[GraphPath, GraphPath], cell: _Cell):
-    """The affine ways of the track distance on a cell: rows ``(c1, c2, c0)`` of ``c1 p1 + c2 p2 + c0``."""
-    track = route.track
-    nodes = track.node_distances
-    placed = [_on_cell(paths[v], cell.segments[v]) for v in range(2)]
-    edges = [edge for edge, _, _ in placed]
-    sign = [s for _, s, _ in placed]  # s_i = offset_i + sign_i * p_i on the cell
-    offset = [o for _, _, o in placed]
-    lengths = [track.length(e) for e in edges]
-    ends = [track.ends(e) for e in edges]
-    rows = []
-    for end_1 in (0, 1):
-        for end_2 in (0, 1):
-            f1, f2 = (-1.0 if end_1 else 1.0), (-1.0 if end_2 else 1.0)
-            constant = float(nodes[ends[0][end_1], ends[1][end_2]])
-            constant += (lengths[0] if end_1 else 0.0) + (lengths[1] if end_2 else 0.0)
-            rows.append((f1 * sign[0], f2 * sign[1], constant + f1 * offset[0] + f2 * offset[1]))
-    if edges[0] == edges[1]:  # along the edge: the order the guess has there stays (no passing)
-        ahead = (offset[0] + sign[0] * cell.inside[0]) - (offset[1] + sign[1] * cell.inside[1])
-        f = 1.0 if ahead >= 0.0 else -1.0  # f (s1 - s2) >= d
-        rows.append((f * sign[0], -f * sign[1], f * (offset[0] - offset[1])))
-    return rows
+    Every way through the edges' ends; on one edge also ``|s1 - s2|``, on the side the guess keeps
+    there (the vehicles do not pass each other on an edge).
+    """
+    ways, along = cell_ways(route.track, paths, cell.segments)
+    if along is not None:
+        a, b, c = along
+        f = 1.0 if a * cell.inside[0] + b * cell.inside[1] + c >= 0.0 else -1.0  # f (s1 - s2) >= d
+        ways.append((f * a, f * b, f * c))
+    return ways
 
 
 def _cusp_after(path: GraphPath, segment: int) -> bool:

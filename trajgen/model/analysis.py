@@ -9,6 +9,7 @@ import numpy as np
 from limits import Limits
 from topology import GraphRoute, Route
 from topology.indexed import JUNCTION_INDEX, track_distance
+from trajgen.model.graph_schedule import GraphSchedule
 from trajgen.model.profiles import rest_to_rest_time
 from trajgen.model.schedule import Schedule
 
@@ -109,6 +110,8 @@ def travelled(schedule: Schedule, period: float = 0.01):
         (metres, never decreasing), leg index and distance from the junction.
     """
     state = schedule.sample(period)
+    if isinstance(schedule, GraphSchedule):  # its travel is kept: no need to add up the steps
+        return state.t, state.travel, state.edge, state.s
     step = track_distance(state.leg[:, :-1], state.s[:, :-1], state.leg[:, 1:], state.s[:, 1:])
     distance = np.concatenate([np.zeros((2, 1)), np.cumsum(step, axis=1)], axis=1)
     return state.t, distance, state.leg, state.s

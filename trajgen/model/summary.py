@@ -57,8 +57,24 @@ def class_name(route: Route) -> str:
     return _PLANNER_CLASS[route.instruction].format(graph=graph)
 
 
-def class_label(route: Route) -> str:
-    """The route's homotopy class for people: :func:`class_name` and whether it is the planner's."""
+def graph_class_label(route: GraphRoute) -> str:
+    """A route's class on a track graph in words: its moves in order, by the vehicles' names."""
+    track, names = route.track, route.names
+    return (
+        "; ".join(
+            f"{names[m.vehicle]} {track.name(m.points[0])} -> {track.name(m.points[-1])}" for m in route.moves
+        )
+        or "no move"
+    )
+
+
+def class_label(route: Route | GraphRoute) -> str:
+    """The route's homotopy class for people: :func:`class_name` and whether it is the planner's.
+
+    On a track graph: its moves in order (:func:`graph_class_label`).
+    """
+    if isinstance(route, GraphRoute):
+        return graph_class_label(route)
     return _class_text(class_name(route), route.homotopy is Homotopy.PLANNED, route.graph.cycle is not None)
 
 

@@ -23,9 +23,10 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from topology import StarGraph
+from topology import StarGraph, TrackGraph
 from topology.validation import short_repr
 from trajgen.errors import InputError
+from trajgen.model.graph_schedule import GraphSchedule
 from trajgen.model.summary import class_name
 from trajgen.plots.animation_layout import (
     DEFAULT_FPS,
@@ -46,6 +47,7 @@ from trajgen.plots.animation_layout import (
 )
 from trajgen.plots.figure import frame_painter, new_figure
 from trajgen.plots.speed import VEHICLE_COLOURS
+from trajgen.plots.track_layout import TrackLayout
 from trajgen.progress import progress
 from trajgen.verification import VerifiedSchedule, require_verified
 
@@ -113,7 +115,7 @@ class _Scene:
             0.5,
             0.965,
             f"{names[0]} and {names[1]}: {schedule.method.name} schedule, {schedule.duration:.2f} s, "
-            f"{class_name(schedule.route)}",
+            + ("on a track graph" if isinstance(schedule, GraphSchedule) else class_name(schedule.route)),
             ha="center",
             va="center",
             fontsize=11,
@@ -126,7 +128,11 @@ class _Scene:
             )
             for v, (x, ha) in enumerate(((0.03, "left"), (0.97, "right")))
         ]
-        self.vehicles = self._draw_track(schedule.route.graph, layout)
+        self.graph = isinstance(schedule, GraphSchedule)
+        if self.graph:
+            self.vehicles = self._draw_graph_track(schedule.track, layout)
+        else:
+            self.vehicles = self._draw_track(schedule.route.graph, layout)
         self.bar, self.minimum, self.bar_value = self._draw_bar(layout)
         moving = [self.clock, *self.speeds]
         for disc, dot, name in self.vehicles:
@@ -138,15 +144,90 @@ class _Scene:
         sizes = (FRAME_WIDTH_PX, FRAME_HEIGHT_PX, FRAME_WIDTH_PX, FRAME_HEIGHT_PX)
         return self.figure.add_axes([value / size for value, size in zip(box, sizes, strict=True)])
 
-    def _draw_track(self, graph: StarGraph, layout: FrameLayout) -> list:
+    def _draw_graph_track(self, track: TrackGraph, layout: FrameLayout) -> list:
+        """The track graph as :class:`~trajgen.plots.track_layout.TrackLayout` draws it.
+
+        Its nodes named, both vehicles' starts and goals marked; returns the vehicles' moving artists.
+        """
+        axis = self._axes(layout.track_box)
+        axis.set_xlim(*layout.track_xlim)
+        axis.set_ylim(*layout.track_ylim)
+        axis.set_aspect("auto")  # the limits already give a metre the same pixels both ways
+        axis.set_axis_off()
+        drawn = TrackLayout.of(track)
+        for line in drawn.edges:
+            axis.plot(line[:, 0], line[:, 1], color="0.75", linewidth=7, solid_capstyle="round", zorder=1)
+        for name, (x, y) in zip(track.nodes, drawn.nodes, strict=True):
+            axis.plot([x], [y], "o", color="white", markeredgecolor="0.3", markersize=6, zorder=2)
+            axis.annotate(name, (x, y), xytext=(7, 7), textcoords="offset points", fontsize=9, color="0.3")
+        self._mark_ends(axis)
+        axis.legend(loc="upper right", fontsize=8, framealpha=0.9, ncols=2)
+        self._scale_bar(axis, layout, ("lower left",))
+        return self._vehicle_artists(axis)
+
+    def _mark_ends(self, axis) -> None:
         geometry = self.geometry
+        for v in range(2):
+            for k, marker, what in ((0, "o", "start"), (-1, "s", "goal")):
+                axis.plot(
+                    geometry.x[v, k],
+                    geometry.y[v, k],
+                    marker,
+                    markersize=13,
+                    markerfacecolor="none",
+                    markeredgecolor=VEHICLE_COLOURS[v],
+                    markeredgewidth=1.5,
+                    zorder=3,
+                    label=f"{self.names[v]} {what}",
+                )
+
+    def _scale_bar(self, axis, layout: FrameLayout, corners) -> None:
+        span = layout.track_xlim[1] - layout.track_xlim[0]
+        height = layout.track_ylim[1] - layout.track_ylim[0]
+        length = _round_length(0.2 * span)
+        left = "left" in corners[-1]
+        x0 = layout.track_xlim[0] + 0.04 * span if left else layout.track_xlim[1] - 0.04 * span - length
+        lower = "lower" in corners[-1]
+        y0 = layout.track_ylim[0] + 0.05 * height if lower else layout.track_ylim[1] - 0.08 * height
+        axis.plot([x0, x0 + length], [y0, y0], color="black", linewidth=2, solid_capstyle="butt")
+        axis.text(
+            x0 + 0.5 * length,
+            y0 + 0.012 * height,
+            f"{length:g} m (to scale)",
+            ha="center",
+            va="bottom",
+            fontsize=8,
+        )
+
+    def _vehicle_artists(self, axis) -> list:
+        radius = 0.5 * self.geometry.min_separation
+        vehicles = []
+        for v in range(2):
+            colour = VEHICLE_COLOURS[v]
+            disc = axis.fill(*_disc(0.0, 0.0, radius).T, color=colour, alpha=0.3, linewidth=0, zorder=4)[0]
+            dot = axis.plot(
+                [0.0], [0.0], "o", color=colour, markersize=10, markeredgecolor="black", markeredgewidth=0.8
+            )[0]
+            name = axis.annotate(
+                self.names[v],
+                (0.0, 0.0),
+                xytext=(0.0, 0.0),
+                textcoords="offset points",
+                fontsize=10,
+                color=colour,
+                weight="bold",
+            )
+            vehicles.append((disc, dot, name))
+        self.radius = radius
+        return vehicles
+
+    def _draw_track(self, graph: StarGraph, layout: FrameLayout) -> list:
         axis = self._axes(layout.track_box)
         axis.set_xlim(*layout.track_xlim)
         axis.set_ylim(*layout.track_ylim)
         axis.set_aspect("auto")  # the limits already give a metre the same pixels both ways
         axis.set_axis_off()
         span = layout.track_xlim[1] - layout.track_xlim[0]
-        height = layout.track_ylim[1] - layout.track_ylim[0]
         for name, length, angle in zip(graph.names, graph.lengths, np.radians(graph.angles_deg), strict=True):
             direction = np.array([math.cos(angle), math.sin(angle)])
             axis.plot(
@@ -171,55 +252,11 @@ class _Scene:
             fontsize=9,
             color="0.3",
         )
-        for v in range(2):
-            for k, marker, what in ((0, "o", "start"), (-1, "s", "goal")):
-                axis.plot(
-                    geometry.x[v, k],
-                    geometry.y[v, k],
-                    marker,
-                    markersize=13,
-                    markerfacecolor="none",
-                    markeredgecolor=VEHICLE_COLOURS[v],
-                    markeredgewidth=1.5,
-                    zorder=3,
-                    label=f"{self.names[v]} {what}",
-                )
+        self._mark_ends(axis)
         corners = _free_corners(graph, layout)
         axis.legend(loc=corners[0], fontsize=8, framealpha=0.9, ncols=2)
-        length = _round_length(0.2 * span)
-        left = "left" in corners[1]
-        x0 = layout.track_xlim[0] + 0.04 * span if left else layout.track_xlim[1] - 0.04 * span - length
-        lower = "lower" in corners[1]
-        y0 = layout.track_ylim[0] + 0.05 * height if lower else layout.track_ylim[1] - 0.08 * height
-        axis.plot([x0, x0 + length], [y0, y0], color="black", linewidth=2, solid_capstyle="butt")
-        axis.text(
-            x0 + 0.5 * length,
-            y0 + 0.012 * height,
-            f"{length:g} m (to scale)",
-            ha="center",
-            va="bottom",
-            fontsize=8,
-        )
-        radius = 0.5 * geometry.min_separation
-        vehicles = []
-        for v in range(2):
-            colour = VEHICLE_COLOURS[v]
-            disc = axis.fill(*_disc(0.0, 0.0, radius).T, color=colour, alpha=0.3, linewidth=0, zorder=4)[0]
-            dot = axis.plot(
-                [0.0], [0.0], "o", color=colour, markersize=10, markeredgecolor="black", markeredgewidth=0.8
-            )[0]
-            name = axis.annotate(
-                self.names[v],
-                (0.0, 0.0),
-                xytext=(0.0, 0.0),
-                textcoords="offset points",
-                fontsize=10,
-                color=colour,
-                weight="bold",
-            )
-            vehicles.append((disc, dot, name))
-        self.radius = radius
-        return vehicles
+        self._scale_bar(axis, layout, corners)
+        return self._vehicle_artists(axis)
 
     def _draw_bar(self, layout: FrameLayout):
         figure, geometry = self.figure, self.geometry
@@ -264,7 +301,7 @@ class _Scene:
             # the name beside the leg (clear of the leg's label), on the side away from the other vehicle
             away = np.array([x - geometry.x[1 - v, k], y - geometry.y[1 - v, k]])
             away = away / np.hypot(*away) if np.hypot(*away) > 0.0 else np.array([0.0, 1.0])
-            radius = math.hypot(x, y)
+            radius = 0.0 if self.graph else math.hypot(x, y)  # beside a star's leg; on a graph: away
             if radius > 0.0:
                 across = np.array([-y, x]) / radius
                 away = across if across @ away >= 0.0 else -across
@@ -373,7 +410,9 @@ def animate(
     names = _check_names(names)
     play = playback(schedule.duration, fps=fps, max_frames=max_frames)
     geometry = frame_geometry(verified, play.times())
-    layout = frame_layout(schedule.route.graph, geometry)
+    layout = frame_layout(
+        schedule.track if isinstance(schedule, GraphSchedule) else schedule.route.graph, geometry
+    )
     scene = _Scene(verified, geometry, layout, names, play)
     count = play.frame_count
     samples = [scene.pixels(k) for k in sorted({0, int(np.argmin(geometry.distance)), count - 1})]

@@ -19,12 +19,14 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from topology import JUNCTION_INDEX, StarGraph
+from topology import JUNCTION_INDEX, StarGraph, TrackGraph
 from topology.indexed import track_distance
 from topology.validation import short_repr
 from trajgen.errors import OptionError
+from trajgen.model.graph_schedule import GraphSchedule
 from trajgen.model.values import ArrayValue, frozen
 from trajgen.plots.gif import GIF_DELAY_UNIT_MS
+from trajgen.plots.track_layout import TrackLayout
 from trajgen.verification import VerifiedSchedule, require_verified
 
 __all__ = [
@@ -223,6 +225,18 @@ def frame_geometry(verified: VerifiedSchedule, times) -> FrameGeometry:
     """
     schedule = require_verified(verified, "frame_geometry").schedule
     state = schedule.state(times)
+    required = max(schedule.limits.min_separation, schedule.route.min_separation)
+    if isinstance(schedule, GraphSchedule):  # where the track's layout draws each position
+        layout = TrackLayout.of(schedule.track)
+        xy = np.stack([layout.points(state.edge[v], state.s[v]) for v in range(2)])  # (2, n, 2)
+        return FrameGeometry(
+            t=state.t,
+            x=xy[:, :, 0],
+            y=xy[:, :, 1],
+            velocity=state.velocity,
+            distance=schedule.track.distances(state.edge[0], state.s[0], state.edge[1], state.s[1]),
+            min_separation=required,
+        )
     angles = np.radians(np.array(schedule.route.graph.angles_deg))
     direction = angles[np.where(state.leg == JUNCTION_INDEX, 0, state.leg)]
     return FrameGeometry(
@@ -295,17 +309,23 @@ def _box(fraction: tuple[float, float, float, float]) -> tuple[float, float, flo
     return (left * FRAME_WIDTH_PX, bottom * FRAME_HEIGHT_PX, width * FRAME_WIDTH_PX, height * FRAME_HEIGHT_PX)
 
 
-def frame_layout(graph: StarGraph, geometry: FrameGeometry) -> FrameLayout:
+def frame_layout(graph: StarGraph | TrackGraph, geometry: FrameGeometry) -> FrameLayout:
     """The layout of the frames of ``geometry`` on ``graph``: the whole track to scale, and the bar's range.
 
-    The track area shows every leg with a margin for the labels and the vehicles' discs,
-    widened in one direction so that a metre is as many pixels across as up. The bar's
-    range is the largest track distance of the frames (at least :data:`NEAR_FACTOR`
+    The track area shows every leg (every edge of a track graph, as
+    :class:`~trajgen.plots.track_layout.TrackLayout` draws it) with a margin for the labels and
+    the vehicles' discs, widened in one direction so that a metre is as many pixels across as up.
+    The bar's range is the largest track distance of the frames (at least :data:`NEAR_FACTOR`
     times the minimum), with 5 % to spare.
     """
-    angles = np.radians(np.array(graph.angles_deg))
-    ends_x = np.append(np.array(graph.lengths) * np.cos(angles), 0.0)
-    ends_y = np.append(np.array(graph.lengths) * np.sin(angles), 0.0)
+    if isinstance(graph, TrackGraph):
+        drawn = TrackLayout.of(graph)
+        every = np.vstack([drawn.nodes, *drawn.edges])
+        ends_x, ends_y = every[:, 0], every[:, 1]
+    else:
+        angles = np.radians(np.array(graph.angles_deg))
+        ends_x = np.append(np.array(graph.lengths) * np.cos(angles), 0.0)
+        ends_y = np.append(np.array(graph.lengths) * np.sin(angles), 0.0)
     span = max(float(np.ptp(ends_x)), float(np.ptp(ends_y)), 1e-9)
     margin = 0.14 * span + 0.5 * geometry.min_separation
     xlim = [float(ends_x.min()) - margin, float(ends_x.max()) + margin]

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import textwrap
 from collections.abc import Mapping
 
 import numpy as np
@@ -10,6 +11,8 @@ from trajgen.errors import InputError
 from trajgen.methods import METHODS
 from trajgen.model.analysis import travelled
 from trajgen.model.coordination import CoordinationDiagram, schedule_paths
+from trajgen.model.graph_cells import too_close_polygons
+from trajgen.model.graph_schedule import GraphSchedule
 from trajgen.model.summary import class_label
 from trajgen.plots.figure import drawing_area, finished, polygon_patch
 from trajgen.plots.speed import VEHICLE_COLOURS, plot_period
@@ -20,6 +23,27 @@ __all__ = ["METHOD_COLOURS", "plot_coordination"]
 _PALETTE = ("tab:blue", "tab:green", "tab:red", "tab:purple", "tab:brown", "tab:pink", "tab:olive")
 #: Curve colour of each registered method, in registry order.
 METHOD_COLOURS = {name: _PALETTE[k % len(_PALETTE)] for k, name in enumerate(METHODS.names)}
+
+
+def _too_close(schedule, required: float, curve: np.ndarray):
+    """``(leader, polygon)`` of every convex part of the too-close region of ``schedule``'s paths.
+
+    On a junction, the conflicts of :class:`~trajgen.model.coordination.CoordinationDiagram`; on a
+    track graph, :func:`~trajgen.model.graph_cells.too_close_polygons`, each led by the vehicle the
+    schedule's curve (``curve``, its travel, shape (2, n)) lets pass first: the part lies above the
+    curve where vehicle 1 goes first.
+    """
+    if not isinstance(schedule, GraphSchedule):
+        paths, times, _ = schedule_paths(schedule)
+        diagram = CoordinationDiagram(paths, required, schedule, times)
+        return [(conflict.leader, polygon) for conflict in diagram.conflicts for polygon in conflict.polygons]
+    parts = []
+    for part in too_close_polygons(schedule.track, schedule.paths, required):
+        x, y = np.mean(np.array(part.polygon), axis=0)
+        below = curve[1][curve[0] <= x]  # the curve is monotone: its height where it reaches x
+        height = float(below.max()) if below.size else 0.0
+        parts.append((0 if y > height else 1, part.polygon))
+    return parts
 
 
 def plot_coordination(verified: Mapping[str, VerifiedSchedule], *, figure=None):
@@ -60,18 +84,14 @@ def plot_coordination(verified: Mapping[str, VerifiedSchedule], *, figure=None):
     for axis, names in zip(panels, groups.values(), strict=True):
         reference = schedules[names[0]]
         required = max(reference.limits.min_separation, reference.route.min_separation)
-        paths, times, _ = schedule_paths(reference)
-        diagram = CoordinationDiagram(paths, required, reference, times)
         labelled: set[int] = set()
-        for conflict in diagram.conflicts:  # exact: convex polygons, in the colour of who passes first
-            leader = conflict.leader
-            for polygon in conflict.polygons:
-                label = None if leader in labelled else f"too close: vehicle {leader + 1} passes first"
-                labelled.add(leader)
-                patch = polygon_patch(
-                    polygon, facecolor=VEHICLE_COLOURS[leader], alpha=0.3, edgecolor="none", label=label
-                )
-                axis.add_patch(patch)
+        for leader, polygon in _too_close(reference, required, distances[names[0]]):
+            label = None if leader in labelled else f"too close: vehicle {leader + 1} passes first"
+            labelled.add(leader)
+            patch = polygon_patch(
+                polygon, facecolor=VEHICLE_COLOURS[leader], alpha=0.3, edgecolor="none", label=label
+            )
+            axis.add_patch(patch)
         for name in names:
             axis.plot(
                 distances[name][0],
@@ -84,11 +104,8 @@ def plot_coordination(verified: Mapping[str, VerifiedSchedule], *, figure=None):
         axis.margins(0.04)  # a curve along a path's end (one vehicle waits) stays clear of the frame
         axis.set_xlabel("vehicle 1 travelled [m]")
         axis.set_ylabel("vehicle 2 travelled [m]")
-        axis.set_title(
-            f"paths of {', '.join(names)}: class {class_label(reference.route)}\n"
-            f"(shaded: closer than {required:g} m)",
-            fontsize=9,
-        )
+        title = textwrap.fill(f"paths of {', '.join(names)}: class {class_label(reference.route)}", 64)
+        axis.set_title(f"{title}\n(shaded: closer than {required:g} m)", fontsize=9)
         axis.legend(loc="best", fontsize=7)
         axis.grid(True, alpha=0.3)
     if len(groups) > 1:

@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from topology.indexed import track_distance
+from trajgen.model.graph_schedule import GraphSchedule
 from trajgen.model.summary import class_label
 from trajgen.plots.figure import drawing_axis, finished
 from trajgen.plots.speed import plot_period
@@ -29,7 +30,10 @@ def plot_separation(verified: VerifiedSchedule, *, ax=None):
     """
     schedule = require_verified(verified, "plot_separation").schedule
     state = schedule.sample(plot_period(schedule.duration))
-    distance = track_distance(state.leg[0], state.s[0], state.leg[1], state.s[1])
+    if isinstance(schedule, GraphSchedule):
+        distance = schedule.track.distances(state.edge[0], state.s[0], state.edge[1], state.s[1])
+    else:
+        distance = track_distance(state.leg[0], state.s[0], state.leg[1], state.s[1])
     required = max(schedule.limits.min_separation, schedule.route.min_separation)
     axis = drawing_axis(ax, figsize=(10.5, 4))
     axis.plot(state.t, distance, label="track distance")

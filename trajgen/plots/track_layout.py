@@ -62,6 +62,10 @@ class TrackLayout:
             edges.append(readonly(_edge_line(nodes[start], nodes[end], track.length(number), rank)))
         return cls(track, readonly(nodes), tuple(edges), given)
 
+    def points(self, edges, s) -> np.ndarray:
+        """The x/y where the points ``(edges[i], s[i])`` are drawn, shape (n, 2)."""
+        return np.array([self.point(EdgePoint(int(e), float(x))) for e, x in zip(edges, s, strict=True)])
+
     def point(self, point: EdgePoint) -> np.ndarray:
         """The x/y where ``point`` is drawn, shape (2,)."""
         return self.along(point.edge, point.s, point.s)[-1]
