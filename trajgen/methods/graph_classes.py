@@ -137,7 +137,8 @@ def solve_graph(method, route: GraphRoute, limits: Limits) -> GraphSchedule:
     bound = lower_bound(route, limits)
     solved = [_one_class(method, r, limits) for r in routes]
     made = [(k, schedule) for k, (schedule, _) in enumerate(solved) if schedule is not None]
-    chosen = min(made, key=lambda item: (round(item[1].duration, 9), item[0]))[0] if made else 0
+    # a tie within a microsecond keeps the route's own class (the first)
+    chosen = min(made, key=lambda item: (round(item[1].duration, 6), item[0]))[0] if made else 0
     classes = tuple(
         GraphClassResult(
             graph_class_label(r),
