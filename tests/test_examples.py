@@ -44,6 +44,8 @@ FIGURES = {
     "11_live_over_mqtt": (r"closest approach on the true positions: ([0-9.]+) m", 1.610, 0.002),
     # head-on on a line with a passing loop: agv2 takes the loop (11.5 m against the main's 10 m)
     "12_plan_a_track_graph": (r"agv2 drives ([0-9.]+) m", 30.5, 1e-9),
+    # the H: 33.586 s optimal (agv1 waits in c) against 51.5 s of moves one at a time
+    "13_time_a_track_graph": (r"optimal / exact = ([0-9.]+)", 0.6522, 0.002),
 }
 
 

@@ -68,7 +68,8 @@ def test_optimal_is_jerk_limited_verified_and_faster_than_toppra(name):
     assert sum(c["chosen"] for c in classes) == 1
     chosen = next(c for c in classes if c["chosen"])
     assert chosen["makespan_s"] == pytest.approx(optimal.schedule.duration)
-    assert all(c["makespan_s"] >= chosen["makespan_s"] - 1e-9 for c in classes if c["makespan_s"] is not None)
+    # the fastest, a tie within a microsecond keeping the route's own class
+    assert all(c["makespan_s"] >= chosen["makespan_s"] - 1e-6 for c in classes if c["makespan_s"] is not None)
     check_profiles(ScenarioFile(EXAMPLES / f"{name}.toml"), _texts(optimal), jerk=True)
 
 

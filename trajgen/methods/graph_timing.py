@@ -22,7 +22,6 @@ import numpy as np
 from limits import Limits
 from topology import GraphRoute, TrackGraph
 from trajgen.errors import InputError, SolverError
-from trajgen.methods.toppra_timing import toppra_kinematics
 from trajgen.model.axes import piece_profiles
 from trajgen.model.blended import Blend, BlendedPath
 from trajgen.model.graph_paths import GraphPath, graph_paths
@@ -139,6 +138,8 @@ def overlapped_moves(route: GraphRoute, limits: Limits, method, *, grid_points: 
     InputError
         A bad route or limits.
     """
+    from trajgen.methods.toppra_timing import toppra_kinematics  # TOPPRA only when it times something
+
     check_graph_request(route, limits)
     corners, movers = travel_corners(route)
     paths = graph_paths(route)

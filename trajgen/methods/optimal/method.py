@@ -59,10 +59,9 @@ _POSITIVE_SEPARATION = 1e-3
 #: Planned clearance above the minimum separation, metres: the solvers meet constraints to ~1e-8 m,
 #: the verifier demands the minimum to 1e-9 m.
 _SEPARATION_MARGIN = 1e-6
-#: Where the separation (nearly) fills the shortest leg, the waiting vehicle must park at the very end
-#: of a leg while the other passes the junction: no strict interior, and with the full margin no
-#: solution. There the margin shrinks to this and the legs are planned this much longer (the verifier
-#: allows 1e-6 m past a leg's end), so a thin interior exists.
+#: Where the separation (nearly) fills the shortest leg, the waiting vehicle parks at a leg's very end
+#: while the other passes (no strict interior): the margin shrinks to this and the legs are planned
+#: this much longer (the verifier allows 1e-6 m past a leg's end), so a thin interior exists.
 _TIGHT_MARGIN = 2e-7
 _LEG_SLACK = 5e-7
 #: Default of ``Optimal.refinement_tolerance``: far from a vehicle's own S-curve successive passes gain
@@ -150,8 +149,7 @@ class Optimal(TimingMethod):
         class only.
     cache : SolverCache or None, optional
         Where compiled NLPs are kept; ``None`` (default): the process-wide :meth:`shared_cache`.
-
-    On a track graph the problem is :mod:`trajgen.methods.graph_optimal`'s.
+        On a track graph: :mod:`trajgen.methods.graph_optimal`'s problem, no cache.
     """
 
     name: ClassVar[str] = "optimal"
@@ -275,9 +273,7 @@ class Optimal(TimingMethod):
         except OptionError:  # start and goal retract to one boundary point up to round-off
             return [route]
 
-    def schedule_graph(self, route, limits: Limits):
-        """The optimal schedule of a route on a track graph (verified), or the flagged ``exact`` one."""
-        return solve_graph(self, route, limits)
+    schedule_graph = solve_graph  # on a track graph (verified), or the flagged ``exact`` one
 
     def schedule(self, route: Route, limits: Limits) -> Schedule:
         """The optimal schedule from ``route``'s start to its goal (verified), or the flagged ``exact`` one.
