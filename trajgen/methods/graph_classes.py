@@ -121,6 +121,8 @@ def solve_graph(method, route: GraphRoute, limits: Limits) -> GraphSchedule:
     With ``homotopy="fastest"`` the route's class and up to two others
     (:func:`topology.plan_graph_classes`: where the other vehicle yields) are solved and the fastest
     verified schedule is returned, its ``route`` its class's; ``"planned"`` solves the route's class.
+    Where the ``exact`` schedule is as fast (the vehicles never wait for each other), it is returned,
+    with a note.
 
     Raises
     ------
@@ -163,4 +165,9 @@ def solve_graph(method, route: GraphRoute, limits: Limits) -> GraphSchedule:
             )
         )
         return dataclasses.replace(graph_fallback(route, limits, reason, failure), info=info)
-    return dataclasses.replace(solved[chosen][0], info=info)
+    best = solved[chosen][0]
+    exact = Exact().schedule_graph(route, limits)
+    if exact.duration <= best.duration:  # the vehicles never meet: each move's own S-curve is optimal
+        note = f"the moves one at a time ({exact.duration:.3f} s) are as fast as any solved class"
+        return dataclasses.replace(exact, method=method, notes=(note,), info=info)
+    return dataclasses.replace(best, info=info)

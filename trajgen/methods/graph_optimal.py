@@ -291,6 +291,8 @@ def _run(nlp: _Nlp, objective, initial: np.ndarray, method, iterations: int) -> 
                 "max_iter": iterations,
                 "max_wall_time": float(method.time_limit),
                 "tol": 1e-9,
+                "constr_viol_tol": 1e-10,  # the dynamics to round-off: the motion is integrated again
+                "mumps_mem_percent": 2000,  # MUMPS re-allocating memory again and again took most of the time
                 "acceptable_iter": 0,
                 "bound_relax_factor": 0.0,
                 # measured on the examples and the star as a graph: adaptive stalls on some, and a
@@ -359,16 +361,16 @@ def _end_state(start: np.ndarray, durations: np.ndarray, jerks: np.ndarray) -> n
 def _ending_exactly(
     start: np.ndarray, target: float, durations: np.ndarray, jerks: np.ndarray, *, at_rest: bool
 ) -> np.ndarray:
-    """``jerks`` with its last ones corrected so the stretch ends exactly at ``target`` with velocity 0.
+    """``jerks`` corrected so the stretch ends exactly at ``target`` with velocity 0.
 
     The solver meets its equalities to its tolerance; integrated again, a stretch ends a few 1e-10
     off. Each interval's jerk moves the end state linearly (``h`` in acceleration, ``h^2/2 + h R``
-    in velocity, ``h^3/6 + h^2 R/2 + h R^2/2`` in position, ``R`` the time after it), so the last
-    three intervals' corrections (a few 1e-10 m/s^3) put it back exactly: position and velocity where
-    the path turns back, and acceleration too at the goal (``at_rest``).
+    in velocity, ``h^3/6 + h^2 R/2 + h R^2/2`` in position, ``R`` the time after it), so the least
+    correction of all its intervals' jerks (a few 1e-10 m/s^3) puts it back exactly: position and
+    velocity where the path turns back, and acceleration too at the goal (``at_rest``).
     """
-    usable = durations >= 1e-3 * max(float(durations.max(initial=0.0)), 1e-300)  # well-conditioned
-    last = np.nonzero(usable)[0][-3:]
+    # every interval of the stretch long enough to be well conditioned: the least correction of all
+    last = np.nonzero(durations >= 1e-3 * max(float(durations.max(initial=0.0)), 1e-300))[0]
     if last.size == 0:
         return jerks
     after = np.concatenate([np.cumsum(durations[::-1])[::-1][1:], [0.0]])

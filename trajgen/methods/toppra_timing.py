@@ -16,7 +16,7 @@ import logging
 import numpy as np
 
 from limits import Limits
-from trajgen.errors import SolverError
+from trajgen.errors import InputError, SolverError
 from trajgen.model.blended import BlendedPath, ToppraKinematics
 from trajgen.model.values import sorted_unique
 
@@ -71,7 +71,10 @@ def toppra_kinematics(path: BlendedPath, limits: Limits, grid_points: int) -> To
     if np.any(mean <= 0.0):
         raise SolverError("TOPPRA returned a zero path velocity inside a section")
     times = np.concatenate([[0.0], np.cumsum(np.diff(grid) / mean)])
-    return fit_to_limits(ToppraKinematics(path, grid, speed, times), limits)
+    try:
+        return fit_to_limits(ToppraKinematics(path, grid, speed, times), limits)
+    except InputError as error:  # e.g. two grid points at one time: TOPPRA's numbers, not the caller's
+        raise SolverError(f"TOPPRA's timing of a section is not usable: {error}") from None
 
 
 def fit_to_limits(kinematics: ToppraKinematics, limits: Limits) -> ToppraKinematics:

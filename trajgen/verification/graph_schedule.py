@@ -65,6 +65,9 @@ class _Pieces:
             start, length, travel = start[keep], length[keep], travel[:, keep]
         self.start, self.length, self.travel = start, length, travel
         middle = np.stack([polynomials.evaluate(travel[v], 0.5 * length) for v in range(2)])
+        # a vehicle standing at a boundary (within round-off) is in the later segment, whichever side
+        # of it the round-off puts its travel: else it would seem to turn back and forth there
+        middle += POSITION_TOLERANCE
         self.segment = np.stack(
             [
                 np.clip(
