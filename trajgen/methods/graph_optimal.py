@@ -397,7 +397,7 @@ def _through_cusps(phases: list[tuple[float, float]], targets: dict[int, float])
     node), where the vehicle is at rest (:func:`_ending_exactly`). Each stretch is integrated on its
     own from the state the one before ends in.
     """
-    times, initial, jerks = [0.0], [], []
+    initial, jerks = [], []
     first, state = 0, np.zeros(3)
     goal = max(targets)
     for node in sorted(targets):
@@ -420,7 +420,6 @@ def _through_cusps(phases: list[tuple[float, float]], targets: dict[int, float])
                 f"{targets[node]:.9g} m at rest"
             )
         if stretch.duration > 0.0:
-            times.extend(times[-1] + stretch.times[1:])
             initial.extend(stretch.initial)
             jerks.extend(stretch.jerk)
             end = _end_state(stretch.initial[-1], np.diff(stretch.times[-2:]), stretch.jerk[-1:])
@@ -428,7 +427,10 @@ def _through_cusps(phases: list[tuple[float, float]], targets: dict[int, float])
         first = node
     if not jerks:
         return PiecewiseCubic.from_phases(0.0, [])
-    return PiecewiseCubic(np.array(times), np.array(initial), np.array(jerks))
+    # the knots from all the phases at once, the same floats for both vehicles (no sliver pieces
+    # between their knots where one vehicle's numbers would be read with the other's segment)
+    kept = np.array([d for d, _ in phases if d > 0.0])
+    return PiecewiseCubic(np.concatenate([[0.0], np.cumsum(kept)]), np.array(initial), np.array(jerks))
 
 
 def optimal_graph_schedule(route: GraphRoute, limits: Limits, method) -> GraphSchedule:

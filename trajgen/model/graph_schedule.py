@@ -18,13 +18,12 @@ import numpy as np
 
 from limits import Limits
 from topology import GraphRoute, TrackGraph
-from topology.validation import finite_real
 from trajgen.errors import InputError
 from trajgen.model.graph_paths import GraphPath
 from trajgen.model.schedule import (
     FallbackReason,
-    Kinematics,
     MethodInfo,
+    TimedSection,
     check_period,
     sample_block,
     sample_rows,
@@ -34,28 +33,9 @@ from trajgen.model.values import ArrayValue, frozen
 __all__ = ["GraphSchedule", "GraphSection", "GraphState"]
 
 
-@dataclass(frozen=True, slots=True)
-class GraphSection:
-    """A stretch of a schedule on a track graph: both vehicles' travel over the section's local time.
-
-    Attributes
-    ----------
-    start_time : float
-        Seconds from the start of the schedule.
-    kinematics : Kinematics
-        Travel of both vehicles (metres along their paths), its velocity, acceleration and jerk.
-    """
-
-    start_time: float
-    kinematics: Kinematics
-
-    def __post_init__(self) -> None:
-        finite_real(self.start_time, "section start_time (seconds)", InputError)
-
-    @property
-    def duration(self) -> float:
-        """Seconds."""
-        return self.kinematics.duration
+#: A stretch of a schedule on a track graph: both vehicles' travel (metres along their paths) over
+#: the section's local time (``start_time``, ``kinematics``, ``duration``).
+GraphSection = TimedSection
 
 
 @dataclass(frozen=True, slots=True, eq=False)

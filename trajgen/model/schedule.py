@@ -35,6 +35,7 @@ __all__ = [
     "Schedule",
     "ScheduleState",
     "Section",
+    "TimedSection",
     "TimingMethod",
     "check_period",
     "check_request",
@@ -272,7 +273,31 @@ class CubicKinematics(Kinematics):
 
 
 @dataclass(frozen=True, slots=True)
-class Section:
+class TimedSection:
+    """A stretch of a schedule in time: both vehicles' motion over the section's local time.
+
+    Attributes
+    ----------
+    start_time : float
+        Seconds from the start of the schedule.
+    kinematics : Kinematics
+        Motion of both vehicles (their signed axes on a junction, their travel on a track graph).
+    """
+
+    start_time: float
+    kinematics: Kinematics
+
+    def __post_init__(self) -> None:
+        finite_real(self.start_time, "section start_time (seconds)", InputError)
+
+    @property
+    def duration(self) -> float:
+        """Seconds."""
+        return self.kinematics.duration
+
+
+@dataclass(frozen=True, slots=True)
+class Section(TimedSection):
     """A stretch of a schedule in which each vehicle's axis maps monotonically onto the track.
 
     Attributes
@@ -285,17 +310,7 @@ class Section:
         Axis -> track position, per vehicle.
     """
 
-    start_time: float
-    kinematics: Kinematics
     maps: tuple[AxisMap, AxisMap]
-
-    def __post_init__(self) -> None:
-        finite_real(self.start_time, "section start_time (seconds)", InputError)
-
-    @property
-    def duration(self) -> float:
-        """Seconds."""
-        return self.kinematics.duration
 
 
 @dataclass(frozen=True, slots=True, eq=False)

@@ -30,7 +30,7 @@ from trajgen.model import polynomials
 from trajgen.model.graph_schedule import GraphSchedule
 from trajgen.model.pieces import UncheckableKinematicsError, kinematics_polynomials, split_at_values
 from trajgen.verification.graph_route import TrackDistances
-from trajgen.verification.piecewise import allowance, continuity_allowance
+from trajgen.verification.piecewise import allowance, continuity_allowance, time_resolution
 from trajgen.verification.report import (
     POSITION_TOLERANCE,
     REST_TOLERANCE,
@@ -65,9 +65,6 @@ class _Pieces:
             start, length, travel = start[keep], length[keep], travel[:, keep]
         self.start, self.length, self.travel = start, length, travel
         middle = np.stack([polynomials.evaluate(travel[v], 0.5 * length) for v in range(2)])
-        # a vehicle standing at a boundary (within round-off) is in the later segment, whichever side
-        # of it the round-off puts its travel: else it would seem to turn back and forth there
-        middle += POSITION_TOLERANCE
         self.segment = np.stack(
             [
                 np.clip(
@@ -76,6 +73,10 @@ class _Pieces:
                 for v, path in enumerate(schedule.paths)
             ]
         )
+        # a piece shorter than the time's round-off holds the numbers of the piece before: its segment too
+        sliver = np.nonzero(length <= time_resolution(schedule))[0]
+        for k in sliver[sliver > 0]:
+            self.segment[:, k] = self.segment[:, k - 1]
 
     @property
     def count(self) -> int:
@@ -246,20 +247,23 @@ def _check_motion(schedule: GraphSchedule, pieces: _Pieces, failures: list[str])
                 )
         if pieces.count > 1:
             scale = max(1.0, path.length)
-            # along the vehicle's axis: at a cusp its travel's acceleration changes sign, the axis's goes on
-            heading = path.headings[pieces.segment[vehicle]] if path.headings.size else np.ones(pieces.count)
+            # in travel, which never decreases; where the path turns back (at rest) the travel's
+            # acceleration changes sign while the acceleration along the vehicle's axis goes on
+            boundary = pieces.travel[vehicle][1:, 0]
+            at_cusp = np.zeros(boundary.size, dtype=bool)
+            for cusp in path.cusps:
+                at_cusp |= np.abs(boundary - cusp) <= POSITION_TOLERANCE
             for order, name in enumerate(["position", "velocity", "acceleration"][: schedule.smoothness + 1]):
-                sign_before, sign_after = (1.0, 1.0) if order == 0 else (heading[:-1], heading[1:])
-                before = sign_before * polynomials.evaluate(derivatives[order][:-1], h[:-1])
-                after = sign_after * derivatives[order][1:, 0]
+                before = polynomials.evaluate(derivatives[order][:-1], h[:-1])
+                after = derivatives[order][1:, 0]
                 tolerance = continuity_allowance(schedule, vehicle, name, scale)
-                jumps = np.nonzero(~(np.abs(before - after) <= tolerance))[0]
+                gap = np.abs(before - after)
+                if order == 2:
+                    gap = np.where(at_cusp, np.minimum(gap, np.abs(before + after)), gap)
+                jumps = np.nonzero(~(gap <= tolerance))[0]
                 if jumps.size:
                     k = int(jumps[0])
-                    failures.append(
-                        f"{who} {name} jumps by {abs(before[k] - after[k]):.3g} at "
-                        f"t={pieces.start[k + 1]:.6f} s"
-                    )
+                    failures.append(f"{who} {name} jumps by {gap[k]:.3g} at t={pieces.start[k + 1]:.6f} s")
         # at rest where the path turns back (the acceleration along its axis is continuous, above)
         if path.cusps.size and pieces.count > 1:
             boundary = pieces.travel[vehicle][1:, 0]
