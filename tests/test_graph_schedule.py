@@ -19,6 +19,7 @@ from trajgen.errors import InputError, OptionError, VerificationError
 from trajgen.export.csv import CsvOptions, profile_chunk_pair
 from trajgen.methods import make_schedule
 from trajgen.methods.exact import Exact
+from trajgen.methods.optimal import Optimal
 from trajgen.model.graph_schedule import GraphSchedule, GraphSection
 from trajgen.model.profiles import PiecewiseCubic, rest_to_rest_time, scurve_phases
 from trajgen.model.schedule import CubicKinematics, TimingMethod
@@ -226,3 +227,43 @@ def test_seeded_random_graphs_are_timed_and_verified_with_the_rows_safe(tmp_path
         if checked == 60:
             break
     assert checked == 60
+
+
+def _with_acceleration_step(
+    schedule: GraphSchedule, section: int, interval: int, step: float
+) -> GraphSchedule:
+    """The schedule with vehicle 1's acceleration stepped by ``step`` at the start of one interval."""
+    profile = schedule.sections[section].kinematics.vehicles[0]
+    initial = np.array(profile.initial)
+    initial[interval, 2] += step
+    stepped = PiecewiseCubic(profile.times, initial, profile.jerk)
+    other = schedule.sections[section].kinematics.vehicles[1]
+    sections = list(schedule.sections)
+    sections[section] = GraphSection(sections[section].start_time, CubicKinematics((stepped, other)))
+    return dataclasses.replace(schedule, sections=tuple(sections))
+
+
+def test_the_verifier_finds_an_acceleration_step_and_allows_a_sign_change_only_where_the_path_turns_back():
+    scenario = load_scenario(EXAMPLES / "h.toml")
+    schedule = make_schedule(scenario.route(), scenario.limits, method="exact")
+    # mid-move (the cruise of the first move): a step of 0.2 m/s^2 is a jump
+    with pytest.raises(VerificationError, match=r"vehicle 1 acceleration jumps by 0.2"):
+        certify(_with_acceleration_step(schedule, 0, 3, 0.2))
+
+
+@pytest.mark.slow
+def test_the_optimal_h_reverses_smoothly_at_the_cusp_and_verifies():
+    """agv1 turns back in c at full deceleration: its travel's acceleration -0.5 -> +0.5 m/s^2 there,
+    the acceleration along its axis continuous; the verifier allows that sign change at the cusp only.
+    """
+    scenario = load_scenario(EXAMPLES / "h.toml")
+    optimal = make_schedule(scenario.route(), scenario.limits, method=Optimal(homotopy="planned"))
+    assert optimal.fallback_reason is None
+    assert certify(optimal).report.passed
+    t = np.linspace(0.0, optimal.duration, 400_001)
+    travel = optimal.travel(t)[0]
+    k = int(np.argmin(np.abs(travel[0] - optimal.paths[0].cusps[0]) + 10.0 * np.abs(travel[1])))
+    assert travel[2, k - 2] < -0.4
+    assert travel[2, k + 2] > 0.4
+    state = optimal.state(t[k - 2 : k + 3])
+    assert np.ptp(state.acceleration[0]) < 0.01  # along the axis: no step
