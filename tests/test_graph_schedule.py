@@ -253,8 +253,10 @@ def test_the_verifier_finds_an_acceleration_step_and_allows_a_sign_change_only_w
 
 @pytest.mark.slow
 def test_the_optimal_h_reverses_smoothly_at_the_cusp_and_verifies():
-    """agv1 turns back in c at full deceleration: its travel's acceleration -0.5 -> +0.5 m/s^2 there,
-    the acceleration along its axis continuous; the verifier allows that sign change at the cusp only.
+    """agv1 turns back in c at full deceleration.
+
+    Its travel's acceleration goes -0.5 -> +0.5 m/s^2 there, the acceleration along its axis is
+    continuous; the verifier allows that sign change at the cusp only.
     """
     scenario = load_scenario(EXAMPLES / "h.toml")
     optimal = make_schedule(scenario.route(), scenario.limits, method=Optimal(homotopy="planned"))
