@@ -10,7 +10,7 @@ given sequence of cells is therefore in one homotopy class, and keeping it safe 
 The problem (a CasADi SX NLP, solved by IPOPT): phases, one per cell of the sequence the ``toppra``
 schedule of the route visits (its hand-overs already overlapped), each of free duration (zero: a
 corner passed in an instant) with :data:`NODES` control intervals of constant jerk per vehicle, at
-fixed shares of it, denser at its ends (:data:`END_DENSITIES`, tried in turn); the state of each
+fixed shares of it, denser at its ends (:data:`ATTEMPTS`, tried in turn); the state of each
 vehicle is its travel, velocity and acceleration, integrated exactly. Between the nodes the
 constraints hold too: travel (a cubic) and velocity (a quadratic) through their Bernstein
 coefficients, whose convex hull contains the curve, so the cell's bounds and its separation
@@ -39,10 +39,15 @@ from trajgen.model.graph_schedule import GraphSchedule, GraphSection
 from trajgen.model.profiles import PiecewiseCubic
 from trajgen.model.schedule import CubicKinematics
 
-__all__ = ["END_DENSITIES", "NODES", "optimal_graph_schedule"]
+__all__ = ["ATTEMPTS", "NODES", "optimal_graph_schedule"]
 
 logger = logging.getLogger(__name__)
 
+#: The problems tried in turn, each to its iteration limit: the weight of cosine (end-dense) spacing in
+#: each cell's grid (0: uniform), and whether MUMPS scales the KKT systems. Measured on 40 seeded
+#: random graphs and the examples: without its scaling MUMPS factors most systems 2 to 6 times faster,
+#: with it a few more converge; the end-dense grid resolves the jerk ramps at the cells' ends.
+ATTEMPTS = ((0.8, False), (0.8, True), (0.0, True))
 #: Control intervals per phase (cell).
 NODES = 16
 #: Metres a position may stray past its cell's bounds (a strict interior for the solver; the path's
@@ -50,11 +55,6 @@ NODES = 16
 _MARGIN = 1e-4
 #: Share of the velocity and acceleration limits the problem plans with (the re-integration's round-off).
 _HEADROOM = 1.0 - 1e-5
-#: Weights of cosine (end-dense) spacing in each cell's grid, tried in turn (0: uniform, the surest).
-END_DENSITIES = (0.8, 0.0)
-#: Shortest time in a cell, seconds: a corner of two boundaries is passed almost in an instant. Not
-#: zero: the intervals of a cell of no time would repeat the same constraints (a degenerate problem).
-MIN_CELL = 0.0
 #: A cell passed in less than this is passed in an instant (its intervals are dropped), seconds.
 _INSTANT = 1e-9
 #: Share of the jerk limit the problem plans with: room for the corrections of :func:`_ending_exactly`.
@@ -201,7 +201,7 @@ def _problem(route: GraphRoute, limits: Limits, paths, cells: list[_Cell], *, de
     count = phases * n
     nlp = _Nlp()
     inf = math.inf
-    durations = nlp.variable("T", (phases, 1), MIN_CELL, inf)  # a corner: passed almost in an instant
+    durations = nlp.variable("T", (phases, 1), 0.0, inf)  # a corner of two boundaries: in an instant
     state = nlp.variable("x", (6, count + 1), -inf, inf)  # p1 v1 a1 p2 v2 a2, column-major
     jerk = nlp.variable("j", (2, count), -inf, inf)
     offset_state = len(nlp.lower) - 6 * (count + 1) - 2 * count
@@ -274,7 +274,7 @@ def _problem(route: GraphRoute, limits: Limits, paths, cells: list[_Cell], *, de
     return nlp, objective, (durations, state, jerk)
 
 
-def _run(nlp: _Nlp, objective, initial: np.ndarray, method, iterations: int) -> np.ndarray:
+def _run(nlp: _Nlp, objective, initial: np.ndarray, method, iterations: int, *, scaling: bool) -> np.ndarray:
     """Solve with IPOPT from ``initial``; the stacked solution, or RuntimeError naming IPOPT's status."""
     import casadi as ca
 
@@ -293,6 +293,9 @@ def _run(nlp: _Nlp, objective, initial: np.ndarray, method, iterations: int) -> 
                 "tol": 1e-9,
                 "constr_viol_tol": 1e-10,  # the dynamics to round-off: the motion is integrated again
                 "mumps_mem_percent": 2000,  # MUMPS re-allocating memory again and again took most of the time
+                # MUMPS' own scaling (its default) made some KKT systems slow to factor (the H: 75 ms an
+                # iteration against 12 ms): see ATTEMPTS
+                **({} if scaling else {"mumps_permuting_scaling": 0, "mumps_scaling": 0}),
                 "acceptable_iter": 0,
                 "bound_relax_factor": 0.0,
                 # measured on the examples and the star as a graph: adaptive stalls on some, and a
@@ -315,8 +318,9 @@ def _run(nlp: _Nlp, objective, initial: np.ndarray, method, iterations: int) -> 
 def _solve(route: GraphRoute, limits: Limits, paths, cells: list[_Cell], guess: GraphSchedule, method):
     """Solve the problem from the ``toppra`` schedule: interval durations (count,), jerks (2, count).
 
-    The grids of :data:`END_DENSITIES` are tried in turn (the end-dense one resolves the jerk ramps
-    at the cells' ends better, the uniform one converges where it does not).
+    The problems of :data:`ATTEMPTS` are tried in turn (the end-dense grid resolves the jerk ramps
+    at the cells' ends better, the uniform one converges where it does not; MUMPS' scaling is
+    slower and converges on a few more).
 
     Raises
     ------
@@ -326,7 +330,7 @@ def _solve(route: GraphRoute, limits: Limits, paths, cells: list[_Cell], guess: 
     phases, n = len(cells), NODES
     count = phases * n
     failures = []
-    for density in END_DENSITIES:
+    for density, scaling in ATTEMPTS:
         fractions = _fractions(density)
         starts = np.concatenate([[0.0], np.cumsum(fractions)[:-1]])
         nlp, objective, _ = _problem(route, limits, paths, cells, density=density)
@@ -341,9 +345,9 @@ def _solve(route: GraphRoute, limits: Limits, paths, cells: list[_Cell], guess: 
         state = np.vstack([values[0, :3], values[1, :3]])
         initial = np.concatenate([spans, state.ravel(order="F"), np.zeros(2 * count)])
         try:
-            solution = _run(nlp, objective, initial, method, method.max_iterations)
+            solution = _run(nlp, objective, initial, method, method.max_iterations, scaling=scaling)
         except RuntimeError as error:
-            failures.append(f"grid {density:g}: {error}")
+            failures.append(f"grid {density:g}{', scaled' if scaling else ''}: {error}")
             continue
         steps = np.concatenate([duration * fractions for duration in solution[:phases]])
         return steps, solution[phases + 6 * (count + 1) :].reshape((2, count), order="F")
