@@ -148,15 +148,15 @@ def test_the_verifier_finds_a_path_that_is_not_the_routes():
         certify(dataclasses.replace(schedule, route=other))
 
 
-def test_a_graph_run_writes_both_csv_files_and_refuses_what_it_cannot_write_yet(tmp_path):
+def test_a_graph_run_writes_both_csv_files_and_refuses_a_spline_dialect_without_jerk_limits(tmp_path):
     scenario = load_scenario(EXAMPLES / "passing-loop.toml")
     result = run(scenario, outputs=Outputs(csv_dir=tmp_path / "csv"))
     assert result.method.name == "exact"
     assert result.verified.report.passed
     assert sorted(p.name for p in result.files) == ["agv1.csv", "agv2.csv"]
     assert result.summary()["route"]["travel_m"] == list(result.route.travel)
-    with pytest.raises(InputError, match="dialect 'siemens-xy' is not written for a track graph yet"):
-        run(scenario, outputs=Outputs(csv_dir=tmp_path / "t", dialect="siemens-xy"))
+    with pytest.raises(OptionError, match="dialect 'logix-time-cam' interpolates a cubic spline"):
+        run(scenario, method="toppra", outputs=Outputs(csv_dir=tmp_path / "t", dialect="logix-time-cam"))
     assert not (tmp_path / "t").exists()
 
 

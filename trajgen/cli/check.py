@@ -17,7 +17,7 @@ SHOWN_FAILURES = 10
 def _command_check(args: argparse.Namespace) -> int:
     from trajgen.export.plc.check import check_profiles
 
-    scenario = scenario_from(args.scenario)
+    scenario = scenario_from(args.scenario, graph=True)
     verdict = check_profiles(
         scenario, args.csv, dialect=args.dialect, jerk=not args.ignore_jerk, max_points=args.max_points
     )
@@ -30,8 +30,12 @@ def _command_check(args: argparse.Namespace) -> int:
         print(
             f"points: {summary['points'][0]} and {summary['points'][1]}; closest approach "
             f"{summary['min_separation_m']:.4f} m (minimum {scenario.limits.min_separation:g} m); "
-            f"homotopy class: {summary['homotopy']}"
-            + (f" ({summary['class']})" if "class" in summary else "")
+            + (
+                f"homotopy class: {summary['homotopy']}"
+                + (f" ({summary['class']})" if "class" in summary else "")
+                if "homotopy" in summary
+                else f"class: {summary['class']}"
+            )
         )
         failures = summary["failures"]
         for failure in failures[:SHOWN_FAILURES]:

@@ -107,6 +107,15 @@ class GraphSchedule:
     fallback_reason : FallbackReason or None
         Set when the requested method could not deliver and this is the ``exact`` schedule instead.
     info : MethodInfo or None
+    smoothness : int or None
+        Continuous derivatives of position: 2 (acceleration too) when jerk-limited, else 1
+        (``None``: that default). A table read back sets its interpolation's.
+    end_tolerance : float or None
+        Metres a table read back may be off its start, goal and path ends (``None``: a computed
+        schedule, held to round-off there and from piece to piece).
+    checked_limits : int or None
+        Derivatives (1 = velocity, ...) whose limits are checked on the pieces in closed form
+        (``None``: all); a table read back has the others checked from its points.
     """
 
     route: GraphRoute
@@ -118,8 +127,13 @@ class GraphSchedule:
     notes: tuple[str, ...] = ()
     fallback_reason: FallbackReason | None = None
     info: MethodInfo | None = None
+    smoothness: int | None = None
+    end_tolerance: float | None = None
+    checked_limits: int | None = None
 
     def __post_init__(self) -> None:
+        if self.smoothness is None:
+            object.__setattr__(self, "smoothness", 2 if self.jerk_limited else 1)
         object.__setattr__(self, "sections", tuple(self.sections))
         object.__setattr__(self, "notes", tuple(self.notes))
         if not self.sections:
@@ -138,16 +152,6 @@ class GraphSchedule:
     def track(self) -> TrackGraph:
         """The track the route runs on."""
         return self.route.track
-
-    @property
-    def end_tolerance(self) -> None:
-        """``None``: held to round-off at its ends and from piece to piece (see :class:`Schedule`)."""
-        return None
-
-    @property
-    def smoothness(self) -> int:
-        """Continuous derivatives of position (2: acceleration too, when jerk-limited)."""
-        return 2 if self.jerk_limited else 1
 
     @property
     def duration(self) -> float:

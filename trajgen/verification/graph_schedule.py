@@ -196,6 +196,10 @@ def _check_motion(schedule: GraphSchedule, pieces: _Pieces, failures: list[str])
     if schedule.jerk_limited:
         names.append(("jerk", "max_jerk", "m/s^3"))
     ratios: list = [[0.0, 0.0], [0.0, 0.0], [0.0, 0.0] if schedule.jerk_limited else None]
+    if schedule.checked_limits is not None:  # a table read back: the rest is checked from its points
+        names = names[: schedule.checked_limits]
+    end_tolerance = POSITION_TOLERANCE if schedule.end_tolerance is None else schedule.end_tolerance
+    past_end = max(TRACK_END_TOLERANCE, schedule.end_tolerance or 0.0)
     start_error = goal_error = 0.0
     h = pieces.length
     for vehicle, path in enumerate(schedule.paths):
@@ -205,18 +209,18 @@ def _check_motion(schedule: GraphSchedule, pieces: _Pieces, failures: list[str])
         first, last = float(c[0, 0]), float(polynomials.evaluate(c[-1:], h[-1:])[0])
         start_error = max(start_error, abs(first))
         goal_error = max(goal_error, abs(last - path.length))
-        if abs(first) > POSITION_TOLERANCE or abs(last - path.length) > POSITION_TOLERANCE:
+        if abs(first) > end_tolerance or abs(last - path.length) > end_tolerance:
             failures.append(
                 f"{who}'s travel runs from {first:.9g} m to {last:.9g} m: expected 0 to its path's "
                 f"{path.length:.9g} m"
             )
-        if np.any(low < -TRACK_END_TOLERANCE) or np.any(high > path.length + TRACK_END_TOLERANCE):
+        if np.any(low < -past_end) or np.any(high > path.length + past_end):
             failures.append(f"{who}'s travel leaves 0 to {path.length:g} m")
         derivatives = [c]
         for _ in range(3):
             derivatives.append(polynomials.derivative(derivatives[-1]))
         velocity_low, when, _, _ = polynomials.extrema(derivatives[1], h)
-        backwards = np.nonzero(velocity_low < -allowance(schedule, vehicle, "velocity"))[0]
+        backwards = np.nonzero(_backwards(schedule, vehicle, c, h, velocity_low))[0]
         if backwards.size:
             k = int(backwards[0])
             failures.append(
@@ -226,8 +230,8 @@ def _check_motion(schedule: GraphSchedule, pieces: _Pieces, failures: list[str])
         for order in (1, 2):
             begin = abs(float(derivatives[order][0, 0]))
             end = abs(float(polynomials.evaluate(derivatives[order][-1:], h[-1:])[0]))
-            if order == 2 and not schedule.jerk_limited:
-                continue
+            if order > schedule.smoothness or (order == 2 and not schedule.jerk_limited):
+                continue  # a linearly interpolated table has no velocity at its ends: the drive ramps
             if max(begin, end) > REST_TOLERANCE:
                 failures.append(
                     f"{who} is not at rest at the {'start' if begin > end else 'goal'}: "
@@ -265,7 +269,7 @@ def _check_motion(schedule: GraphSchedule, pieces: _Pieces, failures: list[str])
                     k = int(jumps[0])
                     failures.append(f"{who} {name} jumps by {gap[k]:.3g} at t={pieces.start[k + 1]:.6f} s")
         # at rest where the path turns back (the acceleration along its axis is continuous, above)
-        if path.cusps.size and pieces.count > 1:
+        if path.cusps.size and pieces.count > 1 and schedule.smoothness >= 1:
             boundary = pieces.travel[vehicle][1:, 0]
             turning = [
                 k
@@ -303,6 +307,34 @@ def _distance_terms(schedule: GraphSchedule, distances: TrackDistances, edges: n
     return terms, s[0] - s[1]
 
 
+def _separation_slack(schedule: GraphSchedule) -> float:
+    """How far below the separation a schedule may come, metres: round-off.
+
+    A table judged by its points only (``checked_limits == 0``: a generic CSV read back, whose
+    cubic between two rows is the reader's, not the drive's) is held to the separation at its
+    points exactly and between them to its tolerance.
+    """
+    if schedule.checked_limits == 0 and schedule.end_tolerance is not None:
+        return max(POSITION_TOLERANCE, schedule.end_tolerance)
+    return POSITION_TOLERANCE
+
+
+def _backwards(
+    schedule: GraphSchedule, vehicle: int, c: np.ndarray, h: np.ndarray, velocity_low: np.ndarray
+) -> np.ndarray:
+    """Pieces on which a vehicle drives back along its path, by more than a table's tolerance.
+
+    A computed schedule never drives back (beyond velocity round-off); a table read back may wiggle
+    back at rest by no more than its ``end_tolerance`` (metres), its interpolation's round-off.
+    """
+    if schedule.end_tolerance is None:
+        return velocity_low < -allowance(schedule, vehicle, "velocity")
+    low, t_low, high, t_high = polynomials.extrema(c, h)
+    before = np.concatenate([[-np.inf], np.maximum.accumulate(high)[:-1]])
+    furthest = np.maximum(np.maximum(before, c[:, 0]), np.where(t_high < t_low, high, -np.inf))
+    return furthest - low > schedule.end_tolerance
+
+
 def _check_separation(
     schedule: GraphSchedule, pieces: _Pieces, distances: TrackDistances, failures: list[str]
 ) -> float:
@@ -334,7 +366,7 @@ def _check_separation(
             f"the vehicles pass each other on edge {schedule.track.edges[edges[0, j]].name!r} between "
             f"t={pieces.start[j]:.6f} s and t={pieces.start[j] + pieces.length[j]:.6f} s"
         )
-    elif closest[k] < required - POSITION_TOLERANCE:
+    elif closest[k] < required - _separation_slack(schedule):
         failures.append(
             f"separation {closest[k]:.9g} m at t={pieces.start[k] + when[k]:.6f} s is below the minimum "
             f"{required:g} m (vehicle 1 on {schedule.track.edges[edges[0, k]].name!r}, vehicle 2 on "

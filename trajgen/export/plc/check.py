@@ -19,16 +19,17 @@ from pathlib import Path
 
 import numpy as np
 
-from topology import Homotopy, Route, plan
+from topology import GraphRoute, Homotopy, Route, plan, plan_graph_classes
 from topology.indexed import track_distance
+from topology.validation import short_repr
 from trajgen.errors import OptionError, ProfileFileError
 from trajgen.export.csv import profile_paths
 from trajgen.export.plc.dialects import DIALECTS, Dialect, DialectName, TableDialect
 from trajgen.export.plc.files import table_paths
 from trajgen.export.plc.table_check import TableCheck, check_tables
 from trajgen.export.plc.tables import ProfileTable
-from trajgen.model.summary import class_name
-from trajgen.scenario import Scenario
+from trajgen.model.summary import class_name, graph_class_label
+from trajgen.scenario import GraphScenario, Scenario
 from trajgen.scenario.reading import FileKind, file_label, read_bounded
 
 __all__ = ["MAX_FILE_BYTES", "ProfileCheck", "check_profiles", "profile_files"]
@@ -75,6 +76,13 @@ class ProfileCheck:
 
     def summary(self) -> dict:
         """JSON-ready verdict (``trajgen check --json``); 4 to 8 legs add ``class`` (a route on ``G_k``)."""
+        route = self.check.route
+        if isinstance(route, GraphRoute):  # a track graph: the class is the moves, in order
+            where = {"class": graph_class_label(route)}
+        else:
+            where = {"homotopy": route.homotopy.value}
+            if route.graph.cycle is None:
+                where["class"] = class_name(route)
         return {
             "dialect": self.dialect.name.value,
             "files": [str(path) for path in self.files],
@@ -82,22 +90,30 @@ class ProfileCheck:
             "failures": list(self.failures),
             "points": [int(table.times.size) for table in self.tables],
             "min_separation_m": self.check.report.min_separation,
-            "homotopy": self.check.route.homotopy.value,
-            **({} if self.check.route.graph.cycle is not None else {"class": class_name(self.check.route)}),
+            **where,
             "ratios": {k: (list(v) if v is not None else None) for k, v in self.check.ratios.items()},
         }
 
 
-def profile_files(scenario: Scenario, directory: str | Path, dialect: Dialect) -> tuple[Path, Path]:
+def profile_files(
+    scenario: Scenario | GraphScenario, directory: str | Path, dialect: Dialect
+) -> tuple[Path, Path]:
     """The two files of ``dialect`` for the scenario's vehicles in ``directory``."""
     if isinstance(dialect, TableDialect):
         return table_paths(dialect, scenario.names, directory)
     return profile_paths(scenario.names, directory)
 
 
-def _routes(scenario: Scenario) -> tuple[Route, ...]:
-    """The planner's route in its instruction's class, then the other class's (if there is another)."""
+def _routes(scenario: Scenario | GraphScenario) -> tuple[Route | GraphRoute, ...]:
+    """The planner's route in its instruction's class, then the other class's (if there is another).
+
+    On a track graph: the classes the timing methods take (:func:`topology.plan_graph_classes`).
+    """
     separation = scenario.limits.min_separation
+    if isinstance(scenario, GraphScenario):
+        return plan_graph_classes(
+            scenario.track, scenario.start, scenario.goal, min_separation=separation, names=scenario.names
+        )
     routes = [plan(scenario.track, scenario.start, scenario.goal, min_separation=separation)]
     # where start and goal retract to one boundary point, the other way round is a full turn: none
     with contextlib.suppress(OptionError):
@@ -113,10 +129,60 @@ def _routes(scenario: Scenario) -> tuple[Route, ...]:
     return tuple(routes)
 
 
-def _generic_columns(parsed, vehicle: int, check: TableCheck, scenario: Scenario, jerk: bool) -> list[str]:
-    """A generic CSV's other columns agree with its motion and keep the limits they state."""
+def _graph_places(parsed, vehicle: int, check: TableCheck, scenario: GraphScenario) -> list[str]:
+    """A track graph's generic CSV: each row's edge and s are where its axis puts the vehicle, x/y on them."""
+    columns, table, track = parsed.columns, parsed.table, scenario.track
+    name = f"vehicle {vehicle + 1}"
+    known = {edge.name: k for k, edge in enumerate(track.edges)}
+    names = columns["edge"]
+    unknown = [k for k, edge in enumerate(names) if edge not in known]
+    if unknown:
+        k = unknown[0]
+        return [
+            f"{name} row at t={table.times[k]:.6f} s: edge {short_repr(names[k])} is not on the track: "
+            f"expected one of {short_repr(sorted(known))}"
+        ]
+    edges = np.array([known[edge] for edge in names], dtype=int)
+    s = columns["s"]
+    failures = []
+    lengths = np.array([edge.length for edge in track.edges])[edges]
+    outside = (s < -1e-6) | (s > lengths + 1e-6)
+    if outside.any():
+        k = int(np.argmax(outside))
+        failures.append(
+            f"{name} row at t={table.times[k]:.6f} s: s {s[k]:.9g} m is off edge {names[k]!r} "
+            f"(0 to {track.edges[edges[k]].length:g} m)"
+        )
+    if check.schedule is not None:
+        state = check.schedule.state(table.times)
+        apart = track.distances(edges, np.clip(s, 0.0, lengths), state.edge[vehicle], state.s[vehicle])
+        where = np.nonzero(apart > 1e-6)[0]
+        if where.size:
+            k = int(where[0])
+            failures.append(
+                f"{name} row at t={table.times[k]:.6f} s says edge {names[k]!r}, s {s[k]:.9g} m, but its "
+                f"axis puts it on edge {track.edges[state.edge[vehicle, k]].name!r}, s "
+                f"{state.s[vehicle, k]:.9g} m"
+            )
+    if "x" in columns and track.coordinates is not None:
+        coordinates = np.asarray(track.coordinates, dtype=float)
+        ends = np.array([track.ends(k) for k in range(len(track.edges))], dtype=int)[edges]
+        point = coordinates[ends[:, 0]] + (s / lengths)[:, None] * (
+            coordinates[ends[:, 1]] - coordinates[ends[:, 0]]
+        )
+        off = np.hypot(columns["x"] - point[:, 0], columns["y"] - point[:, 1])
+        if np.any(off > 1e-6):
+            k = int(np.argmax(off))
+            failures.append(
+                f"{name} row at t={table.times[k]:.6f} s: x, y do not lie at edge {names[k]!r}, "
+                f"s {s[k]:.9g} m"
+            )
+    return failures
+
+
+def _star_places(parsed, vehicle: int, check: TableCheck, scenario: Scenario) -> list[str]:
+    """A junction's generic CSV: each row's leg and s are where its axis puts the vehicle, x/y on them."""
     columns, table = parsed.columns, parsed.table
-    limits = scenario.limits.vehicles[vehicle]
     name = f"vehicle {vehicle + 1}"
     failures = []
     if check.schedule is not None:
@@ -151,6 +217,25 @@ def _generic_columns(parsed, vehicle: int, check: TableCheck, scenario: Scenario
             f"{name} row at t={table.times[k]:.6f} s: x, y do not lie at leg {legs[k]}, "
             f"s {columns['s'][k]:.9g} m"
         )
+    return failures
+
+
+def _generic_columns(
+    parsed, vehicle: int, check: TableCheck, scenario: Scenario | GraphScenario, jerk: bool
+) -> list[str]:
+    """A generic CSV's other columns agree with its motion and keep the limits they state."""
+    columns, table = parsed.columns, parsed.table
+    limits = scenario.limits.vehicles[vehicle]
+    name = f"vehicle {vehicle + 1}"
+    if isinstance(scenario, GraphScenario) != ("edge" in columns):
+        expected = (
+            "a track graph's (an edge column)" if isinstance(scenario, GraphScenario) else "a junction's"
+        )
+        return [f"{name}'s generic CSV is not for this scenario's track: expected {expected} columns"]
+    if isinstance(scenario, GraphScenario):
+        failures = _graph_places(parsed, vehicle, check, scenario)
+    else:
+        failures = _star_places(parsed, vehicle, check, scenario)
     # the v column against the positions: for any motion within max_acceleration the central
     # difference is within max_acceleration (h0^2 + h1^2) / (2 (h0 + h1)) of the velocity
     if table.times.size >= 3:
@@ -205,7 +290,7 @@ def _read(dialect: Dialect, text, source: str):
 
 
 def check_profiles(
-    scenario: Scenario,
+    scenario: Scenario | GraphScenario,
     directory: str | Path,
     *,
     dialect: Dialect | str = "generic",
@@ -216,7 +301,7 @@ def check_profiles(
 
     Parameters
     ----------
-    scenario : Scenario
+    scenario : Scenario or GraphScenario
     directory : path
         Holds ``<vehicle name><suffix>`` of both vehicles.
     dialect : Dialect or str, optional

@@ -29,6 +29,7 @@ from topology import Option
 from topology.validation import short_repr
 from trajgen.errors import OptionError, ProfileFileError
 from trajgen.export.csv import HEADER_NAMES, Units
+from trajgen.export.graph_rows import GRAPH_HEADER_NAMES
 from trajgen.export.numbers import format_number_rows
 from trajgen.export.plc.tables import Interpolation, ProfileTable
 from trajgen.lazy import RenamedAttribute
@@ -45,8 +46,11 @@ __all__ = [
 
 #: Decimal places of the times and values the table dialects write.
 DECIMALS = 9
-#: The columns of the generic CSV, in order (:data:`~trajgen.export.csv.HEADER_NAMES`).
+#: The columns of the generic CSV, in order (:data:`~trajgen.export.csv.HEADER_NAMES`); on a track
+#: graph ``edge`` (the name) stands where ``leg`` does, and ``x``, ``y`` are there with coordinates only.
 GENERIC_COLUMNS = ("t", "axis", "v", "a", "j", "leg", "s", "x", "y")
+#: Where the leg, or a track graph's edge name, is among the columns.
+EDGE_COLUMN = 5
 
 
 class DialectName(Option):
@@ -76,7 +80,8 @@ class ParsedProfile:
         Format deviations (line ends, header, point count), each naming the line.
     columns : dict of str to ndarray, or None
         Every column of a ``generic`` file in SI units (``t``, ``axis``, ``v``, ``a``, ``j``,
-        ``leg`` (1-based, 0 at the junction), ``s``, ``x``, ``y``), shape (n,) each.
+        ``leg`` (1-based, 0 at the junction), ``s``, ``x``, ``y``), shape (n,) each; on a track
+        graph ``edge`` (names, dtype object) instead of ``leg``, and ``x``, ``y`` only if written.
     """
 
     table: ProfileTable
@@ -335,6 +340,10 @@ class GenericDialect(Dialect):
         delimiter = header[3:4] if header.startswith("t_s") else ""
         names = header.split(delimiter) if delimiter else []
         units = next((unit for unit, expected in HEADER_NAMES.items() if tuple(names) == expected), None)
+        graph = False
+        for unit in Units if units is None else ():  # a track graph's: the edge by name, x/y optional
+            if tuple(names) in (GRAPH_HEADER_NAMES[unit.value], GRAPH_HEADER_NAMES[unit.value][:7]):
+                units, graph = unit, True
         if units is None:
             raise ProfileFileError(
                 f"{source} line 1: header {short_repr(header)} is not trajgen's: expected "
@@ -346,6 +355,7 @@ class GenericDialect(Dialect):
         comma = delimiter != "," and any("," in row for row in rows[:1])
         columns = np.empty((len(names), len(rows)))
         places = []
+        edges: list[str] = []
         for n, row in enumerate(rows):
             fields = row.split(delimiter)
             if len(fields) != len(names):
@@ -354,6 +364,10 @@ class GenericDialect(Dialect):
                     f"expected {len(names)} ({short_repr(row)})"
                 )
             for k, field in enumerate(fields):
+                if graph and k == EDGE_COLUMN:
+                    edges.append(field)
+                    columns[k, n] = 0.0
+                    continue
                 columns[k, n], decimals = _number(
                     field.replace(",", ".") if comma else field, source, n + 2, names[k]
                 )
@@ -363,14 +377,18 @@ class GenericDialect(Dialect):
             raise ProfileFileError(
                 f"{source} line 2: the first time is {float(columns[0, 0])!r} s, expected 0"
             )
-        legs = columns[5]
-        if not np.all(legs == np.round(legs)):
+        legs = columns[EDGE_COLUMN]
+        if not graph and not np.all(legs == np.round(legs)):
             bad = int(np.argmax(legs != np.round(legs)))
             raise ProfileFileError(f"{source} line {bad + 2}: leg {legs[bad]!r} is not a whole number")
         resolution = 0.5 * 10.0 ** -max(places) / units.scale
         scaled = {
-            name: columns[k] / (1.0 if k in (0, 5) else units.scale) for k, name in enumerate(GENERIC_COLUMNS)
+            name: columns[k] / (1.0 if k in (0, EDGE_COLUMN) else units.scale)
+            for k, name in enumerate(GENERIC_COLUMNS[: len(names)])
         }
+        if graph:
+            del scaled["leg"]
+            scaled["edge"] = np.array(edges, dtype=object)
         table = ProfileTable(
             columns[0],
             scaled["axis"],

@@ -22,7 +22,8 @@ import numpy as np
 from topology.indexed import track_distance
 from trajgen.errors import InputError, OutputLimitError
 from trajgen.export.plc.tables import Interpolation, ProfileTable, divided_differences, limit_ratios, slowdown
-from trajgen.model.pieces import schedule_pieces
+from trajgen.model.graph_schedule import GraphSchedule
+from trajgen.model.pieces import kinematics_polynomials, schedule_pieces
 from trajgen.model.schedule import Schedule
 from trajgen.model.values import sorted_unique
 from trajgen.verification import VerifiedSchedule, require_verified
@@ -88,17 +89,32 @@ def _spread(times: np.ndarray) -> np.ndarray:
     return times[keep]
 
 
-def _reference_times(schedule: Schedule, decimals: int, points: int) -> tuple[np.ndarray, np.ndarray]:
+def _pieces(schedule: Schedule | GraphSchedule) -> tuple[np.ndarray, np.ndarray]:
+    """Start time and length (seconds) of every polynomial piece of ``schedule``, shape (n,) each."""
+    if isinstance(schedule, Schedule):
+        pieces = schedule_pieces(schedule)
+        return pieces.start, pieces.length
+    starts, lengths = [], []
+    for section in schedule.sections:
+        times = kinematics_polynomials(section.kinematics)[0]
+        starts.append(section.start_time + times[:-1])
+        lengths.append(np.diff(times))
+    return np.concatenate(starts), np.concatenate(lengths)
+
+
+def _reference_times(
+    schedule: Schedule | GraphSchedule, decimals: int, points: int
+) -> tuple[np.ndarray, np.ndarray]:
     """Candidate times, and the pieces' boundaries (both rounded to ``decimals``).
 
     The candidates: SAMPLES_PER_PIECE per piece, and ``4 * points`` evenly (finer than any table
     of ``points`` points needs), so their number grows with the pieces and the points, not the duration.
     """
-    pieces = schedule_pieces(schedule)
+    start, length = _pieces(schedule)
     duration = schedule.duration
-    boundaries = np.concatenate([[0.0, duration], pieces.start, pieces.start + pieces.length])
+    boundaries = np.concatenate([[0.0, duration], start, start + length])
     fractions = np.linspace(0.0, 1.0, SAMPLES_PER_PIECE + 1)
-    grid = (pieces.start[:, None] + pieces.length[:, None] * fractions[None, :]).ravel()
+    grid = (start[:, None] + length[:, None] * fractions[None, :]).ravel()
     boundaries = sorted_unique(np.clip(np.round(boundaries, decimals), 0.0, duration))
     boundaries = _spread(boundaries)
     even = np.linspace(0.0, duration, 4 * points + 1)
@@ -159,7 +175,7 @@ def _matched_velocities(
 
 
 def _table(
-    schedule: Schedule,
+    schedule: Schedule | GraphSchedule,
     vehicle: int,
     times: np.ndarray,
     interpolation: Interpolation,
@@ -187,9 +203,13 @@ def _errors(table: ProfileTable, grid: np.ndarray, axis: np.ndarray, velocity: n
     return np.abs(values[0] - axis), np.abs(values[1] * scale - velocity)
 
 
-def _closest_approaches(grid: np.ndarray, state, separation: float) -> np.ndarray:
-    """Times of the grid where the vehicles' track distance has a local minimum near ``separation``."""
-    distance = track_distance(state.leg[0], state.s[0], state.leg[1], state.s[1])
+def _closest_approaches(schedule: Schedule | GraphSchedule, grid: np.ndarray, state) -> np.ndarray:
+    """Times of the grid where the vehicles' track distance has a local minimum near the separation."""
+    separation = schedule.limits.min_separation
+    if isinstance(schedule, GraphSchedule):
+        distance = schedule.track.distances(state.edge[0], state.s[0], state.edge[1], state.s[1])
+    else:
+        distance = track_distance(state.leg[0], state.s[0], state.leg[1], state.s[1])
     if distance.size < 3:
         return np.zeros(0)
     inner = (distance[1:-1] < distance[:-2]) & (distance[1:-1] <= distance[2:])
@@ -227,7 +247,7 @@ def _equidistributed(grid: np.ndarray, density: np.ndarray, required: np.ndarray
 
 
 def _points(
-    schedule: Schedule,
+    schedule: Schedule | GraphSchedule,
     vehicle: int,
     interpolation: Interpolation,
     max_points: int,
@@ -332,7 +352,7 @@ def resample(
         raise InputError(f"max_points must be an integer >= 2, got {max_points!r}")
     grid, boundaries = _reference_times(schedule, decimals, max_points)
     state = schedule.state(grid)
-    critical = _closest_approaches(grid, state, schedule.limits.min_separation)
+    critical = _closest_approaches(schedule, grid, state)
     points = [
         _points(schedule, vehicle, interpolation, max_points, grid, boundaries, state, critical)
         for vehicle in range(2)

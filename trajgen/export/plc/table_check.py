@@ -16,7 +16,7 @@ from typing import ClassVar
 import numpy as np
 
 from limits import Limits
-from topology import JUNCTION_INDEX, Route
+from topology import JUNCTION_INDEX, GraphRoute, Route
 from topology.validation import short_repr
 from trajgen.errors import InputError
 from trajgen.export.plc.tables import (
@@ -27,13 +27,24 @@ from trajgen.export.plc.tables import (
     difference_checks,
     limit_ratios,
 )
+from trajgen.model.graph_paths import GraphPath, graph_paths
+from trajgen.model.graph_schedule import GraphSchedule, GraphSection
 from trajgen.model.paths import VehiclePath
 from trajgen.model.profiles import PiecewiseCubic
 from trajgen.model.schedule import AxisMap, CubicKinematics, Schedule, Section, TimingMethod
+from trajgen.model.summary import graph_class_label
 from trajgen.model.values import sorted_unique
 from trajgen.verification import VerificationReport, verify
 
-__all__ = ["TableCheck", "TableMotion", "check_tables", "junction_crossings", "leg_visits"]
+__all__ = [
+    "TableCheck",
+    "TableMotion",
+    "check_tables",
+    "graph_travel",
+    "junction_crossings",
+    "leg_visits",
+    "turning_points",
+]
 
 
 def leg_visits(route: Route, vehicle: int) -> tuple[int, ...]:
@@ -59,18 +70,7 @@ def junction_crossings(motion: PiecewiseCubic, junction: float) -> list[float]:
     Between consecutive piece ends and velocity zeros the motion is monotone, so each sign
     change of ``axis - junction`` there holds one crossing, found by bisection.
     """
-    begin = motion.times[:-1]
-    length = np.diff(motion.times)
-    v0, a0, j = motion.initial[:, 1], motion.initial[:, 2], motion.jerk
-    roots = []
-    with np.errstate(divide="ignore", invalid="ignore"):  # v(h) = v0 + a0 h + j h^2 / 2 = 0
-        root = np.sqrt(a0 * a0 - 2.0 * j * v0)
-        roots += [(-a0 + root) / j, (-a0 - root) / j, -v0 / a0]
-    candidates = [motion.times]
-    for h in roots:
-        inside = np.isfinite(h) & (h > 0.0) & (h < length)
-        candidates.append(begin[inside] + h[inside])
-    times = sorted_unique(np.concatenate(candidates))
+    times = _monotone_times(motion)
     gap = motion.evaluate(times)[0] - junction
     sign = np.where(np.abs(gap) <= CROSSING_TOLERANCE, 0.0, np.sign(gap))
     nonzero = np.nonzero(sign)[0]
@@ -129,9 +129,15 @@ def _stays(
     return starts, maps, max(0, len(crossings) - (len(visits) - 1))
 
 
-def _slice(profile: PiecewiseCubic, begin: float, end: float) -> PiecewiseCubic:
-    """The part of ``profile`` from ``begin`` to ``end`` seconds, in local time (at rest past its end)."""
-    inner = profile.times[(profile.times > begin) & (profile.times < end)]
+def _slice(
+    profile: PiecewiseCubic, begin: float, end: float, cuts: np.ndarray | None = None
+) -> PiecewiseCubic:
+    """The part of ``profile`` from ``begin`` to ``end`` seconds, in local time (at rest past its end).
+
+    ``cuts``: more times (seconds) at which a piece ends.
+    """
+    knots = profile.times if cuts is None else sorted_unique(np.concatenate([profile.times, cuts]))
+    inner = knots[(knots > begin) & (knots < end)]
     times = np.concatenate([[begin], inner, [end]])
     last = profile.duration
     k = np.clip(np.searchsorted(profile.times, times[:-1], side="right") - 1, 0, len(profile.jerk) - 1)
@@ -147,6 +153,88 @@ def _slice(profile: PiecewiseCubic, begin: float, end: float) -> PiecewiseCubic:
         initial[ended] = (end_position, 0.0, 0.0)
         jerk[ended] = 0.0
     return PiecewiseCubic(times - begin, initial, jerk)
+
+
+def _monotone_times(motion: PiecewiseCubic) -> np.ndarray:
+    """The piece ends and velocity zeros of ``motion``: it is monotone between consecutive ones."""
+    begin = motion.times[:-1]
+    length = np.diff(motion.times)
+    v0, a0, j = motion.initial[:, 1], motion.initial[:, 2], motion.jerk
+    candidates = [motion.times]
+    with np.errstate(divide="ignore", invalid="ignore"):  # v(h) = v0 + a0 h + j h^2 / 2 = 0
+        root = np.sqrt(a0 * a0 - 2.0 * j * v0)
+        for h in ((-a0 + root) / j, (-a0 - root) / j, -v0 / a0):
+            inside = np.isfinite(h) & (h > 0.0) & (h < length)
+            candidates.append(begin[inside] + h[inside])
+    return sorted_unique(np.concatenate(candidates))
+
+
+def turning_points(motion: PiecewiseCubic, tolerance: float) -> tuple[np.ndarray, np.ndarray]:
+    """Times (s) and axis values (m) where ``motion`` turns back, once it has gone back ``tolerance``.
+
+    The first move is the axis's positive direction (the convention of the files). A turn is
+    where the axis is furthest before it comes back by more than ``tolerance`` metres, so a
+    wiggle at rest no larger than the table's round-off is no turn.
+    """
+    times = _monotone_times(motion)
+    axis = motion.evaluate(times)[0]
+    direction, furthest, where = 1.0, float(axis[0]), 0
+    turns: list[int] = []
+    for k in range(1, axis.size):
+        x = float(axis[k])
+        if (x - furthest) * direction > 0.0:
+            furthest, where = x, k
+        elif (furthest - x) * direction > tolerance:
+            turns.append(where)
+            direction, furthest, where = -direction, x, k
+    index = np.array(turns, dtype=int)
+    return times[index], axis[index]
+
+
+def graph_travel(motion: PiecewiseCubic, tolerance: float) -> tuple[PiecewiseCubic, np.ndarray]:
+    """The metres a vehicle has driven (its travel) under an axis ``motion``, and the travel at each turn.
+
+    Between turns (:func:`turning_points`) the travel is the axis, signed by the direction of
+    that stretch, so it grows while the vehicle drives either way.
+
+    Returns
+    -------
+    PiecewiseCubic
+        The travel over the motion's time, with a piece end at each turn.
+    ndarray, shape (r,)
+        The travel at each turn, metres.
+    """
+    turn_times, turn_axis = turning_points(motion, tolerance)
+    whole = _slice(motion, 0.0, motion.duration, turn_times)
+    run = np.searchsorted(turn_times, whole.times[:-1], side="right")
+    signs = np.where(np.arange(turn_times.size + 1) % 2 == 0, 1.0, -1.0)
+    anchors = np.concatenate([[float(whole.initial[0, 0]) if whole.jerk.size else 0.0], turn_axis])
+    travel_at = np.concatenate([[0.0], np.cumsum(signs[:-1] * np.diff(anchors))])
+    sign = signs[run]
+    initial = sign[:, None] * whole.initial
+    initial[:, 0] += travel_at[run] - sign * anchors[run]
+    return PiecewiseCubic(whole.times, initial, sign * whole.jerk), travel_at[1:]
+
+
+def _turn_failures(turns: np.ndarray, path: GraphPath, vehicle: int, tolerance: float) -> list[str]:
+    """A table turns back exactly where its path does: as often, at the same travel."""
+    who = f"vehicle {vehicle + 1}"
+    cusps = path.cusps
+    if turns.size != cusps.size:
+        where = ", ".join(f"{p:.6g}" for p in turns[:5]) or "nowhere"
+        return [
+            f"{who}'s table turns back {turns.size} time(s) (at {where} m of travel): expected "
+            f"{cusps.size}, where its path turns back"
+            + (f" (at {', '.join(f'{p:.6g}' for p in cusps[:5])} m)" if cusps.size else "")
+        ]
+    off = np.abs(turns - cusps)
+    if off.size and off.max() > tolerance:
+        k = int(np.argmax(off))
+        return [
+            f"{who}'s table turns back at {turns[k]:.9g} m of travel: expected {cusps[k]:.9g} m, where its "
+            "path turns back"
+        ]
+    return []
 
 
 @dataclass(frozen=True, slots=True)
@@ -203,16 +291,35 @@ class TableMotion(TimingMethod):
                 maps.append(stay_maps[vehicle][stay])
             kinematics = CubicKinematics(tuple(_slice(m, begin, finish) for m in motions))
             sections.append(Section(begin, kinematics, tuple(maps)))
-        smoothness = min(table.interpolation.smoothness for table in self.tables)
-        return Schedule(
+        return Schedule(route, limits, self, tuple(sections), jerk_limited=self.jerk, **self._read_back())
+
+    def _read_back(self) -> dict:
+        """What a table read back is held to: its interpolation's smoothness, tolerances and limits."""
+        return {
+            "smoothness": min(table.interpolation.smoothness for table in self.tables),
+            "end_tolerance": max(END_TOLERANCES[table.interpolation] for table in self.tables),
+            "checked_limits": min(table.interpolation.closed_form for table in self.tables),
+        }
+
+    def schedule_graph(self, route: GraphRoute, limits: Limits) -> GraphSchedule:
+        """The tables' motion along a route on a track graph: each vehicle's travel along its path.
+
+        The axis of a table turns back where its path does (checked by :func:`check_tables`);
+        between turns its travel is the axis, signed by the stretch's direction.
+        """
+        given = self.motions or tuple(table.motion() for table in self.tables)
+        tolerance = self._read_back()["end_tolerance"]
+        travels = [graph_travel(motion, tolerance)[0] for motion in given]
+        end = max(travel.duration for travel in travels)
+        kinematics = CubicKinematics(tuple(_slice(travel, 0.0, end) for travel in travels))
+        return GraphSchedule(
             route,
             limits,
             self,
-            tuple(sections),
+            graph_paths(route),
+            (GraphSection(0.0, kinematics),),
             jerk_limited=self.jerk,
-            smoothness=smoothness,
-            end_tolerance=max(END_TOLERANCES[table.interpolation] for table in self.tables),
-            checked_limits=min(table.interpolation.closed_form for table in self.tables),
+            **self._read_back(),
         )
 
 
@@ -230,9 +337,9 @@ class TableCheck:
         and goal, homotopy class, closed-form limits).
     ratios : dict
         Worst |v|, |a|, |j| over each limit per vehicle (:func:`limit_ratios`).
-    route : Route
+    route : Route or GraphRoute
         The route the tables were read along.
-    schedule : Schedule or None
+    schedule : Schedule, GraphSchedule or None
         The tables' motion along it, as verified (None if they could not be read along it).
     """
 
@@ -240,17 +347,21 @@ class TableCheck:
     failures: tuple[str, ...]
     report: VerificationReport
     ratios: dict
-    route: Route
-    schedule: Schedule | None = None
+    route: Route | GraphRoute
+    schedule: Schedule | GraphSchedule | None = None
 
     def summary(self) -> dict:
-        """JSON-ready verdict."""
+        """JSON-ready verdict (``homotopy`` on a junction; on a track graph ``class``, the moves)."""
+        if isinstance(self.route, GraphRoute):
+            where = {"class": graph_class_label(self.route)}
+        else:
+            where = {"homotopy": self.route.homotopy.value}
         return {
             "passed": self.passed,
             "failures": list(self.failures),
             "min_separation_m": self.report.min_separation,
             "ratios": {k: (list(v) if v is not None else None) for k, v in self.ratios.items()},
-            "homotopy": self.route.homotopy.value,
+            **where,
         }
 
 
@@ -303,16 +414,39 @@ def _orientations(route: Route) -> list[tuple[int, int]]:
     return [(first[0] * a, first[1] * b) for a, b in ((1, 1), (-1, 1), (1, -1), (-1, -1))]
 
 
+def _check_graph_tables(
+    tables: tuple[ProfileTable, ProfileTable],
+    motions: tuple[PiecewiseCubic, PiecewiseCubic],
+    route: GraphRoute,
+    limits: Limits,
+    *,
+    jerk: bool,
+    failures: list[str],
+) -> TableCheck:
+    """:func:`check_tables` along a route on a track graph: the axes turn back where the paths do."""
+    method = TableMotion(tables, jerk=jerk, motions=motions)
+    schedule = method.schedule_graph(route, limits)
+    tolerance = max(schedule.end_tolerance, 1e-6)
+    for vehicle, motion in enumerate(motions):
+        turns = graph_travel(motion, schedule.end_tolerance)[1]
+        failures += _turn_failures(turns, schedule.paths[vehicle], vehicle, tolerance)
+    report = verify(schedule)
+    failures += list(report.failures)
+    ratios = limit_ratios(tables, limits, jerk=jerk)
+    return TableCheck(not failures, tuple(failures), report, ratios, route, schedule)
+
+
 def check_tables(
-    tables: tuple[ProfileTable, ProfileTable], route: Route, limits: Limits, *, jerk: bool = True
+    tables: tuple[ProfileTable, ProfileTable], route: Route | GraphRoute, limits: Limits, *, jerk: bool = True
 ) -> TableCheck:
     """Verify two profile tables as their controllers interpolate them, along ``route``.
 
     Parameters
     ----------
     tables : tuple of 2 ProfileTable
-    route : Route
-        The route the tables follow (its homotopy class is checked).
+    route : Route or GraphRoute
+        The route the tables follow (its homotopy class is checked; on a track graph, its
+        class: which vehicle passes first at each conflict, and each vehicle's path).
     limits : Limits
     jerk : bool, optional
         Hold the tables to the jerk limits (default True).
@@ -348,6 +482,8 @@ def check_tables(
                 )
         failures += _velocity_steps(table, vehicle, limits.vehicles[vehicle].max_acceleration)
     motions = tuple(table.motion() for table in tables)
+    if isinstance(route, GraphRoute):
+        return _check_graph_tables(tables, motions, route, limits, jerk=jerk, failures=failures)
     # the files do not say which way along its leg each vehicle's axis grows: read both ways
     verdicts = []
     for orientations in _orientations(route):

@@ -1,0 +1,194 @@
+"""PLC tables and ``trajgen check`` on track graphs: written, read back as interpolated, faults found."""
+
+from __future__ import annotations
+
+import dataclasses
+import functools
+import json
+
+import numpy as np
+import pytest
+
+from tests.conftest import REPO
+from trajgen import certify
+from trajgen.cli import main
+from trajgen.errors import OptionError, VerificationError
+from trajgen.export.plc.check import check_profiles
+from trajgen.export.plc.dialects import DIALECTS, TableDialect
+from trajgen.export.plc.files import plc_tables
+from trajgen.export.plc.table_check import check_tables, graph_travel, turning_points
+from trajgen.export.plc.tables import Interpolation, ProfileTable
+from trajgen.methods import make_schedule
+from trajgen.model.profiles import PiecewiseCubic
+from trajgen.scenario import load_scenario
+
+EXAMPLES = REPO / "examples" / "graphs"
+FEASIBLE = ["h", "main-line-with-sidings", "passing-loop", "ring-with-spurs"]
+TABLE_DIALECTS = [dialect for dialect in DIALECTS if isinstance(dialect, TableDialect)]
+
+
+@functools.cache
+def _verified(name: str, method: str):
+    scenario = load_scenario(EXAMPLES / f"{name}.toml")
+    return scenario, certify(make_schedule(scenario.route(), scenario.limits, method=method))
+
+
+def _hurried(table: ProfileTable) -> ProfileTable:
+    """The same table without the rest it starts with: the vehicle sets off at t = 0."""
+    moving = int(np.nonzero(table.values != table.values[0])[0][0]) - 1
+    return ProfileTable(
+        table.times[moving:] - table.times[moving], table.values[moving:], table.interpolation
+    )
+
+
+def test_turning_points_and_travel_of_a_motion_that_goes_two_metres_and_back_one_and_a_half():
+    # forward 2 m in 2 s, back 1.5 m in 1.5 s (velocity steps: a linear table)
+    table = ProfileTable([0.0, 2.0, 3.5], [0.0, 2.0, 0.5], Interpolation.LINEAR)
+    times, axis = turning_points(table.motion(), 1e-9)
+    assert times.tolist() == [2.0]
+    assert axis.tolist() == [2.0]
+    travel, turns = graph_travel(table.motion(), 1e-9)
+    assert turns.tolist() == [2.0]
+    assert travel.evaluate(np.array([1.0, 2.0, 3.0, 3.5]))[0].tolist() == pytest.approx([1.0, 2.0, 3.0, 3.5])
+    assert np.all(travel.evaluate(np.linspace(0.0, 3.5, 50))[1] >= 0.0)
+
+
+def test_a_wiggle_within_the_tolerance_is_no_turn_and_one_beyond_it_is():
+    motion = PiecewiseCubic(
+        np.array([0.0, 1.0, 2.0]), np.array([[0.0, 1.0, 0.0], [1.0, -1e-7, 0.0]]), np.zeros(2)
+    )
+    assert turning_points(motion, 1e-6)[0].size == 0
+    assert turning_points(motion, 1e-8)[0].tolist() == [1.0]
+
+
+@pytest.mark.parametrize("method", ["exact", "toppra"])
+@pytest.mark.parametrize("name", FEASIBLE)
+def test_every_table_dialect_on_every_example_graph_is_verified_as_its_controller_interpolates(name, method):
+    scenario, verified = _verified(name, method)
+    for dialect in TABLE_DIALECTS:
+        if dialect.interpolation is Interpolation.CUBIC and not verified.schedule.jerk_limited:
+            with pytest.raises(OptionError, match="interpolates a cubic spline: it needs a jerk-limited"):
+                plc_tables(verified, dialect)
+            continue
+        tables = plc_tables(verified, dialect)
+        assert tables.check.passed, (dialect.name, tables.check.failures)
+        assert tables.check.report.min_separation >= scenario.limits.min_separation - 1e-9
+        assert all(table.times.size <= dialect.point_limit for table in tables.resampled.tables)
+        # the tables run the schedule: as long, or slowed down uniformly, never faster
+        assert max(t.duration for t in tables.resampled.tables) >= verified.schedule.duration - 1e-6
+        # and they are read along the route's paths: each turn back where its path turns back
+        paths = tables.check.schedule.paths
+        for vehicle, table in enumerate(tables.resampled.tables):
+            turns = graph_travel(table.motion(), 1e-6)[1]
+            assert turns == pytest.approx(paths[vehicle].cusps, abs=1e-6)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("name", FEASIBLE)
+def test_every_table_dialect_of_the_optimal_schedule_on_every_example_graph_is_verified(name):
+    scenario, verified = _verified(name, "optimal")
+    assert verified.schedule.jerk_limited
+    for dialect in TABLE_DIALECTS:
+        tables = plc_tables(verified, dialect)
+        assert tables.check.passed, (dialect.name, tables.check.failures)
+        assert tables.check.report.min_separation >= scenario.limits.min_separation - 1e-9
+
+
+def test_a_table_that_sets_off_before_its_turn_is_found_to_break_the_separation():
+    scenario, verified = _verified("h", "exact")
+    first, second = plc_tables(verified, "siemens-xy").resampled.tables
+    assert check_tables((first, second), verified.schedule.route, scenario.limits).passed
+    assert second.values[1] == second.values[0]  # agv2 waits for agv1's first move
+    early = check_tables((first, _hurried(second)), verified.schedule.route, scenario.limits)
+    assert not early.passed
+    assert any("below the minimum 1.5 m" in f or "pass each other" in f for f in early.failures), (
+        early.failures
+    )
+
+
+def test_a_table_that_turns_back_where_its_path_does_not_or_misses_a_turn_is_refused():
+    scenario, verified = _verified("h", "exact")
+    first, second = plc_tables(verified, "siemens-xy").resampled.tables
+    route = verified.schedule.route
+    assert verified.schedule.paths[0].cusps.size == 1  # agv1 goes up c and comes back
+    # agv1 driven on instead of back: its axis keeps growing after the turn
+    cusp = int(np.argmax(first.values))
+    onward = first.values.copy()
+    onward[cusp:] = 2.0 * first.values[cusp] - first.values[cusp:]
+    missed = check_tables((dataclasses.replace(first, values=onward), second), route, scenario.limits)
+    assert not missed.passed
+    assert any(
+        f.startswith("vehicle 1's table turns back 0 time(s) (at nowhere m of travel): expected 1")
+        for f in missed.failures
+    ), missed.failures
+    # agv2 (no turn on its path) made to back up half a metre midway and go on
+    k = second.times.size // 2
+    times = np.concatenate([second.times[: k + 1], second.times[k] + [1.0, 2.0], second.times[k + 1 :] + 2.0])
+    values = np.concatenate([second.values[: k + 1], second.values[k] - [0.5, 0.0], second.values[k + 1 :]])
+    backed = ProfileTable(times, values, Interpolation.LINEAR)
+    extra = check_tables((first, backed), route, scenario.limits, jerk=False)
+    assert any(f.startswith("vehicle 2's table turns back 2 time(s)") for f in extra.failures), extra.failures
+
+
+def test_check_reads_a_graphs_generic_csv_and_its_tables_from_the_command_line(tmp_path, capsys):
+    scenario_file = str(EXAMPLES / "h.toml")
+    assert main(["schedule", scenario_file, "--csv", str(tmp_path / "generic")]) == 0
+    assert main(["schedule", scenario_file, "--csv", str(tmp_path / "cam"), "--dialect", "twincat-cam"]) == 0
+    capsys.readouterr()
+    assert main(["check", scenario_file, "--csv", str(tmp_path / "generic")]) == 0
+    out = capsys.readouterr().out
+    assert "class: agv1 A -> c:1.5; agv2 D -> A; agv1 c:1.5 -> D" in out
+    assert "PASS" in out
+    assert (
+        main(["check", scenario_file, "--csv", str(tmp_path / "cam"), "--dialect", "twincat-cam", "--json"])
+        == 0
+    )
+    summary = json.loads(capsys.readouterr().out)
+    assert summary["passed"]
+    assert summary["class"] == "agv1 A -> c:1.5; agv2 D -> A; agv1 c:1.5 -> D"
+    assert "homotopy" not in summary
+
+
+def test_a_graph_csv_whose_edge_or_s_column_lies_is_found(tmp_path):
+    scenario = load_scenario(EXAMPLES / "h.toml")
+    assert main(["schedule", str(EXAMPLES / "h.toml"), "--csv", str(tmp_path)]) == 0
+    path = tmp_path / "agv2.csv"
+    original = path.read_bytes()
+    rows = original.split(b"\r\n")
+    fields = rows[40].split(b";")
+    fields[5] = b"zz"
+    rows[40] = b";".join(fields)
+    path.write_bytes(b"\r\n".join(rows))
+    verdict = check_profiles(scenario, tmp_path)
+    assert not verdict.passed
+    assert any("edge 'zz' is not on the track" in f for f in verdict.failures), verdict.failures
+    rows = original.split(b"\r\n")
+    fields = rows[40].split(b";")
+    fields[6] = f"{float(fields[6]) - 0.25:.9f}".encode()
+    rows[40] = b";".join(fields)
+    path.write_bytes(b"\r\n".join(rows))
+    verdict = check_profiles(scenario, tmp_path)
+    assert any("but its axis puts it on edge" in f for f in verdict.failures), verdict.failures
+
+
+def test_a_junctions_csv_checked_against_a_graph_says_it_is_not_for_that_track(tmp_path):
+    assert main(["schedule", str(REPO / "trajgen" / "data" / "swap.toml"), "--csv", str(tmp_path)]) == 0
+    verdict = check_profiles(load_scenario(EXAMPLES / "h.toml"), tmp_path)
+    assert not verdict.passed
+    assert any("is not for this scenario's track: expected a track graph's" in f for f in verdict.failures)
+
+
+def test_a_table_set_that_fails_as_interpolated_is_never_returned(monkeypatch):
+    _, verified = _verified("h", "exact")
+    import trajgen.export.plc.files as files
+
+    real = files.check_tables
+
+    def early(tables, route, limits, *, jerk=True):
+        return real((tables[0], _hurried(tables[1])), route, limits, jerk=jerk)
+
+    monkeypatch.setattr(files, "check_tables", early)
+    with pytest.raises(
+        VerificationError, match=r"the siemens-xy tables .* fail as their controllers interpolate"
+    ):
+        plc_tables(verified, "siemens-xy")
