@@ -7,7 +7,7 @@ import json
 from datetime import UTC, datetime
 
 from topology.validation import short_repr
-from trajgen.cli.options import add_method, method_from, scenario_from
+from trajgen.cli.options import add_method, scenario_from, scenario_method
 from trajgen.cli.parser import EXIT_OK
 from trajgen.errors import OptionError
 from trajgen.export.atomic import check_output_paths, commit_files
@@ -93,8 +93,8 @@ def _command_export(args: argparse.Namespace) -> int:
     from trajgen.model.summary import provenance
     from trajgen.pipeline import run
 
-    scenario = scenario_from(args.scenario)
-    method = method_from(args)
+    scenario = scenario_from(args.scenario, graph=True)
+    method = scenario_method(args, scenario)
     names = scenario.names
     options = Vda5050Options(
         start_time=parse_start_time(args.start_time),
@@ -106,6 +106,7 @@ def _command_export(args: argparse.Namespace) -> int:
     )
     check_output_paths(order_paths(names, args.out))  # before anything is computed
     result = run(scenario, method=method)
+    method = result.method
     files = order_files(result.verified, names, args.out, options=options)
     check_output_paths(files)
     written = commit_files(files)

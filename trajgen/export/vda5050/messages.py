@@ -16,11 +16,13 @@ from dataclasses import dataclass
 from datetime import datetime, timedelta
 from pathlib import PurePosixPath
 
-from topology import JUNCTION_INDEX, JUNCTION_NAME, StarGraph
+from topology import JUNCTION_INDEX, JUNCTION_NAME, StarGraph, TrackGraph
 from trajgen.errors import OptionError
+from trajgen.export.vda5050.graph_path import GraphOrderPath
 from trajgen.export.vda5050.options import Vda5050Options
 from trajgen.export.vda5050.path import NodeKind, OrderPath, PathEdge, PathNode
 from trajgen.export.vda5050.release import OrderReleases, Release, order_releases
+from trajgen.model.graph_schedule import GraphSchedule
 from trajgen.model.schedule import Schedule
 from trajgen.scenario.naming import check_vehicle_names
 from trajgen.verification import VerifiedSchedule, require_verified
@@ -125,9 +127,67 @@ def _edge(graph: StarGraph, path: OrderPath, edge: PathEdge, sequence: int, rele
     )
 
 
+def _graph_node(path: GraphOrderPath, index: int, sequence: int, released: bool, map_id: str, deviation):
+    from vda5050.model.order import Node
+
+    node = path.nodes[index]
+    xy = path.track.xy(node.point)
+    position = None
+    if xy is not None:  # a track without coordinates has none to give
+        position = {
+            "x": _coordinate(xy[0]),
+            "y": _coordinate(xy[1]),
+            "allowed_deviation_xy": deviation,
+            "map_id": map_id,
+        }
+    return Node(
+        node_id=path.node_id(index),
+        sequence_id=sequence,
+        node_description=_node_description(node),
+        released=released,
+        node_position=position,
+        actions=[],
+    )
+
+
+def _graph_edge(path: GraphOrderPath, index: int, sequence: int, released: bool):
+    from vda5050.model.order import Edge
+
+    edge = path.edges[index]
+    first, second = path.node_id(index), path.node_id(index + 1)
+    leaves_node = path.track.node_at(path.nodes[index].point) is not None
+    return Edge(
+        edge_id=edge_id(first, second),
+        sequence_id=sequence,
+        released=released,
+        start_node_id=first,
+        end_node_id=second,
+        max_speed=edge.max_speed,
+        length=_coordinate(edge.length),
+        orientation=math.pi if edge.backward else 0.0,
+        orientation_type="TANGENTIAL",
+        # the track edge taken where the vehicle leaves a node of the track
+        direction=path.track.edges[edge.stretches[0][0]].name if leaves_node and edge.length > 0.0 else None,
+        actions=[],
+    )
+
+
+def _node_name(graph: StarGraph | TrackGraph, path: OrderPath | GraphOrderPath, index: int) -> str:
+    """The id of node ``index`` of ``path``."""
+    if isinstance(path, GraphOrderPath):
+        return path.node_id(index)
+    node = path.nodes[index]
+    return node_id(graph, node.leg, node.s)
+
+
+def _layout(schedule: Schedule | GraphSchedule) -> StarGraph | TrackGraph:
+    """The track a schedule's node ids and positions are on."""
+    return schedule.track if isinstance(schedule, GraphSchedule) else schedule.route.graph
+
+
 def order_elements(
-    graph: StarGraph,
-    path: OrderPath,
+    graph: StarGraph | TrackGraph,
+    path: OrderPath | GraphOrderPath,
     *,
     first: int,
     decision_point: int,
@@ -143,8 +203,9 @@ def order_elements(
 
     Parameters
     ----------
-    graph : StarGraph
-    path : OrderPath
+    graph : StarGraph or TrackGraph
+        The junction of an ``OrderPath``; a ``GraphOrderPath`` uses its own track.
+    path : OrderPath or GraphOrderPath
     first : int
         Index of the first node sent: 0 for an order, the previous decision point for an update.
     decision_point : int
@@ -166,6 +227,15 @@ def order_elements(
         Edge ``k`` has ``sequenceId`` ``2 k + 1`` (plus the offset).
     """
     last = len(path.nodes) - 1 if last is None else last
+    if isinstance(path, GraphOrderPath):  # on a track graph: the path knows its track
+        nodes = [
+            _graph_node(path, j, sequence_offset + 2 * j, j <= decision_point, map_id, node_deviation)
+            for j in range(first, last + 1)
+        ]
+        edges = [
+            _graph_edge(path, k, sequence_offset + 2 * k + 1, k < decision_point) for k in range(first, last)
+        ]
+        return nodes, edges
     nodes = [
         _node(graph, path.nodes[j], sequence_offset + 2 * j, j <= decision_point, map_id, node_deviation)
         for j in range(first, last + 1)
@@ -310,7 +380,7 @@ def render_orders(
 
     schedule, names = _checked(verified, names, options, "render_orders")
     plan = _releases(verified, releases, plan, "render_orders")
-    graph = schedule.route.graph
+    graph = _layout(schedule)
     messages = []
     for release in plan.releases:
         vehicle = release.vehicle
@@ -345,12 +415,13 @@ def render_orders(
     return tuple(messages)
 
 
-def _manifest(schedule: Schedule, plan: OrderReleases, messages, names, options: Vda5050Options) -> dict:
-    graph = schedule.route.graph
+def _manifest(
+    schedule: Schedule | GraphSchedule, plan: OrderReleases, messages, names, options: Vda5050Options
+) -> dict:
+    graph = _layout(schedule)
 
     def node_ref(vehicle: int, index: int) -> dict:
-        node = plan.paths[vehicle].nodes[index]
-        return {"node_id": node_id(graph, node.leg, node.s), "sequence_id": 2 * index}
+        return {"node_id": _node_name(graph, plan.paths[vehicle], index), "sequence_id": 2 * index}
 
     entries = []
     for message in messages:
@@ -381,7 +452,7 @@ def _manifest(schedule: Schedule, plan: OrderReleases, messages, names, options:
             "manufacturer": options.manufacturers[vehicle],
             "serial_number": options.serial_number(vehicle, names),
             "order_id": f"{options.order_id}-{name}",
-            "nodes": [node_id(graph, n.leg, n.s) for n in path.nodes],
+            "nodes": [_node_name(graph, path, index) for index in range(len(path.nodes))],
             "messages": sum(1 for m in messages if m.vehicle == vehicle),
         }
     return {

@@ -79,6 +79,11 @@ class PathNode:
     departure: float
     kinds: tuple[NodeKind, ...]
 
+    @property
+    def claim(self) -> tuple[int, float, float]:
+        """The node as a stretch ``(leg, s, s)`` of no length."""
+        return (self.leg, self.s, self.s)
+
 
 @dataclass(frozen=True, slots=True)
 class PathEdge:
@@ -109,6 +114,11 @@ class PathEdge:
         """Metres."""
         return self.high - self.low
 
+    @property
+    def claim(self) -> tuple[int, float, float]:
+        """The stretch ``(leg, low, high)`` the vehicle may be on while it drives the edge."""
+        return (self.leg, self.low, self.high)
+
 
 @dataclass(frozen=True, slots=True)
 class OrderPath:
@@ -116,6 +126,15 @@ class OrderPath:
 
     nodes: tuple[PathNode, ...]
     edges: tuple[PathEdge, ...]
+
+    @staticmethod
+    def gap(first: tuple[int, float, float], second: tuple[int, float, float]) -> float:
+        """Track distance between two stretches ``(leg, low, high)`` (leg JUNCTION_INDEX: the point O)."""
+        leg_a, low_a, high_a = first
+        leg_b, low_b, high_b = second
+        if leg_a == leg_b and leg_a != JUNCTION_INDEX:
+            return max(0.0, low_b - high_a, low_a - high_b)
+        return low_a + low_b
 
 
 @dataclass(frozen=True, slots=True)

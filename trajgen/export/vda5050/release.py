@@ -35,10 +35,11 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from topology import JUNCTION_INDEX
 from topology.validation import short_repr
 from trajgen.errors import InputError, ScheduleError
+from trajgen.export.vda5050.graph_path import GraphOrderPath, graph_vehicle_path
 from trajgen.export.vda5050.path import OrderPath, vehicle_path
+from trajgen.model.graph_schedule import GraphSchedule
 from trajgen.model.pieces import schedule_pieces
 from trajgen.verification import POSITION_TOLERANCE, VerifiedSchedule, require_verified
 
@@ -86,25 +87,16 @@ class OrderReleases:
 
     Attributes
     ----------
-    paths : tuple of 2 OrderPath
+    paths : tuple of 2 OrderPath (a junction) or 2 GraphOrderPath (a track graph)
     releases : tuple of Release
         By ``send_at`` (and in the replay's order at equal times).
     planned_duration : float
         When both vehicles reach their goals in the replay (the schedule's duration plus the waits), s.
     """
 
-    paths: tuple[OrderPath, OrderPath]
+    paths: tuple[OrderPath, OrderPath] | tuple[GraphOrderPath, GraphOrderPath]
     releases: tuple[Release, ...]
     planned_duration: float
-
-
-def _gap(first: tuple[int, float, float], second: tuple[int, float, float]) -> float:
-    """Track distance between two stretches ``(leg, low, high)`` (leg JUNCTION_INDEX: the point O)."""
-    leg_a, low_a, high_a = first
-    leg_b, low_b, high_b = second
-    if leg_a == leg_b and leg_a != JUNCTION_INDEX:
-        return max(0.0, low_b - high_a, low_a - high_b)
-    return low_a + low_b
 
 
 class BaseRelease:
@@ -125,7 +117,9 @@ class BaseRelease:
 
     Parameters
     ----------
-    paths : tuple of 2 OrderPath
+    paths : tuple of 2 OrderPath or GraphOrderPath
+        Both vehicles' paths, on a junction or on a track graph: each node and edge has a
+        ``claim``, and the path's ``gap`` is the track distance between two claims.
     separation : float
         The minimum separation, metres.
 
@@ -139,8 +133,9 @@ class BaseRelease:
         self.paths = paths
         # conflict: closer than the separation (verifier's tolerance); at 0, touching
         self.threshold = max(separation - POSITION_TOLERANCE, POSITION_TOLERANCE)
-        self.stretches = [[(e.leg, e.low, e.high) for e in path.edges] for path in paths]
-        self.points = [[(n.leg, n.s, n.s) for n in path.nodes] for path in paths]
+        self.stretches = [[edge.claim for edge in path.edges] for path in paths]
+        self.points = [[node.claim for node in path.nodes] for path in paths]
+        self.gap = paths[0].gap
         self.after = self._node_plan()
         #: per vehicle, the last node it reached and the index of its decision point
         self.reached = [0, 0]
@@ -153,9 +148,9 @@ class BaseRelease:
         """Each vehicle's goal node index."""
         return (len(self.points[0]) - 1, len(self.points[1]) - 1)
 
-    def apart(self, first: tuple[int, float, float], second: tuple[int, float, float]) -> bool:
-        """Whether two stretches ``(leg, low, high)`` keep the separation."""
-        return _gap(first, second) >= self.threshold
+    def apart(self, first, second) -> bool:
+        """Whether two claims (a node's or an edge's ``claim``) keep the separation."""
+        return self.gap(first, second) >= self.threshold
 
     def _node_plan(self) -> tuple[list[int], list[int]]:
         """Per vehicle and edge, the node the other vehicle must have reached before the edge is released."""
@@ -330,10 +325,13 @@ def order_releases(verified: VerifiedSchedule, *, spacing: float | None = None) 
         schedule: 220 random scenarios of the three methods, and the tests' cases).
     """
     schedule = require_verified(verified, "order_releases").schedule
-    pieces = schedule_pieces(schedule)
     usable = isinstance(spacing, int | float) and not isinstance(spacing, bool) and math.isfinite(spacing)
     if spacing is not None and not (usable and spacing > 0):
         raise InputError(f"release spacing {short_repr(spacing)} m is not allowed: expected a number > 0")
-    paths = tuple(vehicle_path(schedule, pieces, v, spacing=spacing) for v in (0, 1))
+    if isinstance(schedule, GraphSchedule):
+        paths = tuple(graph_vehicle_path(schedule, v, spacing=spacing) for v in (0, 1))
+    else:
+        pieces = schedule_pieces(schedule)
+        paths = tuple(vehicle_path(schedule, pieces, v, spacing=spacing) for v in (0, 1))
     releases, finish = _Replay(paths, schedule.limits.min_separation).run()
     return OrderReleases(paths, tuple(releases), max(finish, schedule.duration))

@@ -1,0 +1,209 @@
+"""VDA 5050 orders on track graphs: valid, accepted, and safe whatever the vehicles' timing."""
+
+from __future__ import annotations
+
+import functools
+import json
+import math
+from datetime import UTC, datetime
+
+import numpy as np
+import pytest
+from vda5050.domain.order import AcceptanceDecision
+
+from limits import Limits, VehicleLimits
+from tests.conftest import REPO
+from tests.support.graph_rows import ScenarioFile
+from tests.support.vda5050_reference import SimulatedVehicle, parse_order, schema_errors
+from topology import TrackGraph, plan_graph
+from trajgen import certify
+from trajgen.cli import main
+from trajgen.export.vda5050 import Vda5050Options, render_manifest, render_orders
+from trajgen.export.vda5050.graph_path import GraphOrderPath
+from trajgen.export.vda5050.path import NodeKind
+from trajgen.export.vda5050.release import BaseRelease, order_releases
+from trajgen.methods import make_schedule
+from trajgen.scenario import load_scenario
+
+EXAMPLES = REPO / "examples" / "graphs"
+FEASIBLE = ["h", "main-line-with-sidings", "passing-loop", "ring-with-spurs"]
+OPTIONS = Vda5050Options(start_time=datetime(2026, 1, 1, tzinfo=UTC), map_id="plant")
+
+
+@functools.cache
+def _case(name: str, method: str):
+    scenario = load_scenario(EXAMPLES / f"{name}.toml")
+    verified = certify(make_schedule(scenario.route(), scenario.limits, method=method))
+    releases = order_releases(verified)
+    messages = render_orders(verified, scenario.names, options=OPTIONS, releases=releases)
+    return scenario, verified, releases, messages
+
+
+def _documents(name: str, method: str) -> dict[str, list[dict]]:
+    scenario, _, _, messages = _case(name, method)
+    out: dict[str, list[dict]] = {vehicle: [] for vehicle in scenario.names}
+    for message in messages:
+        out[scenario.names[message.vehicle]].append(json.loads(message.data))
+    return out
+
+
+@pytest.mark.parametrize("method", ["exact", "toppra", pytest.param("optimal", marks=pytest.mark.slow)])
+@pytest.mark.parametrize("name", FEASIBLE)
+def test_every_graph_order_is_valid_and_each_vehicle_accepts_its_order_and_every_update(name, method):
+    scenario = _case(name, method)[0]
+    for vehicle, documents in _documents(name, method).items():
+        for document in documents:
+            assert schema_errors(document) == []
+            parse_order(document)  # the sdk's model takes it unchanged
+        start = scenario.track.xy(scenario.start[scenario.names.index(vehicle)])
+        receiver = SimulatedVehicle(documents[0], *start, map_id=OPTIONS.map_id)
+        decisions = [receiver.receive(document).decision for document in documents]
+        expected = [AcceptanceDecision.ACCEPT_NEW] + [AcceptanceDecision.ACCEPT_UPDATE] * (len(documents) - 1)
+        assert decisions == expected, vehicle
+
+
+@pytest.mark.parametrize("name", FEASIBLE)
+def test_graph_nodes_sit_at_junctions_parking_points_and_reversals_with_their_x_and_y(name):
+    scenario, verified, releases, _ = _case(name, "exact")
+    track = scenario.track
+    for vehicle, path in enumerate(releases.paths):
+        graph_path = verified.schedule.paths[vehicle]
+        travels = [node.travel for node in path.nodes]
+        # every node of the track the path passes, every reversal, each move's end
+        for k in range(1, graph_path.edges.size):
+            assert min(abs(t - graph_path.starts[k]) for t in travels) < 1e-9
+        assert travels[0] == 0.0
+        assert travels[-1] == pytest.approx(graph_path.length)
+        reversals = [n.travel for n in path.nodes if NodeKind.REVERSAL in n.kinds]
+        assert reversals == pytest.approx(list(graph_path.cusps))
+        for document in _documents(name, "exact")[scenario.names[vehicle]]:
+            for node in document["nodes"]:
+                index = node["sequenceId"] // 2
+                x, y = track.xy(path.nodes[index].point)
+                assert (node["nodePosition"]["x"], node["nodePosition"]["y"]) == pytest.approx(
+                    (x, y), abs=1e-9
+                )
+                assert node["nodeId"] == path.node_id(index)
+        # an order edge's length is the path's travel between its nodes; reversed after a turn back
+        for edge in path.edges:
+            a, b = path.nodes[edge.index], path.nodes[edge.index + 1]
+            assert edge.length == pytest.approx(b.travel - a.travel)
+            assert sum(high - low for _, low, high in edge.stretches) == pytest.approx(edge.length)
+            assert edge.backward == (graph_path.heading(0.5 * (a.travel + b.travel))[0] < 0)
+
+
+def test_the_claims_gap_equals_the_least_track_distance_between_sampled_points():
+    scenario = load_scenario(EXAMPLES / "passing-loop.toml")
+    track = scenario.track
+    path = GraphOrderPath(track, (), ())
+    rng = np.random.default_rng(7)
+    lengths = [edge.length for edge in track.edges]
+    for _ in range(200):
+        claims = []
+        for _ in range(2):
+            stretches = []
+            for _ in range(rng.integers(1, 3)):
+                edge = int(rng.integers(len(lengths)))
+                low, high = np.sort(rng.uniform(0.0, lengths[edge], 2))
+                stretches.append((edge, float(low), float(high)))
+            claims.append(tuple(stretches))
+        sampled, slack = math.inf, math.inf
+        for (ea, la, ha), (eb, lb, hb) in ((a, b) for a in claims[0] for b in claims[1]):
+            sa, sb = np.meshgrid(np.linspace(la, ha, 41), np.linspace(lb, hb, 41))
+            distances = track.distances(np.full(sa.size, ea), sa.ravel(), np.full(sb.size, eb), sb.ravel())
+            if distances.min() < sampled:
+                # the track distance is 1-Lipschitz in each point: between samples at most this lower
+                sampled, slack = float(distances.min()), 0.5 * ((ha - la) + (hb - lb)) / 40
+        gap = path.gap(*claims)
+        assert gap <= sampled + 1e-9
+        assert gap >= sampled - slack - 1e-9
+
+
+@pytest.mark.parametrize("method", ["exact", "toppra", pytest.param("optimal", marks=pytest.mark.slow)])
+@pytest.mark.parametrize("name", FEASIBLE)
+def test_the_releases_keep_the_separation_whatever_the_timing_and_never_deadlock(name, method):
+    """Both vehicles driven at random paces, each only within its released base, 30 seeded runs.
+
+    The separation is measured by the tests' own track distance (from the scenario file alone).
+    """
+    scenario, verified, releases, _ = _case(name, method)
+    own = ScenarioFile(EXAMPLES / f"{name}.toml")
+    names = [edge.name for edge in scenario.track.edges]
+    paths = verified.schedule.paths
+    step = 0.05
+    for seed in range(30):
+        rng = np.random.default_rng(seed)
+        rule = BaseRelease(releases.paths, scenario.limits.min_separation)
+        travel = [0.0, 0.0]
+        closest = math.inf
+        for _ in range(100_000):
+            if rule.reached == list(rule.last):
+                break
+            limits = [releases.paths[v].nodes[rule.released[v]].travel for v in (0, 1)]
+            movable = [v for v in (0, 1) if travel[v] < limits[v] - 1e-12]
+            assert movable, f"deadlock at nodes {rule.reached} (seed {seed})"
+            v = int(rng.choice(movable))
+            travel[v] = min(travel[v] + rng.uniform(0.2, 1.0) * step, limits[v])
+            nodes = releases.paths[v].nodes
+            while (
+                rule.reached[v] < rule.released[v] and nodes[rule.reached[v] + 1].travel <= travel[v] + 1e-12
+            ):
+                rule.reach(v, rule.reached[v] + 1)
+            where = []
+            for u in (0, 1):
+                edge, s = paths[u].locate(travel[u])
+                where.append((names[int(edge[0])], float(s[0])))
+            closest = min(closest, own.distance(*where))
+        else:
+            pytest.fail(f"not at the goals after 100,000 steps (seed {seed})")
+        # at every sample (one vehicle moves per step, the distance is 1-Lipschitz in its travel)
+        assert closest >= scenario.limits.min_separation - 1e-9, (seed, closest)
+        assert (
+            closest >= scenario.limits.min_separation - 1e-9
+            or closest >= scenario.limits.min_separation - step
+        )
+
+
+def test_export_vda5050_writes_a_graphs_orders_and_manifest(tmp_path, capsys):
+    out = tmp_path / "orders"
+    args = [
+        "export-vda5050",
+        str(EXAMPLES / "h.toml"),
+        "--out",
+        str(out),
+        "--start-time",
+        "2026-01-01T00:00:00Z",
+    ]
+    assert main([*args, "--json"]) == 0
+    summary = json.loads(capsys.readouterr().out)
+    assert summary["method"] == "exact"
+    assert summary["vehicles"]["agv1"]["nodes"] == ["A", "J1", "J2", "c:1.5", "J2", "D"]
+    assert summary["vehicles"]["agv2"]["nodes"] == ["D", "J2", "J1", "A"]
+    manifest = json.loads((out / "manifest.json").read_text())
+    assert [m["file"] for m in manifest["messages"]] == [
+        "agv1/order-000.json",
+        "agv2/order-000.json",
+        "agv2/order-001.json",
+        "agv1/order-001.json",
+    ]
+    # agv2 waits at D until agv1 is parked at c:1.5; agv1 goes back once agv2 has passed J1
+    assert manifest["messages"][2]["trigger"] == {"vehicle": "agv1", "node_id": "c:1.5", "sequence_id": 6}
+    assert manifest["messages"][3]["trigger"] == {"vehicle": "agv2", "node_id": "J1", "sequence_id": 4}
+    first = json.loads((out / "agv1" / "order-000.json").read_text())
+    assert [e.get("direction") for e in first["edges"]] == ["a", "m", "c", None, "e"]
+    assert [e["orientation"] for e in first["edges"]] == [0.0, 0.0, 0.0, math.pi, math.pi]
+
+
+def test_a_graph_without_coordinates_has_orders_without_node_positions(tmp_path):
+    track = TrackGraph.from_edges({"a": ("J", "A", 6.0), "b": ("J", "B", 6.0), "c": ("J", "C", 6.0)})
+    route = plan_graph(track, ("A", "B"), ("B", "A"), min_separation=1.5)
+    agv = VehicleLimits(max_velocity=1.0, max_acceleration=0.5, max_jerk=1.0)
+    verified = certify(make_schedule(route, Limits((agv, agv), 1.5), method="exact"))
+    messages = render_orders(verified, ("one", "two"), options=OPTIONS)
+    for message in messages:
+        document = json.loads(message.data)
+        assert schema_errors(document) == []
+        assert all("nodePosition" not in node for node in document["nodes"])
+    manifest = json.loads(render_manifest(verified, ("one", "two"), messages, options=OPTIONS))
+    assert manifest["vehicles"]["one"]["nodes"][0] == "A"
+    assert manifest["vehicles"]["one"]["nodes"][-1] == "B"

@@ -1,0 +1,270 @@
+"""The node and edge graph of each vehicle's VDA 5050 path on a track graph, from its verified schedule.
+
+Each vehicle's nodes are where its path starts and ends, every node of the track it passes (a
+junction, or where one edge meets the next), every end of one of its moves of the route (a
+*parking point*: there it can wait while the other vehicle moves, so the release of the bases can
+follow the route's order), and every reversal (where its path turns back on an edge). With
+``spacing``, release nodes split longer edges. Each order edge covers a stretch of the path, on one
+or more edges of the track, and carries the highest speed the schedule reaches on it (``maxSpeed``).
+A node's ``claim`` and an edge's ``claim`` are the stretches of track edges ``(edge, low, high)`` the
+vehicle may be on there; :meth:`GraphOrderPath.gap` is the track distance between two claims, which
+the release of the bases (:class:`~trajgen.export.vda5050.release.BaseRelease`) keeps at least the
+separation.
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from topology import EdgePoint, TrackGraph
+from trajgen.export.vda5050.path import NODE_TOLERANCE, NodeKind
+from trajgen.model.graph_paths import GraphPath
+from trajgen.model.graph_schedule import GraphSchedule
+from trajgen.model.pieces import kinematics_polynomials, shift
+from trajgen.model.polynomials import derivative, extrema
+
+__all__ = ["GraphOrderPath", "GraphPathEdge", "GraphPathNode", "graph_vehicle_path"]
+
+#: A claim: stretches ``(edge, low, high)`` of track edges, metres from each edge's ``from`` node.
+Claim = tuple[tuple[int, float, float], ...]
+
+
+@dataclass(frozen=True, slots=True)
+class GraphPathNode:
+    """A node of one vehicle's path on a track graph.
+
+    Attributes
+    ----------
+    travel : float
+        Metres the vehicle has driven along its path when there.
+    point : EdgePoint
+        Where it is: an edge and the metres from its ``from`` node (a track node canonically).
+    axis : float
+        The vehicle's signed axis there, metres.
+    arrival, departure : float
+        When the schedule reaches and leaves the node, seconds.
+    kinds : tuple of NodeKind
+    """
+
+    travel: float
+    point: EdgePoint
+    axis: float
+    arrival: float
+    departure: float
+    kinds: tuple[NodeKind, ...]
+
+    @property
+    def claim(self) -> Claim:
+        """The node as a stretch of no length."""
+        return ((self.point.edge, self.point.s, self.point.s),)
+
+
+@dataclass(frozen=True, slots=True)
+class GraphPathEdge:
+    """An edge of one vehicle's path, from node ``index`` to node ``index + 1``.
+
+    Attributes
+    ----------
+    index : int
+    stretches : tuple of (int, float, float)
+        The track edges it runs along, in order: ``(edge, low, high)``, metres from each edge's
+        ``from`` node.
+    length : float
+        Metres.
+    max_speed : float
+        Highest speed the schedule reaches on it, m/s, at most the vehicle's limit (rounded up to 1 µm/s).
+    backward : bool
+        Whether the vehicle drives it against the direction of its first move (after a reversal).
+    """
+
+    index: int
+    stretches: Claim
+    length: float
+    max_speed: float
+    backward: bool
+
+    @property
+    def claim(self) -> Claim:
+        """The track the vehicle may be on while it drives the edge."""
+        return self.stretches
+
+
+@dataclass(frozen=True, slots=True)
+class GraphOrderPath:
+    """One vehicle's nodes and edges on a track graph (``len(edges) == len(nodes) - 1``)."""
+
+    track: TrackGraph
+    nodes: tuple[GraphPathNode, ...]
+    edges: tuple[GraphPathEdge, ...]
+
+    def gap(self, first: Claim, second: Claim) -> float:
+        """Track distance between two claims, metres: 0 where they share track.
+
+        Each way between two points (along one edge, or through an end of each edge) is affine in
+        each point's position, so its least value over two stretches is at a pair of their ends.
+        """
+        low = math.inf
+        for (edge_a, low_a, high_a), (edge_b, low_b, high_b) in itertools.product(first, second):
+            if edge_a == edge_b and low_a <= high_b and low_b <= high_a:
+                return 0.0
+            corners = np.array(list(itertools.product((low_a, high_a), (low_b, high_b))))
+            distances = self.track.distances(
+                np.full(4, edge_a), corners[:, 0], np.full(4, edge_b), corners[:, 1]
+            )
+            low = min(low, float(distances.min()))
+        return low
+
+    def node_id(self, index: int) -> str:
+        """Node ``index``'s id: a track node's name, or ``"<edge>:<metres>"`` (to 1 µm)."""
+        point = self.nodes[index].point
+        node = self.track.node_at(point)
+        if node is not None:
+            return self.track.nodes[node]
+        metres = f"{point.s:.6f}".rstrip("0").rstrip(".")
+        return f"{self.track.edges[point.edge].name}:{metres}"
+
+
+def _marks(schedule: GraphSchedule, path: GraphPath, vehicle: int) -> dict[float, set[NodeKind]]:
+    """Travel (metres) of every node of the path, and why each is there."""
+    marks: dict[float, set[NodeKind]] = {0.0: {NodeKind.START}}
+    marks.setdefault(path.length, set()).add(NodeKind.GOAL)
+    for k in range(1, path.edges.size):
+        kind = NodeKind.JUNCTION if path.edges[k] != path.edges[k - 1] else NodeKind.REVERSAL
+        marks.setdefault(float(path.starts[k]), set()).add(kind)
+    travel = 0.0
+    track = schedule.track
+    for move in schedule.route.moves:  # each move's end: a parking point of the route
+        if move.vehicle != vehicle:
+            continue
+        for a, b, edge in zip(move.points[:-1], move.points[1:], move.edges, strict=True):
+            travel += abs(track.position_on(b, edge) - track.position_on(a, edge))
+        marks.setdefault(min(travel, path.length), set()).add(NodeKind.STOP)
+    merged: dict[float, set[NodeKind]] = {}
+    for mark in sorted(marks):
+        near = [kept for kept in merged if abs(kept - mark) <= NODE_TOLERANCE]
+        if near:
+            merged[near[0]] |= marks[mark]
+        else:
+            merged[mark] = set(marks[mark])
+    return merged
+
+
+def _with_spacing(marks: dict[float, set[NodeKind]], spacing: float | None) -> dict[float, set[NodeKind]]:
+    if spacing is None:
+        return marks
+    travels = sorted(marks)
+    for a, b in itertools.pairwise(travels):
+        count = math.ceil((b - a) / spacing - 1e-9)
+        for n in range(1, count):
+            marks[a + (b - a) * n / count] = {NodeKind.RELEASE}
+    return dict(sorted(marks.items()))
+
+
+def _times(schedule: GraphSchedule, vehicle: int, travel: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """When the vehicle first reaches and last leaves each travel value (its travel never decreases)."""
+    duration = schedule.duration
+    results = []
+    for target, reach in ((travel - NODE_TOLERANCE, True), (travel + NODE_TOLERANCE, False)):
+        low, high = np.zeros(travel.size), np.full(travel.size, duration)
+        for _ in range(60):
+            middle = 0.5 * (low + high)
+            driven = schedule.travel(middle)[vehicle, 0]
+            beyond = driven >= target if reach else driven > target
+            high = np.where(beyond, middle, high)
+            low = np.where(beyond, low, middle)
+        results.append(high if reach else low)
+    arrival = np.where(travel <= NODE_TOLERANCE, 0.0, results[0])
+    departure = np.where(travel >= schedule.paths[vehicle].length - NODE_TOLERANCE, duration, results[1])
+    return arrival, np.maximum(departure, arrival)
+
+
+def _max_speeds(schedule: GraphSchedule, vehicle: int, begin: np.ndarray, end: np.ndarray) -> np.ndarray:
+    """Highest speed of the vehicle in each ``[begin, end]``, m/s (closed form, piece by piece)."""
+    starts, lengths, travel = [], [], []
+    for section in schedule.sections:
+        times, polynomials, _ = kinematics_polynomials(section.kinematics)
+        starts.append(section.start_time + times[:-1])
+        lengths.append(np.diff(times))
+        travel.append(polynomials[vehicle])
+    start, length, c = np.concatenate(starts), np.concatenate(lengths), np.concatenate(travel)
+    peaks = []
+    for t0, t1 in zip(begin, end, strict=True):
+        mask = (start < t1) & (start + length > t0)
+        if not mask.any():
+            peaks.append(0.0)
+            continue
+        low = np.maximum(t0 - start[mask], 0.0)
+        high = np.minimum(t1 - start[mask], length[mask])
+        v_low, _, v_high, _ = extrema(derivative(shift(c[mask], low)), np.maximum(high - low, 0.0))
+        peaks.append(float(np.max(np.maximum(np.abs(v_low), np.abs(v_high)))))
+    return np.array(peaks)
+
+
+def _stretches(path: GraphPath, a: float, b: float) -> tuple[tuple[int, float, float], ...]:
+    """The track edges the path runs along between travel ``a`` and ``b``, ``(edge, low, high)`` each."""
+    if path.edges.size == 0:
+        return ((path.home.edge, path.home.s, path.home.s),)
+    stretches = []
+    directions = path.directions
+    for k in range(path.edges.size):
+        lo, hi = max(a, float(path.starts[k])), min(b, float(path.starts[k + 1]))
+        if hi - lo < NODE_TOLERANCE and (stretches or k + 1 < path.edges.size and b > lo):
+            continue  # only touches this segment at one of its ends
+        s = path.s_from[k] + directions[k] * (np.array([lo, hi]) - path.starts[k])
+        stretches.append((int(path.edges[k]), float(s.min()), float(s.max())))
+    return tuple(stretches)
+
+
+def graph_vehicle_path(
+    schedule: GraphSchedule, vehicle: int, *, spacing: float | None = None
+) -> GraphOrderPath:
+    """The nodes and edges of ``vehicle``'s (0 or 1) VDA 5050 path on a track graph.
+
+    Parameters
+    ----------
+    schedule : GraphSchedule
+        A verified schedule.
+    vehicle : int
+        0 or 1.
+    spacing : float, optional
+        Longest edge, metres: longer ones get release nodes between (``None``: none).
+
+    Returns
+    -------
+    GraphOrderPath
+    """
+    path = schedule.paths[vehicle]
+    marks = _with_spacing(_marks(schedule, path, vehicle), spacing)
+    travel = np.array(sorted(marks))
+    arrival, departure = _times(schedule, vehicle, travel)
+    axis = path.axis(travel)
+    edges, s = path.locate(travel)
+    nodes = []
+    for k, p in enumerate(travel):
+        point = schedule.track.canonical(EdgePoint(int(edges[k]), float(s[k])))
+        kinds = marks[float(p)]
+        if len(kinds) > 1:  # a stop is named only where nothing else names the node
+            kinds = kinds - {NodeKind.STOP}
+        ordered = tuple(kind for kind in NodeKind if kind in kinds)
+        nodes.append(
+            GraphPathNode(float(p), point, float(axis[k]), float(arrival[k]), float(departure[k]), ordered)
+        )
+    limit = schedule.limits.vehicles[vehicle].max_velocity
+    peaks = _max_speeds(schedule, vehicle, departure[:-1], arrival[1:])
+    order_edges = []
+    for index, (a, b) in enumerate(itertools.pairwise(nodes)):
+        middle = 0.5 * (a.travel + b.travel)
+        order_edges.append(
+            GraphPathEdge(
+                index=index,
+                stretches=_stretches(path, a.travel, b.travel),
+                length=b.travel - a.travel,
+                max_speed=min(math.ceil(peaks[index] * 1e6) / 1e6, limit),
+                backward=bool(path.edges.size and path.heading(middle)[0] < 0),
+            )
+        )
+    return GraphOrderPath(schedule.track, tuple(nodes), tuple(order_edges))
