@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 
 from tests.conftest import REPO
+from tests.support.graph_cases import random_routes
 from trajgen import certify
 from trajgen.cli import main
 from trajgen.errors import OptionError, VerificationError
@@ -192,3 +193,19 @@ def test_a_table_set_that_fails_as_interpolated_is_never_returned(monkeypatch):
         VerificationError, match=r"the siemens-xy tables .* fail as their controllers interpolate"
     ):
         plc_tables(verified, "siemens-xy")
+
+
+@pytest.mark.slow
+def test_every_table_dialect_on_seeded_random_graphs_is_verified_as_interpolated():
+    """20 random trees and graphs with loops (no node coordinates), exact and toppra."""
+    for seed, route, limits in random_routes(20, 3000):
+        for method in ("exact", "toppra"):
+            verified = certify(make_schedule(route, limits, method=method))
+            for dialect in TABLE_DIALECTS:
+                if dialect.interpolation is Interpolation.CUBIC and not verified.schedule.jerk_limited:
+                    continue
+                tables = plc_tables(verified, dialect)
+                assert tables.check.passed, (seed, method, dialect.name)
+                for vehicle, table in enumerate(tables.resampled.tables):
+                    turns = graph_travel(table.motion(), 1e-6)[1]
+                    assert turns == pytest.approx(verified.schedule.paths[vehicle].cusps, abs=1e-6)

@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 
 from tests.conftest import REPO
+from tests.support.graph_cases import random_routes
 from tests.support.graph_rows import ScenarioFile, check_profiles
 from topology import TrackGraph, class_signature, plan_graph, plan_graph_classes
 from trajgen import certify
@@ -165,34 +166,8 @@ def test_the_schedule_command_lists_each_class_and_its_makespan(capsys):
     assert "(other):" in text
 
 
-def _random_routes(count: int, first_seed: int):
-    """Seeded random track graphs (trees and graphs with loops) with a feasible route, two unequal AGVs."""
-    import dataclasses
-
-    from limits import Limits, VehicleLimits
-    from tests.support.grid_oracle import random_case
-    from topology import InfeasibleError
-
-    agv = VehicleLimits(max_velocity=1.0, max_acceleration=0.5, max_jerk=1.0)
-    faster = dataclasses.replace(agv, max_velocity=1.4, max_jerk=2.0)
-    found = 0
-    for seed in range(first_seed, first_seed + 20 * count):
-        case = random_case(seed, loops=seed % 2 == 1)
-        if case is None:
-            continue
-        edges, start, goal, separation = case
-        try:
-            route = plan_graph(TrackGraph.from_edges(edges), start, goal, min_separation=separation)
-        except InfeasibleError:
-            continue
-        yield seed, route, Limits((agv, faster), separation)
-        found += 1
-        if found == count:
-            return
-
-
 def test_toppra_on_seeded_random_graphs_is_verified_and_never_slower_than_exact_without_jerk():
-    for seed, route, limits in _random_routes(40, 1000):
+    for seed, route, limits in random_routes(40, 1000):
         toppra = make_schedule(route, limits, method="toppra")
         assert toppra.fallback_reason is None, (seed, toppra.notes)
         assert certify(toppra).report.passed
@@ -203,7 +178,7 @@ def test_toppra_on_seeded_random_graphs_is_verified_and_never_slower_than_exact_
 @pytest.mark.slow
 def test_optimal_on_seeded_random_graphs_is_verified_or_flagged_and_never_slower_than_exact():
     solved = 0
-    for seed, route, limits in _random_routes(10, 2000):
+    for seed, route, limits in random_routes(10, 2000):
         schedule = make_schedule(route, limits, method="optimal")
         assert certify(schedule).report.passed, seed
         exact = make_schedule(route, limits, method="exact")
