@@ -212,7 +212,7 @@ def _stretches(path: GraphPath, a: float, b: float) -> tuple[tuple[int, float, f
     directions = path.directions
     for k in range(path.edges.size):
         lo, hi = max(a, float(path.starts[k])), min(b, float(path.starts[k + 1]))
-        if hi - lo < NODE_TOLERANCE and (stretches or k + 1 < path.edges.size and b > lo):
+        if hi - lo < NODE_TOLERANCE and (stretches or (k + 1 < path.edges.size and b > lo)):
             continue  # only touches this segment at one of its ends
         s = path.s_from[k] + directions[k] * (np.array([lo, hi]) - path.starts[k])
         stretches.append((int(path.edges[k]), float(s.min()), float(s.max())))
