@@ -25,8 +25,10 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from limits import VehicleLimits
+from trajgen.model.graph_cells import too_close_polygons
+from trajgen.model.graph_schedule import GraphSchedule
 from trajgen.model.paths import VehiclePath
-from trajgen.model.pieces import Pieces, schedule_pieces
+from trajgen.model.pieces import Pieces, kinematics_polynomials, schedule_pieces
 from trajgen.model.values import sorted_unique
 
 __all__ = [
@@ -203,11 +205,18 @@ def _joined(p: Polygon, q: Polygon) -> bool:
 
 
 class _Curve:
-    """The plan's curve ``(p1(t), p2(t))``: travel from each vehicle's axis, exact between samples."""
+    """The plan's curve ``(p1(t), p2(t))``: travel from each vehicle's axis, exact between samples.
+
+    On a track graph the schedule's travel itself.
+    """
 
     def __init__(self, schedule, times: np.ndarray) -> None:
         self.schedule = schedule
         self.times = times
+        self.graph = isinstance(schedule, GraphSchedule)
+        if self.graph:
+            self.travel = schedule.travel(times)[:, 0]
+            return
         axis = schedule.state(times).axis  # (2, n)
         self.axis = axis
         self.travel = np.concatenate(
@@ -216,6 +225,8 @@ class _Curve:
 
     def at(self, t: np.ndarray, k: int) -> np.ndarray:
         """Both vehicles' travel at times ``t`` of ``[times[k], times[k + 1]]``, shape (2, n)."""
+        if self.graph:
+            return self.schedule.travel(t)[:, 0]
         axis = self.schedule.state(t).axis
         return self.travel[:, k : k + 1] + np.abs(axis - self.axis[:, k : k + 1])
 
@@ -241,11 +252,11 @@ class CoordinationDiagram:
 
     Parameters
     ----------
-    paths : tuple of 2 VehiclePath
+    paths : tuple of 2 VehiclePath, or 2 GraphPath on a track graph
         Each vehicle's path of the plan, in travel coordinates.
     separation : float
         Track distance the conflicts keep, metres.
-    schedule : Schedule
+    schedule : Schedule or GraphSchedule
         The verified plan: it decides who passes each conflict first.
     times : ndarray, shape (n,)
         Instants of the plan at which neither vehicle turns between two consecutive ones (the
@@ -257,15 +268,20 @@ class CoordinationDiagram:
     def __init__(self, paths: tuple[VehiclePath, VehiclePath], separation: float, schedule, times) -> None:
         self.paths = paths
         self.separation = float(separation)
-        first, second = _segments(paths[0]), _segments(paths[1])
         polygons: list[Polygon] = []
         where: list[tuple[int, int]] = []
-        for i, a in enumerate(first):
-            for j, b in enumerate(second):
-                polygon = _obstacle(a, b, self.separation)
-                if len(polygon) >= 3 and _area(polygon) > _AREA:
-                    polygons.append(tuple(polygon))
-                    where.append((i, j))
+        if isinstance(schedule, GraphSchedule):  # the convex parts of each cell, one per way
+            for part in too_close_polygons(schedule.track, paths, self.separation):
+                polygons.append(part.polygon)
+                where.append(part.segments)
+        else:
+            first, second = _segments(paths[0]), _segments(paths[1])
+            for i, a in enumerate(first):
+                for j, b in enumerate(second):
+                    polygon = _obstacle(a, b, self.separation)
+                    if len(polygon) >= 3 and _area(polygon) > _AREA:
+                        polygons.append(tuple(polygon))
+                        where.append((i, j))
         parent = list(range(len(polygons)))
 
         def root(k: int) -> int:
@@ -452,6 +468,12 @@ def schedule_times(schedule, pieces: Pieces | None = None) -> np.ndarray:
     Every piece boundary and middle, and every instant a vehicle comes to rest and turns (a root of
     its velocity). ``pieces``: the schedule's (:func:`~trajgen.model.pieces.schedule_pieces`), if at hand.
     """
+    if isinstance(schedule, GraphSchedule):  # travel never turns: the piece boundaries and middles
+        times = [np.array([0.0, schedule.duration])]
+        for section in schedule.sections:
+            knots = section.start_time + kinematics_polynomials(section.kinematics)[0]
+            times += [knots, 0.5 * (knots[:-1] + knots[1:])]
+        return sorted_unique(np.clip(np.concatenate(times), 0.0, schedule.duration))
     pieces = schedule_pieces(schedule) if pieces is None else pieces
     times = [np.array([0.0, schedule.duration]), pieces.start, pieces.start + 0.5 * pieces.length]
     if pieces.count:
