@@ -162,3 +162,36 @@ def test_a_forced_fallback_is_reported_in_the_json_and_the_text(command, monkeyp
     assert main([command, scenario]) == 0
     text = capsys.readouterr().out
     assert "exact (fallback from optimal: solver-failed)" in text
+
+
+def test_the_optimal_plan_on_a_track_graph_is_byte_identical_alone_and_under_load(tmp_path):
+    """The H's generic CSV and its SIMATIC tables, alone and beside CPU-bound processes."""
+    scenario = REPO / "examples" / "graphs" / "h.toml"
+    store = tmp_path / "store"
+    runs = []
+    for label in ("alone", "loaded"):
+        with _every_core_busy() if label == "loaded" else contextlib.nullcontext():
+            files = {}
+            for dialect in ("generic", "siemens-xy"):
+                out = tmp_path / label / dialect
+                summary = json.loads(
+                    _trajgen(
+                        "schedule",
+                        str(scenario),
+                        "--method",
+                        "optimal",
+                        "--csv",
+                        str(out),
+                        "--dialect",
+                        dialect,
+                        "--json",
+                        store=store,
+                    ).stdout
+                )
+                assert summary["fallback_reason"] is None
+                files |= {f"{dialect}/{path.name}": path.read_bytes() for path in sorted(out.iterdir())}
+            runs.append((files, summary["duration_s"]))
+    (alone, alone_duration), (loaded, loaded_duration) = runs
+    assert len(alone) == 4
+    assert alone == loaded
+    assert alone_duration == loaded_duration

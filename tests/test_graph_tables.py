@@ -197,8 +197,8 @@ def test_a_table_set_that_fails_as_interpolated_is_never_returned(monkeypatch):
 
 @pytest.mark.slow
 def test_every_table_dialect_on_seeded_random_graphs_is_verified_as_interpolated():
-    """20 random trees and graphs with loops (no node coordinates), exact and toppra."""
-    for seed, route, limits in random_routes(20, 3000):
+    """10 random trees and graphs with loops (no node coordinates), exact and toppra."""
+    for seed, route, limits in random_routes(10, 3000):
         for method in ("exact", "toppra"):
             verified = certify(make_schedule(route, limits, method=method))
             for dialect in TABLE_DIALECTS:
