@@ -201,8 +201,19 @@ def test_export_vda5050_writes_a_graphs_orders_and_manifest(tmp_path, capsys):
     assert main([*args, "--json"]) == 0
     summary = json.loads(capsys.readouterr().out)
     assert summary["method"] == "exact"
-    assert summary["vehicles"]["agv1"]["nodes"] == ["A", "J1", "J2", "c:1.5", "J2", "D"]
-    assert summary["vehicles"]["agv2"]["nodes"] == ["D", "J2", "J1", "A"]
+    assert summary["vehicles"]["agv1"]["nodes"] == [
+        "A",
+        "a:1.5",
+        "J1",
+        "m:1.5",
+        "m:6.5",
+        "J2",
+        "c:1.5",
+        "J2",
+        "e:1.5",
+        "D",
+    ]
+    assert summary["vehicles"]["agv2"]["nodes"] == ["D", "e:1.5", "J2", "m:6.5", "m:1.5", "J1", "a:1.5", "A"]
     manifest = json.loads((out / "manifest.json").read_text())
     assert [m["file"] for m in manifest["messages"]] == [
         "agv1/order-000.json",
@@ -210,12 +221,16 @@ def test_export_vda5050_writes_a_graphs_orders_and_manifest(tmp_path, capsys):
         "agv2/order-001.json",
         "agv1/order-001.json",
     ]
-    # agv2 waits at D until agv1 is parked at c:1.5; agv1 goes back once agv2 has passed J1
-    assert manifest["messages"][2]["trigger"] == {"vehicle": "agv1", "node_id": "c:1.5", "sequence_id": 6}
-    assert manifest["messages"][3]["trigger"] == {"vehicle": "agv2", "node_id": "J1", "sequence_id": 4}
+    # agv2 drives up to the edge of J2's zone at once, and on once agv1 is parked at c:1.5, 1.5 m past
+    # J2; agv1 goes back once agv2 is 1.5 m past J2 on its way to J1
+    assert manifest["messages"][1]["decision_point"] == {"node_id": "e:1.5", "sequence_id": 2}
+    assert manifest["messages"][2]["trigger"] == {"vehicle": "agv1", "node_id": "c:1.5", "sequence_id": 12}
+    assert manifest["messages"][3]["trigger"] == {"vehicle": "agv2", "node_id": "m:6.5", "sequence_id": 6}
     first = json.loads((out / "agv1" / "order-000.json").read_text())
-    assert [e.get("direction") for e in first["edges"]] == ["a", "m", "c", None, "e"]
-    assert [e["orientation"] for e in first["edges"]] == [0.0, 0.0, 0.0, math.pi, math.pi]
+    assert [e.get("direction") for e in first["edges"]] == [None, None, "m", None, None, "c", None, "e", None]
+    assert [e["orientation"] for e in first["edges"]] == [0.0] * 6 + [math.pi] * 3
+    assert first["nodes"][1]["nodeDescription"] == "hold: the minimum separation from junction J1"
+    assert first["nodes"][6]["nodeDescription"] == "reversal, hold: the minimum separation from junction J2"
 
 
 def test_a_graph_without_coordinates_has_orders_without_node_positions(tmp_path):
@@ -231,3 +246,12 @@ def test_a_graph_without_coordinates_has_orders_without_node_positions(tmp_path)
     manifest = json.loads(render_manifest(verified, ("one", "two"), messages, options=OPTIONS))
     assert manifest["vehicles"]["one"]["nodes"][0] == "A"
     assert manifest["vehicles"]["one"]["nodes"][-1] == "B"
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("name", FEASIBLE)
+def test_the_optimal_plans_orders_with_their_waits_run_faster_than_moving_one_vehicle_at_a_time(name):
+    """The hold nodes at the edge of each junction's zone let a vehicle come up while the other passes."""
+    _, _, releases, _ = _case(name, "optimal")
+    _, exact, _, _ = _case(name, "exact")
+    assert releases.planned_duration < exact.schedule.duration

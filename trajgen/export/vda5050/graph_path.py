@@ -3,7 +3,9 @@
 Each vehicle's nodes are where its path starts and ends, every node of the track it passes (a
 junction, or where one edge meets the next), every end of one of its moves of the route (a
 *parking point*: there it can wait while the other vehicle moves, so the release of the bases can
-follow the route's order), and every reversal (where its path turns back on an edge). With
+follow the route's order), every reversal (where its path turns back on an edge), and a *hold
+node* the separation before and after each junction it passes (there it can wait while the other
+vehicle passes the junction, and beyond it the junction is free for the other). With
 ``spacing``, release nodes split longer edges. Each order edge covers a stretch of the path, on one
 or more edges of the track, and carries the highest speed the schedule reaches on it (``maxSpeed``).
 A node's ``claim`` and an edge's ``claim`` are the stretches of track edges ``(edge, low, high)`` the
@@ -21,7 +23,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from topology import EdgePoint, TrackGraph
-from trajgen.export.vda5050.path import NODE_TOLERANCE, NodeKind
+from trajgen.export.vda5050.path import HOLD_MARGIN, NODE_TOLERANCE, NodeKind
 from trajgen.model.graph_paths import GraphPath
 from trajgen.model.graph_schedule import GraphSchedule
 from trajgen.model.pieces import kinematics_polynomials, shift
@@ -48,6 +50,8 @@ class GraphPathNode:
     arrival, departure : float
         When the schedule reaches and leaves the node, seconds.
     kinds : tuple of NodeKind
+    junction : str or None
+        The junction a hold node is the separation away from (its name).
     """
 
     travel: float
@@ -56,6 +60,17 @@ class GraphPathNode:
     arrival: float
     departure: float
     kinds: tuple[NodeKind, ...]
+    junction: str | None = None
+
+    @property
+    def description(self) -> str:
+        """Why the node is there, for ``nodeDescription``: its kinds, a hold's junction."""
+        return ", ".join(
+            f"hold: the minimum separation from junction {self.junction}"
+            if kind is NodeKind.HOLD
+            else kind.value
+            for kind in self.kinds
+        )
 
     @property
     def claim(self) -> Claim:
@@ -118,6 +133,13 @@ class GraphOrderPath:
             low = min(low, float(distances.min()))
         return low
 
+    def junction_at(self, index: int) -> bool:
+        """Whether node ``index`` is a junction of the track (a node where three or more edges meet)."""
+        node = self.track.node_at(self.nodes[index].point)
+        if node is None:
+            return False
+        return sum(node in self.track.ends(k) for k in range(len(self.track.edges))) >= 3
+
     def node_id(self, index: int) -> str:
         """Node ``index``'s id: a track node's name, or ``"<edge>:<metres>"`` (to 1 µm)."""
         point = self.nodes[index].point
@@ -128,8 +150,13 @@ class GraphOrderPath:
         return f"{self.track.edges[point.edge].name}:{metres}"
 
 
-def _marks(schedule: GraphSchedule, path: GraphPath, vehicle: int) -> dict[float, set[NodeKind]]:
-    """Travel (metres) of every node of the path, and why each is there."""
+def _marks(
+    schedule: GraphSchedule, path: GraphPath, vehicle: int, holds: dict[float, str]
+) -> dict[float, set[NodeKind]]:
+    """Travel (metres) of every node of the path, and why each is there.
+
+    ``holds`` is filled with the junction each hold node is the separation away from, by travel.
+    """
     marks: dict[float, set[NodeKind]] = {0.0: {NodeKind.START}}
     marks.setdefault(path.length, set()).add(NodeKind.GOAL)
     for k in range(1, path.edges.size):
@@ -143,11 +170,27 @@ def _marks(schedule: GraphSchedule, path: GraphPath, vehicle: int) -> dict[float
         for a, b, edge in zip(move.points[:-1], move.points[1:], move.edges, strict=True):
             travel += abs(track.position_on(b, edge) - track.position_on(a, edge))
         marks.setdefault(min(travel, path.length), set()).add(NodeKind.STOP)
+    # the edge of each junction's zone, the separation before and after it: there a vehicle can
+    # wait while the other passes the junction, and beyond it it has left the junction to the other
+    separation = schedule.limits.min_separation
+    degree = np.bincount(
+        np.array([track.ends(k) for k in range(len(track.edges))]).ravel(), minlength=len(track.nodes)
+    )
+    for k in range(1, path.edges.size):
+        node = track.node_at(EdgePoint(int(path.edges[k]), float(path.s_from[k])))
+        if node is None or degree[node] < 3:
+            continue
+        for hold in (float(path.starts[k]) - separation, float(path.starts[k]) + separation):
+            if HOLD_MARGIN < hold < path.length - HOLD_MARGIN:
+                marks.setdefault(hold, set()).add(NodeKind.HOLD)
+                holds[hold] = track.nodes[node]
     merged: dict[float, set[NodeKind]] = {}
     for mark in sorted(marks):
         near = [kept for kept in merged if abs(kept - mark) <= NODE_TOLERANCE]
         if near:
             merged[near[0]] |= marks[mark]
+            if mark in holds:
+                holds.setdefault(near[0], holds[mark])
         else:
             merged[mark] = set(marks[mark])
     return merged
@@ -238,7 +281,8 @@ def graph_vehicle_path(
     GraphOrderPath
     """
     path = schedule.paths[vehicle]
-    marks = _with_spacing(_marks(schedule, path, vehicle), spacing)
+    holds: dict[float, str] = {}
+    marks = _with_spacing(_marks(schedule, path, vehicle, holds), spacing)
     travel = np.array(sorted(marks))
     arrival, departure = _times(schedule, vehicle, travel)
     axis = path.axis(travel)
@@ -250,8 +294,11 @@ def graph_vehicle_path(
         if len(kinds) > 1:  # a stop is named only where nothing else names the node
             kinds = kinds - {NodeKind.STOP}
         ordered = tuple(kind for kind in NodeKind if kind in kinds)
+        junction = holds.get(float(p)) if NodeKind.HOLD in kinds else None
         nodes.append(
-            GraphPathNode(float(p), point, float(axis[k]), float(arrival[k]), float(departure[k]), ordered)
+            GraphPathNode(
+                float(p), point, float(axis[k]), float(arrival[k]), float(departure[k]), ordered, junction
+            )
         )
     limit = schedule.limits.vehicles[vehicle].max_velocity
     peaks = _max_speeds(schedule, vehicle, departure[:-1], arrival[1:])

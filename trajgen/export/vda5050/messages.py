@@ -143,7 +143,7 @@ def _graph_node(path: GraphOrderPath, index: int, sequence: int, released: bool,
     return Node(
         node_id=path.node_id(index),
         sequence_id=sequence,
-        node_description=_node_description(node),
+        node_description=node.description,
         released=released,
         node_position=position,
         actions=[],
@@ -155,7 +155,7 @@ def _graph_edge(path: GraphOrderPath, index: int, sequence: int, released: bool)
 
     edge = path.edges[index]
     first, second = path.node_id(index), path.node_id(index + 1)
-    leaves_node = path.track.node_at(path.nodes[index].point) is not None
+    leaves_junction = path.junction_at(index)
     return Edge(
         edge_id=edge_id(first, second),
         sequence_id=sequence,
@@ -166,8 +166,10 @@ def _graph_edge(path: GraphOrderPath, index: int, sequence: int, released: bool)
         length=_coordinate(edge.length),
         orientation=math.pi if edge.backward else 0.0,
         orientation_type="TANGENTIAL",
-        # the track edge taken where the vehicle leaves a node of the track
-        direction=path.track.edges[edge.stretches[0][0]].name if leaves_node and edge.length > 0.0 else None,
+        # the track edge taken where the vehicle leaves a junction
+        direction=path.track.edges[edge.stretches[0][0]].name
+        if leaves_junction and edge.length > 0.0
+        else None,
         actions=[],
     )
 
