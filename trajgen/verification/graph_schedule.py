@@ -42,6 +42,8 @@ __all__ = ["verify_graph_schedule"]
 
 #: Area below which a convex part of the too-close region is a touching line, not an obstacle, m².
 _SLIVER_AREA = 1e-12
+#: Pieces whose separation is computed at once (the memory of a table read back stays bounded).
+_BLOCK = 1 << 15
 
 
 class _Pieces:
@@ -335,26 +337,40 @@ def _backwards(
     return furthest - low > schedule.end_tolerance
 
 
-def _check_separation(
-    schedule: GraphSchedule, pieces: _Pieces, distances: TrackDistances, failures: list[str]
-) -> float:
-    """The least track distance over the whole schedule, in closed form."""
-    edges, s = _track_polynomials(schedule, pieces)
+def _closest_on_pieces(
+    schedule: GraphSchedule, distances: TrackDistances, edges: np.ndarray, s: np.ndarray, length: np.ndarray
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Least track distance on each piece, when (from the piece's start) and whether they pass there."""
     terms, along = _distance_terms(schedule, distances, edges, s)
-    h = np.repeat(pieces.length, 4)
-    low, t_low, _, _ = polynomials.extrema(terms.reshape(-1, terms.shape[2]), h)
+    count = length.size
+    low, t_low, _, _ = polynomials.extrema(terms.reshape(-1, terms.shape[2]), np.repeat(length, 4))
     low, t_low = low.reshape(-1, 4), t_low.reshape(-1, 4)
     way = np.argmin(low, axis=1)
-    closest = low[np.arange(pieces.count), way]
-    when = t_low[np.arange(pieces.count), way]
+    closest = low[np.arange(count), way]
+    when = t_low[np.arange(count), way]
     same = edges[0] == edges[1]
-    a_low, at_low, a_high, at_high = polynomials.extrema(along, pieces.length)
+    a_low, at_low, a_high, at_high = polynomials.extrema(along, length)
     crossing = same & (a_low < 0.0) & (a_high > 0.0)
     gap = np.where(a_high <= 0.0, -a_high, a_low)
     gap_when = np.where(a_high <= 0.0, at_high, at_low)
     nearer = same & (gap < closest)
     closest = np.where(nearer, np.where(crossing, 0.0, gap), closest)
     when = np.where(nearer, gap_when, when)
+    return closest, when, crossing
+
+
+def _check_separation(
+    schedule: GraphSchedule, pieces: _Pieces, distances: TrackDistances, failures: list[str]
+) -> float:
+    """The least track distance over the whole schedule, in closed form."""
+    edges, s = _track_polynomials(schedule, pieces)
+    closest, when, crossing = np.empty(pieces.count), np.empty(pieces.count), np.empty(pieces.count, bool)
+    # in blocks of pieces: a table read back has a piece per row, up to a million
+    for first in range(0, pieces.count, _BLOCK):
+        block = slice(first, min(first + _BLOCK, pieces.count))
+        closest[block], when[block], crossing[block] = _closest_on_pieces(
+            schedule, distances, edges[:, block], s[:, block], pieces.length[block]
+        )
     if not np.all(np.isfinite(closest)):
         failures.append("the track distance is not finite on some piece: expected finite numbers")
         return math.nan
