@@ -5,12 +5,13 @@ from __future__ import annotations
 import dataclasses
 import functools
 import json
+import tempfile
 
 import numpy as np
 import pytest
 
 from tests.conftest import REPO
-from tests.support.graph_cases import random_routes
+from tests.support.graph_cases import CONVOY, TINY_BACK_OFF, random_routes
 from trajgen import certify
 from trajgen.cli import main
 from trajgen.errors import OptionError, VerificationError
@@ -209,3 +210,65 @@ def test_every_table_dialect_on_seeded_random_graphs_is_verified_as_interpolated
                 for vehicle, table in enumerate(tables.resampled.tables):
                     turns = graph_travel(table.motion(), 1e-6)[1]
                     assert turns == pytest.approx(verified.schedule.paths[vehicle].cusps, abs=1e-6)
+
+
+@pytest.mark.parametrize("dialect", [d.name.value for d in DIALECTS])
+def test_a_vehicle_that_backs_off_a_micrometre_and_returns_is_written_and_checked(dialect, tmp_path):
+    """agv2 starts 1 µm inside the separation from J1: it backs off 1 µm for agv1 and comes back."""
+    scenario_file = tmp_path / "tiny.toml"
+    scenario_file.write_text(TINY_BACK_OFF)
+    scenario = load_scenario(scenario_file)
+    verified = certify(make_schedule(scenario.route(), scenario.limits, method="exact"))
+    assert verified.schedule.paths[1].length == pytest.approx(2e-6)
+    assert verified.schedule.paths[1].cusps.size == 1
+    out = tmp_path / "files"
+    assert main(["schedule", str(scenario_file), "--csv", str(out), "--dialect", dialect]) == 0
+    verdict = check_profiles(scenario, out, dialect=dialect)
+    assert verdict.passed, verdict.failures
+
+
+@pytest.mark.parametrize("honest", [True, False], ids=["s-column-follows", "s-column-lies"])
+def test_a_generic_csv_whose_last_rows_creep_nine_micrometres_too_close_is_refused(honest, tmp_path):
+    """agv1 parks exactly the separation behind agv2; its file then creeps 9 µm further, row by row."""
+    scenario_file = tmp_path / "convoy.toml"
+    scenario_file.write_text(CONVOY)
+    scenario = load_scenario(scenario_file)
+    out = tmp_path / "files"
+    assert main(["schedule", str(scenario_file), "--csv", str(out)]) == 0
+    lines = (out / "agv1.csv").read_text().splitlines()
+    t, axis, *rest = lines[-1].split(";")
+    step = 0.01
+    extra = []
+    for k in range(1, 201):  # a smooth creep over 2 s: far within every limit
+        u = k / 200.0
+        creep = 9e-6 * u * u * u * (10.0 - 15.0 * u + 6.0 * u * u)
+        s_column = float(rest[4]) + (creep if honest else 0.0)
+        x_column = float(rest[5]) + (creep if honest else 0.0)
+        row = [f"{float(t) + k * step:.6f}", f"{float(axis) + creep:.9f}", *rest[:4], f"{s_column:.9f}"]
+        extra.append(";".join([*row, f"{x_column:.9f}", rest[6]]))
+    (out / "agv1.csv").write_text("\r\n".join(lines + extra) + "\r\n")
+    second = (out / "agv2.csv").read_text().splitlines()
+    t2 = float(second[-1].split(";")[0])
+    pad = [";".join([f"{t2 + k * step:.6f}", *second[-1].split(";")[1:]]) for k in range(1, 201)]
+    (out / "agv2.csv").write_text("\r\n".join(second + pad) + "\r\n")
+    verdict = check_profiles(scenario, out)
+    assert not verdict.passed
+    assert any("below the minimum 1.5 m" in f for f in verdict.failures), verdict.failures
+    lies = [f for f in verdict.failures if "but its axis puts it on edge 'e'" in f]
+    assert bool(lies) != honest, verdict.failures
+
+
+@pytest.mark.slow
+def test_the_generic_csv_of_seeded_random_graphs_passes_check():
+    """20 random trees and graphs with loops, exact and toppra: trajgen's own files pass its check."""
+    from trajgen.export.csv import write_profiles
+    from trajgen.scenario import GraphScenario
+
+    for seed, route, limits in random_routes(20, 3000):
+        scenario = GraphScenario(route.track, limits, ("agv1", "agv2"), route.start, route.goal)
+        for method in ("exact", "toppra"):
+            verified = certify(make_schedule(route, limits, method=method))
+            with tempfile.TemporaryDirectory() as directory:
+                write_profiles(verified, scenario.names, directory)
+                verdict = check_profiles(scenario, directory, jerk=verified.schedule.jerk_limited)
+            assert verdict.passed, (seed, method, verdict.failures)

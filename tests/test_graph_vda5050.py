@@ -13,7 +13,7 @@ from vda5050.domain.order import AcceptanceDecision
 
 from limits import Limits, VehicleLimits
 from tests.conftest import REPO
-from tests.support.graph_cases import random_routes
+from tests.support.graph_cases import TINY_BACK_OFF, random_routes
 from tests.support.graph_rows import ScenarioFile
 from tests.support.vda5050_reference import SimulatedVehicle, parse_order, schema_errors
 from topology import TrackGraph, plan_graph
@@ -80,11 +80,18 @@ def test_graph_nodes_sit_at_junctions_parking_points_and_reversals_with_their_x_
         for document in _documents(name, "exact")[scenario.names[vehicle]]:
             for node in document["nodes"]:
                 index = node["sequenceId"] // 2
+                assert node["nodeId"] == path.node_id(index)
+                if not path.placed(index):  # inside a curved edge: where it is, the scenario does not say
+                    assert "nodePosition" not in node
+                    assert track.node_at(path.nodes[index].point) is None
+                    edge = track.edges[path.nodes[index].point.edge]
+                    start, end = (track.coordinates[n] for n in track.ends(path.nodes[index].point.edge))
+                    assert edge.length > math.dist(start, end)
+                    continue
                 x, y = track.xy(path.nodes[index].point)
                 assert (node["nodePosition"]["x"], node["nodePosition"]["y"]) == pytest.approx(
                     (x, y), abs=1e-9
                 )
-                assert node["nodeId"] == path.node_id(index)
         # an order edge's length is the path's travel between its nodes; reversed after a turn back
         for edge in path.edges:
             a, b = path.nodes[edge.index], path.nodes[edge.index + 1]
@@ -255,3 +262,25 @@ def test_the_optimal_plans_orders_with_their_waits_run_faster_than_moving_one_ve
     _, _, releases, _ = _case(name, "optimal")
     _, exact, _, _ = _case(name, "exact")
     assert releases.planned_duration < exact.schedule.duration
+
+
+def test_a_vehicle_that_backs_off_a_micrometre_gets_orders_that_keep_the_separation(tmp_path):
+    path = tmp_path / "tiny.toml"
+    path.write_text(TINY_BACK_OFF)
+    scenario = load_scenario(path)
+    verified = certify(make_schedule(scenario.route(), scenario.limits, method="exact"))
+    releases = order_releases(verified)
+    # its start, its parking point 1 µm back and its goal are three nodes, not one
+    assert [releases.paths[1].node_id(k) for k in range(len(releases.paths[1].nodes))] == [
+        "b:1.499999",
+        "b:1.5",
+        "b:1.499999",
+    ]
+    track = scenario.track
+
+    def distance(a, b):
+        return float(track.distances([a[0]], [a[1]], [b[0]], [b[1]])[0])
+
+    for pace in range(5):
+        closest = _drive_at_random_paces(verified, releases, distance, pace)
+        assert closest >= scenario.limits.min_separation - 1e-9

@@ -151,6 +151,7 @@ class SimulatedVehicle:
         self.policy = OrderAcceptancePolicy()
         self.session = VehicleSession(key=VehicleKey(self.manufacturer, self.serial_number))
         self.states_sent = 0
+        self.x, self.y = x, y
         self.session.apply_state(self.state(order=None, x=x, y=y))
 
     def state(self, order: Order | None, x: float, y: float) -> State:
@@ -227,6 +228,8 @@ class SimulatedVehicle:
         if result.accepted:
             self.session.apply_order(order)
             decision_point = [node for node in order.nodes if node.released][-1].node_position
+            if decision_point is not None:  # a node without a position: the vehicle knows where it is
+                self.x, self.y = decision_point.x, decision_point.y
             self.states_sent += 1
-            self.session.apply_state(self.state(order, decision_point.x, decision_point.y))
+            self.session.apply_state(self.state(order, self.x, self.y))
         return result

@@ -75,16 +75,23 @@ class GraphPath(ArrayValue):
             return np.zeros(p.shape, dtype=int)
         return np.clip(np.searchsorted(self.starts, p, side="right") - 1, 0, self.edges.size - 1)
 
-    def locate(self, p) -> tuple[np.ndarray, np.ndarray]:
+    def locate(self, p, *, extend: bool = False) -> tuple[np.ndarray, np.ndarray]:
         """Edge number and metres from its ``from`` node at travel values ``p``, shape (n,) each.
 
-        Travel outside ``[0, length]`` (round-off at the ends) is clipped to it.
+        Travel outside ``[0, length]`` (round-off at the ends) is clipped to it; with ``extend``,
+        it runs on along the first and last segment's edge instead (within the edge), as a
+        vehicle that creeps past its start or goal does.
         """
         p = np.atleast_1d(np.asarray(p, dtype=float))
         if self.edges.size == 0:
             return np.full(p.shape, self.home.edge, dtype=int), np.full(p.shape, self.home.s)
         k = self.segment(p)
-        along = np.clip(p - self.starts[k], 0.0, self.starts[k + 1] - self.starts[k])
+        low = np.full(p.shape, -np.inf) if extend else np.zeros(p.shape)
+        high = self.starts[k + 1] - self.starts[k]
+        if extend:
+            low = np.where(k == 0, -np.inf, 0.0)
+            high = np.where(k == self.edges.size - 1, np.inf, high)
+        along = np.clip(p - self.starts[k], low, high)
         s = self.s_from[k] + self.directions[k] * along
         return self.edges[k], s
 

@@ -257,12 +257,17 @@ def _check_motion(schedule: GraphSchedule, pieces: _Pieces, failures: list[str])
             # acceleration changes sign while the acceleration along the vehicle's axis goes on
             boundary = pieces.travel[vehicle][1:, 0]
             at_cusp = np.zeros(boundary.size, dtype=bool)
+            # a table read back turns within its tolerance of the path's cusp, and is placed by the
+            # path's axis after the turn: its travel may step there by twice that (at rest)
+            window = POSITION_TOLERANCE if schedule.end_tolerance is None else schedule.end_tolerance
             for cusp in path.cusps:
-                at_cusp |= np.abs(boundary - cusp) <= POSITION_TOLERANCE
+                at_cusp |= np.abs(boundary - cusp) <= window + POSITION_TOLERANCE
             for order, name in enumerate(["position", "velocity", "acceleration"][: schedule.smoothness + 1]):
                 before = polynomials.evaluate(derivatives[order][:-1], h[:-1])
                 after = derivatives[order][1:, 0]
                 tolerance = continuity_allowance(schedule, vehicle, name, scale)
+                if order == 0 and schedule.end_tolerance is not None:
+                    tolerance = np.where(at_cusp, tolerance + 2.0 * schedule.end_tolerance, tolerance)
                 gap = np.abs(before - after)
                 if order == 2:
                     gap = np.where(at_cusp, np.minimum(gap, np.abs(before + after)), gap)
@@ -339,8 +344,12 @@ def _backwards(
 
 def _closest_on_pieces(
     schedule: GraphSchedule, distances: TrackDistances, edges: np.ndarray, s: np.ndarray, length: np.ndarray
-) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Least track distance on each piece, when (from the piece's start) and whether they pass there."""
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Least track distance on each piece and when (from its start), whether they pass, at its start.
+
+    Returns four arrays of shape (n,): the least distance (m), its time from the piece's start (s),
+    whether the vehicles pass each other on one edge, and the distance at the piece's start (m).
+    """
     terms, along = _distance_terms(schedule, distances, edges, s)
     count = length.size
     low, t_low, _, _ = polynomials.extrema(terms.reshape(-1, terms.shape[2]), np.repeat(length, 4))
@@ -356,7 +365,9 @@ def _closest_on_pieces(
     nearer = same & (gap < closest)
     closest = np.where(nearer, np.where(crossing, 0.0, gap), closest)
     when = np.where(nearer, gap_when, when)
-    return closest, when, crossing
+    at_start = np.min(terms[:, :, 0], axis=1)
+    at_start = np.where(same, np.minimum(at_start, np.abs(along[:, 0])), at_start)
+    return closest, when, crossing, at_start
 
 
 def _check_separation(
@@ -365,10 +376,11 @@ def _check_separation(
     """The least track distance over the whole schedule, in closed form."""
     edges, s = _track_polynomials(schedule, pieces)
     closest, when, crossing = np.empty(pieces.count), np.empty(pieces.count), np.empty(pieces.count, bool)
+    at_start = np.empty(pieces.count)
     # in blocks of pieces: a table read back has a piece per row, up to a million
     for first in range(0, pieces.count, _BLOCK):
         block = slice(first, min(first + _BLOCK, pieces.count))
-        closest[block], when[block], crossing[block] = _closest_on_pieces(
+        closest[block], when[block], crossing[block], at_start[block] = _closest_on_pieces(
             schedule, distances, edges[:, block], s[:, block], pieces.length[block]
         )
     if not np.all(np.isfinite(closest)):
@@ -381,6 +393,13 @@ def _check_separation(
         failures.append(
             f"the vehicles pass each other on edge {schedule.track.edges[edges[0, j]].name!r} between "
             f"t={pieces.start[j]:.6f} s and t={pieces.start[j] + pieces.length[j]:.6f} s"
+        )
+    elif np.min(at_start) < required - POSITION_TOLERANCE:  # at its points, a table is held exactly
+        j = int(np.argmin(at_start))
+        failures.append(
+            f"separation {at_start[j]:.9g} m at t={pieces.start[j]:.6f} s is below the minimum "
+            f"{required:g} m (vehicle 1 on {schedule.track.edges[edges[0, j]].name!r}, vehicle 2 on "
+            f"{schedule.track.edges[edges[1, j]].name!r})"
         )
     elif closest[k] < required - _separation_slack(schedule):
         failures.append(

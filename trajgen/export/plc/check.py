@@ -154,15 +154,17 @@ def _graph_places(parsed, vehicle: int, check: TableCheck, scenario: GraphScenar
             f"(0 to {track.edges[edges[k]].length:g} m)"
         )
     if check.schedule is not None:
-        state = check.schedule.state(table.times)
-        apart = track.distances(edges, np.clip(s, 0.0, lengths), state.edge[vehicle], state.s[vehicle])
+        # where the axis puts it, also past either end of its path (a vehicle creeping on)
+        travel = check.schedule.travel(table.times)[vehicle, 0]
+        on_edge, along = check.schedule.paths[vehicle].locate(travel, extend=True)
+        along = np.clip(along, 0.0, np.array([edge.length for edge in track.edges])[on_edge])
+        apart = track.distances(edges, np.clip(s, 0.0, lengths), on_edge, along)
         where = np.nonzero(apart > 1e-6)[0]
         if where.size:
             k = int(where[0])
             failures.append(
                 f"{name} row at t={table.times[k]:.6f} s says edge {names[k]!r}, s {s[k]:.9g} m, but its "
-                f"axis puts it on edge {track.edges[state.edge[vehicle, k]].name!r}, s "
-                f"{state.s[vehicle, k]:.9g} m"
+                f"axis puts it on edge {track.edges[on_edge[k]].name!r}, s {along[k]:.9g} m"
             )
     if "x" in columns and track.coordinates is not None:
         coordinates = np.asarray(track.coordinates, dtype=float)

@@ -347,7 +347,8 @@ class GenericDialect(Dialect):
         if units is None:
             raise ProfileFileError(
                 f"{source} line 1: header {short_repr(header)} is not trajgen's: expected "
-                f"{';'.join(HEADER_NAMES[Units.METRES])!r} (any delimiter, or the mm columns)"
+                f"{';'.join(HEADER_NAMES[Units.METRES])!r} (on a track graph "
+                f"{';'.join(GRAPH_HEADER_NAMES['m'])!r}; any delimiter, or the mm columns)"
             )
         rows = lines[1:]
         if not rows:

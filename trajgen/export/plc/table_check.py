@@ -10,6 +10,7 @@ of exactly what the controllers will drive, in closed form between the points to
 from __future__ import annotations
 
 import itertools
+import math
 from dataclasses import dataclass, field
 from typing import ClassVar
 
@@ -191,29 +192,39 @@ def turning_points(motion: PiecewiseCubic, tolerance: float) -> tuple[np.ndarray
     return times[index], axis[index]
 
 
-def graph_travel(motion: PiecewiseCubic, tolerance: float) -> tuple[PiecewiseCubic, np.ndarray]:
+def graph_travel(
+    motion: PiecewiseCubic, tolerance: float, path: GraphPath | None = None
+) -> tuple[PiecewiseCubic, np.ndarray]:
     """The metres a vehicle has driven (its travel) under an axis ``motion``, and the travel at each turn.
 
     Between turns (:func:`turning_points`) the travel is the axis, signed by the direction of
-    that stretch, so it grows while the vehicle drives either way.
+    that stretch, so it grows while the vehicle drives either way. With ``path``, whose cusps the
+    turns are matched to (as many), each stretch after a turn is placed by the path's own axis: a
+    table that turns a little short of or beyond the path's cusp (within its tolerance) is where
+    its axis says after the turn, not off by twice that.
 
     Returns
     -------
     PiecewiseCubic
         The travel over the motion's time, with a piece end at each turn.
     ndarray, shape (r,)
-        The travel at each turn, metres.
+        The travel at each turn, metres, as the table's own axis gives it.
     """
     turn_times, turn_axis = turning_points(motion, tolerance)
     whole = _slice(motion, 0.0, motion.duration, turn_times)
     run = np.searchsorted(turn_times, whole.times[:-1], side="right")
     signs = np.where(np.arange(turn_times.size + 1) % 2 == 0, 1.0, -1.0)
-    anchors = np.concatenate([[float(whole.initial[0, 0]) if whole.jerk.size else 0.0], turn_axis])
+    start = float(whole.initial[0, 0]) if whole.jerk.size else 0.0
+    anchors = np.concatenate([[start], turn_axis])
     travel_at = np.concatenate([[0.0], np.cumsum(signs[:-1] * np.diff(anchors))])
+    turns = travel_at[1:].copy()
+    if path is not None and path.cusps.size == turn_times.size:
+        travel_at[1:] = path.cusps
+        anchors[1:] = start + path.axis(path.cusps)
     sign = signs[run]
     initial = sign[:, None] * whole.initial
     initial[:, 0] += travel_at[run] - sign * anchors[run]
-    return PiecewiseCubic(whole.times, initial, sign * whole.jerk), travel_at[1:]
+    return PiecewiseCubic(whole.times, initial, sign * whole.jerk), turns
 
 
 def _turn_failures(turns: np.ndarray, path: GraphPath, vehicle: int, tolerance: float) -> list[str]:
@@ -301,6 +312,21 @@ class TableMotion(TimingMethod):
             "checked_limits": min(table.interpolation.closed_form for table in self.tables),
         }
 
+    def turn_tolerances(self, paths: tuple[GraphPath, GraphPath]) -> tuple[float, float]:
+        """How far back each table must come to count as turning, metres.
+
+        The interpolation's tolerance, but less than half of the shortest stretch between its
+        path's turns (a vehicle that backs off a micrometre turns twice in a micrometre), and more
+        than its values' round-off.
+        """
+        tolerance = self._read_back()["end_tolerance"]
+        out = []
+        for table, path in zip(self.tables, paths, strict=True):
+            runs = np.diff(np.concatenate([[0.0], path.cusps, [path.length]]))
+            shortest = float(runs.min()) if path.cusps.size else math.inf
+            out.append(max(min(tolerance, 0.5 * shortest), 4.0 * table.round_off))
+        return out[0], out[1]
+
     def schedule_graph(self, route: GraphRoute, limits: Limits) -> GraphSchedule:
         """The tables' motion along a route on a track graph: each vehicle's travel along its path.
 
@@ -308,15 +334,16 @@ class TableMotion(TimingMethod):
         between turns its travel is the axis, signed by the stretch's direction.
         """
         given = self.motions or tuple(table.motion() for table in self.tables)
-        tolerance = self._read_back()["end_tolerance"]
-        travels = [graph_travel(motion, tolerance)[0] for motion in given]
+        paths = graph_paths(route)
+        tolerances = self.turn_tolerances(paths)
+        travels = [graph_travel(motion, tolerances[v], paths[v])[0] for v, motion in enumerate(given)]
         end = max(travel.duration for travel in travels)
         kinematics = CubicKinematics(tuple(_slice(travel, 0.0, end) for travel in travels))
         return GraphSchedule(
             route,
             limits,
             self,
-            graph_paths(route),
+            paths,
             (GraphSection(0.0, kinematics),),
             jerk_limited=self.jerk,
             **self._read_back(),
@@ -427,8 +454,9 @@ def _check_graph_tables(
     method = TableMotion(tables, jerk=jerk, motions=motions)
     schedule = method.schedule_graph(route, limits)
     tolerance = max(schedule.end_tolerance, 1e-6)
+    turn_tolerances = method.turn_tolerances(schedule.paths)
     for vehicle, motion in enumerate(motions):
-        turns = graph_travel(motion, schedule.end_tolerance)[1]
+        turns = graph_travel(motion, turn_tolerances[vehicle])[1]
         failures += _turn_failures(turns, schedule.paths[vehicle], vehicle, tolerance)
     report = verify(schedule)
     failures += list(report.failures)

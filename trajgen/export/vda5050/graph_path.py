@@ -23,9 +23,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from topology import EdgePoint, TrackGraph
-from trajgen.export.vda5050.path import HOLD_MARGIN, NODE_TOLERANCE, NodeKind
+from trajgen.export.vda5050.path import HOLD_MARGIN, NodeKind
 from trajgen.model.graph_paths import GraphPath
 from trajgen.model.graph_schedule import GraphSchedule
+from trajgen.model.paths import MOVE_RESOLUTION
 from trajgen.model.pieces import kinematics_polynomials, shift
 from trajgen.model.polynomials import derivative, extrema
 
@@ -133,6 +134,22 @@ class GraphOrderPath:
             low = min(low, float(distances.min()))
         return low
 
+    def placed(self, index: int) -> bool:
+        """Whether node ``index``'s x/y is known.
+
+        The track has coordinates, and the node is a node of the track or lies on a straight edge:
+        an edge longer than the straight line between its nodes curves in a way the scenario does
+        not say.
+        """
+        if self.track.coordinates is None:
+            return False
+        point = self.nodes[index].point
+        if self.track.node_at(point) is not None:
+            return True
+        start, end = self.track.ends(point.edge)
+        (x0, y0), (x1, y1) = self.track.coordinates[start], self.track.coordinates[end]
+        return self.track.length(point.edge) <= math.hypot(x1 - x0, y1 - y0) + 1e-9
+
     def junction_at(self, index: int) -> bool:
         """Whether node ``index`` is a junction of the track (a node where three or more edges meet)."""
         node = self.track.node_at(self.nodes[index].point)
@@ -186,7 +203,7 @@ def _marks(
                 holds[hold] = track.nodes[node]
     merged: dict[float, set[NodeKind]] = {}
     for mark in sorted(marks):
-        near = [kept for kept in merged if abs(kept - mark) <= NODE_TOLERANCE]
+        near = [kept for kept in merged if abs(kept - mark) <= MOVE_RESOLUTION]
         if near:
             merged[near[0]] |= marks[mark]
             if mark in holds:
@@ -211,7 +228,7 @@ def _times(schedule: GraphSchedule, vehicle: int, travel: np.ndarray) -> tuple[n
     """When the vehicle first reaches and last leaves each travel value (its travel never decreases)."""
     duration = schedule.duration
     results = []
-    for target, reach in ((travel - NODE_TOLERANCE, True), (travel + NODE_TOLERANCE, False)):
+    for target, reach in ((travel - MOVE_RESOLUTION, True), (travel + MOVE_RESOLUTION, False)):
         low, high = np.zeros(travel.size), np.full(travel.size, duration)
         for _ in range(60):
             middle = 0.5 * (low + high)
@@ -220,8 +237,8 @@ def _times(schedule: GraphSchedule, vehicle: int, travel: np.ndarray) -> tuple[n
             high = np.where(beyond, middle, high)
             low = np.where(beyond, low, middle)
         results.append(high if reach else low)
-    arrival = np.where(travel <= NODE_TOLERANCE, 0.0, results[0])
-    departure = np.where(travel >= schedule.paths[vehicle].length - NODE_TOLERANCE, duration, results[1])
+    arrival = np.where(travel <= MOVE_RESOLUTION, 0.0, results[0])
+    departure = np.where(travel >= schedule.paths[vehicle].length - MOVE_RESOLUTION, duration, results[1])
     return arrival, np.maximum(departure, arrival)
 
 
@@ -255,7 +272,7 @@ def _stretches(path: GraphPath, a: float, b: float) -> tuple[tuple[int, float, f
     directions = path.directions
     for k in range(path.edges.size):
         lo, hi = max(a, float(path.starts[k])), min(b, float(path.starts[k + 1]))
-        if hi - lo < NODE_TOLERANCE and (stretches or (k + 1 < path.edges.size and b > lo)):
+        if hi - lo < MOVE_RESOLUTION and (stretches or (k + 1 < path.edges.size and b > lo)):
             continue  # only touches this segment at one of its ends
         s = path.s_from[k] + directions[k] * (np.array([lo, hi]) - path.starts[k])
         stretches.append((int(path.edges[k]), float(s.min()), float(s.max())))

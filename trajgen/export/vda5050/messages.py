@@ -131,9 +131,9 @@ def _graph_node(path: GraphOrderPath, index: int, sequence: int, released: bool,
     from vda5050.model.order import Node
 
     node = path.nodes[index]
-    xy = path.track.xy(node.point)
+    xy = path.track.xy(node.point) if path.placed(index) else None
     position = None
-    if xy is not None:  # a track without coordinates has none to give
+    if xy is not None:  # a track without coordinates, or a point inside a curved edge, has none to give
         position = {
             "x": _coordinate(xy[0]),
             "y": _coordinate(xy[1]),
