@@ -47,7 +47,7 @@ FIGURES = {
     # the H: 33.586 s optimal (agv1 waits in c) against 51.5 s of moves one at a time
     "13_time_a_track_graph": (r"optimal / exact = ([0-9.]+)", 0.6522, 0.002),
     # the optimal H as orders: released node by node, with the hold nodes at each junction's zone
-    "14_export_a_track_graph": (r"the orders with their waits take ([0-9.]+) s", 36.592, 0.01),
+    "14_export_a_track_graph": (r"the orders with their waits take ([0-9.]+) s", 36.612, 0.01),
 }
 
 

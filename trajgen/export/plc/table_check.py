@@ -35,7 +35,7 @@ from trajgen.model.profiles import PiecewiseCubic
 from trajgen.model.schedule import AxisMap, CubicKinematics, Schedule, Section, TimingMethod
 from trajgen.model.summary import graph_class_label
 from trajgen.model.values import sorted_unique
-from trajgen.verification import VerificationReport, verify
+from trajgen.verification import POSITION_TOLERANCE, VerificationReport, verify
 
 __all__ = [
     "TableCheck",
@@ -460,8 +460,38 @@ def _check_graph_tables(
         failures += _turn_failures(turns, schedule.paths[vehicle], vehicle, tolerance)
     report = verify(schedule)
     failures += list(report.failures)
+    failures += _row_separation(tables, schedule)
     ratios = limit_ratios(tables, limits, jerk=jerk)
     return TableCheck(not failures, tuple(failures), report, ratios, route, schedule)
+
+
+def _row_separation(tables: tuple[ProfileTable, ProfileTable], schedule: GraphSchedule) -> list[str]:
+    """At the points of a table judged by its points only, the separation holds to their round-off.
+
+    The verifier holds such a table (a generic CSV) to its tolerance between the points, where the
+    cubic is the reader's; at the points themselves the file says where the vehicles are.
+    """
+    if min(table.interpolation.closed_form for table in tables) > 0:
+        return []
+    times = sorted_unique(np.concatenate([table.times for table in tables]))
+    travel = schedule.travel(times)[:, 0]
+    # where the axes put them, past either end of a path too (a vehicle creeping on)
+    (edge_1, s_1), (edge_2, s_2) = (
+        path.locate(travel[v], extend=True) for v, path in enumerate(schedule.paths)
+    )
+    track = schedule.track
+    lengths = np.array([edge.length for edge in track.edges])
+    s_1, s_2 = np.clip(s_1, 0.0, lengths[edge_1]), np.clip(s_2, 0.0, lengths[edge_2])
+    apart = track.distances(edge_1, s_1, edge_2, s_2)
+    allowed = schedule.limits.min_separation - POSITION_TOLERANCE - 2.0 * max(t.round_off for t in tables)
+    k = int(np.argmin(apart))
+    if apart[k] >= allowed:
+        return []
+    return [
+        f"separation {apart[k]:.9g} m at the row at t={times[k]:.6f} s is below the minimum "
+        f"{schedule.limits.min_separation:g} m (vehicle 1 on {track.edges[edge_1[k]].name!r}, "
+        f"vehicle 2 on {track.edges[edge_2[k]].name!r})"
+    ]
 
 
 def check_tables(
