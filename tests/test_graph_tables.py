@@ -227,35 +227,92 @@ def test_a_vehicle_that_backs_off_a_micrometre_and_returns_is_written_and_checke
     assert verdict.passed, verdict.failures
 
 
-@pytest.mark.parametrize("honest", [True, False], ids=["s-column-follows", "s-column-lies"])
-def test_a_generic_csv_whose_last_rows_creep_nine_micrometres_too_close_is_refused(honest, tmp_path):
-    """agv1 parks exactly the separation behind agv2; its file then creeps 9 µm further, row by row."""
-    scenario_file = tmp_path / "convoy.toml"
-    scenario_file.write_text(CONVOY)
+def _creeping_files(tmp_path, scenario_text: str, creeper: str, *, creep: float, s_follows: bool):
+    """Trajgen's generic CSVs of a scenario, ``creeper``'s file then creeping ``creep`` metres on.
+
+    Its axis grows by ``creep`` over 200 more rows (2 s, a smooth step: far within every limit);
+    its s and x columns follow or stay. The other file holds its last row as long.
+    """
+    tmp_path.mkdir(parents=True, exist_ok=True)
+    scenario_file = tmp_path / "scenario.toml"
+    scenario_file.write_text(scenario_text)
     scenario = load_scenario(scenario_file)
     out = tmp_path / "files"
     assert main(["schedule", str(scenario_file), "--csv", str(out)]) == 0
-    lines = (out / "agv1.csv").read_text().splitlines()
+    lines = (out / f"{creeper}.csv").read_text().splitlines()
     t, axis, *rest = lines[-1].split(";")
     step = 0.01
     extra = []
-    for k in range(1, 201):  # a smooth creep over 2 s: far within every limit
+    for k in range(1, 201):
         u = k / 200.0
-        creep = 9e-6 * u * u * u * (10.0 - 15.0 * u + 6.0 * u * u)
-        s_column = float(rest[4]) + (creep if honest else 0.0)
-        x_column = float(rest[5]) + (creep if honest else 0.0)
-        row = [f"{float(t) + k * step:.6f}", f"{float(axis) + creep:.9f}", *rest[:4], f"{s_column:.9f}"]
-        extra.append(";".join([*row, f"{x_column:.9f}", rest[6]]))
-    (out / "agv1.csv").write_text("\r\n".join(lines + extra) + "\r\n")
-    second = (out / "agv2.csv").read_text().splitlines()
+        moved = creep * u * u * u * (10.0 - 15.0 * u + 6.0 * u * u)
+        follow = moved if s_follows else 0.0
+        row = [f"{float(t) + k * step:.6f}", f"{float(axis) + moved:.9f}", *rest[:4]]
+        row.append(f"{float(rest[4]) + follow:.9f}")
+        if len(rest) > 5:
+            row += [f"{float(rest[5]) + follow:.9f}", rest[6]]
+        extra.append(";".join(row))
+    (out / f"{creeper}.csv").write_text("\r\n".join(lines + extra) + "\r\n")
+    other = next(name for name in scenario.names if name != creeper)
+    second = (out / f"{other}.csv").read_text().splitlines()
     t2 = float(second[-1].split(";")[0])
     pad = [";".join([f"{t2 + k * step:.6f}", *second[-1].split(";")[1:]]) for k in range(1, 201)]
-    (out / "agv2.csv").write_text("\r\n".join(second + pad) + "\r\n")
+    (out / f"{other}.csv").write_text("\r\n".join(second + pad) + "\r\n")
+    return scenario, out
+
+
+@pytest.mark.parametrize("honest", [True, False], ids=["s-column-follows", "s-column-lies"])
+def test_a_generic_csv_whose_last_rows_creep_nine_micrometres_too_close_is_refused(honest, tmp_path):
+    """agv1 parks exactly the separation behind agv2; its file then creeps 9 µm further, row by row."""
+    scenario, out = _creeping_files(tmp_path, CONVOY, "agv1", creep=9e-6, s_follows=honest)
     verdict = check_profiles(scenario, out)
     assert not verdict.passed
     assert any("below the minimum 1.5 m" in f for f in verdict.failures), verdict.failures
     lies = [f for f in verdict.failures if "but its axis puts it on edge 'e'" in f]
     assert bool(lies) != honest, verdict.failures
+
+
+def test_a_generic_csv_that_creeps_past_a_goal_at_a_track_node_is_refused(tmp_path):
+    """agv1 parks at node J, exactly the separation behind agv2; its axis then creeps 9 µm past J.
+
+    Past J the track does not say which edge it is on (its s column stays at J): the 9 µm are
+    taken off the separation, not clipped away.
+    """
+    at_node = CONVOY.replace('goal = "e:5.5"', 'goal = "J"').replace('goal = "e:7"', 'goal = "e:1.5"')
+    scenario, out = _creeping_files(tmp_path, at_node, "agv1", creep=9e-6, s_follows=False)
+    verdict = check_profiles(scenario, out)
+    assert not verdict.passed
+    assert any("below the minimum 1.5 m" in f and "9 µm of it off its path" in f for f in verdict.failures), (
+        verdict.failures
+    )
+    # the same files without the creep pass: the refusal is the creep's
+    scenario, out = _creeping_files(tmp_path / "still", at_node, "agv1", creep=0.0, s_follows=False)
+    assert check_profiles(scenario, out).passed
+
+
+def test_a_vehicle_that_should_stand_still_and_creeps_nine_micrometres_is_refused(tmp_path):
+    """agv2 stays at e:7 and agv1 parks exactly the separation from it; agv2's axis creeps 9 µm."""
+    standing = CONVOY.replace('start = "w:5"', 'start = "e:7"')
+    scenario, out = _creeping_files(tmp_path, standing, "agv2", creep=9e-6, s_follows=False)
+    verdict = check_profiles(scenario, out)
+    assert not verdict.passed
+    assert any("below the minimum 1.5 m" in f for f in verdict.failures), verdict.failures
+    scenario, out = _creeping_files(tmp_path / "still", standing, "agv2", creep=0.0, s_follows=False)
+    assert check_profiles(scenario, out).passed
+
+
+def test_a_coarse_file_buys_no_closer_approach_than_a_nanometre_one(tmp_path):
+    """The tables of a 4 µm creep, read as if written to 5 decimals (round-off 5 µm), still fail."""
+    scenario, out = _creeping_files(tmp_path, CONVOY, "agv1", creep=4e-6, s_follows=True)
+    tables = tuple(
+        DIALECTS.lookup("generic").read((out / f"{name}.csv").read_bytes(), source=name).table
+        for name in scenario.names
+    )
+    coarse = tuple(dataclasses.replace(table, resolution=5e-6) for table in tables)
+    for given in (tables, coarse):
+        verdict = check_tables(given, scenario.route(), scenario.limits)
+        assert not verdict.passed
+        assert any("below the minimum 1.5 m" in f for f in verdict.failures), verdict.failures
 
 
 @pytest.mark.slow

@@ -158,13 +158,26 @@ class GraphOrderPath:
         return sum(node in self.track.ends(k) for k in range(len(self.track.edges))) >= 3
 
     def node_id(self, index: int) -> str:
-        """Node ``index``'s id: a track node's name, or ``"<edge>:<metres>"`` (to 1 µm)."""
+        """Node ``index``'s id: a track node's name, or ``"<edge>:<metres>"``.
+
+        The metres to 1 µm, or to 1 nm on an edge where two of the path's nodes more than
+        :data:`~trajgen.model.paths.MOVE_RESOLUTION` apart would share their micrometre: distinct
+        places keep distinct ids.
+        """
         point = self.nodes[index].point
         node = self.track.node_at(point)
         if node is not None:
             return self.track.nodes[node]
-        metres = f"{point.s:.6f}".rstrip("0").rstrip(".")
+        metres = f"{point.s:.{self._decimals(point.edge)}f}".rstrip("0").rstrip(".")
         return f"{self.track.edges[point.edge].name}:{metres}"
+
+    def _decimals(self, edge: int) -> int:
+        """Decimal places of the metres in the ids of the path's nodes on ``edge``: 6, or 9 if needed."""
+        places = sorted(node.point.s for node in self.nodes if node.point.edge == edge)
+        for low, high in itertools.pairwise(places):
+            if high - low > MOVE_RESOLUTION and f"{low:.6f}" == f"{high:.6f}":
+                return 9
+        return 6
 
 
 def _marks(
