@@ -18,7 +18,7 @@ from pathlib import PurePosixPath
 
 from topology import JUNCTION_INDEX, JUNCTION_NAME, StarGraph, TrackGraph
 from trajgen.errors import OptionError
-from trajgen.export.vda5050.graph_path import GraphOrderPath
+from trajgen.export.vda5050.graph_path import GraphOrderPath, GraphPathEdge
 from trajgen.export.vda5050.options import Vda5050Options
 from trajgen.export.vda5050.path import NodeKind, OrderPath, PathEdge, PathNode
 from trajgen.export.vda5050.release import OrderReleases, Release, order_releases
@@ -107,10 +107,29 @@ def _node(graph: StarGraph, node: PathNode, sequence: int, released: bool, map_i
 
 
 def _edge(graph: StarGraph, path: OrderPath, edge: PathEdge, sequence: int, released: bool):
+    start, end = path.nodes[edge.index], path.nodes[edge.index + 1]
+    # the leg taken at the junction
+    leaving = start.leg == JUNCTION_INDEX and end.leg != JUNCTION_INDEX
+    return _order_edge(
+        (node_id(graph, start.leg, start.s), node_id(graph, end.leg, end.s)),
+        edge,
+        graph.names[end.leg] if leaving else None,
+        sequence,
+        released,
+    )
+
+
+def _order_edge(
+    ends: tuple[str, str],
+    edge: PathEdge | GraphPathEdge,
+    direction: str | None,
+    sequence: int,
+    released: bool,
+):
+    """The order's edge between node ids ``ends``, taking ``direction`` (a leg or track edge) or none."""
     from vda5050.model.order import Edge
 
-    start, end = path.nodes[edge.index], path.nodes[edge.index + 1]
-    first, second = node_id(graph, start.leg, start.s), node_id(graph, end.leg, end.s)
+    first, second = ends
     return Edge(
         edge_id=edge_id(first, second),
         sequence_id=sequence,
@@ -121,8 +140,7 @@ def _edge(graph: StarGraph, path: OrderPath, edge: PathEdge, sequence: int, rele
         length=_coordinate(edge.length),
         orientation=math.pi if edge.backward else 0.0,
         orientation_type="TANGENTIAL",
-        # the leg taken at the junction
-        direction=graph.names[end.leg] if start.leg == JUNCTION_INDEX and end.leg != JUNCTION_INDEX else None,
+        direction=direction,
         actions=[],
     )
 
@@ -151,26 +169,15 @@ def _graph_node(path: GraphOrderPath, index: int, sequence: int, released: bool,
 
 
 def _graph_edge(path: GraphOrderPath, index: int, sequence: int, released: bool):
-    from vda5050.model.order import Edge
-
     edge = path.edges[index]
-    first, second = path.node_id(index), path.node_id(index + 1)
-    leaves_junction = path.junction_at(index)
-    return Edge(
-        edge_id=edge_id(first, second),
-        sequence_id=sequence,
-        released=released,
-        start_node_id=first,
-        end_node_id=second,
-        max_speed=edge.max_speed,
-        length=_coordinate(edge.length),
-        orientation=math.pi if edge.backward else 0.0,
-        orientation_type="TANGENTIAL",
-        # the track edge taken where the vehicle leaves a junction
-        direction=path.track.edges[edge.stretches[0][0]].name
-        if leaves_junction and edge.length > 0.0
-        else None,
-        actions=[],
+    # the track edge taken where the vehicle leaves a junction
+    leaving = path.junction_at(index) and edge.length > 0.0
+    return _order_edge(
+        (path.node_id(index), path.node_id(index + 1)),
+        edge,
+        path.track.edges[edge.stretches[0][0]].name if leaving else None,
+        sequence,
+        released,
     )
 
 
