@@ -8,11 +8,9 @@ import numpy as np
 import pytest
 
 from tests.conftest import REPO
+from tests.support.graph_cases import verified_example
 from tests.support.graph_rows import ScenarioFile
-from trajgen import certify
-from trajgen.methods import make_schedule
 from trajgen.model.coordination import CoordinationDiagram, schedule_times
-from trajgen.scenario import load_scenario
 
 EXAMPLES = REPO / "examples" / "graphs"
 FEASIBLE = ["h", "main-line-with-sidings", "passing-loop", "ring-with-spurs"]
@@ -20,8 +18,8 @@ FEASIBLE = ["h", "main-line-with-sidings", "passing-loop", "ring-with-spurs"]
 
 @functools.cache
 def _diagram(name: str, method: str):
-    scenario = load_scenario(EXAMPLES / f"{name}.toml")
-    schedule = certify(make_schedule(scenario.route(), scenario.limits, method=method)).schedule
+    scenario, verified = verified_example(name, method)
+    schedule = verified.schedule
     times = schedule_times(schedule)
     diagram = CoordinationDiagram(schedule.paths, scenario.limits.min_separation, schedule, times)
     return scenario, schedule, diagram

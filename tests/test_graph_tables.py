@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import dataclasses
-import functools
 import json
 import tempfile
 
@@ -11,7 +10,7 @@ import numpy as np
 import pytest
 
 from tests.conftest import REPO
-from tests.support.graph_cases import CONVOY, TINY_BACK_OFF, random_routes
+from tests.support.graph_cases import CONVOY, TINY_BACK_OFF, random_routes, verified_example
 from trajgen import certify
 from trajgen.cli import main
 from trajgen.errors import OptionError, VerificationError
@@ -29,10 +28,7 @@ FEASIBLE = ["h", "main-line-with-sidings", "passing-loop", "ring-with-spurs"]
 TABLE_DIALECTS = [dialect for dialect in DIALECTS if isinstance(dialect, TableDialect)]
 
 
-@functools.cache
-def _verified(name: str, method: str):
-    scenario = load_scenario(EXAMPLES / f"{name}.toml")
-    return scenario, certify(make_schedule(scenario.route(), scenario.limits, method=method))
+_verified = verified_example
 
 
 def _hurried(table: ProfileTable) -> ProfileTable:

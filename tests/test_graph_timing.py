@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from tests.conftest import REPO
-from tests.support.graph_cases import random_routes
+from tests.support.graph_cases import random_routes, verified_example
 from tests.support.graph_rows import ScenarioFile, check_profiles
 from topology import TrackGraph, class_signature, plan_graph, plan_graph_classes
 from trajgen import certify
@@ -78,16 +78,14 @@ def test_optimal_is_jerk_limited_verified_and_faster_than_toppra(name):
 @pytest.mark.slow
 @pytest.mark.parametrize("name", FEASIBLE)
 def test_every_method_on_every_example_is_verified_and_exact_toppra_optimal_are_ordered(name):
-    scenario = load_scenario(EXAMPLES / f"{name}.toml")
-    route = scenario.route()
     durations = {}
     for method in ("exact", "toppra", "optimal"):
-        verified = certify(make_schedule(route, scenario.limits, method=method))
+        scenario, verified = verified_example(name, method)
         assert verified.schedule.fallback_reason is None, verified.schedule.notes
         check_profiles(ScenarioFile(EXAMPLES / f"{name}.toml"), _texts(verified), jerk=method != "toppra")
         durations[method] = verified.schedule.duration
     assert durations["exact"] >= durations["toppra"] >= durations["optimal"]
-    assert durations["optimal"] >= lower_bound(route, scenario.limits)
+    assert durations["optimal"] >= lower_bound(scenario.route(), scenario.limits)
 
 
 def test_the_classes_of_a_route_are_distinct_and_the_shortest_comes_first():

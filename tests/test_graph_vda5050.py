@@ -13,7 +13,7 @@ from vda5050.domain.order import AcceptanceDecision
 
 from limits import Limits, VehicleLimits
 from tests.conftest import REPO
-from tests.support.graph_cases import TINY_BACK_OFF, random_routes
+from tests.support.graph_cases import TINY_BACK_OFF, random_routes, verified_example
 from tests.support.graph_rows import ScenarioFile
 from tests.support.vda5050_reference import SimulatedVehicle, parse_order, schema_errors
 from topology import TrackGraph, plan_graph
@@ -33,8 +33,7 @@ OPTIONS = Vda5050Options(start_time=datetime(2026, 1, 1, tzinfo=UTC), map_id="pl
 
 @functools.cache
 def _case(name: str, method: str):
-    scenario = load_scenario(EXAMPLES / f"{name}.toml")
-    verified = certify(make_schedule(scenario.route(), scenario.limits, method=method))
+    scenario, verified = verified_example(name, method)
     releases = order_releases(verified)
     messages = render_orders(verified, scenario.names, options=OPTIONS, releases=releases)
     return scenario, verified, releases, messages

@@ -1,12 +1,34 @@
-"""Seeded random track-graph cases shared by the tests: feasible routes on trees and graphs with loops."""
+"""Track-graph cases shared by the tests.
+
+The examples' verified schedules, seeded random routes on trees and graphs with loops, and small
+scenarios written out.
+"""
 
 from __future__ import annotations
 
 import dataclasses
+import functools
 
 from limits import Limits, VehicleLimits
+from tests.conftest import REPO
 from tests.support.grid_oracle import random_case
 from topology import InfeasibleError, TrackGraph, plan_graph
+from trajgen import certify
+from trajgen.methods import make_schedule
+from trajgen.scenario import load_scenario
+
+#: The example graph scenarios.
+EXAMPLES = REPO / "examples" / "graphs"
+
+
+@functools.cache
+def verified_example(name: str, method: str):
+    """The example ``name``'s scenario and its verified schedule by ``method``, once per process.
+
+    Several test files use the same schedules (the optimal H takes seconds); all are immutable.
+    """
+    scenario = load_scenario(EXAMPLES / f"{name}.toml")
+    return scenario, certify(make_schedule(scenario.route(), scenario.limits, method=method))
 
 
 def random_routes(count: int, first_seed: int):
