@@ -223,6 +223,34 @@ def test_a_vehicle_that_backs_off_a_micrometre_and_returns_is_written_and_checke
     assert verdict.passed, verdict.failures
 
 
+@pytest.mark.parametrize("goal", ["home", "a:3"])
+@pytest.mark.parametrize("back_off", ["1.4999999985", "1.499999998"], ids=["1.5nm", "2nm"])
+@pytest.mark.parametrize("dialect", [d.name.value for d in DIALECTS])
+def test_a_back_off_of_nanometres_is_written_and_passes_check_or_is_refused_unwritten(
+    dialect, back_off, goal, tmp_path
+):
+    """agv2 starts 1.5 or 2 nm inside the separation from J1: a turn of one or two units of the last decimal.
+
+    It backs off for agv1 and comes back, to stay (home) or to drive on to A the other way. The
+    generic CSV, written to the nanometre, must show the turn and pass; a dialect whose table
+    cannot hold it as interpolated is refused with nothing written, never written failing.
+    """
+    text = TINY_BACK_OFF.replace("b:1.499999", f"b:{back_off}")
+    if goal != "home":
+        text = text.replace(f'goal = "b:{back_off}"', f'goal = "{goal}"')
+    scenario_file = tmp_path / "tiny.toml"
+    scenario_file.write_text(text)
+    scenario = load_scenario(scenario_file)
+    out = tmp_path / "files"
+    code = main(["schedule", str(scenario_file), "--csv", str(out), "--dialect", dialect])
+    if code == 0:
+        verdict = check_profiles(scenario, out, dialect=dialect)
+        assert verdict.passed, verdict.failures
+    else:
+        assert dialect != "generic"
+        assert not out.exists() or not any(out.iterdir())
+
+
 def _creeping_files(tmp_path, scenario_text: str, creeper: str, *, creep: float, s_follows: bool):
     """Trajgen's generic CSVs of a scenario, ``creeper``'s file then creeping ``creep`` metres on.
 

@@ -317,14 +317,14 @@ class TableMotion(TimingMethod):
 
         The interpolation's tolerance, but less than half of the shortest stretch between its
         path's turns (a vehicle that backs off a micrometre turns twice in a micrometre), and more
-        than its values' round-off.
+        than its values' round-off (a turn of one unit of a nanometre file's last decimal counts).
         """
         tolerance = self._read_back()["end_tolerance"]
         out = []
         for table, path in zip(self.tables, paths, strict=True):
             runs = np.diff(np.concatenate([[0.0], path.cusps, [path.length]]))
             shortest = float(runs.min()) if path.cusps.size else math.inf
-            out.append(max(min(tolerance, 0.5 * shortest), 4.0 * table.round_off))
+            out.append(max(min(tolerance, 0.5 * shortest), table.round_off))
         return out[0], out[1]
 
     def schedule_graph(self, route: GraphRoute, limits: Limits) -> GraphSchedule:
@@ -420,9 +420,13 @@ def _velocity_steps(table: ProfileTable, vehicle: int, max_acceleration: float) 
 
 
 def _first_move(table: ProfileTable, vehicle: int) -> list[str]:
-    """The axis must grow in the direction of the first move (the convention of the files)."""
+    """The axis must grow in the direction of the first move (the convention of the files).
+
+    A step of one unit of a nanometre file's last decimal is a move (a back-off of a nanometre or
+    two before a long move the other way is the first move).
+    """
     steps = np.diff(table.positions())
-    moving = np.nonzero(np.abs(steps) > CROSSING_TOLERANCE)[0]
+    moving = np.nonzero(np.abs(steps) > min(CROSSING_TOLERANCE, table.round_off))[0]
     if moving.size and steps[moving[0]] < 0.0:
         k = int(moving[0])
         return [
