@@ -15,7 +15,7 @@ from dataclasses import dataclass
 
 from topology import JUNCTION_INDEX, Route
 
-__all__ = ["Interval", "VehiclePath", "interval_distance", "set_distance"]
+__all__ = ["Interval", "VehiclePath", "interval_distance", "set_distance", "travel_within_segment"]
 
 #: Moves of a vehicle shorter than this between two waypoints are ignored, metres.
 MOVE_RESOLUTION = 1e-9
@@ -44,6 +44,24 @@ def set_distance(first: tuple[Interval, ...], second: tuple[Interval, ...]) -> f
             if gap < best:
                 best = gap
     return best
+
+
+def travel_within_segment(
+    travel: tuple[float, float], span: tuple[float, float], s: float, near: float
+) -> float | None:
+    """The travel at ``s`` on a segment, if it lies there nearer ``near`` than both its ends; else None.
+
+    ``travel``: the segment's travel at its start and end; ``span``: its ``s`` there (metres, on
+    one leg or edge). Every other segment of a path lies beyond an end of this one in travel, so
+    such a place is the nearest the path passes ``s`` at.
+    """
+    s_from, s_to = span
+    if not min(s_from, s_to) <= s <= max(s_from, s_to):
+        return None
+    start, end = travel
+    p = start + (s - s_from if s_to > s_from else s_from - s)
+    distance = abs(p - near)
+    return p if distance < near - start and distance < end - near else None
 
 
 @dataclass(frozen=True, slots=True)
@@ -306,14 +324,8 @@ class VehiclePath:
         k = self.segment(near)
         if self.legs[k] != leg:
             return None
-        s_from, s_to = self.s_from[k], self.s_to[k]
-        if not min(s_from, s_to) <= s <= max(s_from, s_to):
-            return None
-        start = self.starts[k]
         end = self.starts[k + 1] if k + 1 < len(self.starts) else self.length
-        p = start + (s - s_from if s_to > s_from else s_from - s)
-        distance = abs(p - near)
-        return p if distance < near - start and distance < end - near else None
+        return travel_within_segment((self.starts[k], end), (self.s_from[k], self.s_to[k]), s, near)
 
     def sweep(self, p_low: float, p_high: float, leg_lengths: tuple[float, ...]) -> tuple[Interval, ...]:
         """The track covered while travel runs over ``[p_low, p_high]``, as stretches per leg.
