@@ -23,6 +23,7 @@ from dataclasses import dataclass
 from ruckig import ControlInterface, InputParameter, Result, Ruckig, Trajectory
 
 from limits import VehicleLimits
+from trajgen.model.graph_vehicle_path import GraphMetric, GraphVehiclePath
 from trajgen.model.paths import VehiclePath, set_distance
 
 __all__ = ["BrakingCheck", "PathState", "ServiceBraking", "emergency_position"]
@@ -94,20 +95,36 @@ class BrakingCheck:
     limits : tuple of 2 VehicleLimits
     emergency : tuple of 2 float
         Emergency deceleration of each vehicle, m/s².
-    leg_lengths : tuple of float, shape (k,)
-        The track's legs (3 to 8), metres.
+    track : tuple of float, shape (k,), or GraphMetric
+        A junction's legs (3 to 8), metres, whose paths are :class:`~trajgen.model.paths.VehiclePath`;
+        or a track graph's metric, whose paths are
+        :class:`~trajgen.model.graph_vehicle_path.GraphVehiclePath`.
     """
 
-    __slots__ = ("_braking", "_emergency", "_lengths", "_pad_acceleration")
+    __slots__ = ("_braking", "_emergency", "_lengths", "_metric", "_pad_acceleration")
 
     def __init__(
-        self, limits: tuple[VehicleLimits, VehicleLimits], emergency: tuple[float, float], leg_lengths
+        self,
+        limits: tuple[VehicleLimits, VehicleLimits],
+        emergency: tuple[float, float],
+        track: tuple[float, ...] | GraphMetric,
     ) -> None:
         self._braking = (ServiceBraking(limits[0]), ServiceBraking(limits[1]))
         self._emergency = emergency
-        self._lengths = tuple(leg_lengths)
+        self._metric = track if isinstance(track, GraphMetric) else None
+        self._lengths = None if self._metric is not None else tuple(track)
         self._pad_acceleration = tuple(
             max(lim.max_acceleration, e) for lim, e in zip(limits, emergency, strict=True)
+        )
+
+    def _sweep(self, path, low: float, high: float) -> tuple:
+        """The stretches of track ``path`` covers while its travel runs over ``[low, high]``."""
+        return path.sweep(low, high) if self._lengths is None else path.sweep(low, high, self._lengths)
+
+    def _apart(self, first: tuple, second: tuple) -> float:
+        """Track distance between two unions of stretches, metres."""
+        return (
+            set_distance(first, second) if self._metric is None else self._metric.set_distance(first, second)
         )
 
     def service(self, vehicle: int) -> ServiceBraking:
@@ -116,7 +133,7 @@ class BrakingCheck:
 
     def clearance(
         self,
-        paths: tuple[VehiclePath, VehiclePath],
+        paths: tuple[VehiclePath, VehiclePath] | tuple[GraphVehiclePath, GraphVehiclePath],
         commanded: tuple[PathState, PathState],
         measured: tuple[PathState, PathState],
         required: float,
@@ -127,7 +144,7 @@ class BrakingCheck:
 
         Parameters
         ----------
-        paths : tuple of 2 VehiclePath
+        paths : tuple of 2 VehiclePath, or of 2 GraphVehiclePath on a track graph
         commanded : tuple of 2 PathState
             The states about to be commanded (service braking starts there).
         measured : tuple of 2 PathState
@@ -189,7 +206,6 @@ class BrakingCheck:
         more evaluations only where they are close. Where the tubes meet at an instant, the conflict
         is real and the check ends there.
         """
-        lengths = self._lengths
         step = horizon / count
         previous = self._bounds(trajectories, durations, ends, measured, 0.0)
         for k in range(1, count + 1):
@@ -203,15 +219,15 @@ class BrakingCheck:
                     pad = pads[vehicle] * width * width / 8.0
                     low = min(first[vehicle][0], last[vehicle][0]) - pad
                     high = max(first[vehicle][1], last[vehicle][1]) + pad
-                    sets.append(paths[vehicle].sweep(low, high, lengths))
-                if set_distance(sets[0], sets[1]) >= required:
+                    sets.append(self._sweep(paths[vehicle], low, high))
+                if self._apart(sets[0], sets[1]) >= required:
                     continue
                 if not left:
                     return False
                 middle = 0.5 * (start + end)
                 between = self._bounds(trajectories, durations, ends, measured, middle)
-                at_middle = [paths[v].sweep(between[v][0], between[v][1], lengths) for v in (0, 1)]
-                if set_distance(at_middle[0], at_middle[1]) < required:
+                at_middle = [self._sweep(paths[v], between[v][0], between[v][1]) for v in (0, 1)]
+                if self._apart(at_middle[0], at_middle[1]) < required:
                     return False  # not the intervals' pessimism: the tubes meet at that instant
                 pending.append((middle, end, between, last, left - 1))
                 pending.append((start, middle, first, between, left - 1))

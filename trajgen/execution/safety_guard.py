@@ -13,13 +13,12 @@ reported. A correct frontier never lets that happen.
 
 from __future__ import annotations
 
-import math
-
 from limits import Limits
-from topology import StarGraph
+from topology import StarGraph, TrackGraph
 from topology.indexed import separation as indexed_separation
 from trajgen.execution.braking_check import BrakingCheck, PathState
 from trajgen.model.coordination import stopping_distance
+from trajgen.model.graph_vehicle_path import GraphMetric, GraphVehiclePath
 from trajgen.model.paths import VehiclePath
 
 __all__ = ["SEPARATION_TOLERANCE", "SafetyGuard"]
@@ -36,17 +35,26 @@ class SafetyGuard:
     ----------
     limits : Limits
         The vehicles' limits and the separation to keep, metres.
-    graph : StarGraph
-        The track.
+    graph : StarGraph or TrackGraph
+        The track: a junction (places are a leg and metres from the junction) or a track graph
+        (places are an edge and metres from its ``from`` node).
     """
 
-    __slots__ = ("_check", "_limits", "separation")
+    __slots__ = ("_check", "_limits", "_metric", "separation")
 
-    def __init__(self, limits: Limits, graph: StarGraph) -> None:
+    def __init__(self, limits: Limits, graph: StarGraph | TrackGraph) -> None:
         vehicles = limits.vehicles
-        self._check = BrakingCheck(vehicles, tuple(v.emergency_braking for v in vehicles), graph.lengths)
+        self._metric = GraphMetric(graph) if isinstance(graph, TrackGraph) else None
+        track = self._metric if self._metric is not None else graph.lengths
+        self._check = BrakingCheck(vehicles, tuple(v.emergency_braking for v in vehicles), track)
         self._limits = vehicles
         self.separation = limits.min_separation
+
+    def _distance(self, first: tuple[int, float], second: tuple[int, float]) -> float:
+        """Track distance between two places, metres."""
+        if self._metric is None:
+            return indexed_separation((first[0], first[1], second[0], second[1]))
+        return self._metric.distance(first[0], first[1], second[0], second[1])
 
     def required(self, measured) -> float:
         """The track distance to keep, metres: the separation, less if a fault already left them closer.
@@ -57,13 +65,14 @@ class SafetyGuard:
         Parameters
         ----------
         measured : tuple of 2 VehicleState
+            Their ``leg`` and ``s`` (on a track graph: the edge and metres on it).
         """
-        apart = indexed_separation((measured[0].leg, measured[0].s, measured[1].leg, measured[1].s))
+        apart = self._distance((measured[0].leg, measured[0].s), (measured[1].leg, measured[1].s))
         return min(self.separation - SEPARATION_TOLERANCE, apart - 1e-12)
 
     def certifies(
         self,
-        paths: tuple[VehiclePath, VehiclePath],
+        paths: tuple[VehiclePath, VehiclePath] | tuple[GraphVehiclePath, GraphVehiclePath],
         commanded: tuple[PathState, PathState],
         measured: tuple[PathState, PathState],
         required: float,
@@ -80,7 +89,6 @@ class SafetyGuard:
         distance each vehicle drives, and none drives farther than its service stop from its
         commanded state (it starts there, or at most as far from its measured one as the two differ).
         """
-        gap = math.inf
         travel = 0.0
         for v in (0, 1):
             command, measure = commanded[v], measured[v]
@@ -88,8 +96,7 @@ class SafetyGuard:
             travel += (
                 stop + abs(command.p - measure.p) + measure.v * measure.v / self._limits[v].emergency_braking
             )
-        first, second = paths[0].locate(commanded[0].p), paths[1].locate(commanded[1].p)
-        gap = indexed_separation((first[0], first[1], second[0], second[1]))
+        gap = self._distance(paths[0].locate(commanded[0].p), paths[1].locate(commanded[1].p))
         if gap - travel >= required:
             return True
         return self._check.clearance(paths, commanded, measured, required, refine=hold)
