@@ -19,7 +19,7 @@ from dataclasses import dataclass
 
 from topology import TrackGraph
 from trajgen.model.graph_paths import GraphPath
-from trajgen.model.paths import travel_within_segment
+from trajgen.model.paths import TravelAxis, travel_within_segment
 
 __all__ = ["GraphMetric", "GraphVehiclePath", "Stretch"]
 
@@ -93,8 +93,11 @@ class GraphMetric:
 
 
 @dataclass(frozen=True, slots=True)
-class GraphVehiclePath:
+class GraphVehiclePath(TravelAxis):
     """One vehicle's path on a track graph, parameterised by its travel ``p`` (metres), for execution.
+
+    Its segment, heading, axis, travel at an axis value and next stop are :class:`TravelAxis`'s,
+    as a junction's :class:`~trajgen.model.paths.VehiclePath`.
 
     Attributes
     ----------
@@ -170,11 +173,6 @@ class GraphVehiclePath:
             tuple(track.length(k) for k in range(track.edge_count)),
         )
 
-    def segment(self, p: float) -> int:
-        """Index of the segment holding travel ``p`` (clipped to the path)."""
-        k = bisect.bisect_right(self.starts, p) - 1
-        return 0 if k < 0 else k
-
     def _along(self, k: int, p: float) -> float:
         """Metres from segment ``k``'s edge's ``from`` node at travel ``p`` (clipped to the segment)."""
         end = self.starts[k + 1] if k + 1 < len(self.starts) else self.length
@@ -203,40 +201,6 @@ class GraphVehiclePath:
             return self.home
         k = self.segment(p)
         return self.edges[k], self._along(k, p)
-
-    def heading(self, p: float) -> int:
-        """``d axis / dp`` at travel ``p``."""
-        return self.headings[self.segment(p)] if self.edges else 1
-
-    def axis(self, p: float) -> float:
-        """The signed axis at travel ``p``, metres (beyond the ends: along the end segments)."""
-        if not self.edges:
-            return self.axis_starts[0]
-        k = self.segment(p)
-        return self.axis_starts[k] + self.headings[k] * (p - self.starts[k])
-
-    def travel_at_axis(self, axis: float, near: float, velocity: float) -> float:
-        """The travel at which the signed axis is ``axis``, moving at ``velocity`` (m/s) along it.
-
-        The axis runs back and forth through reversals: the first segment from ``near``'s that
-        holds ``axis`` and is driven in the direction of ``velocity`` is taken; the end segments
-        run on beyond the path's ends.
-        """
-        if not self.edges:
-            return 0.0
-        k = self.segment(near)
-        last = len(self.edges) - 1
-        while True:
-            p = self.starts[k] + self.headings[k] * (axis - self.axis_starts[k])
-            end = self.starts[k + 1] if k < last else math.inf
-            if k == last or (p <= end + 1e-9 and self.headings[k] * velocity >= 0.0):
-                return max(p, self.starts[k]) if k else p
-            k += 1
-
-    def next_stop(self, p: float, tolerance: float) -> float:
-        """The first reversal more than ``tolerance`` ahead of travel ``p``, or the path's end."""
-        k = bisect.bisect_right(self.stops, p + tolerance)
-        return self.stops[k] if k < len(self.stops) else self.length
 
     def project(self, edge: int, s: float, near: float, metric: GraphMetric, slack: float = 1e-9):
         """The travel at which the path passes ``(edge, s)``, nearest ``near``; ``None`` if it never does.

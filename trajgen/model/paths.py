@@ -15,7 +15,14 @@ from dataclasses import dataclass
 
 from topology import JUNCTION_INDEX, Route
 
-__all__ = ["Interval", "VehiclePath", "interval_distance", "set_distance", "travel_within_segment"]
+__all__ = [
+    "Interval",
+    "TravelAxis",
+    "VehiclePath",
+    "interval_distance",
+    "set_distance",
+    "travel_within_segment",
+]
 
 #: Moves of a vehicle shorter than this between two waypoints are ignored, metres.
 MOVE_RESOLUTION = 1e-9
@@ -64,8 +71,66 @@ def travel_within_segment(
     return p if distance < near - start and distance < end - near else None
 
 
+class TravelAxis:
+    """What a path in travel coordinates answers from its segments' travel, headings and axis alone.
+
+    Shared by :class:`VehiclePath` (a junction's legs) and
+    :class:`~trajgen.model.graph_vehicle_path.GraphVehiclePath` (a track graph's edges), which
+    hold ``starts``, ``headings``, ``axis_starts``, ``stops`` and ``length`` as described there.
+    Plain floats: these run every control cycle.
+    """
+
+    __slots__ = ()
+
+    starts: tuple[float, ...]
+    headings: tuple[int, ...]
+    axis_starts: tuple[float, ...]
+    stops: tuple[float, ...]
+    length: float
+
+    def segment(self, p: float) -> int:
+        """Index of the segment holding travel ``p`` (clipped to the path)."""
+        k = bisect.bisect_right(self.starts, p) - 1
+        return 0 if k < 0 else k
+
+    def heading(self, p: float) -> int:
+        """``d axis / dp`` at travel ``p``."""
+        return self.headings[self.segment(p)] if self.headings else 1
+
+    def axis(self, p: float) -> float:
+        """The vehicle's signed axis at travel ``p`` (beyond the ends: extended along the end segments)."""
+        if not self.headings:
+            return self.axis_starts[0] if self.axis_starts else 0.0
+        k = self.segment(p)
+        return self.axis_starts[k] + self.headings[k] * (p - self.starts[k])
+
+    def travel_at_axis(self, axis: float, near: float, velocity: float) -> float:
+        """The travel at which the vehicle's signed axis is ``axis``, moving at ``velocity`` along it.
+
+        The axis runs back and forth through reversals, so one value can be met more than once:
+        the first segment from ``near``'s that holds ``axis`` and is driven in the direction of
+        ``velocity`` (m/s, along the axis) is taken. The end segments run on beyond the path's ends.
+        """
+        if not self.headings:
+            return 0.0
+        k = self.segment(near)
+        last = len(self.headings) - 1
+        while True:
+            p = self.starts[k] + self.headings[k] * (axis - self.axis_starts[k])
+            end = self.starts[k + 1] if k < last else math.inf
+            forward = self.headings[k] * velocity >= 0.0
+            if k == last or (p <= end + 1e-9 and forward):
+                return max(p, self.starts[k]) if k else p
+            k += 1
+
+    def next_stop(self, p: float, tolerance: float) -> float:
+        """The first reversal ahead of travel ``p`` (more than ``tolerance`` ahead), or the path's end."""
+        k = bisect.bisect_right(self.stops, p + tolerance)
+        return self.stops[k] if k < len(self.stops) else self.length
+
+
 @dataclass(frozen=True, slots=True)
-class VehiclePath:
+class VehiclePath(TravelAxis):
     """One vehicle's path along a route, parameterised by travelled distance ``p`` (metres).
 
     The path is a sequence of segments, each on one leg and monotone in ``s``;
@@ -187,11 +252,6 @@ class VehiclePath:
             home,
         )
 
-    def segment(self, p: float) -> int:
-        """Index of the segment holding travel ``p`` (clipped to the path)."""
-        k = bisect.bisect_right(self.starts, p) - 1
-        return 0 if k < 0 else k
-
     def place(self, p: float) -> tuple[int, float, int, float, int]:
         """Everything about travel ``p`` at once: ``(leg, s, heading, axis, branch)``.
 
@@ -227,41 +287,6 @@ class VehiclePath:
             return 1
         k = self.segment(p)
         return 1 if self.s_to[k] > self.s_from[k] else -1
-
-    def heading(self, p: float) -> int:
-        """``d axis / dp`` at travel ``p``."""
-        return self.headings[self.segment(p)] if self.legs else 1
-
-    def axis(self, p: float) -> float:
-        """The vehicle's signed axis at travel ``p`` (beyond the ends: extended along the end segments)."""
-        if not self.legs:
-            return self.axis_starts[0] if self.axis_starts else 0.0
-        k = self.segment(p)
-        return self.axis_starts[k] + self.headings[k] * (p - self.starts[k])
-
-    def travel_at_axis(self, axis: float, near: float, velocity: float) -> float:
-        """The travel at which the vehicle's signed axis is ``axis``, moving at ``velocity`` along it.
-
-        The axis runs back and forth through reversals, so one value can be met more than once:
-        the first segment from ``near``'s that holds ``axis`` and is driven in the direction of
-        ``velocity`` (m/s, along the axis) is taken. The end segments run on beyond the path's ends.
-        """
-        if not self.legs:
-            return 0.0
-        k = self.segment(near)
-        last = len(self.legs) - 1
-        while True:
-            p = self.starts[k] + self.headings[k] * (axis - self.axis_starts[k])
-            end = self.starts[k + 1] if k < last else math.inf
-            forward = self.headings[k] * velocity >= 0.0
-            if k == last or (p <= end + 1e-9 and forward):
-                return max(p, self.starts[k]) if k else p
-            k += 1
-
-    def next_stop(self, p: float, tolerance: float) -> float:
-        """The first reversal ahead of travel ``p`` (more than ``tolerance`` ahead), or the path's end."""
-        k = bisect.bisect_right(self.stops, p + tolerance)
-        return self.stops[k] if k < len(self.stops) else self.length
 
     def project(self, leg: int, s: float, near: float, slack: float = 1e-9) -> float | None:
         """The travel at which the path passes ``(leg, s)``, nearest ``near``; ``None`` if it never does.
