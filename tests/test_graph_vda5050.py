@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import functools
 import json
 import math
@@ -302,3 +303,12 @@ def test_nodes_less_than_a_micrometre_apart_keep_distinct_ids(tmp_path):
     for message in messages:
         for edge in json.loads(message.data)["edges"]:
             assert edge["startNodeId"] != edge["endNodeId"], edge
+    # a chain of places 0.8 nm apart spans 1.6 nm: its ends are distinct places with distinct ids
+    chain = (1.5000000002, 1.5000000010, 1.5000000018)
+    path = releases.paths[1]
+    nodes = tuple(
+        dataclasses.replace(path.nodes[0], point=dataclasses.replace(path.nodes[0].point, s=s)) for s in chain
+    )
+    chained = dataclasses.replace(path, nodes=nodes, edges=path.edges[:2])
+    ids = [chained.node_id(k) for k in range(3)]
+    assert ids[0] != ids[2], ids

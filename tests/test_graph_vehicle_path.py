@@ -60,19 +60,44 @@ def test_a_place_projects_back_to_its_travel_and_an_axis_value_to_its_travel(nam
 
 
 def test_a_position_off_the_path_does_not_project_and_one_past_its_end_runs_on():
-    _, track, route = CASES[0]
-    metric = GraphMetric(track)
-    path = graph_paths(route)[0]
-    fast = GraphVehiclePath.from_path(path, track)
-    used = set(fast.edges)
-    other = next(k for k in range(track.edge_count) if k not in used)
-    assert fast.project(other, 0.5 * track.length(other), 0.0, metric) is None
-    # past the goal along the last segment's edge: travel beyond the length
-    k = len(fast.edges) - 1
-    ahead = 1.0 if fast.s_to[k] > fast.s_from[k] else -1.0
-    end = fast.s_to[k] + ahead * 0.25
-    if 0.0 <= end <= track.length(fast.edges[k]):
-        assert fast.project(fast.edges[k], end, fast.length, metric) == pytest.approx(fast.length + 0.25)
+    """Off the path: None. Past the goal along the last edge: travel beyond the length.
+
+    The same for the edge's end node given on another of its edges (the same node).
+    """
+    ran_on, nodes_elsewhere = 0, 0
+    for _, track, route in CASES:
+        metric = GraphMetric(track)
+        fast = GraphVehiclePath.from_path(graph_paths(route)[0], track)
+        if not fast.edges:
+            continue
+        used = set(fast.edges) | set(graph_paths(route)[1].edges.tolist())
+        for other in (k for k in range(track.edge_count) if k not in used):
+            midway = 0.5 * track.length(other)
+            if metric.distance(other, midway, *fast.locate(0.0)) > midway + 1e-6:  # not a neighbour
+                assert fast.project(other, midway, 0.0, metric) is None
+        k = len(fast.edges) - 1
+        edge, ahead = fast.edges[k], (1.0 if fast.s_to[k] > fast.s_from[k] else -1.0)
+        top = track.length(edge)
+        room = top - fast.s_to[k] if ahead > 0 else fast.s_to[k]
+        if room > 0.25:
+            ran_on += 1
+            end = fast.s_to[k] + ahead * 0.25
+            assert fast.project(edge, end, fast.length, metric) == pytest.approx(fast.length + 0.25)
+        node = track.ends(edge)[1 if ahead > 0 else 0]
+        at_node = fast.length + room
+        assert fast.project(edge, top if ahead > 0 else 0.0, at_node, metric) == pytest.approx(at_node)
+        for neighbour in range(track.edge_count):
+            u, v = track.ends(neighbour)
+            if neighbour == edge or node not in (u, v) or neighbour in fast.edges:
+                continue
+            nodes_elsewhere += 1
+            given = 0.0 if u == node else track.length(neighbour)
+            assert fast.project(neighbour, given, at_node, metric) == pytest.approx(at_node), (
+                edge,
+                neighbour,
+            )
+    assert ran_on >= 3, ran_on
+    assert nodes_elsewhere >= 3, nodes_elsewhere
 
 
 def test_the_metric_agrees_with_the_tracks_vectorised_distances():
@@ -154,14 +179,36 @@ def test_an_axis_given_the_other_way_round_flips_every_heading():
         assert against.axis(float(q)) == pytest.approx(2.0 - along.axis(float(q)))
 
 
-def test_a_vehicle_that_stays_put_sweeps_and_is_at_its_home_only():
+def test_a_vehicle_that_stays_put_sweeps_its_home_and_any_travel_off_it_is_overrun():
+    """Its path does not say which way it would go: travel off 0 is all overrun, in any direction."""
+    still = 0
     for _, track, route in CASES:
         for path in graph_paths(route):
             if path.edges.size:
                 continue
+            still += 1
             fast = GraphVehiclePath.from_path(path, track)
-            assert fast.sweep(-1.0, 1.0) == ((path.home.edge, path.home.s, path.home.s),)
+            assert fast.sweep(-1.0, 0.5) == ((path.home.edge, path.home.s, path.home.s),)
+            assert fast.overrun(-1.0, 0.5) == 1.0
+            assert fast.overrun(0.0, 0.0) == 0.0
             assert all(fast.locate(q) == fast.home for q in (-1.0, 0.0, 1.0))
+    assert still >= 1
+
+
+def test_the_overrun_is_what_runs_past_the_end_segments_edge_ends_only():
+    """Within the end segments' edges the sweep holds the run-on: no overrun; past them, the rest."""
+    for _, track, route in CASES:
+        fast = GraphVehiclePath.from_path(graph_paths(route)[0], track)
+        if not fast.edges:
+            continue
+        assert fast.overrun(0.0, fast.length) == 0.0
+        k = len(fast.edges) - 1
+        room = track.length(fast.edges[k]) - fast.s_to[k] if fast.s_to[k] > fast.s_from[k] else fast.s_to[k]
+        assert fast.overrun(0.0, fast.length + room) == pytest.approx(0.0, abs=1e-12)
+        assert fast.overrun(0.0, fast.length + room + 0.3) == pytest.approx(0.3)
+        top = track.length(fast.edges[0])
+        back = fast.s_from[0] if fast.s_to[0] > fast.s_from[0] else top - fast.s_from[0]
+        assert fast.overrun(-back - 0.2, fast.length) == pytest.approx(0.2)
 
 
 @pytest.mark.parametrize(("name", "track", "route"), CASES, ids=[c[0] for c in CASES])

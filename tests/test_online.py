@@ -304,6 +304,35 @@ def test_what_the_check_certifies_holds_under_every_braking_of_both(
             assert track_distance(paths, one, two).min() >= required - 2e-3
 
 
+def test_a_stop_that_runs_past_a_goal_at_the_junction_is_not_certified(tmp_path):
+    """A vehicle 1 cm before its goal at the junction at 0.5 m/s runs past it: not certified.
+
+    agv1's goal is the junction O, agv2's C:1.5, exactly the separation away; agv1's emergency stop
+    runs 11.5 cm past O onto one of the legs (1.385 m from agv2 if it is C). The sweep stops at O
+    (the end of agv1's leg A); the 11.5 cm past it are its overrun, taken off the distance, so the
+    check refuses; arriving at rest, the same plan is certified.
+    """
+    text = (REPO / "examples" / "swap.toml").read_text()
+    text = text.replace('goal = "B:10.0"', 'goal = "O"').replace(
+        'start = "B:10.0"\ngoal = "A:10.0"', 'start = "B:10.0"\ngoal = "C:1.5"'
+    )
+    scenario_file = tmp_path / "goal_at_the_junction.toml"
+    scenario_file.write_text(text)
+    scenario = load_scenario(scenario_file)
+    paths = tuple(VehiclePath.from_route(scenario.route(), v) for v in (0, 1))
+    assert paths[0].locate(paths[0].length) == (JUNCTION_INDEX, 0.0)
+    assert paths[1].locate(paths[1].length) == (2, 1.5)
+    lengths = scenario.track.lengths
+    assert paths[0].overrun(paths[0].length, paths[0].length + 0.115, lengths) == pytest.approx(0.115)
+    # 0.115 m past O on leg C, by the planner's own track distance
+    assert indexed_separation((2, 0.115, 2, 1.5)) == pytest.approx(1.385)
+    check = BrakingCheck((AGV, AGV), (1.0, 1.0), lengths)
+    ends = (PathState(paths[0].length, 0.0, 0.0), PathState(paths[1].length, 0.0, 0.0))
+    running_on = (PathState(paths[0].length - 0.01, 0.5, 0.0), ends[1])
+    assert not check.clearance(paths, ends, running_on, 1.5 - 1e-6)
+    assert check.clearance(paths, ends, ends, 1.5 - 1e-6)
+
+
 # -- the executor: undisturbed, every method plays its plan -------------------------------------
 
 STOP_BOUND_SLACK = 1.0  # seconds: the "+ 1 s" of the bound D + 3 max(v/a + a/j) + 1 s

@@ -117,15 +117,25 @@ class BrakingCheck:
             max(lim.max_acceleration, e) for lim, e in zip(limits, emergency, strict=True)
         )
 
-    def _sweep(self, path, low: float, high: float) -> tuple:
-        """The stretches of track ``path`` covers while its travel runs over ``[low, high]``."""
-        return path.sweep(low, high) if self._lengths is None else path.sweep(low, high, self._lengths)
+    def _sweep(self, path, low: float, high: float) -> tuple[tuple, float]:
+        """The track ``path`` covers while its travel runs over ``[low, high]``, and its overrun.
 
-    def _apart(self, first: tuple, second: tuple) -> float:
-        """Track distance between two unions of stretches, metres."""
-        return (
-            set_distance(first, second) if self._metric is None else self._metric.set_distance(first, second)
+        The overrun: metres the vehicle may be beyond those stretches (past a clipped end of its
+        path's end segments).
+        """
+        if self._lengths is None:
+            return path.sweep(low, high), path.overrun(low, high)
+        return path.sweep(low, high, self._lengths), path.overrun(low, high, self._lengths)
+
+    def _apart(self, first: tuple[tuple, float], second: tuple[tuple, float]) -> float:
+        """A sound track distance between two swept sets and their overruns, metres."""
+        (stretches_a, overrun_a), (stretches_b, overrun_b) = first, second
+        gap = (
+            set_distance(stretches_a, stretches_b)
+            if self._metric is None
+            else self._metric.set_distance(stretches_a, stretches_b)
         )
+        return gap - overrun_a - overrun_b
 
     def service(self, vehicle: int) -> ServiceBraking:
         """The service braking of ``vehicle`` (0 or 1)."""

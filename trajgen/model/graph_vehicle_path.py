@@ -234,7 +234,13 @@ class GraphVehiclePath(TravelAxis):
                 off = abs(clamped - s)
                 p = self.starts[k] + (clamped - s_from) * sign
             else:  # the segment's ends, one of which may be the same node as the point
-                candidates = ((self.starts[k], s_from), (end, s_to))
+                candidates = [(self.starts[k], s_from), (end, s_to)]
+                top = self.edge_lengths[seg_edge]
+                # the end segments run on to their edge's end node, which may be the point
+                if k == 0:
+                    candidates.append((-s_from, 0.0) if sign > 0 else (-(top - s_from), top))
+                if k == last:
+                    candidates.append((end + top - s_to, top) if sign > 0 else (end + s_to, 0.0))
                 off, p = min((metric.distance(edge, s, seg_edge, at), q) for q, at in candidates)
             if off > slack:
                 continue
@@ -251,11 +257,22 @@ class GraphVehiclePath(TravelAxis):
         end = self.starts[k + 1] if k + 1 < len(self.starts) else self.length
         return travel_within_segment((self.starts[k], end), (self.s_from[k], self.s_to[k]), s, near)
 
+    def overrun(self, p_low: float, p_high: float) -> float:
+        """Metres travel over ``[p_low, p_high]`` may run beyond :meth:`sweep` (:meth:`run_on_overrun`).
+
+        Past a track node where :meth:`sweep` stops at its edge's end, the vehicle is on another
+        edge of the node; a track distance to the sweep less this overrun is sound.
+        """
+        if not self.edges:
+            return self.run_on_overrun(p_low, p_high, (0.0, 0.0))
+        lengths = self.edge_lengths
+        return self.run_on_overrun(p_low, p_high, (lengths[self.edges[0]], lengths[self.edges[-1]]))
+
     def sweep(self, p_low: float, p_high: float) -> tuple[Stretch, ...]:
         """The track covered while travel runs over ``[p_low, p_high]``, as stretches per edge.
 
-        Travel before 0 or past :attr:`length` runs on along the first or last segment's edge
-        (clipped to the edge), so a vehicle off the ends of its path is still accounted for.
+        Travel before 0 or past :attr:`length` runs on along the first or last segment's edge,
+        clipped to the edge: what runs beyond the edge's end is :meth:`overrun`.
         """
         if not self.edges:
             edge, s = self.home

@@ -82,11 +82,35 @@ class TravelAxis:
 
     __slots__ = ()
 
+    s_from: tuple[float, ...]
+    s_to: tuple[float, ...]
     starts: tuple[float, ...]
     headings: tuple[int, ...]
     axis_starts: tuple[float, ...]
     stops: tuple[float, ...]
     length: float
+
+    def run_on_overrun(self, p_low: float, p_high: float, tops: tuple[float, float]) -> float:
+        """How far travel over ``[p_low, p_high]`` may take the vehicle beyond what its sweep holds, metres.
+
+        Before 0 or past :attr:`length` the sweep runs on along the end segment's leg or edge and
+        is clipped at its ends (``0`` and ``tops``: the first and last segment's leg or edge
+        length). Beyond a clipped end the vehicle is on some other leg or edge of that node: within
+        the clipped metres of it, so a track distance to the sweep, less this overrun, is a sound
+        distance to the vehicle (the track distance is 1-Lipschitz). A path that does not move
+        sweeps its home point only: any travel away from 0 is overrun.
+        """
+        if not self.headings:
+            return max(abs(p_low), abs(p_high))
+        overrun = 0.0
+        if p_low < 0.0:
+            s = self.s_from[0] + (p_low if self.s_to[0] > self.s_from[0] else -p_low)
+            overrun = max(-s, s - tops[0], 0.0)
+        if p_high > self.length:
+            beyond = p_high - self.length
+            s = self.s_to[-1] + (beyond if self.s_to[-1] > self.s_from[-1] else -beyond)
+            overrun = max(overrun, -s, s - tops[1])
+        return overrun
 
     def segment(self, p: float) -> int:
         """Index of the segment holding travel ``p`` (clipped to the path)."""
@@ -351,6 +375,12 @@ class VehiclePath(TravelAxis):
             return None
         end = self.starts[k + 1] if k + 1 < len(self.starts) else self.length
         return travel_within_segment((self.starts[k], end), (self.s_from[k], self.s_to[k]), s, near)
+
+    def overrun(self, p_low: float, p_high: float, leg_lengths: tuple[float, ...]) -> float:
+        """Metres travel over ``[p_low, p_high]`` may run beyond :meth:`sweep` (:meth:`run_on_overrun`)."""
+        if not self.legs:
+            return self.run_on_overrun(p_low, p_high, (0.0, 0.0))
+        return self.run_on_overrun(p_low, p_high, (leg_lengths[self.legs[0]], leg_lengths[self.legs[-1]]))
 
     def sweep(self, p_low: float, p_high: float, leg_lengths: tuple[float, ...]) -> tuple[Interval, ...]:
         """The track covered while travel runs over ``[p_low, p_high]``, as stretches per leg.

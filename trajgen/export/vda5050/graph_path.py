@@ -173,11 +173,15 @@ class GraphOrderPath:
 
     def _decimals(self, edge: int) -> int:
         """Decimal places of the metres in the ids of the path's nodes on ``edge``: 6, or 9 if needed."""
-        places = sorted(node.point.s for node in self.nodes if node.point.edge == edge)
-        for low, high in itertools.pairwise(places):
-            if high - low > MOVE_RESOLUTION and f"{low:.6f}" == f"{high:.6f}":
-                return 9
-        return 6
+        # every pair sharing a micrometre, not only neighbours: a chain of places under
+        # MOVE_RESOLUTION apart can span more than it
+        spans: dict[str, tuple[float, float]] = {}
+        for node in self.nodes:
+            if node.point.edge == edge:
+                s = node.point.s
+                low, high = spans.get(f"{s:.6f}", (s, s))
+                spans[f"{s:.6f}"] = (min(low, s), max(high, s))
+        return 9 if any(high - low > MOVE_RESOLUTION for low, high in spans.values()) else 6
 
 
 def _marks(
