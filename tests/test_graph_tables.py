@@ -59,6 +59,21 @@ def test_a_wiggle_within_the_tolerance_is_no_turn_and_one_beyond_it_is():
     assert turning_points(motion, 1e-8)[0].tolist() == [1.0]
 
 
+def test_near_where_the_path_turns_a_fine_back_off_is_a_turn_and_elsewhere_it_is_no_turn():
+    """A 5 nm return at 1 m: a turn where the path turns there (fine 1 nm), none elsewhere (1 µm).
+
+    An interpolation's overshoot at a stop between two rows is such a return, where the path
+    stops but does not turn; a path's own back-off of nanometres is one where it turns.
+    """
+    motion = PiecewiseCubic(
+        np.array([0.0, 1.0, 2.0]), np.array([[0.0, 1.0, 0.0], [1.0, -5e-9, 0.0]]), np.zeros(2)
+    )
+    assert turning_points(motion, 1e-6, expected=np.array([1.0]), fine=1e-9)[0].tolist() == [1.0]
+    assert turning_points(motion, 1e-6, expected=np.array([1.0 + 2e-6]), fine=1e-9)[0].size == 0
+    assert turning_points(motion, 1e-6, expected=np.empty(0), fine=1e-9)[0].size == 0
+    assert turning_points(motion, 1e-6)[0].size == 0
+
+
 @pytest.mark.parametrize("method", ["exact", "toppra"])
 @pytest.mark.parametrize("name", FEASIBLE)
 def test_every_table_dialect_on_every_example_graph_is_verified_as_its_controller_interpolates(name, method):
@@ -224,16 +239,19 @@ def test_a_vehicle_that_backs_off_a_micrometre_and_returns_is_written_and_checke
 
 
 @pytest.mark.parametrize("goal", ["home", "a:3"])
-@pytest.mark.parametrize("back_off", ["1.4999999985", "1.499999998"], ids=["1.5nm", "2nm"])
+@pytest.mark.parametrize(
+    "back_off", ["1.4999999985", "1.499999998", "1.4999999975"], ids=["1.5nm", "2nm", "2.5nm"]
+)
 @pytest.mark.parametrize("dialect", [d.name.value for d in DIALECTS])
 def test_a_back_off_of_nanometres_is_written_and_passes_check_or_is_refused_unwritten(
     dialect, back_off, goal, tmp_path
 ):
-    """agv2 starts 1.5 or 2 nm inside the separation from J1: a turn of one or two units of the last decimal.
+    """agv2 starts 1.5 to 2.5 nm inside the separation from J1: a turn of a few units of the last decimal.
 
     It backs off for agv1 and comes back, to stay (home) or to drive on to A the other way. The
-    generic CSV, written to the nanometre, must show the turn and pass; a dialect whose table
-    cannot hold it as interpolated is refused with nothing written, never written failing.
+    generic CSV, written to the nanometre, must show the turn and pass (at 2.5 nm its interpolated
+    overshoot at agv2's later stop is no turn); a dialect whose table cannot hold it as
+    interpolated is refused with nothing written, never written failing.
     """
     text = TINY_BACK_OFF.replace("b:1.499999", f"b:{back_off}")
     if goal != "home":

@@ -170,13 +170,30 @@ def _monotone_times(motion: PiecewiseCubic) -> np.ndarray:
     return sorted_unique(np.concatenate(candidates))
 
 
-def turning_points(motion: PiecewiseCubic, tolerance: float) -> tuple[np.ndarray, np.ndarray]:
+def turning_points(
+    motion: PiecewiseCubic, tolerance: float, *, expected: np.ndarray | None = None, fine: float | None = None
+) -> tuple[np.ndarray, np.ndarray]:
     """Times (s) and axis values (m) where ``motion`` turns back, once it has gone back ``tolerance``.
 
     The first move is the axis's positive direction (the convention of the files). A turn is
     where the axis is furthest before it comes back by more than ``tolerance`` metres, so a
     wiggle at rest no larger than the table's round-off is no turn.
+
+    Parameters
+    ----------
+    motion : PiecewiseCubic
+    tolerance : float
+        How far back the axis must come to turn, metres.
+    expected : ndarray, shape (r,), optional
+        The axis values where the path turns, in order. Within ``tolerance`` of the next of them
+        a turn counts once the axis has come back ``fine`` metres (a path may back off by less
+        than ``tolerance``); elsewhere an interpolation's overshoot at a stop between two rows,
+        within ``tolerance``, is no turn.
+    fine : float, optional
+        The tolerance near the expected turns, metres (``tolerance`` if not given).
     """
+    expected = np.empty(0) if expected is None else np.asarray(expected, dtype=float)
+    fine = tolerance if fine is None else fine
     times = _monotone_times(motion)
     axis = motion.evaluate(times)[0]
     direction, furthest, where = 1.0, float(axis[0]), 0
@@ -185,7 +202,9 @@ def turning_points(motion: PiecewiseCubic, tolerance: float) -> tuple[np.ndarray
         x = float(axis[k])
         if (x - furthest) * direction > 0.0:
             furthest, where = x, k
-        elif (furthest - x) * direction > tolerance:
+            continue
+        near = len(turns) < expected.size and abs(furthest - expected[len(turns)]) <= tolerance
+        if (furthest - x) * direction > (fine if near else tolerance):
             turns.append(where)
             direction, furthest, where = -direction, x, k
     index = np.array(turns, dtype=int)
@@ -193,7 +212,7 @@ def turning_points(motion: PiecewiseCubic, tolerance: float) -> tuple[np.ndarray
 
 
 def graph_travel(
-    motion: PiecewiseCubic, tolerance: float, path: GraphPath | None = None
+    motion: PiecewiseCubic, tolerance: float, path: GraphPath | None = None, *, fine: float | None = None
 ) -> tuple[PiecewiseCubic, np.ndarray]:
     """The metres a vehicle has driven (its travel) under an axis ``motion``, and the travel at each turn.
 
@@ -210,11 +229,12 @@ def graph_travel(
     ndarray, shape (r,)
         The travel at each turn, metres, as the table's own axis gives it.
     """
-    turn_times, turn_axis = turning_points(motion, tolerance)
+    start = float(motion.initial[0, 0]) if motion.jerk.size else 0.0
+    expected = None if path is None else start + path.axis(path.cusps)
+    turn_times, turn_axis = turning_points(motion, tolerance, expected=expected, fine=fine)
     whole = _slice(motion, 0.0, motion.duration, turn_times)
     run = np.searchsorted(turn_times, whole.times[:-1], side="right")
     signs = np.where(np.arange(turn_times.size + 1) % 2 == 0, 1.0, -1.0)
-    start = float(whole.initial[0, 0]) if whole.jerk.size else 0.0
     anchors = np.concatenate([[start], turn_axis])
     travel_at = np.concatenate([[0.0], np.cumsum(signs[:-1] * np.diff(anchors))])
     turns = travel_at[1:].copy()
@@ -312,20 +332,23 @@ class TableMotion(TimingMethod):
             "checked_limits": min(table.interpolation.closed_form for table in self.tables),
         }
 
-    def turn_tolerances(self, paths: tuple[GraphPath, GraphPath]) -> tuple[float, float]:
-        """How far back each table must come to count as turning, metres.
+    def turn_tolerances(self, paths: tuple[GraphPath, GraphPath]) -> tuple[tuple[float, float], ...]:
+        """How far back each table must come to count as turning, metres: ``(tolerance, fine)``.
 
-        The interpolation's tolerance, but less than half of the shortest stretch between its
-        path's turns (a vehicle that backs off a micrometre turns twice in a micrometre), and more
-        than its values' round-off (a turn of one unit of a nanometre file's last decimal counts).
+        ``tolerance``: the interpolation's, and more than the values' round-off; a wiggle within
+        it (an interpolation's overshoot at a stop between two rows) is no turn. ``fine``, near
+        where the path turns: less than half of the shortest stretch between its path's turns (a
+        vehicle that backs off a micrometre turns twice in a micrometre), and more than the
+        round-off (a turn of one unit of a nanometre file's last decimal counts).
         """
         tolerance = self._read_back()["end_tolerance"]
         out = []
         for table, path in zip(self.tables, paths, strict=True):
             runs = np.diff(np.concatenate([[0.0], path.cusps, [path.length]]))
             shortest = float(runs.min()) if path.cusps.size else math.inf
-            out.append(max(min(tolerance, 0.5 * shortest), table.round_off))
-        return out[0], out[1]
+            fine = max(min(tolerance, 0.5 * shortest), table.round_off)
+            out.append((max(tolerance, table.round_off), fine))
+        return tuple(out)
 
     def schedule_graph(self, route: GraphRoute, limits: Limits) -> GraphSchedule:
         """The tables' motion along a route on a track graph: each vehicle's travel along its path.
@@ -336,7 +359,10 @@ class TableMotion(TimingMethod):
         given = self.motions or tuple(table.motion() for table in self.tables)
         paths = graph_paths(route)
         tolerances = self.turn_tolerances(paths)
-        travels = [graph_travel(motion, tolerances[v], paths[v])[0] for v, motion in enumerate(given)]
+        travels = [
+            graph_travel(motion, tolerances[v][0], paths[v], fine=tolerances[v][1])[0]
+            for v, motion in enumerate(given)
+        ]
         end = max(travel.duration for travel in travels)
         kinematics = CubicKinematics(tuple(_slice(travel, 0.0, end) for travel in travels))
         return GraphSchedule(
@@ -460,7 +486,8 @@ def _check_graph_tables(
     tolerance = max(schedule.end_tolerance, 1e-6)
     turn_tolerances = method.turn_tolerances(schedule.paths)
     for vehicle, motion in enumerate(motions):
-        turns = graph_travel(motion, turn_tolerances[vehicle])[1]
+        coarse, fine = turn_tolerances[vehicle]
+        turns = graph_travel(motion, coarse, schedule.paths[vehicle], fine=fine)[1]
         failures += _turn_failures(turns, schedule.paths[vehicle], vehicle, tolerance)
     report = verify(schedule)
     failures += list(report.failures)
