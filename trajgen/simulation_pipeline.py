@@ -26,7 +26,7 @@ from trajgen.methods import METHODS
 from trajgen.model.schedule import TimingMethod
 from trajgen.model.summary import format_provenance
 from trajgen.plots import plot_simulation, png_bytes
-from trajgen.scenario import Scenario
+from trajgen.scenario import GraphScenario, Scenario
 
 __all__ = ["SIMULATION_PLOT_NAME", "SimulationRun", "format_simulation", "run_simulation", "simulation_paths"]
 
@@ -108,7 +108,7 @@ class SimulationRun:
 
 
 def run_simulation(
-    scenario: Scenario,
+    scenario: Scenario | GraphScenario,
     specs: Sequence[str] = (),
     *,
     period: float = 0.01,
@@ -122,7 +122,7 @@ def run_simulation(
 
     Parameters
     ----------
-    scenario : Scenario
+    scenario : Scenario or GraphScenario
     specs : sequence of str
         ``--fault`` specs (:mod:`trajgen.execution.faults`), e.g. ``stop:agv1@8+3``.
     period : float, optional
@@ -151,8 +151,10 @@ def run_simulation(
         A bad fault spec (:class:`~trajgen.execution.faults.FaultError`), period, margin, method,
         CSV options or output path; raised before anything is computed, nothing written.
     """
-    if not isinstance(scenario, Scenario):
-        raise InputError(f"run_simulation expects a Scenario, got {type(scenario).__name__}")
+    if not isinstance(scenario, (Scenario, GraphScenario)):
+        raise InputError(
+            f"run_simulation expects a Scenario or a GraphScenario, got {type(scenario).__name__}"
+        )
     if isinstance(specs, str):
         raise InputError(f"fault specs must be a sequence of str, got the string {short_repr(specs)}")
     period, position_margin = _check_settings(period, position_margin)

@@ -16,7 +16,7 @@ def _command_simulate(args: argparse.Namespace) -> int:
     from trajgen.export.csv import CsvOptions
     from trajgen.simulation_pipeline import format_simulation, run_simulation  # the executor and its Ruckig
 
-    scenario = scenario_from(args.scenario)
+    scenario = scenario_from(args.scenario, graph=True)
     run = run_simulation(
         scenario,
         args.fault,
@@ -61,7 +61,8 @@ def register(commands) -> None:
         "  lag:NAME@T=MS    from T s NAME follows its setpoints MS ms late (at most 200)\n"
         "  jump:NAME@T=DS   at T s NAME's measured position is corrected by DS m\n"
         "                   (|DS| at most --position-margin)\n"
-        "  goal:NAME@T=LEG:S  at T s a new goal LEG:S (metres from the junction) is requested",
+        "  goal:NAME@T=LEG:S  at T s a new goal LEG:S (metres from the junction) is requested;\n"
+        "                   on a track graph EDGE:S (metres from the edge's from node) or a node",
     )
     simulate.add_argument(
         "--period", type=float, default=0.01, help="control period, seconds (0.002 to 0.1; 0.01)"

@@ -31,10 +31,9 @@ import logging
 import math
 
 from limits import Limits
-from topology import JUNCTION_INDEX, Configuration, Position, Route
+from topology import Configuration
 from trajgen.errors import InputError, ScheduleError, TrajgenError
 from trajgen.execution.braking_check import PathState
-from trajgen.execution.goals import goal_refusal, schedule_from_rest
 from trajgen.execution.messages import (
     PERIOD_RANGE,
     Command,
@@ -46,19 +45,13 @@ from trajgen.execution.messages import (
     checked_names,
     checked_number,
     checked_period,
-    checked_state,
 )
-from trajgen.execution.motion import AT_REST, PlanPlayer, VehicleMotion
+from trajgen.execution.motion import AT_REST, VehicleMotion
 from trajgen.execution.safety_guard import SafetyGuard
-from trajgen.model.coordination import (
-    CoordinationDiagram,
-    earliest_rest,
-    schedule_times,
-    schedule_waypoints,
-    stopping_distance,
-)
+from trajgen.execution.tracks import execution_track
+from trajgen.model.coordination import CoordinationDiagram, earliest_rest, stopping_distance
+from trajgen.model.graph_vehicle_path import GraphVehiclePath
 from trajgen.model.paths import VehiclePath
-from trajgen.model.summary import class_name
 from trajgen.verification import VerifiedSchedule, require_verified
 from trajgen.verification.braking_rule import BRAKING_RULE_TOLERANCE
 
@@ -125,7 +118,9 @@ class Executor:
                 "min_separation must be between 0 m and the schedule's "
                 f"{schedule.limits.min_separation!r} m, got {min_separation!r}"
             )
-        self.graph = schedule.route.graph
+        self._track = execution_track(schedule)
+        #: The track: a junction's StarGraph, or a TrackGraph.
+        self.graph = self._track.graph
         self.limits: Limits = Limits(schedule.limits.vehicles, float(min_separation))
         self.period = period
         self._guard = SafetyGuard(self.limits, self.graph)
@@ -152,29 +147,18 @@ class Executor:
         """
         schedule = verified.schedule
         self.schedule = schedule
-        self._route: Route = schedule.route
-        self._goal: Configuration = schedule.route.goal
-        self._plan = PlanPlayer(verified)
-        times = schedule_times(schedule)
-        waypoints = schedule_waypoints(schedule, times)
-        paths = []
+        self._route = schedule.route
+        self._goal = schedule.route.goal
+        loaded = self._track.load(verified, axis_start=axis_start, orientation=orientation)
+        self._plan = loaded.player
         self._plan_axis0 = [self._plan.state(v, 0.0)[0] for v in (0, 1)]
-        for v in (0, 1):
-            start = self._plan_axis0[v] if axis_start is None else axis_start[v]
-            sign = None
-            if orientation[v] is not None:
-                leg, sign = orientation[v]
-                first = VehiclePath.from_waypoints(waypoints, v)
-                if first.legs and first.legs[0] != leg:  # it leaves the junction on another leg: ds flips
-                    sign = -sign
-            paths.append(VehiclePath.from_waypoints(waypoints, v, axis_start=start, orientation=sign))
-        self._paths = (paths[0], paths[1])
+        self._paths = loaded.paths
         # the plan's axis grows in each vehicle's first move (+1 heading at the start); the paths keep the
         # vehicles' own axes, which may run the other way after a re-plan
-        self._axis_sign = [p.headings[0] if p.legs else 1 for p in self._paths]
+        self._axis_sign = [p.headings[0] if p.headings else 1 for p in self._paths]
         self._axis_base = [p.axis(0.0) for p in self._paths]
         self._diagram = CoordinationDiagram(
-            self._paths, self.limits.min_separation + self.position_margin, schedule, times
+            loaded.diagram_paths, self.limits.min_separation + self.position_margin, schedule, loaded.times
         )
         self._plan_time = 0.0
         self._on_plan = [True, True]
@@ -196,12 +180,12 @@ class Executor:
         return self._time
 
     @property
-    def route(self) -> Route:
-        """The route being driven: the plan's (a new goal's after a re-plan)."""
+    def route(self):
+        """The route being driven (a Route, or a GraphRoute): the plan's (a new goal's after a re-plan)."""
         return self._route
 
     @property
-    def paths(self) -> tuple[VehiclePath, VehiclePath]:
+    def paths(self) -> tuple[VehiclePath, VehiclePath] | tuple[GraphVehiclePath, GraphVehiclePath]:
         """Both vehicles' paths of the plan, in travel coordinates."""
         return self._paths
 
@@ -211,8 +195,8 @@ class Executor:
         return self._diagram
 
     @property
-    def goal(self) -> Configuration:
-        """The goal both vehicles are driving to."""
+    def goal(self):
+        """The goal both vehicles are driving to (a Configuration, or two EdgePoints on a track graph)."""
         return self._goal
 
     @property
@@ -230,22 +214,28 @@ class Executor:
         return self._on_plan[vehicle]
 
     # -- requests --------------------------------------------------------------------------------
-    def request_goal(self, vehicle: int, position: Position) -> GoalDecision:
-        """Ask for a new goal of ``vehicle`` (0 or 1): taken once both are at rest, or refused with why."""
+    def request_goal(self, vehicle: int, position) -> GoalDecision:
+        """Ask for a new goal of ``vehicle`` (0 or 1): taken once both are at rest, or refused with why.
+
+        ``position``: a :class:`~topology.Position` on a junction; on a track graph an
+        :class:`~topology.EdgePoint`, ``"EDGE:s"`` or a node's name.
+        """
         if vehicle not in (0, 1):
             raise InputError(f"vehicle must be 0 or 1, got {vehicle!r}")
         try:
-            position = self.graph.check(position)
+            candidate = self._track.goal_with(self._next_goal or self._goal, vehicle, position)
         except InputError as error:
             return self._refuse(f"goal {position} of {self.names[vehicle]}: {error}")
-        goal = list(self._next_goal or self._goal)
-        goal[vehicle] = position
-        candidate = Configuration(*goal)
-        reason = goal_refusal(self.graph, candidate, self.limits.min_separation + 2.0 * self.position_margin)
+        required = self.limits.min_separation + 2.0 * self.position_margin
+        reason = self._track.goal_refusal(candidate, required)
         if reason is not None:
             return self._refuse(f"{self.names[vehicle]}: {reason}")
         self._next_goal = candidate
-        self._log("goal-accepted", f"new goal {position} for {self.names[vehicle]}: both stop, then re-plan")
+        self._log(
+            "goal-accepted",
+            f"new goal {self._track.name(candidate[vehicle])} for {self.names[vehicle]}: "
+            "both stop, then re-plan",
+        )
         return GoalDecision(True)
 
     def request_speed_limit(self, vehicle: int, speed: float) -> None:
@@ -274,7 +264,7 @@ class Executor:
         -------
         Command
         """
-        measured = (checked_state(first, 1, self.graph), checked_state(second, 2, self.graph))
+        measured = (self._track.check_state(first, 1), self._track.check_state(second, 2))
         along = self._locate(measured)
         if along is None:
             return self._emergency_stop(measured, "a vehicle is off its path beyond the margins")
@@ -309,7 +299,7 @@ class Executor:
                 v,
                 state,
                 frontier + max(_AT, min(BRAKING_RULE_TOLERANCE, self.position_margin)),
-                jerk_limited=self.schedule.jerk_limited,
+                jerk_limited=True,
             ):
                 return state, heading * jerk, axis
             self._leave_plan(v, f"{self.names[v]} meets its frontier at {frontier:.3f} m")
@@ -330,7 +320,7 @@ class Executor:
 
     def _plan_state(self, v: int, t: float) -> tuple[float, float, float, float]:
         """The plan's axis (in the vehicle's own axis), velocity, acceleration and jerk at ``t``."""
-        axis, velocity, acceleration, jerk, _, _ = self._plan.state(v, t)
+        axis, velocity, acceleration, jerk = self._plan.state(v, t)
         sign = self._axis_sign[v]
         return (
             self._axis_base[v] + sign * (axis - self._plan_axis0[v]),
@@ -443,31 +433,33 @@ class Executor:
         )
         if at_rest:
             goal, self._next_goal = self._next_goal, None
-            start = Configuration(*(self._position(state) for state in measured))
+            start = self._track.start_of(tuple(self._track.position(state) for state in measured))
             try:
-                verified = schedule_from_rest(
-                    self.graph,
+                verified = self._track.plan_from_rest(
                     self.limits,
                     start,
                     goal,
                     method=self.schedule.method,
                     margin=self.position_margin,
+                    names=self.names,
                 )
             except (TrajgenError, ScheduleError) as error:
                 self.rejected_goals += 1
-                self._log("goal-refused", f"no plan from {start} to {goal}: {error}")
+                self._log(
+                    "goal-refused",
+                    f"no plan from {self._track.name(start)} to {self._track.name(goal)}: {error}",
+                )
             else:
                 # where each vehicle stands (the plan starts there), not its setpoint: no offset carried on
                 axes = [self._paths[v].axis(along[v].p) for v in (0, 1)]
-                orientation = [self._orientation(v, along[v].p) for v in (0, 1)]
+                orientation = [self._track.orientation(self._paths[v], along[v].p) for v in (0, 1)]
                 self.replans += 1
                 self._load(verified, axis_start=axes, orientation=orientation)
-                route = verified.schedule.route
-                way = route.way_round.value
-                kind = f"way round {way}" if route.graph.cycle is not None else class_name(route)
+                kind = self._track.describe(verified.schedule.route)
                 self._log(
                     "replan",
-                    f"new goal: from {start} to {goal}, {kind}, {verified.schedule.duration:.3f} s planned",
+                    f"new goal: from {self._track.name(start)} to {self._track.name(goal)}, {kind}, "
+                    f"{verified.schedule.duration:.3f} s planned",
                 )
                 along = self._locate(measured) or along
         proposals = [(*self._motions[v].brake(self._command[v], self.period), None) for v in (0, 1)]
@@ -484,9 +476,9 @@ class Executor:
             slack = self.position_tolerance + self.position_margin
             near = self._command[v].p
             # next to a reversal one place is on the path twice: travel never runs back, so the later
-            p = path.project(measured[v].leg, measured[v].s, near + slack, slack)
+            p = self._track.project(path, measured[v].leg, measured[v].s, near + slack, slack)
             if p is None or abs(p - near) > slack:
-                p = path.project(measured[v].leg, measured[v].s, near, slack)
+                p = self._track.project(path, measured[v].leg, measured[v].s, near, slack)
             if p is None:
                 return None
             p = min(max(p, 0.0), path.length)
@@ -561,8 +553,8 @@ class Executor:
         acceleration = min(max(acceleration, -most), most)
         seed = PathState(state.p, velocity, acceleration)
         # a drive closing a gap measures a transient acceleration; kept, it could carry the vehicle
-        # past its next reversal, which coasting from the same speed would not
-        tip = self._paths[v].next_stop(state.p, 0.0)
+        # past its next reversal or its frontier, which coasting from the same speed would not
+        tip = min(self._paths[v].next_stop(state.p, 0.0), self._frontiers[v])
         if acceleration > 0.0 and not self._stops_by(v, seed, tip):
             coasting = PathState(state.p, velocity, 0.0)
             if self._stops_by(v, coasting, tip):
@@ -574,22 +566,6 @@ class Executor:
         self.rejected_goals += 1
         self._log("goal-refused", reason)
         return GoalDecision(False, reason)
-
-    def _position(self, state: VehicleState) -> Position:
-        if state.leg == JUNCTION_INDEX or state.s <= 0.0:
-            return Position(None, 0.0)
-        return Position(self.graph.names[state.leg], min(state.s, self.graph.lengths[state.leg]))
-
-    def _orientation(self, v: int, p: float) -> tuple[int, int] | None:
-        """``(leg, ds / d axis)`` of ``v`` at travel ``p`` (``None`` at the junction, unmoved).
-
-        An unmoved path's axis grows away from the junction (:class:`~trajgen.model.paths.VehiclePath`).
-        """
-        path = self._paths[v]
-        if not path.legs:
-            leg = path.home[0]
-            return None if leg == JUNCTION_INDEX else (leg, 1)
-        return path.legs[path.segment(p)], path.outward(p) * path.heading(p)
 
     def _log(self, kind: str, detail: str) -> None:
         self.events.append(Event(self._time, kind, detail))

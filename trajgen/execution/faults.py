@@ -20,7 +20,7 @@ import math
 import re
 from dataclasses import dataclass
 
-from topology import Option, Position, StarGraph
+from topology import EdgePoint, Option, Position, StarGraph, TrackGraph
 from topology.validation import short_repr
 from trajgen.errors import InputError
 
@@ -59,7 +59,7 @@ class Fault:
         When it starts, seconds.
     value : float
         ``stop``: duration, s; ``slow``: top speed, m/s; ``lag``: delay, s; ``jump``: metres; ``goal``: 0.
-    goal : Position or None
+    goal : Position, EdgePoint (on a track graph) or None
         The requested goal (``goal`` only).
     spec : str
         The text it was parsed from.
@@ -71,7 +71,7 @@ class Fault:
     vehicle: int
     time: float
     value: float
-    goal: Position | None = None
+    goal: Position | EdgePoint | None = None
     spec: str = ""
     duration: float = math.inf
 
@@ -101,7 +101,7 @@ def parse_fault(
     spec: object,
     *,
     names: tuple[str, str],
-    graph: StarGraph,
+    graph: StarGraph | TrackGraph,
     max_velocity: tuple[float, float],
     max_jump: float,
 ) -> Fault:
@@ -113,8 +113,8 @@ def parse_fault(
         For example ``stop:agv1@5+3``.
     names : tuple of 2 str
         The vehicles' names.
-    graph : StarGraph
-        The track (for ``goal``).
+    graph : StarGraph or TrackGraph
+        The track (for ``goal``: ``LEG:s`` on a junction, ``EDGE:s`` or a node on a track graph).
     max_velocity : tuple of 2 float
         The vehicles' top speeds, m/s (a ``slow`` speed must be below it).
     max_jump : float
@@ -166,7 +166,8 @@ def parse_fault(
         raise FaultError(f"fault {short_repr(spec)}: {kind.value} takes {expected}")
     if kind is FaultKind.GOAL:
         try:
-            goal = graph.check(Position.parse(text))
+            on_graph = isinstance(graph, TrackGraph)
+            goal = graph.point(text) if on_graph else graph.check(Position.parse(text))
         except InputError as error:
             raise FaultError(f"fault {short_repr(spec)}: goal: {error}") from None
         return Fault(kind, vehicle, time, 0.0, goal, spec)

@@ -12,12 +12,19 @@ where they stand, the timing method times it, the verifier certifies it
 from __future__ import annotations
 
 from limits import Limits
-from topology import Configuration, StarGraph, plan
+from topology import Configuration, EdgePoint, InfeasibleError, StarGraph, TrackGraph, plan, plan_graph
 from trajgen.methods import METHODS, make_schedule
 from trajgen.model.schedule import TimingMethod
+from trajgen.scenario import GraphScenario
 from trajgen.verification import VerifiedSchedule, certify
 
-__all__ = ["execution_margin", "goal_refusal", "schedule_for_execution", "schedule_from_rest"]
+__all__ = [
+    "execution_margin",
+    "goal_refusal",
+    "graph_schedule_from_rest",
+    "schedule_for_execution",
+    "schedule_from_rest",
+]
 
 
 def execution_margin(scenario, position_margin: float) -> float:
@@ -25,11 +32,22 @@ def execution_margin(scenario, position_margin: float) -> float:
 
     The plan needs twice the margin on top of the separation (:func:`schedule_for_execution`), which must
     fit the shortest leg and the start and goal; where it does not, the margin shrinks (to 0 when the
-    separation is the shortest leg).
+    separation is the shortest leg). On a track graph: the start and goal, and the margin is 0 where
+    the planner finds no route for the wider separation.
     """
     track = scenario.track
+    separation = scenario.limits.min_separation
+    if isinstance(scenario, GraphScenario):
+        room = min(track.distance(*scenario.start), track.distance(*scenario.goal))
+        margin = max(0.0, min(position_margin, 0.5 * (room - separation)))
+        if margin > 0.0:  # on a graph the wider separation may close a siding or a loop
+            try:
+                plan_graph(track, scenario.start, scenario.goal, min_separation=separation + 2.0 * margin)
+            except InfeasibleError:
+                return 0.0
+        return margin
     room = min(track.shortest_leg, track.separation(scenario.start), track.separation(scenario.goal))
-    return max(0.0, min(position_margin, 0.5 * (room - scenario.limits.min_separation)))
+    return max(0.0, min(position_margin, 0.5 * (room - separation)))
 
 
 def schedule_from_rest(
@@ -56,6 +74,30 @@ def schedule_from_rest(
     return certify(make_schedule(route, planned, method=for_execution(method)))
 
 
+def graph_schedule_from_rest(
+    track: TrackGraph,
+    limits: Limits,
+    start: tuple[EdgePoint, EdgePoint],
+    goal: tuple[EdgePoint, EdgePoint],
+    *,
+    method: TimingMethod | str | None,
+    margin: float,
+    names: tuple[str, str] = ("vehicle 1", "vehicle 2"),
+) -> VerifiedSchedule:
+    """:func:`schedule_from_rest` on a track graph: the exact planner's route, timed, verified.
+
+    Raises
+    ------
+    InfeasibleError
+        No collision-free route keeps the separation ``limits.min_separation + 2 margin``.
+    VerificationError
+        The timed plan fails the verifier (it is never executed).
+    """
+    separation = limits.min_separation + 2.0 * margin
+    route = plan_graph(track, start, goal, min_separation=separation, names=names)
+    return certify(make_schedule(route, Limits(limits.vehicles, separation), method=for_execution(method)))
+
+
 def for_execution(method: TimingMethod | str | None) -> TimingMethod:
     """``method`` as it plans for execution: ``optimal`` with the braking rule in its problem."""
     return METHODS.create(method).for_execution()
@@ -71,6 +113,16 @@ def schedule_for_execution(
     second margin is the plan's clearance between them.
     """
     margin = execution_margin(scenario, position_margin)
+    if isinstance(scenario, GraphScenario):
+        return graph_schedule_from_rest(
+            scenario.track,
+            scenario.limits,
+            scenario.start,
+            scenario.goal,
+            method=method,
+            margin=margin,
+            names=scenario.names,
+        )
     return schedule_from_rest(
         scenario.track, scenario.limits, scenario.start, scenario.goal, method=method, margin=margin
     )

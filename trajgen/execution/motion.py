@@ -14,20 +14,23 @@ from __future__ import annotations
 import bisect
 import math
 
+import numpy as np
 from ruckig import ControlInterface, InputParameter, Result, Ruckig, Trajectory
 
 from limits import VehicleLimits
-from topology import JUNCTION_INDEX
 from trajgen.errors import ScheduleError
 from trajgen.execution.braking_check import PathState
+from trajgen.model.graph_vehicle_path import GraphVehiclePath
 from trajgen.model.paths import VehiclePath
-from trajgen.model.pieces import schedule_pieces
+from trajgen.model.pieces import kinematics_polynomials, schedule_pieces, split_at_values
 from trajgen.verification import VerifiedSchedule
 
-__all__ = ["AT_REST", "PlanPlayer", "VehicleMotion", "ruckig_jerk", "travel_state"]
+__all__ = ["AT_REST", "GraphPlanPlayer", "PlanPlayer", "VehicleMotion", "ruckig_jerk", "travel_state"]
 
 #: Relative slack on the acceleration limit given to Ruckig (far below the 1e-6 the limits are checked to).
 _SLACK = 1e-9
+#: A piece that reaches a segment's end within this at one of its ends is not split there, metres.
+_SPLIT_MARGIN = 1e-9
 #: A vehicle slower than this is at rest, m/s.
 AT_REST = 1e-6
 
@@ -52,41 +55,93 @@ def ruckig_jerk(trajectory: Trajectory, t: float) -> float:
 
 
 class PlanPlayer:
-    """A verified schedule as plain polynomial pieces per vehicle, evaluated every cycle.
+    """A verified schedule as plain polynomial pieces of each vehicle's axis, evaluated every cycle.
 
     Parameters
     ----------
-    verified : VerifiedSchedule
+    starts : list of float, shape (m,)
+        Each piece's start, seconds.
+    duration : float
+        The plan's makespan, seconds.
+    axis : list of 2 lists of 5 floats per piece
+        Each vehicle's polynomial on each piece (time since the piece's start), ascending powers.
     """
 
-    __slots__ = ("axis", "duration", "legs", "s_offset", "s_sign", "starts")
+    __slots__ = ("axis", "duration", "starts")
 
-    def __init__(self, verified: VerifiedSchedule) -> None:
+    def __init__(self, starts: list[float], duration: float, axis: list[list[list[float]]]) -> None:
+        self.starts = starts
+        self.duration = duration
+        self.axis = axis
+
+    @classmethod
+    def of(cls, verified: VerifiedSchedule) -> PlanPlayer:
+        """The player of a verified schedule on a junction (its axis as the schedule's pieces give it)."""
         pieces = schedule_pieces(verified.schedule)
-        self.starts = [float(x) for x in pieces.start]
-        self.duration = float(verified.schedule.duration)
-        self.axis = [[[float(c) for c in row] for row in pieces.axis[v]] for v in (0, 1)]
-        self.legs = [[int(x) for x in pieces.leg[v]] for v in (0, 1)]
-        self.s_offset = [[float(x) for x in pieces.s_offset[v]] for v in (0, 1)]
-        self.s_sign = [[float(x) for x in pieces.s_sign[v]] for v in (0, 1)]
+        return cls(
+            [float(x) for x in pieces.start],
+            float(verified.schedule.duration),
+            [[[float(c) for c in row] for row in pieces.axis[v]] for v in (0, 1)],
+        )
 
-    def state(self, vehicle: int, t: float) -> tuple[float, float, float, float, int, float]:
-        """Axis, velocity, acceleration, jerk, leg, s of ``vehicle`` at ``t`` (clipped to the plan)."""
-        if not self.starts:
-            return 0.0, 0.0, 0.0, 0.0, JUNCTION_INDEX, 0.0
+    def _polynomial(self, vehicle: int, t: float) -> tuple[float, float, float, float]:
+        """The value and its three derivatives of ``vehicle``'s polynomial at ``t`` (clipped)."""
         t = min(max(t, 0.0), self.duration)
         k = max(bisect.bisect_right(self.starts, t) - 1, 0)
         u = t - self.starts[k]
         c0, c1, c2, c3, c4 = self.axis[vehicle][k]
-        axis = c0 + u * (c1 + u * (c2 + u * (c3 + u * c4)))
+        value = c0 + u * (c1 + u * (c2 + u * (c3 + u * c4)))
+        if t >= self.duration:
+            return value, 0.0, 0.0, 0.0
         velocity = c1 + u * (2.0 * c2 + u * (3.0 * c3 + u * 4.0 * c4))
         acceleration = 2.0 * c2 + u * (6.0 * c3 + u * 12.0 * c4)
-        jerk = 6.0 * c3 + u * 24.0 * c4
-        if t >= self.duration:
-            velocity = acceleration = jerk = 0.0
-        s = max(self.s_offset[vehicle][k] + self.s_sign[vehicle][k] * axis, 0.0)
-        leg = self.legs[vehicle][k] if s > 0.0 else JUNCTION_INDEX
-        return axis, velocity, acceleration, jerk, leg, s
+        return value, velocity, acceleration, 6.0 * c3 + u * 24.0 * c4
+
+    def state(self, vehicle: int, t: float) -> tuple[float, float, float, float]:
+        """Axis (m), velocity, acceleration and jerk of ``vehicle`` at ``t`` (s, clipped to the plan)."""
+        if not self.starts:
+            return 0.0, 0.0, 0.0, 0.0
+        return self._polynomial(vehicle, t)
+
+
+class GraphPlanPlayer(PlanPlayer):
+    """A verified schedule on a track graph, played as each vehicle's axis.
+
+    The schedule's pieces give each vehicle's travel; they are split where a path's segment ends,
+    and on each piece the axis is the travel signed by that segment's heading (it grows along the
+    first move and runs back after each reversal, :class:`GraphVehiclePath`). The segment is the
+    one at the piece's middle, never a travel value's round-off next to a reversal.
+    """
+
+    __slots__ = ()
+
+    def __init__(self, verified: VerifiedSchedule) -> None:
+        schedule = verified.schedule
+        parts = []
+        for section in schedule.sections:
+            times, travel, intervals = kinematics_polynomials(section.kinematics)
+            parts.append((section.start_time + times, travel, intervals))
+        ends = np.concatenate([p[0][:-1] for p in parts] + [parts[-1][0][-1:]])
+        travel = np.concatenate([p[1] for p in parts], axis=1)
+        intervals = np.concatenate([p[2] for p in parts], axis=1)
+        paths = tuple(GraphVehiclePath.from_path(path, schedule.track) for path in schedule.paths)
+        bounds = tuple(path.starts[1:] for path in paths)
+        starts, lengths, travel, _ = split_at_values(ends, travel, intervals, bounds, margin=_SPLIT_MARGIN)
+        axis: list[list[list[float]]] = [[], []]
+        for v, path in enumerate(paths):
+            for k in range(starts.size):
+                row = [float(c) for c in travel[v, k]]
+                if not path.headings:
+                    axis[v].append([path.axis(0.0), 0.0, 0.0, 0.0, 0.0])
+                    continue
+                u = 0.5 * float(lengths[k])
+                middle = row[0] + u * (row[1] + u * (row[2] + u * (row[3] + u * row[4])))
+                segment = path.segment(middle)
+                heading = path.headings[segment]
+                coefficients = [heading * c for c in row]
+                coefficients[0] += path.axis_starts[segment] - heading * path.starts[segment]
+                axis[v].append(coefficients)
+        super().__init__([float(x) for x in starts], float(schedule.duration), axis)
 
 
 class VehicleMotion:

@@ -2,7 +2,8 @@
 
 Each vehicle moves along the track after its setpoints: it lands on each
 setpoint while it is on track, passes the junction onto the leg the setpoint
-names, and is stopped by the end of a leg. Faults
+names (on a track graph: a node onto the edge the setpoint is on or names next),
+and is stopped by the end of a leg. Faults
 (:mod:`trajgen.execution.faults`) act here only; the executor sees their effects
 through the measurements. A stop (or the executor's emergency brake) brakes at
 the vehicle's emergency deceleration; a drive that is off its setpoint (after
@@ -17,12 +18,13 @@ import collections
 import math
 from collections.abc import Sequence
 
-from topology import JUNCTION_INDEX
+from topology import JUNCTION_INDEX, TrackGraph
 from trajgen.execution.executor import Executor
 from trajgen.execution.faults import Fault, FaultKind
 from trajgen.execution.messages import Command, VehicleState
+from trajgen.model.graph_vehicle_path import GraphVehiclePath
 
-__all__ = ["Body", "Plant"]
+__all__ = ["Body", "GraphBody", "Plant"]
 
 #: How fast a drive closes a gap to its setpoint beyond the setpoints' own speed (fraction of max_velocity).
 _CORRECTION = 0.2
@@ -64,9 +66,72 @@ class Body:
         if blocked:
             self.v = self.a = 0.0
 
+    def steer(self, setpoint) -> None:
+        """Take the leg ``setpoint`` names for the next pass through the junction."""
+        if setpoint.branch != JUNCTION_INDEX:  # a path that never moves, parked at the junction, names no leg
+            self.branch = setpoint.branch
+
     def state(self) -> VehicleState:
         """What the vehicle's sensors measure: its true state."""
         return VehicleState(self.leg if self.s > 0.0 else JUNCTION_INDEX, self.s, self.v, self.a)
+
+
+class GraphShape:
+    """A track graph's edge lengths and end nodes as plain tuples, for the plant's every cycle."""
+
+    __slots__ = ("ends", "lengths")
+
+    def __init__(self, track: TrackGraph) -> None:
+        self.lengths = tuple(track.length(k) for k in range(track.edge_count))
+        self.ends = tuple(track.ends(k) for k in range(track.edge_count))
+
+
+class GraphBody:
+    """One vehicle's true state on a track graph: ``leg`` is its edge, ``s`` metres from its ``from`` node.
+
+    ``orientation`` is ``ds / d axis`` on its edge. At a node it passes onto the edge its setpoint
+    is on, or else the branch its setpoint names; with neither (a reversal, a dead end) the node
+    stops it.
+    """
+
+    __slots__ = ("a", "ahead", "axis", "j", "leg", "orientation", "s", "v")
+
+    def __init__(self, edge: int, s: float, orientation: int, axis: float) -> None:
+        self.leg, self.s, self.orientation, self.axis = edge, s, orientation, axis
+        self.ahead = (edge, edge)
+        self.v = self.a = self.j = 0.0
+
+    def steer(self, setpoint) -> None:
+        """Take the edges ``setpoint`` is on and names next, for the next node it passes."""
+        self.ahead = (setpoint.leg, setpoint.branch)
+
+    def move(self, d_axis: float, shape: GraphShape) -> None:
+        """Drive ``d_axis`` metres along the axis, through a node onto the edge it is steered to."""
+        s = self.s + self.orientation * d_axis
+        top = shape.lengths[self.leg]
+        blocked = 0.0
+        if s < 0.0 or s > top:
+            start, end = shape.ends[self.leg]
+            node, past = (start, -s) if s < 0.0 else (end, s - top)
+            onto = next((e for e in self.ahead if e != self.leg and node in shape.ends[e]), None)
+            if onto is None:
+                blocked, s = past, min(max(s, 0.0), top)
+            else:
+                here = 1 if start == node else -1
+                there = 1 if shape.ends[onto][0] == node else -1
+                self.leg, self.orientation = onto, -self.orientation * here * there
+                length = shape.lengths[onto]
+                if past > length:  # beyond the next edge too within one cycle: stopped at its end
+                    blocked, past = past - length, length
+                s = past if there > 0 else length - past
+        self.s = s
+        self.axis += d_axis - math.copysign(blocked, d_axis)
+        if blocked:
+            self.v = self.a = 0.0
+
+    def state(self) -> VehicleState:
+        """What the vehicle's sensors measure: its true state."""
+        return VehicleState(self.leg, self.s, self.v, self.a)
 
 
 class Lag:
@@ -83,22 +148,25 @@ class Lag:
         self.items.append(setpoint)
 
     def at(self, time: float):
-        """Axis, velocity, acceleration, branch at ``time`` (linear between kept setpoints)."""
+        """Axis, velocity, acceleration at ``time``, and the setpoint before it (which steers).
+
+        Linear between the kept setpoints.
+        """
         times = list(self.times)
         k = bisect.bisect_right(times, time) - 1
         if k < 0:
             first = self.items[0]
-            return first.axis, first.velocity, first.acceleration, first.branch
+            return first.axis, first.velocity, first.acceleration, first
         if k >= len(times) - 1:
             last = self.items[-1]
-            return last.axis, last.velocity, last.acceleration, last.branch
+            return last.axis, last.velocity, last.acceleration, last
         a, b = self.items[k], self.items[k + 1]
         w = (time - times[k]) / (times[k + 1] - times[k])
         return (
             a.axis + w * (b.axis - a.axis),
             a.velocity + w * (b.velocity - a.velocity),
             a.acceleration + w * (b.acceleration - a.acceleration),
-            a.branch,
+            a,
         )
 
 
@@ -106,9 +174,16 @@ class Plant:
     """Both vehicles' true motion under setpoints and faults."""
 
     def __init__(self, executor: Executor, faults: Sequence[Fault], period: float) -> None:
-        self.lengths = executor.graph.lengths
         self.period = period
         self.limits = executor.limits
+        self.faults = list(faults)
+        size = math.ceil(0.25 / period) + 4
+        self.lags = (Lag(size), Lag(size))
+        if isinstance(executor.graph, TrackGraph):
+            self.lengths = GraphShape(executor.graph)
+            self.bodies = [_graph_body(path) for path in executor.paths]
+            return
+        self.lengths = executor.graph.lengths
         self.bodies = []
         for path in executor.paths:
             leg, s = path.locate(0.0)
@@ -119,9 +194,6 @@ class Plant:
                 leg = leg if leg != JUNCTION_INDEX else 0
                 orientation = 1
             self.bodies.append(Body(leg, s, orientation, path.axis(0.0), leg))
-        self.faults = list(faults)
-        size = math.ceil(0.25 / period) + 4
-        self.lags = (Lag(size), Lag(size))
 
     def measure(self) -> tuple[VehicleState, VehicleState]:
         """Both vehicles' measured states."""
@@ -160,18 +232,17 @@ class Plant:
             lag = self._active(FaultKind.LAG, v, t)
             if lag is not None:
                 delay = min(lag.value, 0.5 * (t + dt - lag.time))
-                axis, velocity, acceleration, branch = self.lags[v].at(t + dt - delay)
+                axis, velocity, acceleration, steering = self.lags[v].at(t + dt - delay)
                 jerk = setpoint.jerk
             else:
-                axis, velocity, acceleration, jerk, branch = (
+                axis, velocity, acceleration, jerk, steering = (
                     setpoint.axis,
                     setpoint.velocity,
                     setpoint.acceleration,
                     setpoint.jerk,
-                    setpoint.branch,
+                    setpoint,
                 )
-            if branch != JUNCTION_INDEX:  # a path that never moves, parked at the junction, names no leg
-                body.branch = branch
+            body.steer(steering)
             slow = self._active(FaultKind.SLOW, v, t)
             cap = slow.value if slow is not None else math.inf  # a throttled drive's top speed
             wanted = axis - body.axis
@@ -193,3 +264,12 @@ class Plant:
             body.j = (a_new - body.a) / dt
             body.a, body.v = a_new, v_new
             body.move(step, self.lengths)
+
+
+def _graph_body(path: GraphVehiclePath) -> GraphBody:
+    """A vehicle at the start of its path on a track graph, its axis as the path's."""
+    if not path.edges:
+        edge, s = path.home
+        return GraphBody(edge, s, 1, path.axis(0.0))
+    orientation = (1 if path.s_to[0] > path.s_from[0] else -1) * path.headings[0]
+    return GraphBody(path.edges[0], path.s_from[0], orientation, path.axis(0.0))

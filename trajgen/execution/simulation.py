@@ -22,7 +22,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from limits import Limits
-from topology import StarGraph
+from topology import StarGraph, TrackGraph
 from topology.indexed import leg_travel
 from topology.indexed import separation as indexed_separation
 from trajgen.errors import InputError
@@ -33,10 +33,11 @@ from trajgen.execution.messages import Command, Event, Mode, VehicleState
 from trajgen.execution.plant import Plant
 from trajgen.execution.trace import PLOT_SAMPLES, Decimated, Trace
 from trajgen.export.csv import CsvOptions
+from trajgen.model.graph_vehicle_path import GraphMetric
 from trajgen.model.schedule import TimingMethod
 from trajgen.model.summary import provenance
 from trajgen.model.values import frozen
-from trajgen.scenario import Scenario
+from trajgen.scenario import GraphScenario, Scenario
 from trajgen.verification import VerifiedSchedule
 
 __all__ = ["PLOT_SAMPLES", "SimulationResult", "Trace", "parse_faults", "simulate"]
@@ -155,7 +156,7 @@ class SimulationResult:
 
 
 def parse_faults(
-    scenario: Scenario, specs: Sequence[str], *, position_margin: float = 0.05
+    scenario: Scenario | GraphScenario, specs: Sequence[str], *, position_margin: float = 0.05
 ) -> tuple[Fault, ...]:
     """Parse ``--fault`` specs against a scenario (see :func:`~trajgen.execution.faults.parse_fault`).
 
@@ -214,19 +215,40 @@ def _between(before, bodies, first: float, second: float, bend: float) -> float:
     return 0.5 * (first + second - moved)
 
 
-def _time_limit(planned: float, faults: Sequence[Fault], limits: Limits, graph: StarGraph) -> float:
+def _graph_between(before, bodies, first: float, second: float, bend: float) -> float:
+    """:func:`_between` on a track graph: a lower bound of the track distance between two cycles, metres.
+
+    While each vehicle stays on its edge, the track distance is the least of affine functions of
+    the two positions (``|s1 - s2|`` on one edge while neither passes the other): concave, so
+    along the two motions it dips below the smaller end value by at most the bend of the motions
+    (each leaves the chord between its two places by at most its bend, and the distance is
+    1-Lipschitz); 0 if two vehicles on one edge swapped order. Through a node: the mean of the two
+    ends less half of how far both drove.
+    """
+    if all(old[0] == b.leg for old, b in zip(before, bodies, strict=True)):
+        if before[0][0] == before[1][0] and (before[0][1] - before[1][1]) * (bodies[0].s - bodies[1].s) < 0.0:
+            return 0.0
+        return min(first, second) - bend
+    moved = sum(abs(b.axis - old[5]) for old, b in zip(before, bodies, strict=True))
+    return 0.5 * (first + second - moved)
+
+
+def _time_limit(
+    planned: float, faults: Sequence[Fault], limits: Limits, graph: StarGraph | TrackGraph
+) -> float:
     """Simulated time after which the run counts as stuck, seconds."""
     slowest = min(v.max_velocity for v in limits.vehicles)
     for fault in faults:
         if fault.kind is FaultKind.SLOW:
             slowest = min(slowest, fault.value)
-    crawl = 2.0 * sum(graph.lengths) * 2.0 / slowest  # both vehicles round the whole track twice
+    total = graph.total_length if isinstance(graph, TrackGraph) else sum(graph.lengths)
+    crawl = 2.0 * total * 2.0 / slowest  # both vehicles round the whole track twice
     latest = max((f.time + (f.value if f.kind is FaultKind.STOP else 0.0) for f in faults), default=0.0)
     return latest + 3.0 * planned + crawl + 60.0
 
 
 def simulate(
-    scenario: Scenario,
+    scenario: Scenario | GraphScenario,
     faults: Sequence[Fault] = (),
     *,
     period: float = 0.01,
@@ -262,8 +284,8 @@ def simulate(
     SimulationResult, Trace or None
         The trace's temporary files are closed by ``Trace.close``.
     """
-    if not isinstance(scenario, Scenario):
-        raise InputError(f"simulate expects a Scenario, got {type(scenario).__name__}")
+    if not isinstance(scenario, (Scenario, GraphScenario)):
+        raise InputError(f"simulate expects a Scenario or a GraphScenario, got {type(scenario).__name__}")
     margin = execution_margin(scenario, position_margin)
     for fault in faults:
         if not isinstance(fault, Fault):
@@ -292,7 +314,21 @@ def simulate(
     worst = [0.0, 0.0, 0.0]
     separation_violations = limit_violations = 0
     bodies = plant.bodies
-    separation = indexed_separation((bodies[0].leg, bodies[0].s, bodies[1].leg, bodies[1].s))
+    on_graph = isinstance(scenario, GraphScenario)
+    if on_graph:
+        metric = GraphMetric(scenario.track)
+
+        def apart() -> float:
+            return metric.distance(bodies[0].leg, bodies[0].s, bodies[1].leg, bodies[1].s)
+
+        between_cycles = _graph_between
+    else:
+
+        def apart() -> float:
+            return indexed_separation((bodies[0].leg, bodies[0].s, bodies[1].leg, bodies[1].s))
+
+        between_cycles = _between
+    separation = apart()
     smallest = certified = separation
     required = limits.min_separation
     if spool is not None:
@@ -326,18 +362,18 @@ def simulate(
                     limit_violations += 1
                 for k in range(3):
                     worst[k] = max(worst[k], ratios[k])
-            before = [(b.leg, b.s, b.a, b.v, b.orientation) for b in bodies]
+            before = [(b.leg, b.s, b.a, b.v, b.orientation, b.axis) for b in bodies]
             plant.advance(command, t)
             cycle += 1
             t = cycle * period
-            now = indexed_separation((bodies[0].leg, bodies[0].s, bodies[1].leg, bodies[1].s))
+            now = apart()
             # how far the motions (acceleration between its values at the two cycles) leave their chords
             bend = (
                 sum(max(abs(old[2]), abs(b.a)) for old, b in zip(before, bodies, strict=True))
                 * period**2
                 / 8.0
             )
-            between = _between(before, bodies, separation, now, bend)
+            between = between_cycles(before, bodies, separation, now, bend)
             smallest = min(smallest, now)
             certified = min(certified, now, between)
             if min(now, between) < required - _VIOLATION_TOLERANCE:

@@ -520,7 +520,7 @@ def schedule_paths(
 
     Returns
     -------
-    paths : tuple of 2 VehiclePath
+    paths : tuple of 2 VehiclePath (2 GraphPath of a GraphSchedule)
         Travel coordinates, each vehicle's axis as the schedule's.
     times : ndarray, shape (n,)
         Seconds.
@@ -529,6 +529,8 @@ def schedule_paths(
         its travel at any ``t`` is the one before plus how far its axis moved since.
     """
     times = schedule_times(schedule, pieces)
+    if isinstance(schedule, GraphSchedule):  # its paths are the route's, its travel the schedule's
+        return schedule.paths, times, schedule.travel(times)[:, 0]
     waypoints = schedule_waypoints(schedule, times)
     axis = schedule.state(times).axis
     paths = tuple(VehiclePath.from_waypoints(waypoints, v, axis_start=float(axis[v, 0])) for v in (0, 1))

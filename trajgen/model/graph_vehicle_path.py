@@ -208,8 +208,9 @@ class GraphVehiclePath(TravelAxis):
         A position within ``slack`` metres of the path counts as on it (the track distance to the
         closest place of a segment, measured by ``metric``: a node of the track given on another
         of its edges is the same node). Before the start or past the end of the path on the end
-        segments' edges, the travel is below 0 or above :attr:`length`. Of the places within
-        ``slack``, the one nearest ``near`` is taken.
+        segments' edges, the travel is below 0 or above :attr:`length`. A place that holds the
+        position exactly is preferred to one within ``slack`` of it; among those, the one nearest
+        ``near`` (within ``slack`` of it counting as near).
         """
         if not self.edges:
             home_edge, home_s = self.home
@@ -244,7 +245,9 @@ class GraphVehiclePath(TravelAxis):
                 off, p = min((metric.distance(edge, s, seg_edge, at), q) for q, at in candidates)
             if off > slack:
                 continue
-            key = (max(abs(p - near) - slack, 0.0), abs(p - near))
+            # how far off plus how far outside the window of ``slack`` about ``near``: a place that
+            # holds the point exactly beats a segment's end within ``slack`` of it (as on a junction)
+            key = ((off if off > 1e-9 else 0.0) + max(abs(p - near) - slack, 0.0), abs(p - near))
             if key < best_key:
                 best, best_key = p, key
         return best

@@ -24,6 +24,8 @@ __all__ = [
     "travel_within_segment",
 ]
 
+#: A velocity below this along the axis is at rest for :meth:`TravelAxis.travel_at_axis`, m/s.
+_STILL = 1e-9
 #: Moves of a vehicle shorter than this between two waypoints are ignored, metres.
 MOVE_RESOLUTION = 1e-9
 #: One stretch of track: (leg index, smallest s, largest s), metres.
@@ -133,7 +135,8 @@ class TravelAxis:
 
         The axis runs back and forth through reversals, so one value can be met more than once:
         the first segment from ``near``'s that holds ``axis`` and is driven in the direction of
-        ``velocity`` (m/s, along the axis) is taken. The end segments run on beyond the path's ends.
+        ``velocity`` (m/s, along the axis; at rest, either way) is taken. The end segments run on
+        beyond the path's ends.
         """
         if not self.headings:
             return 0.0
@@ -142,7 +145,8 @@ class TravelAxis:
         while True:
             p = self.starts[k] + self.headings[k] * (axis - self.axis_starts[k])
             end = self.starts[k + 1] if k < last else math.inf
-            forward = self.headings[k] * velocity >= 0.0
+            # at rest (to round-off) either way will do: a sign of 1e-17 m/s must not skip a segment
+            forward = self.headings[k] * velocity >= -_STILL
             if k == last or (p <= end + 1e-9 and forward):
                 return max(p, self.starts[k]) if k else p
             k += 1
