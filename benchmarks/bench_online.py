@@ -15,9 +15,12 @@
    limit violations, emergency brakes, the braking check's holds, and the time lost against the
    undisturbed plan (median, worst). Scenarios are spread over ``--workers`` processes.
 3. With ``--fault-free``, each scenario also runs without faults: the makespan against the plan.
+4. With ``--graph``, the scenarios are random track graphs instead
+   (:func:`trajgen.scenario.graph_sampling.graph_online_campaign`: trees and graphs with loops),
+   their faults :func:`~trajgen.scenario.graph_sampling.graph_campaign_faults`.
 
 Run: ``python benchmarks/bench_online.py [--count 200] [--seed 11] [--timed 20] [--workers 2]
-[--method NAME] [--repeats 3] [--fault-free]``.
+[--method NAME] [--repeats 3] [--fault-free] [--graph]``.
 """
 
 from __future__ import annotations
@@ -34,17 +37,20 @@ from trajgen.execution import Executor
 from trajgen.execution.goals import execution_margin, schedule_for_execution
 from trajgen.execution.simulation import parse_faults, simulate
 from trajgen.progress import progress
+from trajgen.scenario.graph_sampling import graph_campaign_faults, graph_online_campaign
 from trajgen.scenario.sampling import campaign_faults, online_campaign
 
 
-def run_case(args: tuple[int, int, str | None, bool]) -> dict:
+def run_case(args: tuple[int, int, str | None, bool] | tuple[int, int, str | None, bool, bool]) -> dict:
     """One campaign scenario: its faults and the summary of its simulation (and of a fault-free one)."""
-    k, seed, method, fault_free = args
+    k, seed, method, fault_free, *graph = args
     logging.disable(logging.WARNING)
-    scenario = online_campaign(k + 1, seed=seed)[k]
+    on_graph = bool(graph and graph[0])
+    scenario = (graph_online_campaign if on_graph else online_campaign)(k + 1, seed=seed)[k]
     verified = schedule_for_execution(scenario, method=method)
     margin = execution_margin(scenario, 0.05)
-    specs = campaign_faults(scenario, verified.schedule.duration, seed=1000 + k, margin=margin)
+    faults = graph_campaign_faults if on_graph else campaign_faults
+    specs = faults(scenario, verified.schedule.duration, seed=1000 + k, margin=margin)
     try:
         result, _ = simulate(scenario, parse_faults(scenario, specs), verified=verified)
     except Exception as error:  # a crash is a failed scenario, reported with the others
@@ -57,7 +63,7 @@ def run_case(args: tuple[int, int, str | None, bool]) -> dict:
 
 
 def timed_cycles(
-    count: int, seed: int, method: str | None, repeats: int = 1
+    count: int, seed: int, method: str | None, repeats: int = 1, graph: bool = False
 ) -> tuple[list[float], list[float], list[float], list[float]]:
     """Wall time of every executor step (µs) that does not plan, and of those that do (ms).
 
@@ -105,7 +111,7 @@ def timed_cycles(
             runs = []
             for _ in range(max(1, repeats)):
                 steps.clear()
-                run_case((k, seed, method, False))
+                run_case((k, seed, method, False, graph))
                 runs.append(list(steps))
             for kind, elapsed in runs[0]:
                 {"plan": replans, "collected": collected, "cycle": cycles}[kind].append(elapsed)
@@ -167,10 +173,17 @@ def main() -> None:
         "--repeats", type=int, default=3, help="runs of each timed scenario (each cycle's fastest is its own)"
     )
     parser.add_argument("--fault-free", action="store_true", help="also run each scenario without faults")
+    parser.add_argument(
+        "--graph",
+        action="store_true",
+        help="random track graphs (trees and loops: trajgen.scenario.graph_sampling) instead of junctions",
+    )
     args = parser.parse_args()
 
     if args.timed:
-        cycles, collected, replans, own = timed_cycles(args.timed, args.seed, args.method, args.repeats)
+        cycles, collected, replans, own = timed_cycles(
+            args.timed, args.seed, args.method, args.repeats, args.graph
+        )
         print(f"executor cycle (both vehicles), {len(cycles)} cycles of {args.timed} scenarios:")
         print(
             f"  median {statistics.median(cycles):.1f} us, p99 {percentile(cycles, 0.99):.1f} us, "
@@ -204,7 +217,7 @@ def main() -> None:
         return
     started = time.perf_counter()
     with multiprocessing.Pool(args.workers) as pool:
-        cases = [(k, args.seed, args.method, args.fault_free) for k in range(args.count)]
+        cases = [(k, args.seed, args.method, args.fault_free, args.graph) for k in range(args.count)]
         done = progress(pool.imap_unordered(run_case, cases), total=len(cases), description="campaign")
         rows = sorted(done, key=lambda r: r["k"])
     wall = time.perf_counter() - started
@@ -215,7 +228,8 @@ def main() -> None:
     relative = [r["time_lost_s"] / r["planned_s"] for r in rows if r["reached_goal"] and r["planned_s"] > 0]
     methods = sorted({r["method"] for r in rows})
     print(
-        f"campaign: {args.count} scenarios (seed {args.seed}, plans by {', '.join(methods)}), "
+        f"campaign: {args.count} {'track-graph ' if args.graph else ''}scenarios "
+        f"(seed {args.seed}, plans by {', '.join(methods)}), "
         f"1-3 faults each, {wall:.0f} s wall"
     )
     print(f"  crashed (an exception in the run): {len(crashed)}")

@@ -27,6 +27,7 @@ from __future__ import annotations
 
 import bisect
 import collections
+import dataclasses
 import logging
 import math
 
@@ -121,7 +122,17 @@ class Executor:
         self._track = execution_track(schedule)
         #: The track: a junction's StarGraph, or a TrackGraph.
         self.graph = self._track.graph
-        self.limits: Limits = Limits(schedule.limits.vehicles, float(min_separation))
+        vehicles = schedule.limits.vehicles
+        if not schedule.jerk_limited:
+            # a plan that does not limit jerk (toppra) changes its acceleration at once: re-timed and
+            # braking, its vehicles do so too, or a hold from a high acceleration would overspeed
+            vehicles = tuple(
+                dataclasses.replace(v, max_jerk=max(v.max_jerk, v.max_acceleration / period))
+                for v in vehicles
+            )
+        #: The limits the executor drives within: the schedule's (with a jerk of ``max_acceleration /
+        #: period`` for a plan that does not limit jerk) and the separation it keeps.
+        self.limits: Limits = Limits(vehicles, float(min_separation))
         self.period = period
         self._guard = SafetyGuard(self.limits, self.graph)
         self._motions = (VehicleMotion(self.limits.vehicles[0]), VehicleMotion(self.limits.vehicles[1]))

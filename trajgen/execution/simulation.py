@@ -219,16 +219,23 @@ def _graph_between(before, bodies, first: float, second: float, bend: float) -> 
     """:func:`_between` on a track graph: a lower bound of the track distance between two cycles, metres.
 
     While each vehicle stays on its edge, the track distance is the least of affine functions of
-    the two positions (``|s1 - s2|`` on one edge while neither passes the other): concave, so
-    along the two motions it dips below the smaller end value by at most the bend of the motions
-    (each leaves the chord between its two places by at most its bend, and the distance is
-    1-Lipschitz); 0 if two vehicles on one edge swapped order. Through a node: the mean of the two
-    ends less half of how far both drove.
+    the two positions, ``c + σ1 s1 + σ2 s2`` (one per way between them, ``|s1 - s2|`` on one edge
+    while neither passes the other), so it is at least the smaller end value unless one of them
+    dips inside the cycle: only if its rate turns from closing to opening there, and then by at
+    most the bend of the two motions (``max |a| * dt**2 / 8`` each). 0 if two vehicles on one edge
+    swapped order. Through a node: the mean of the two ends less half of how far both drove.
     """
     if all(old[0] == b.leg for old, b in zip(before, bodies, strict=True)):
         if before[0][0] == before[1][0] and (before[0][1] - before[1][1]) * (bodies[0].s - bodies[1].s) < 0.0:
             return 0.0
-        return min(first, second) - bend
+        start = [old[4] * old[3] for old in before]  # ds / dt = (ds / d axis) * (d axis / dt)
+        end = [b.orientation * b.v for b in bodies]
+        turns = any(
+            first_sign * start[0] + second_sign * start[1] < 0.0 < first_sign * end[0] + second_sign * end[1]
+            for first_sign in (1.0, -1.0)
+            for second_sign in (1.0, -1.0)
+        )
+        return min(first, second) - (bend if turns else 0.0)
     moved = sum(abs(b.axis - old[5]) for old, b in zip(before, bodies, strict=True))
     return 0.5 * (first + second - moved)
 
