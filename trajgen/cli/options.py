@@ -37,15 +37,15 @@ def scenario_from(path: str | None, *, graph: bool = False) -> Scenario:
     ------
     ScenarioError
         A track graph (``[track]`` with ``edges``) where the command takes junctions only
-        (``graph=False``): today ``trajgen plan``, ``schedule``, ``check``, ``export-vda5050`` and
-        ``animate`` take graphs.
+        (``graph=False``): today ``trajgen plan``, ``schedule``, ``check``, ``export-vda5050``,
+        ``animate`` and ``simulate`` take graphs.
     """
     scenario = default_scenario() if path is None else load_scenario(path)
     if isinstance(scenario, GraphScenario) and not graph:
         raise ScenarioError(
             f"{scenario.source}: a track with edges (a track graph) is planned by 'trajgen plan', timed by "
             "'trajgen schedule', its files checked by 'trajgen check', its VDA 5050 orders written by "
-            "'trajgen export-vda5050' and drawn by 'trajgen animate'; "
+            "'trajgen export-vda5050', drawn by 'trajgen animate' and simulated by 'trajgen simulate'; "
             "this command does not take one yet: "
             "expected a [track] with legs (docs/graphs.md)"
         )
