@@ -20,6 +20,7 @@ from trajgen.execution.plant import GraphBody, GraphShape
 from trajgen.execution.simulation import parse_faults, simulate
 from trajgen.execution.tracks import GraphTrack
 from trajgen.scenario import GraphScenario, load_scenario
+from trajgen.scenario.graph_sampling import graph_campaign_faults, graph_online_campaign
 
 NAMES = ["h", "passing-loop", "main-line-with-sidings", "ring-with-spurs"]
 
@@ -276,3 +277,28 @@ def test_the_margin_on_a_graph_shrinks_to_what_the_start_and_goal_leave():
     result, _ = simulate(scenario, method="exact")
     assert result.reached_goal
     assert result.violations == 0
+
+
+@pytest.mark.parametrize("method", ["exact", "toppra"])
+def test_seeded_random_track_graphs_with_faults_reach_their_goals_without_a_violation(method):
+    """Trees and graphs with loops, random limits, one to three faults each (the bench's campaign)."""
+    for k, scenario in enumerate(graph_online_campaign(8, seed=23)):
+        verified = schedule_for_execution(scenario, method=method)
+        margin = execution_margin(scenario, 0.05)
+        specs = graph_campaign_faults(scenario, verified.schedule.duration, seed=k, margin=margin)
+        result, _ = simulate(scenario, parse_faults(scenario, specs), verified=verified)
+        assert result.reached_goal, (k, specs)
+        assert result.violations == 0, (k, specs, result.summary())
+        assert result.emergency_brakes == 0, (k, specs)
+
+
+def test_the_campaign_draws_trees_and_loops_whose_start_and_goal_keep_the_separation():
+    scenarios = graph_online_campaign(6, seed=5)
+    assert scenarios == graph_online_campaign(6, seed=5)  # seeded: the same draw
+    for k, scenario in enumerate(scenarios):
+        track = scenario.track
+        cycle = track.edge_count - len(track.nodes) + 1  # independent loops of a connected graph
+        assert (cycle > 0) == (k % 2 == 1), k
+        for pair in (scenario.start, scenario.goal):
+            assert track.distance(*pair) >= scenario.limits.min_separation
+        scenario.route()  # a route exists

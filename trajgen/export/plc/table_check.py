@@ -20,6 +20,7 @@ from limits import Limits
 from topology import JUNCTION_INDEX, GraphRoute, Route
 from topology.validation import short_repr
 from trajgen.errors import InputError
+from trajgen.export.plc.row_separation import row_separation
 from trajgen.export.plc.tables import (
     CROSSING_TOLERANCE,
     END_TOLERANCES,
@@ -35,7 +36,7 @@ from trajgen.model.profiles import PiecewiseCubic
 from trajgen.model.schedule import AxisMap, CubicKinematics, Schedule, Section, TimingMethod
 from trajgen.model.summary import graph_class_label
 from trajgen.model.values import sorted_unique
-from trajgen.verification import POSITION_TOLERANCE, VerificationReport, verify
+from trajgen.verification import VerificationReport, verify
 
 __all__ = [
     "TableCheck",
@@ -491,67 +492,9 @@ def _check_graph_tables(
         failures += _turn_failures(turns, schedule.paths[vehicle], vehicle, tolerance)
     report = verify(schedule)
     failures += list(report.failures)
-    failures += _row_separation(tables, schedule)
+    failures += row_separation(tables, schedule)
     ratios = limit_ratios(tables, limits, jerk=jerk)
     return TableCheck(not failures, tuple(failures), report, ratios, route, schedule)
-
-
-#: The most round-off a row's values are allowed at the rows of a points-only table, metres: a file
-#: written to nanometres, as trajgen writes them. Fewer decimals buy no closer approach.
-ROW_ROUND_OFF = 5e-10
-
-
-def _row_places(
-    path: GraphPath, travel: np.ndarray, lengths: np.ndarray
-) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Where a vehicle's rows put it: edge, metres on it, and how far it is past what its path says.
-
-    Past either end of its path it runs on along the end's edge (a vehicle creeping on); past the
-    edge's end, or anywhere a vehicle that stays put moves, the track does not say which way: that
-    distance is returned as the *overrun*, metres, to take off the separation (the track distance is
-    1-Lipschitz in each position).
-    """
-    edge, s = path.locate(travel, extend=True)
-    if path.edges.size == 0:
-        return edge, s, np.abs(travel)
-    on_edge = np.clip(s, 0.0, lengths[edge])
-    return edge, on_edge, np.abs(s - on_edge)
-
-
-def _row_separation(tables: tuple[ProfileTable, ProfileTable], schedule: GraphSchedule) -> list[str]:
-    """At the points of a table judged by its points only, the separation holds to their round-off.
-
-    The verifier holds such a table (a generic CSV) to its tolerance between the points, where the
-    cubic is the reader's; at the points themselves the file says where the vehicles are. A vehicle
-    the rows move past the end of its path's edge, or that moves at all where its path stays put,
-    has that much less separation. The round-off allowed is at most a nanometre file's
-    (:data:`ROW_ROUND_OFF`).
-    """
-    if min(table.interpolation.closed_form for table in tables) > 0:
-        return []
-    times = sorted_unique(np.concatenate([table.times for table in tables]))
-    travel = schedule.travel(times)[:, 0]
-    track = schedule.track
-    lengths = np.array([edge.length for edge in track.edges])
-    (edge_1, s_1, over_1), (edge_2, s_2, over_2) = (
-        _row_places(path, travel[v], lengths) for v, path in enumerate(schedule.paths)
-    )
-    apart = track.distances(edge_1, s_1, edge_2, s_2) - over_1 - over_2
-    round_off = min(max(t.round_off for t in tables), ROW_ROUND_OFF)
-    allowed = schedule.limits.min_separation - POSITION_TOLERANCE - 2.0 * round_off
-    k = int(np.argmin(apart))
-    if apart[k] >= allowed:
-        return []
-    past = (
-        f", {1e6 * (over_1[k] + over_2[k]):.3g} µm of it off its path or where it stands"
-        if (over_1[k] + over_2[k] > 0.0)
-        else ""
-    )
-    return [
-        f"separation {apart[k]:.9g} m at the row at t={times[k]:.6f} s is below the minimum "
-        f"{schedule.limits.min_separation:g} m (vehicle 1 on {track.edges[edge_1[k]].name!r}, "
-        f"vehicle 2 on {track.edges[edge_2[k]].name!r}{past})"
-    ]
 
 
 def check_tables(
