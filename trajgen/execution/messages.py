@@ -22,6 +22,7 @@ __all__ = [
     "Mode",
     "Setpoint",
     "VehicleState",
+    "check_measured_numbers",
     "checked_names",
     "checked_number",
     "checked_period",
@@ -188,6 +189,22 @@ def checked_names(names: object) -> tuple[str, str]:
     return names
 
 
+def check_measured_numbers(state: object, number: int) -> None:
+    """Refuse ``state`` unless it is a VehicleState whose numbers are finite.
+
+    Raises
+    ------
+    InputError
+        Not a VehicleState, or ``s``, ``velocity`` or ``acceleration`` not a finite number.
+    """
+    if not isinstance(state, VehicleState):
+        raise InputError(f"vehicle {number} state must be a VehicleState, got {type(state).__name__}")
+    for name in ("s", "velocity", "acceleration"):
+        value = getattr(state, name)
+        if not isinstance(value, (int, float)) or not math.isfinite(value):
+            raise InputError(f"vehicle {number} measured {name} must be a finite number, got {value!r}")
+
+
 def checked_state(state: object, number: int, graph: StarGraph) -> VehicleState:
     """``state`` if it is a measured state on ``graph``, clamped to its leg's end by round-off (1 µm).
 
@@ -196,12 +213,7 @@ def checked_state(state: object, number: int, graph: StarGraph) -> VehicleState:
     InputError
         Not a VehicleState, a number that is not finite, an unknown leg, or a position off its leg.
     """
-    if not isinstance(state, VehicleState):
-        raise InputError(f"vehicle {number} state must be a VehicleState, got {type(state).__name__}")
-    for name in ("s", "velocity", "acceleration"):
-        value = getattr(state, name)
-        if not isinstance(value, (int, float)) or not math.isfinite(value):
-            raise InputError(f"vehicle {number} measured {name} must be a finite number, got {value!r}")
+    check_measured_numbers(state, number)
     count = graph.leg_count
     if state.leg != JUNCTION_INDEX and not 0 <= state.leg < count:
         raise InputError(

@@ -13,8 +13,6 @@ from the edge's ``from`` node (a node may be given on any of its edges).
 
 from __future__ import annotations
 
-import math
-
 from limits import Limits
 from topology import (
     JUNCTION_INDEX,
@@ -28,7 +26,7 @@ from topology import (
 )
 from trajgen.errors import InputError
 from trajgen.execution.goals import goal_refusal, graph_schedule_from_rest, schedule_from_rest
-from trajgen.execution.messages import VehicleState, checked_state
+from trajgen.execution.messages import VehicleState, check_measured_numbers, checked_state
 from trajgen.execution.motion import GraphPlanPlayer, PlanPlayer
 from trajgen.model.coordination import schedule_times, schedule_waypoints
 from trajgen.model.graph_paths import GraphPath, graph_paths
@@ -183,12 +181,7 @@ class GraphTrack:
         InputError
             Not a VehicleState, a number that is not finite, an unknown edge, or a position off it.
         """
-        if not isinstance(state, VehicleState):
-            raise InputError(f"vehicle {number} state must be a VehicleState, got {type(state).__name__}")
-        for name in ("s", "velocity", "acceleration"):
-            value = getattr(state, name)
-            if not isinstance(value, (int, float)) or not math.isfinite(value):
-                raise InputError(f"vehicle {number} measured {name} must be a finite number, got {value!r}")
+        check_measured_numbers(state, number)
         count = self.graph.edge_count
         if isinstance(state.leg, bool) or not isinstance(state.leg, int) or not 0 <= state.leg < count:
             raise InputError(

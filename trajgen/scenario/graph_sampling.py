@@ -8,6 +8,7 @@ import random
 from limits import Limits, VehicleLimits
 from topology import EdgePoint, InfeasibleError, TrackGraph, plan_graph
 from trajgen.scenario.graph import GraphScenario
+from trajgen.scenario.sampling import fault_specs
 
 __all__ = ["graph_campaign_faults", "graph_online_campaign", "random_graph_track"]
 
@@ -100,24 +101,9 @@ def graph_campaign_faults(
     As :func:`~trajgen.scenario.sampling.campaign_faults`: stops, slow drives, lags, jumps within
     the position ``margin`` (none if 0), and new goals ``EDGE:s`` anywhere on the track.
     """
-    rng = random.Random(seed)
-    kinds = ["stop", "slow", "lag", "goal"] + (["jump"] if margin > 0.0 else [])
-    specs = []
-    for _ in range(rng.randint(1, 3)):
-        kind = rng.choice(kinds)
-        vehicle = rng.randrange(2)
-        name = scenario.names[vehicle]
-        at = round(rng.uniform(0.0, 0.9) * duration, 3)
-        top = scenario.limits.vehicles[vehicle].max_velocity
-        if kind == "stop":
-            specs.append(f"stop:{name}@{at}+{round(rng.uniform(0.2, 0.3 * duration + 0.5), 3)}")
-        elif kind == "slow":
-            specs.append(f"slow:{name}@{at}={round(rng.uniform(0.2, 0.9) * top, 4)}")
-        elif kind == "lag":
-            specs.append(f"lag:{name}@{at}={rng.randint(10, 200)}")
-        elif kind == "jump":
-            specs.append(f"jump:{name}@{at}={rng.choice((-1, 1)) * round(rng.uniform(0.2, 1.0) * margin, 5)}")
-        else:
-            point = _random_point(rng, scenario.track)
-            specs.append(f"goal:{name}@{at}={scenario.track.edges[point.edge].name}:{point.s:g}")
-    return tuple(specs)
+
+    def place(rng: random.Random) -> str:
+        point = _random_point(rng, scenario.track)
+        return f"{scenario.track.edges[point.edge].name}:{point.s:g}"
+
+    return fault_specs(scenario, duration, seed=seed, margin=margin, place=place)

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import math
 import random
+from collections.abc import Callable
 from dataclasses import dataclass
 
 from limits import Limits, VehicleLimits
@@ -15,6 +16,7 @@ __all__ = [
     "ReferenceSet",
     "campaign_faults",
     "campaign_scenarios",
+    "fault_specs",
     "online_campaign",
     "random_configuration",
     "random_position",
@@ -249,6 +251,30 @@ def campaign_faults(scenario: Scenario, duration: float, *, seed: int, margin: f
     margin : float
         The executor's position margin in this scenario, metres (jumps stay within it; none if 0).
     """
+
+    def place(rng: random.Random) -> str:
+        position = random_position(rng, scenario.track)
+        return "O" if position.leg is None else f"{position.leg}:{math.floor(position.s * 1e4) / 1e4}"
+
+    return fault_specs(scenario, duration, seed=seed, margin=margin, place=place)
+
+
+def fault_specs(
+    scenario, duration: float, *, seed: int, margin: float, place: Callable[[random.Random], str]
+) -> tuple[str, ...]:
+    """One to three random ``--fault`` specs: stops, slow drives, lags, jumps and new goals.
+
+    Parameters
+    ----------
+    scenario : Scenario or GraphScenario
+    duration : float
+        The undisturbed schedule's duration, seconds (the faults' times lie within it).
+    seed : int
+    margin : float
+        The executor's position margin, metres (jumps stay within it; none if 0).
+    place : callable
+        A random goal's text (``LEG:s`` or ``EDGE:s``) from the random generator given.
+    """
     rng = random.Random(seed)
     kinds = ["stop", "slow", "lag", "goal"] + (["jump"] if margin > 0.0 else [])
     specs = []
@@ -267,7 +293,5 @@ def campaign_faults(scenario: Scenario, duration: float, *, seed: int, margin: f
         elif kind == "jump":
             specs.append(f"jump:{name}@{at}={rng.choice((-1, 1)) * round(rng.uniform(0.2, 1.0) * margin, 5)}")
         else:
-            position = random_position(rng, scenario.track)
-            where = "O" if position.leg is None else f"{position.leg}:{math.floor(position.s * 1e4) / 1e4}"
-            specs.append(f"goal:{name}@{at}={where}")
+            specs.append(f"goal:{name}@{at}={place(rng)}")
     return tuple(specs)
