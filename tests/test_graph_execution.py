@@ -302,3 +302,28 @@ def test_the_campaign_draws_trees_and_loops_whose_start_and_goal_keep_the_separa
         for pair in (scenario.start, scenario.goal):
             assert track.distance(*pair) >= scenario.limits.min_separation
         scenario.route()  # a route exists
+
+
+def test_a_throttled_drive_brakes_down_to_its_cap_no_harder_than_its_emergency_deceleration():
+    """A slow fault caps agv1 at 0.2 m/s while it drives at 1 m/s: it brakes at most at 0.75 m/s².
+
+    A drive dropping to its cap within one cycle (80 m/s² here) made the braking check assume the
+    worst of it and brake both hard (a campaign run on a random graph: 5 emergency-brake cycles).
+    """
+    scenario, verified = plan("h", "exact")
+    emergency = scenario.limits.vehicles[0].emergency_braking
+    accelerations, speeds = [], []
+
+    def observe(executor, measured, command):
+        accelerations.append(measured[0].acceleration)
+        speeds.append(abs(measured[0].velocity))
+
+    result, _ = simulate(
+        scenario, parse_faults(scenario, ["slow:agv1@3=0.2"]), verified=verified, observer=observe
+    )
+    assert result.reached_goal
+    assert result.violations == 0
+    assert result.emergency_brakes == 0
+    assert max(speeds[290:310]) > 0.9  # it was at speed when the cap came
+    assert min(accelerations) >= -emergency - 1e-9
+    assert max(speeds[400:]) <= 0.2 + 1e-9  # and then kept to the cap

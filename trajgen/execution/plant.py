@@ -256,10 +256,12 @@ class Plant:
             # within its top speed, and never runs past the setpoint
             correction = _CORRECTION * self.limits.vehicles[v].max_velocity
             v_new = velocity + max(-correction, min(correction, _GAIN * gap))
-            v_new = max(-cap, min(cap, v_new))
+            # throttled below its speed, a drive brakes down to it, at most at its emergency deceleration
+            top = max(cap, abs(body.v) - self.limits.vehicles[v].emergency_braking * dt)
+            v_new = max(-top, min(top, v_new))
             step = v_new * dt
             if wanted * (wanted - step) < 0.0:
-                step, v_new = wanted, min(max(velocity, -cap), cap)
+                step, v_new = wanted, min(max(velocity, -top), top)
             a_new = (v_new - body.v) / dt
             body.j = (a_new - body.a) / dt
             body.a, body.v = a_new, v_new
