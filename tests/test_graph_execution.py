@@ -165,6 +165,7 @@ def test_a_goal_too_close_to_the_other_vehicles_is_refused_and_the_run_goes_on()
     refused = [e.detail for e in result.events if e.kind == "goal-refused"]
     assert refused
     assert "goal (A, A) leaves the vehicles 0.000 m apart: expected at least 1.600 m" in refused[0]
+    assert "(separation + twice the position margin" in refused[0]  # 1.5 + 2 x 0.05
 
 
 def test_a_goal_fault_off_the_graph_names_the_spec():
@@ -327,3 +328,54 @@ def test_a_throttled_drive_brakes_down_to_its_cap_no_harder_than_its_emergency_d
     assert max(speeds[290:310]) > 0.9  # it was at speed when the cap came
     assert min(accelerations) >= -emergency - 1e-9
     assert max(speeds[400:]) <= 0.2 + 1e-9  # and then kept to the cap
+
+
+def test_a_vehicle_that_stays_put_through_a_re_plan_drives_its_next_move_the_right_way():
+    """A plan in which a vehicle does not move keeps the way its axis runs.
+
+    agv1's axis runs against ``s`` (it starts by driving towards J); a new goal for agv2 leaves it
+    where it stands; its own next goal must then be driven towards A (it drove towards J).
+    """
+    track = TrackGraph.from_edges({"a": ("J", "A", 10.0), "b": ("J", "B", 10.0), "c": ("J", "C", 10.0)})
+    drive = VehicleLimits(max_velocity=1.0, max_acceleration=0.5, max_jerk=1.0)
+    limits = Limits((drive, drive), 1.5)
+    scenario = GraphScenario(track, limits, ("agv1", "agv2"), ("a:8", "b:5"), ("a:3", "b:5"))
+    verified = schedule_for_execution(scenario, method="exact")
+    final = []
+
+    def observe(executor, measured, command):
+        final[:] = measured
+
+    faults = parse_faults(scenario, ["goal:agv2@12=b:8", "goal:agv1@30=a:9"])
+    result, _ = simulate(scenario, faults, verified=verified, observer=observe)
+    assert result.reached_goal, result.summary()
+    assert result.replans == 2
+    assert not any("off its setpoints" in e.detail for e in result.events), result.events
+    assert (final[0].leg, final[1].leg) == (0, 1)
+    assert final[0].s == pytest.approx(9.0, abs=0.05)
+    assert final[1].s == pytest.approx(8.0, abs=0.05)
+
+
+@pytest.mark.parametrize(
+    ("seed", "k", "specs", "emergency"),
+    [
+        # a jump back leaves the drive closing the gap faster than planned: restarted at that
+        # speed, it could not stop at its reversal and waited there for ever
+        (9, 7, ("jump:agv1@6.476=-0.04289",), False),
+        (9, 7, ("jump:agv1@6.476=-0.04289", "slow:agv2@2.121=0.4481"), False),
+        # a lagging drive braked hard stops short of its setpoint; the check took it anywhere up to
+        # the setpoint, too close to the other, and braked both, at rest, for ever
+        (12, 3, ("lag:agv1@4.143=174", "slow:agv1@4.814=1.1585"), True),
+    ],
+    ids=["jump", "jump-slow", "lag-slow"],
+)
+def test_campaign_runs_that_never_reached_the_goal_with_toppra_now_do(seed, k, specs, emergency):
+    scenario = graph_online_campaign(k + 1, seed=seed)[k]
+    verified = schedule_for_execution(scenario, method="toppra")
+    result, _ = simulate(scenario, parse_faults(scenario, specs), verified=verified)
+    assert result.reached_goal, result.summary()
+    assert result.violations == 0
+    if not emergency:
+        assert result.emergency_brakes == 0
+    else:  # the lag hides the drive from its setpoints: braking hard is right, but only until at rest
+        assert result.emergency_brakes < 100

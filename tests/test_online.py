@@ -702,6 +702,7 @@ def test_a_goal_too_close_to_the_other_goal_is_refused_with_the_reason(swap):
     decision = executor.request_goal(0, Position("A", 9.0))  # 1 m from vehicle 2's goal A:10
     assert not decision.accepted
     assert "expected at least 1.600 m" in decision.reason
+    assert "(separation + twice the position margin" in decision.reason  # 1.5 + 2 x 0.05
     assert "A:10" in decision.reason
     assert executor.rejected_goals == 1
     assert executor.goal == scenario.goal  # the run continues to the previous goals
@@ -792,3 +793,19 @@ def test_a_setpoint_naming_no_next_leg_leaves_the_plants_vehicle_on_a_leg(plans)
     state = plant.measure()[0]
     assert state.leg >= 0 or state.s == 0.0, state
     checked_state(state, 1, scenario.track)  # what the executor reads: a place on the track
+
+
+def test_a_vehicle_that_stays_put_through_a_re_plan_drives_its_next_move_the_right_way(plans):
+    """A plan in which a vehicle does not move keeps the way its axis runs.
+
+    agv1 stays put while agv2 re-plans; it drove its own next move the wrong way, off its
+    setpoints, and never arrived.
+    """
+    scenario, verified = plans["swap", "exact"]
+    planned = verified.schedule.duration
+    specs = [f"goal:agv1@{planned + 3:g}=B:5", f"goal:agv2@{planned + 30:g}=A:8"]
+    result, _ = simulate(scenario, parse_faults(scenario, specs), verified=verified)
+    assert result.reached_goal, result.summary()
+    assert result.replans == 2
+    assert result.violations == 0
+    assert not any("off its setpoints" in e.detail for e in result.events), result.events

@@ -370,8 +370,44 @@ class Executor:
                     self.holds += 1
                     break
         if not certified:
+            waiting = self._wait_where_they_stand(measured, along, required)
+            if waiting is not None:
+                return waiting
             return self._emergency_stop(measured, "no setpoints keep the braking invariant")
         return self._emit(proposals, tuple(holding), certified=True)
+
+    def _wait_where_they_stand(self, measured, along, required) -> Command | None:
+        """Vehicles at rest short of their setpoints hold where they stand, if that is certified.
+
+        A drive braked to rest before its setpoint (a lag, then an emergency stop) leaves the
+        setpoint ahead of it; the check takes the vehicle anywhere between the two, which can be
+        closer to the other than either is. Holding it where it stands, and restarting from there,
+        is the way out; else the emergency brake would hold both for ever.
+        """
+        still = [
+            v
+            for v in (0, 1)
+            if self._command[v].v <= AT_REST
+            and abs(measured[v].velocity) <= self.velocity_tolerance * 0.02
+            and abs(self._command[v].p - along[v].p) > 1e-9
+        ]
+        if not still:
+            return None
+        trial = [self._motions[v].brake(self._command[v], self.period)[0] for v in (0, 1)]
+        for v in still:
+            trial[v] = PathState(along[v].p, 0.0, 0.0)
+        if not self._guard.certifies(self._paths, (trial[0], trial[1]), along, required, hold=True):
+            return None
+        proposals = []
+        for v in (0, 1):
+            if v in still:
+                reason = f"{self.names[v]} waits where it stands: the braking check"
+                self._leave_plan(v, reason, rebase=trial[v])
+                proposals.append((self._command[v], 0.0, None))
+            else:
+                proposals.append((*self._motions[v].brake(self._command[v], self.period), None))
+        self.holds += 1
+        return self._emit(proposals, (True, True), certified=True)
 
     def _hold_orders(self) -> tuple[tuple[int, ...], ...]:
         """Which vehicles to hold first: the followers of conflicts not yet passed, then both.
@@ -546,31 +582,9 @@ class Executor:
             self._rebased[v] = self._time
 
     def _seed(self, v: int, state: PathState) -> PathState:
-        """A state to restart from: the measured position, within the limits (never backing up).
-
-        The measured velocity and acceleration are taken where they differ from the commanded ones
-        beyond the tolerance (a stop, a slow drive); else the commanded ones go on (a position
-        correction, or a drive closing a gap, does not change the motion asked of it).
-        """
-        limits = self.limits.vehicles[v]
-        top = self._motions[v].speed_limit
-        command = self._command[v]
-        if abs(state.v - command.v) <= self.velocity_tolerance:
-            state = PathState(state.p, command.v, command.a)
-        velocity = min(max(state.v, 0.0), top)
-        acceleration = min(max(state.a, -limits.max_acceleration), limits.max_acceleration)
-        room = top - velocity if acceleration > 0.0 else velocity
-        most = math.sqrt(max(2.0 * limits.max_jerk * room, 0.0))  # a must reach 0 within [0, top]
-        acceleration = min(max(acceleration, -most), most)
-        seed = PathState(state.p, velocity, acceleration)
-        # a drive closing a gap measures a transient acceleration; kept, it could carry the vehicle
-        # past its next reversal or its frontier, which coasting from the same speed would not
+        """A state to restart from at the measured travel (:meth:`VehicleMotion.restart`)."""
         tip = min(self._paths[v].next_stop(state.p, 0.0), self._frontiers[v])
-        if acceleration > 0.0 and not self._stops_by(v, seed, tip):
-            coasting = PathState(state.p, velocity, 0.0)
-            if self._stops_by(v, coasting, tip):
-                return coasting
-        return seed
+        return self._motions[v].restart(state, self._command[v], tip, self.velocity_tolerance)
 
     # -- helpers ---------------------------------------------------------------------------------
     def _refuse(self, reason: str) -> GoalDecision:

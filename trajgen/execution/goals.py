@@ -134,6 +134,6 @@ def goal_refusal(graph: StarGraph, goal: Configuration, required: float) -> str 
     if apart < required:
         return (
             f"goal {goal} leaves the vehicles {apart:.3f} m apart: expected at least {required:.3f} m "
-            "(separation + position margin)"
+            "(separation + twice the position margin: each vehicle may stand that far off its goal)"
         )
     return None

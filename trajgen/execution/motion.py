@@ -20,6 +20,7 @@ from ruckig import ControlInterface, InputParameter, Result, Ruckig, Trajectory
 from limits import VehicleLimits
 from trajgen.errors import ScheduleError
 from trajgen.execution.braking_check import PathState
+from trajgen.model.coordination import stopping_distance
 from trajgen.model.graph_vehicle_path import GraphVehiclePath
 from trajgen.model.paths import VehiclePath
 from trajgen.model.pieces import kinematics_polynomials, schedule_pieces, split_at_values
@@ -161,12 +162,14 @@ class VehicleMotion:
         "_elapsed",
         "_goal",
         "_input",
+        "_limits",
         "_output",
         "_ruckig",
         "trajectory",
     )
 
     def __init__(self, limits: VehicleLimits) -> None:
+        self._limits = limits
         self._ruckig = Ruckig(1)
         self._input = InputParameter(1)
         self._input.max_velocity = [limits.max_velocity]
@@ -250,6 +253,49 @@ class VehicleMotion:
         if t >= self._braking.duration or v <= 0.0:
             return PathState(max(p, state.p), 0.0, 0.0), 0.0
         return PathState(p, v, a), ruckig_jerk(self._braking, t)
+
+    def restart(self, measured: PathState, command: PathState, tip: float, tolerance: float) -> PathState:
+        """A state to restart from at the measured travel, within the limits, that stops by ``tip``.
+
+        The measured velocity and acceleration are taken where they differ from the commanded
+        ones beyond ``tolerance`` (m/s: a stop, a slow drive); else the commanded ones go on (a
+        position correction, or a drive closing a gap, does not change the motion asked of it).
+        A state that could not stop by ``tip`` (the next reversal or frontier, metres of travel)
+        gives way to one that can: coasting at its speed, else the commanded motion. A drive
+        closing a gap measures a transient speed and acceleration; kept, they could carry the
+        vehicle past its reversal or frontier, which the commanded motion would not.
+        """
+        p = measured.p
+        if abs(measured.v - command.v) <= tolerance:
+            measured = PathState(p, command.v, command.a)
+        seed = self._within_limits(measured)
+        if self._stops_by(seed, tip):
+            return seed
+        commanded = self._within_limits(PathState(p, command.v, command.a))
+        for candidate in (
+            PathState(p, seed.v, 0.0),
+            commanded,
+            PathState(p, commanded.v, min(commanded.a, 0.0)),
+        ):
+            if candidate.v <= seed.v and self._stops_by(candidate, tip):
+                return candidate
+        return seed
+
+    def _within_limits(self, state: PathState) -> PathState:
+        """``state`` with its velocity in ``[0, speed limit]`` and an acceleration it can zero within it."""
+        top = self.speed_limit
+        velocity = min(max(state.v, 0.0), top)
+        most_acceleration = self._limits.max_acceleration
+        acceleration = min(max(state.a, -most_acceleration), most_acceleration)
+        room = top - velocity if acceleration > 0.0 else velocity
+        most = math.sqrt(max(2.0 * self._limits.max_jerk * room, 0.0))  # a must reach 0 within [0, top]
+        return PathState(state.p, velocity, min(max(acceleration, -most), most))
+
+    def _stops_by(self, state: PathState, limit: float) -> bool:
+        """Whether jerk-limited service braking from ``state`` comes to rest by travel ``limit``."""
+        if limit == math.inf:
+            return True
+        return state.p + stopping_distance(state.v, state.a, self._limits) <= limit + 1e-9
 
 
 def travel_state(path: VehiclePath, p: float, velocity: float, acceleration: float) -> PathState:

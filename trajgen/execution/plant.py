@@ -192,7 +192,7 @@ class Plant:
                 orientation = path.outward(0.0) * path.heading(0.0)
             else:
                 leg = leg if leg != JUNCTION_INDEX else 0
-                orientation = 1
+                orientation = path.home_orientation
             self.bodies.append(Body(leg, s, orientation, path.axis(0.0), leg))
 
     def measure(self) -> tuple[VehicleState, VehicleState]:
@@ -272,6 +272,6 @@ def _graph_body(path: GraphVehiclePath) -> GraphBody:
     """A vehicle at the start of its path on a track graph, its axis as the path's."""
     if not path.edges:
         edge, s = path.home
-        return GraphBody(edge, s, 1, path.axis(0.0))
+        return GraphBody(edge, s, path.home_orientation, path.axis(0.0))
     orientation = (1 if path.s_to[0] > path.s_from[0] else -1) * path.headings[0]
     return GraphBody(path.edges[0], path.s_from[0], orientation, path.axis(0.0))

@@ -116,12 +116,12 @@ class JunctionTrack:
     def orientation(self, path: VehiclePath, p: float) -> tuple[int, int] | None:
         """``(leg, ds / d axis)`` of a vehicle at travel ``p`` of ``path``.
 
-        ``None`` at the junction, unmoved. An unmoved path's axis grows away from the junction
-        (:class:`~trajgen.model.paths.VehiclePath`).
+        ``None`` at the junction, unmoved. An unmoved path keeps the orientation it was loaded with
+        (:attr:`~trajgen.model.paths.VehiclePath.home_orientation`).
         """
         if not path.legs:
             leg = path.home[0]
-            return None if leg == JUNCTION_INDEX else (leg, 1)
+            return None if leg == JUNCTION_INDEX else (leg, path.home_orientation)
         return path.legs[path.segment(p)], path.outward(p) * path.heading(p)
 
     def goal_with(self, goal: Configuration, vehicle: int, position) -> Configuration:
@@ -241,11 +241,12 @@ class GraphTrack:
     def orientation(self, path: GraphVehiclePath, p: float) -> tuple[int, float, int]:
         """``(edge, s, ds / d axis)`` of a vehicle at travel ``p`` of ``path``.
 
-        An unmoved path's axis grows with ``s`` on its home edge.
+        An unmoved path keeps the orientation it was loaded with on its home edge
+        (:attr:`~trajgen.model.graph_vehicle_path.GraphVehiclePath.home_orientation`).
         """
         if not path.edges:
             edge, s = path.home
-            return edge, s, 1
+            return edge, s, path.home_orientation
         k = path.segment(p)
         edge, s = path.locate(p)
         return edge, s, (1 if path.s_to[k] > path.s_from[k] else -1) * path.headings[k]
@@ -271,7 +272,8 @@ class GraphTrack:
             names = [self.graph.name(point) for point in goal]
             return (
                 f"goal ({names[0]}, {names[1]}) leaves the vehicles {apart:.3f} m apart: expected at "
-                f"least {required:.3f} m (separation + position margin)"
+                f"least {required:.3f} m (separation + twice the position margin: each vehicle may "
+                "stand that far off its goal)"
             )
         return None
 

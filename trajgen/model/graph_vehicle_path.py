@@ -119,6 +119,9 @@ class GraphVehiclePath(TravelAxis):
         ``(edge, s)`` where the vehicle starts (all of a path that does not move).
     edge_lengths : tuple of float
         Every edge's length, metres: a sweep past either end of the path stays on its edge.
+    home_orientation : int
+        ``ds / d axis`` of a path that does not move: the ``orientation`` it was built with (+1 if
+        none). A vehicle that stays put keeps the way its axis runs, so its next plan continues it.
     """
 
     edges: tuple[int, ...]
@@ -131,6 +134,7 @@ class GraphVehiclePath(TravelAxis):
     stops: tuple[float, ...]
     home: tuple[int, float]
     edge_lengths: tuple[float, ...]
+    home_orientation: int = 1
 
     @classmethod
     def from_path(
@@ -171,6 +175,7 @@ class GraphVehiclePath(TravelAxis):
             tuple(float(c) for c in path.cusps),
             (path.home.edge, path.home.s),
             tuple(track.length(k) for k in range(track.edge_count)),
+            -1 if orientation is not None and orientation < 0 else 1,
         )
 
     def _along(self, k: int, p: float) -> float:

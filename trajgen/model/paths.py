@@ -185,6 +185,9 @@ class VehiclePath(TravelAxis):
         Travel at each reversal, ascending, metres.
     home : tuple of (int, float)
         ``(leg, s)`` of a path that does not move (``m == 0``).
+    home_orientation : int
+        ``ds / d axis`` of a path that does not move: the ``orientation`` it was built with (+1 if
+        none). A vehicle that stays put keeps the way its axis runs, so its next plan continues it.
     """
 
     legs: tuple[int, ...]
@@ -196,6 +199,7 @@ class VehiclePath(TravelAxis):
     length: float
     stops: tuple[float, ...]
     home: tuple[int, float]
+    home_orientation: int = 1
 
     @classmethod
     def from_route(
@@ -278,6 +282,7 @@ class VehiclePath(TravelAxis):
             travel,
             tuple(stops),
             home,
+            -1 if orientation is not None and orientation < 0 else 1,
         )
 
     def place(self, p: float) -> tuple[int, float, int, float, int]:
