@@ -184,7 +184,7 @@ def test_demo_runs_a_built_in_scenario_end_to_end(tmp_path, capsys, legs):
 
 def test_demo_refuses_an_unknown_scenario(tmp_path, capsys):
     assert main(["demo", "--scenario", "roundabout", "--output", str(tmp_path / "out")]) == EXIT_BAD_INPUT
-    assert "built-in scenario 'roundabout' is unknown: expected one of ['swap', 'crossing']" in (
+    assert "built-in scenario 'roundabout' is unknown: expected one of ['swap', 'crossing', 'h']" in (
         capsys.readouterr().err
     )
     assert not (tmp_path / "out").exists()

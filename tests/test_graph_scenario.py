@@ -161,14 +161,3 @@ def test_a_bad_graph_scenario_is_refused_naming_the_key(track, positions, match)
     data = _scenario(track if track.lstrip().startswith("[track") else "[track]\n" + track, start=start)
     with pytest.raises(ScenarioError, match=match):
         parse_scenario(data, source="bad.toml")
-
-
-@pytest.mark.parametrize("command", [["serve", "--broker", "mqtt://127.0.0.1:1"]])
-def test_commands_that_do_not_take_a_graph_yet_refuse_it_plainly(command, capsys):
-    assert main([command[0], str(EXAMPLES / "h.toml"), *command[1:]]) == 2
-    assert (
-        "a track with edges (a track graph) is planned by 'trajgen plan', timed by 'trajgen schedule', its "
-        "files checked by 'trajgen check', its VDA 5050 orders written by 'trajgen export-vda5050', "
-        "drawn by 'trajgen animate' and simulated by 'trajgen simulate'; this command does not take one yet"
-        in capsys.readouterr().err
-    )

@@ -136,3 +136,101 @@ def test_a_vehicle_killed_and_restarted_where_it_stood_completes_the_run_safely(
         f"restart: makespan {summary['makespan_s']:.2f} s of the run against a plan of "
         f"{summary['planned_s']:.2f} s; closest states {closest:.3f} m"
     )
+
+
+def test_a_vehicle_killed_on_the_h_and_restarted_where_it_stood_completes_the_run_safely(tmp_path):
+    """A vehicle on a track graph killed mid-run and restarted where it stood: the run completes.
+
+    It says where it is by its last node and the distance past it; restarted there (``--start
+    EDGE:s``), it reports that place as its node, and the master re-plans from it (its new order
+    numbered from 0, as a new order is).
+    """
+    from trajgen.export.vda5050.graph_path import point_id
+    from trajgen.live.places import snapshot_point
+
+    h = str(REPO / "examples" / "graphs" / "h.toml")
+    scenario = load_scenario(h)
+    track = scenario.track
+    broker = (MosquittoBroker() if mosquitto_available() else EmbeddedBroker()).start()
+    places: dict[str, list] = {"agv1": [], "agv2": []}
+    seen: list = []  # (serial, place) in the order heard
+    settings = BrokerSettings.from_url(broker.url)
+    watcher = make_client(settings, "graph-states")
+    watcher.on_connect = lambda client, *_: client.subscribe("uagv/v2/+/+/state")
+
+    def take(client, userdata, message):
+        state = json.loads(message.payload)
+        upcoming = state.get("nodeStates") or []
+        place = snapshot_point(
+            track,
+            state["lastNodeId"],
+            upcoming[0]["nodeId"] if upcoming else "",
+            state.get("distanceSinceLastNode") or 0.0,
+        )
+        places[state["serialNumber"]].append((place, state["driving"]))
+        seen.append((state["serialNumber"], place))
+
+    watcher.on_message = take
+    watcher.connect(settings.host, settings.port)
+    watcher.loop_start()
+    common = ["--broker", broker.url, "--time-scale", f"{SCALE:g}"]
+    processes = {
+        name: _trajgen("vehicle", h, name, *common, "--exit-at-goal", "--timeout", "600")
+        for name in scenario.names
+    }
+    log = tmp_path / "run.jsonl"
+    serve = _trajgen(
+        "serve", h, *common, "--method", "exact", "--json", "--log", str(log), "--timeout", "600"
+    )
+    try:
+        deadline = time.monotonic() + 60.0
+        while not (places["agv1"] and places["agv1"][-1][1]):  # agv1 drives
+            assert time.monotonic() < deadline, "agv1 never drove"
+            time.sleep(0.05)
+        time.sleep(1.0)
+        os.kill(processes["agv1"].pid, signal.SIGKILL)
+        processes["agv1"].wait(10)
+        time.sleep(0.3)
+        here = places["agv1"][-1][0]
+        time.sleep(0.7)
+        processes["agv1"] = _trajgen(
+            "vehicle",
+            h,
+            "agv1",
+            *common,
+            "--start",
+            point_id(track, here),
+            "--exit-at-goal",
+            "--timeout",
+            "600",
+        )
+        out, err = serve.communicate(timeout=240)
+    finally:
+        for process in [serve, *processes.values()]:
+            if process.poll() is None:
+                process.kill()
+        watcher.disconnect()
+        watcher.loop_stop()
+        broker.stop()
+    assert serve.returncode == 0, err
+    summary = json.loads(out)
+    assert summary["outcome"] == "goals-reached"
+    assert summary["replans"] == 1
+    records = [json.loads(line) for line in log.read_text().splitlines()]
+    assert [(r["vehicle"], r["at"]) for r in records if r["event"] == "restart"] == [
+        ("agv1", point_id(track, here))
+    ]
+    assert not [r for r in records if r["event"] == "ignored"], "the new session's states were all taken"
+    assert places["agv1"][-1][0] == track.point("D")
+    assert places["agv2"][-1][0] == track.point("A")
+    # each vehicle's latest reported place at every state: never closer than the separation
+    latest: dict[str, object] = {}
+    closest = float("inf")
+    for serial, place in seen:
+        latest[serial] = place
+        if len(latest) == 2:
+            closest = min(closest, track.distance(latest["agv1"], latest["agv2"]))
+    assert closest >= scenario.limits.min_separation - STATE_SKEW_M
+    print(
+        f"restart on the H: makespan {summary['makespan_s']:.2f} s of the run; closest states {closest:.3f} m"
+    )

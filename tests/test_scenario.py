@@ -292,3 +292,19 @@ def test_random_three_leg_tracks_are_ygraphs_as_before():
     assert track.names == ("A", "B", "C")
     assert track.cycle is not None
     assert isinstance(random_track(random.Random(3), leg_count=5), StarGraph)
+
+
+def test_the_built_in_h_is_the_example_graph_and_ships_as_package_data():
+    example = REPO / "examples" / "graphs" / "h.toml"
+    packaged = resources.files("trajgen").joinpath("data", "h.toml")
+    assert packaged.is_file()
+    assert packaged.read_text() == example.read_text()
+    shipped, from_file = builtin_scenario("h"), load_scenario(example)
+    assert (shipped.track, shipped.limits, shipped.start, shipped.goal) == (
+        from_file.track,
+        from_file.limits,
+        from_file.start,
+        from_file.goal,
+    )
+    assert [e.name for e in shipped.track.edges] == ["a", "b", "m", "c", "e"]
+    assert [shipped.track.name(p) for p in shipped.start] == ["A", "D"]

@@ -56,14 +56,20 @@ def animation_gif(verified, **options) -> bytes:
 
 def scenario_vehicle(scenario, v: int, identity, *, broker, clock, **options):
     """Vehicle ``v`` of ``scenario`` simulated at its start, not started (``options``: SimulatedVehicle's)."""
-    from trajgen.live.session import position_xy
+    from trajgen.live.places import start_place
     from trajgen.live.vehicle import SimulatedVehicle
 
-    start = (scenario.start.first, scenario.start.second)[v]
+    start = (
+        scenario.start[v]
+        if isinstance(scenario.start, tuple)
+        else (scenario.start.first, scenario.start.second)[v]
+    )
+    xy, node = start_place(scenario.track, start)
     return SimulatedVehicle(
         identity,
         scenario.limits.vehicles[v],
-        position_xy(scenario.track, start),
+        xy,
+        start_node=node,
         broker=broker,
         clock=clock,
         **options,

@@ -47,7 +47,7 @@ def _command_animate(args: argparse.Namespace) -> int:
     from trajgen.plots.animation import animate
     from trajgen.plots.gif import encode_gif
 
-    scenario = scenario_from(args.scenario, graph=True)
+    scenario = scenario_from(args.scenario)
     verified = run(scenario, method=scenario_method(args, scenario)).verified
     gif = encode_gif(animate(verified, names=scenario.names, fps=args.fps, max_frames=args.max_frames))
     (written,) = commit_files({path: gif})

@@ -17,7 +17,7 @@ SHOWN_FAILURES = 10
 def _command_check(args: argparse.Namespace) -> int:
     from trajgen.export.plc.check import check_profiles
 
-    scenario = scenario_from(args.scenario, graph=True)
+    scenario = scenario_from(args.scenario)
     verdict = check_profiles(
         scenario, args.csv, dialect=args.dialect, jerk=not args.ignore_jerk, max_points=args.max_points
     )

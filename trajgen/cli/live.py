@@ -12,6 +12,7 @@ from __future__ import annotations
 import argparse
 import json
 import logging
+import math
 import re
 import signal
 import sys
@@ -19,7 +20,7 @@ import threading
 import time
 from pathlib import Path
 
-from topology import Configuration, Position
+from topology import Configuration, EdgePoint, Position, TrackGraph
 from topology.validation import short_repr
 from trajgen.cli.options import add_method, method_from, scenario_from
 from trajgen.cli.parser import EXIT_FAILURE, EXIT_OK
@@ -33,8 +34,8 @@ logger = logging.getLogger(__name__)
 _GOAL = re.compile(r"(?P<at>[^=]+)=(?P<first>[^,]+),(?P<second>.+)")
 
 
-def _goal(text: str) -> tuple[float, Configuration]:
-    """``T=LEG:S,LEG:S``: at T seconds of the run, a new goal for both vehicles."""
+def _goal(text: str, track) -> tuple[float, Configuration | tuple[EdgePoint, EdgePoint]]:
+    """``T=LEG:S,LEG:S`` (``T=EDGE:S,EDGE:S`` on a track graph): at T s of the run, both new goals."""
     match = _GOAL.fullmatch(text.strip())
     try:
         at = float(match["at"]) if match else float("nan")
@@ -45,6 +46,8 @@ def _goal(text: str) -> tuple[float, Configuration]:
             f"--goal-at {short_repr(text)} cannot be read: expected T=LEG:S,LEG:S (T seconds of the run "
             ">= 0, then both vehicles' new goals, e.g. 20=C:8,A:10)"
         )
+    if isinstance(track, TrackGraph):  # checked here: a goal off the track is refused before connecting
+        return at, (track.point(match["first"].strip()), track.point(match["second"].strip()))
     return at, Configuration(Position.parse(match["first"]), Position.parse(match["second"]))
 
 
@@ -162,7 +165,7 @@ def _command_serve(args: argparse.Namespace) -> int:
 
     require_live("paho", "trajgen serve")
     scenario = scenario_from(args.scenario)
-    goals = sorted((_goal(text) for text in args.goal_at), key=lambda goal: goal[0])
+    goals = sorted((_goal(text, scenario.track) for text in args.goal_at), key=lambda goal: goal[0])
     check_output_paths([args.log] + ([args.plot] if args.plot else []))
     settings = _settings(args)
     ids = _identities(args, scenario)
@@ -196,17 +199,20 @@ def _command_serve(args: argparse.Namespace) -> int:
     return _report(run, args, planning=planning)
 
 
-def _start(args: argparse.Namespace, scenario, v: int) -> Position:
+def _start(args: argparse.Namespace, scenario, v: int) -> Position | EdgePoint:
     """Where the vehicle stands when it starts: ``--start`` (a restart), else its scenario start."""
+    track = scenario.track
+    if isinstance(track, TrackGraph):
+        return track.point(args.start.strip() if args.start is not None else scenario.start[v])
     if args.start is None:
         return (scenario.start.first, scenario.start.second)[v]
-    return scenario.track.check(Position.parse(args.start))
+    return track.check(Position.parse(args.start))
 
 
 def _command_vehicle(args: argparse.Namespace) -> int:
     from trajgen.errors import LiveError
     from trajgen.live.clock import RunClock
-    from trajgen.live.session import position_xy
+    from trajgen.live.places import start_place
     from trajgen.live.vehicle import SimulatedVehicle, StopFault
 
     require_live("paho", "trajgen vehicle")
@@ -220,10 +226,12 @@ def _command_vehicle(args: argparse.Namespace) -> int:
     if args.timeout is not None and not args.timeout > 0.0:
         raise InputError(f"vehicle --timeout {args.timeout!r} is not positive: expected run seconds > 0")
     clock = RunClock(args.time_scale)
+    start, start_node = start_place(scenario.track, _start(args, scenario, v))
     vehicle = SimulatedVehicle(
         _identities(args, scenario)[v],
         scenario.limits.vehicles[v],
-        position_xy(scenario.track, _start(args, scenario, v)),
+        start,
+        start_node=start_node,
         broker=_settings(args),
         clock=clock,
         state_rate=args.state_rate,
@@ -250,8 +258,12 @@ def _command_vehicle(args: argparse.Namespace) -> int:
         raise LiveError(vehicle.link.failure)
     snapshot = vehicle.snapshot
     run_time = vehicle.since_first_order
+    places = [f"x={snapshot.x:.3f} m, y={snapshot.y:.3f} m"] if not math.isnan(snapshot.x) else []
+    if snapshot.node:  # where its orders give no x/y, its node says where it is
+        places.append(f"{snapshot.along:.3f} m past node {snapshot.node}")
+    where = ", ".join(places) or "an unknown place"
     print(
-        f"vehicle {args.name}: stopped at x={snapshot.x:.3f} m, y={snapshot.y:.3f} m "
+        f"vehicle {args.name}: stopped at {where} "
         + (f"{run_time:.3f} s after its first order" if run_time is not None else "without any order")
         + f" ({'at its goal' if snapshot.finished else 'not at a goal'})"
     )
@@ -331,7 +343,7 @@ def register(commands) -> None:
         default=[],
         metavar="T=LEG:S,LEG:S",
         help="at T s of the run, new goals for both vehicles (repeatable): both stop at\n"
-        "their released base, then are re-planned from there",
+        "their released base, then are re-planned from there (EDGE:S or a node on a track graph)",
     )
     serve.add_argument(
         "--timeout", type=float, help="seconds of the run, after planning, before giving up (4x plan + 60)"
@@ -363,7 +375,8 @@ def register(commands) -> None:
     vehicle.add_argument(
         "--start",
         metavar="LEG:S",
-        help="where it stands at start (a restart mid-run); default: its start in the scenario",
+        help="where it stands at start (a restart mid-run; EDGE:S or a node on a track graph);\n"
+        "default: its start in the scenario",
     )
     vehicle.add_argument(
         "--timeout",

@@ -11,7 +11,7 @@ from __future__ import annotations
 import argparse
 import dataclasses
 
-from trajgen.errors import OptionError, ScenarioError
+from trajgen.errors import OptionError
 from trajgen.export import DEFAULT_MAX_ROWS, CsvOptions, Units
 from trajgen.export.plc.dialects import DIALECTS
 from trajgen.methods import METHODS
@@ -30,26 +30,9 @@ __all__ = [
 ]
 
 
-def scenario_from(path: str | None, *, graph: bool = False) -> Scenario:
-    """The scenario of a file, or the built-in one for ``None``.
-
-    Raises
-    ------
-    ScenarioError
-        A track graph (``[track]`` with ``edges``) where the command takes junctions only
-        (``graph=False``): today ``trajgen plan``, ``schedule``, ``check``, ``export-vda5050``,
-        ``animate`` and ``simulate`` take graphs.
-    """
-    scenario = default_scenario() if path is None else load_scenario(path)
-    if isinstance(scenario, GraphScenario) and not graph:
-        raise ScenarioError(
-            f"{scenario.source}: a track with edges (a track graph) is planned by 'trajgen plan', timed by "
-            "'trajgen schedule', its files checked by 'trajgen check', its VDA 5050 orders written by "
-            "'trajgen export-vda5050', drawn by 'trajgen animate' and simulated by 'trajgen simulate'; "
-            "this command does not take one yet: "
-            "expected a [track] with legs (docs/graphs.md)"
-        )
-    return scenario
+def scenario_from(path: str | None) -> Scenario | GraphScenario:
+    """The scenario of a file (a junction's or a track graph's), or the built-in one for ``None``."""
+    return default_scenario() if path is None else load_scenario(path)
 
 
 #: The generic CSV's options and their defaults (``None`` in the parser, so a given one is known).

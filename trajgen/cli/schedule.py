@@ -42,7 +42,7 @@ def _command_plan(args: argparse.Namespace) -> int:
                 f"--plot {args.plot!r} does not name a .png file: expected a file name ending in .png"
             )
         check_output_paths([picture])  # before planning: a bad path is refused at once
-    scenario = scenario_from(args.scenario, graph=True)
+    scenario = scenario_from(args.scenario)
     route = scenario.route()
     if isinstance(route, GraphRoute):
         report = verify_graph_route(route)
@@ -76,7 +76,7 @@ def _route_picture(route, names) -> bytes:
 
 
 def _command_schedule(args: argparse.Namespace) -> int:
-    scenario = scenario_from(args.scenario, graph=True)
+    scenario = scenario_from(args.scenario)
     outputs = Outputs(
         csv_dir=args.csv,
         plot_dir=args.plot,
@@ -110,7 +110,8 @@ def _command_demo(args: argparse.Namespace) -> int:
         print(json.dumps(result.summary(), indent=2))
         return EXIT_OK
     print(f"Demo: the built-in scenario {scenario.source} ({chosen.description}).")
-    print(format_route(result.route))
+    route = result.route
+    print(format_graph_route(route, scenario.names) if isinstance(route, GraphRoute) else format_route(route))
     print(format_run(result.summary()))
     print(f"CSV profiles and plots are in {args.output}/")
     return EXIT_OK

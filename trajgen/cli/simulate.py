@@ -16,7 +16,7 @@ def _command_simulate(args: argparse.Namespace) -> int:
     from trajgen.export.csv import CsvOptions
     from trajgen.simulation_pipeline import format_simulation, run_simulation  # the executor and its Ruckig
 
-    scenario = scenario_from(args.scenario, graph=True)
+    scenario = scenario_from(args.scenario)
     run = run_simulation(
         scenario,
         args.fault,

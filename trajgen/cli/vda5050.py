@@ -93,7 +93,7 @@ def _command_export(args: argparse.Namespace) -> int:
     from trajgen.model.summary import provenance
     from trajgen.pipeline import run
 
-    scenario = scenario_from(args.scenario, graph=True)
+    scenario = scenario_from(args.scenario)
     method = scenario_method(args, scenario)
     names = scenario.names
     options = Vda5050Options(

@@ -240,7 +240,8 @@ class Executor:
         required = self.limits.min_separation + 2.0 * self.position_margin
         reason = self._track.goal_refusal(candidate, required)
         if reason is not None:
-            return self._refuse(f"{self.names[vehicle]}: {reason}")
+            why = "separation + twice the position margin: each vehicle may stand that far off its goal"
+            return self._refuse(f"{self.names[vehicle]}: {reason} ({why})")
         self._next_goal = candidate
         self._log(
             "goal-accepted",

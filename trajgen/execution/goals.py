@@ -132,8 +132,5 @@ def goal_refusal(graph: StarGraph, goal: Configuration, required: float) -> str 
     """Why ``goal`` cannot be taken (the vehicles would end closer than ``required`` metres), or ``None``."""
     apart = graph.separation(goal)
     if apart < required:
-        return (
-            f"goal {goal} leaves the vehicles {apart:.3f} m apart: expected at least {required:.3f} m "
-            "(separation + twice the position margin: each vehicle may stand that far off its goal)"
-        )
+        return f"goal {goal} leaves the vehicles {apart:.3f} m apart: expected at least {required:.3f} m"
     return None

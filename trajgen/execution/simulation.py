@@ -301,6 +301,7 @@ def simulate(
             raise FaultError(
                 f"fault {fault.spec!r}: jump beyond the position margin {margin!r} m kept in this scenario"
             )
+    given = verified
     if verified is None:
         verified = schedule_for_execution(scenario, method=method, position_margin=position_margin)
     executor = Executor(
@@ -434,6 +435,9 @@ def simulate(
         schedule=verified,
         position_margin=margin,
         unapplied_faults=unapplied,
-        method=for_execution(method).name,
+        # a plan handed in without a method: the method asked for is the one that computed it
+        method=for_execution(method).name
+        if method is not None or given is None
+        else given.schedule.method.name,
     )
     return result, spool

@@ -272,8 +272,7 @@ class GraphTrack:
             names = [self.graph.name(point) for point in goal]
             return (
                 f"goal ({names[0]}, {names[1]}) leaves the vehicles {apart:.3f} m apart: expected at "
-                f"least {required:.3f} m (separation + twice the position margin: each vehicle may "
-                "stand that far off its goal)"
+                f"least {required:.3f} m"
             )
         return None
 

@@ -24,6 +24,8 @@ latest order (a vehicle ignores one it already has).
 A new goal: no more base is released; once both vehicles stand at their
 decision points, the planner plans from there and each vehicle gets an order
 update stitched where it stands, with the new path.
+On a junction or a track graph alike: what differs (node ids, goals, re-plans, where a
+vehicle stands) is the executor's track and :mod:`trajgen.live.places`.
 """
 
 from __future__ import annotations
@@ -35,17 +37,17 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from topology import Configuration
+from topology import Configuration, EdgePoint
 from trajgen.errors import InputError
-from trajgen.execution.goals import goal_refusal, schedule_from_rest
-from trajgen.export.vda5050.messages import node_id
+from trajgen.execution.tracks import execution_track
+from trajgen.export.vda5050.messages import path_node_id
 from trajgen.export.vda5050.release import BaseRelease, order_releases
 from trajgen.live.clock import RunClock
-from trajgen.live.geometry import track_position
 from trajgen.live.link import BrokerLink
 from trajgen.live.mqtt import BrokerSettings, Topic, VehicleIdentity, make_client
 from trajgen.live.orders import horizon_length, order_message, path_elements
 from trajgen.live.outcome import LiveOutcome, LiveRun
+from trajgen.live.places import live_goal, restart_place
 from trajgen.live.runlog import RunLog
 from trajgen.live.view import (
     GIVE_UP_AFTER_S,
@@ -54,9 +56,9 @@ from trajgen.live.view import (
     RESEND_INTERVAL_S,
     RESEND_MAX_S,
     VehicleView,
-    never_heard_message,
     not_taken_message,
     reported_order,
+    run_failure,
 )
 from trajgen.methods import METHODS
 from trajgen.model.summary import provenance
@@ -116,7 +118,8 @@ class LiveMaster:
         self.spacing = spacing
         if len(identities) != 2 or identities[0].topic("") == identities[1].topic(""):
             raise InputError("live vehicles must have two different identities (one topic each)")
-        self.graph = verified.schedule.route.graph
+        self._track = execution_track(verified.schedule)
+        self.graph = self._track.graph
         self.limits = verified.schedule.limits
         self.names = tuple(names)
         self.method = method
@@ -136,7 +139,7 @@ class LiveMaster:
         }
         self._lock = threading.RLock()
         self._done = threading.Event()
-        self._goal: Configuration | None = None
+        self._goal: Configuration | tuple[EdgePoint, EdgePoint] | None = None
         self._rule: BaseRelease | None = None
         self._started_at: float | None = None  # run clock at the first orders: the run's time 0
         self._broker_at: float | None = None  # run clock at the first connection to the broker
@@ -154,14 +157,17 @@ class LiveMaster:
         self.link = BrokerLink(self._client, broker, who="master", on_connected=self._connected)
 
     # ----------------------------------------------------------------- plans and orders
-    def _adopt(self, verified: VerifiedSchedule, *, first: bool) -> None:
-        """Take a new plan: paths, release rule, and (after a goal change) the stitch offsets."""
+    def _adopt(self, verified: VerifiedSchedule, *, first: bool, fresh=(False, False)) -> None:
+        """Take a new plan: paths, release rule, and (after a goal change) the stitch offsets.
+
+        ``fresh``: vehicles restarted without their order; a new order numbers its nodes from 0.
+        """
         self._plan_goal = verified.schedule.route.goal
         plan = order_releases(verified, spacing=self.spacing)
         rule = BaseRelease(plan.paths, verified.schedule.limits.min_separation)
         for v, view in enumerate(self._views):
             if not first:
-                view.offset += 2 * view.node
+                view.offset = 0 if fresh[v] else view.offset + 2 * view.node
                 start = view.arcs[view.node]
             else:
                 start = 0.0
@@ -373,7 +379,8 @@ class LiveMaster:
         self._report_errors(view, state)
         if view.rejoined:
             view.rejoined = False
-            if not state.order_id and state.agv_position is not None:  # restarted: its order is gone
+            placed = state.agv_position is not None or bool(state.last_node_id)
+            if not state.order_id and placed:  # restarted: its order is gone
                 self._recover(v, state)
                 return
         expected = f"{self.order_id}-{view.name}"
@@ -411,26 +418,14 @@ class LiveMaster:
         view.state_header = state.header_id
         view.node = max(view.node, j)
         view.driving = state.driving
-        self.log.write(
-            {
-                "t": self._now(),
-                "event": "state",
-                "vehicle": view.name,
-                "x": state.agv_position.x if state.agv_position else None,
-                "y": state.agv_position.y if state.agv_position else None,
-                "node": view.node + view.offset // 2,
-                "along_m": view.arcs[j] + (state.distance_since_last_node or 0.0),
-                "driving": state.driving,
-            }
-        )
+        self.log.write(view.state_record(state, j, self._now()))
         released = self._release()
         if released:
             self._latencies.append(time.perf_counter() - taken)
         self._check_end()
 
     def _node_id(self, v: int, j: int) -> str:
-        node = self._views[v].path.nodes[j]
-        return node_id(self.graph, node.leg, node.s)
+        return path_node_id(self.graph, self._views[v].path, j)
 
     def _release(self) -> int:
         """Take the nodes reached into the rule and send the releases that follow; their count."""
@@ -456,35 +451,42 @@ class LiveMaster:
             self._done.set()
 
     # ----------------------------------------------------------------- goals
-    def request_goal(self, goal: Configuration) -> None:
+    def request_goal(self, goal) -> None:
         """Ask for a new goal: both vehicles stop at their bases, then are re-planned from there.
+
+        ``goal``: a Configuration on a junction; on a track graph both vehicles' positions
+        (``"EDGE:s"``, a node's name, or an EdgePoint).
 
         Raises
         ------
         InputError
             ``goal`` is not on the track, or leaves the vehicles closer than the separation.
         """
-        if not isinstance(goal, Configuration):
-            raise InputError(f"live goal must be a Configuration, got {type(goal).__name__}")
-        goal = Configuration(self.graph.check(goal.first), self.graph.check(goal.second))
-        refusal = goal_refusal(self.graph, goal, self.limits.min_separation)
+        goal = live_goal(self.graph, goal)
+        refusal = self._track.goal_refusal(goal, self.limits.min_separation)
         if refusal is not None:
-            raise InputError(refusal)
+            raise InputError(f"{refusal} (the separation)")
         with self._lock:
             self._goal = goal
             self._done.clear()
-            self.log.write({"t": self._now(), "event": "goal", "goal": str(goal)})
+            self.log.write({"t": self._now(), "event": "goal", "goal": self._track.name(goal)})
             logger.info("master: new goal %s: holding both vehicles at their bases", goal)
             self._maybe_replan()
 
     def _recover(self, v: int, state) -> None:
         """A vehicle back without its order (restarted): hold the other, re-plan from where both stand."""
         view = self._views[v]
-        view.restart = track_position(self.graph, state.agv_position.x, state.agv_position.y)
+        try:
+            view.restart = restart_place(self.graph, state)
+        except InputError as error:
+            topic = view.identity.topic(Topic.STATE)
+            self._ignore(topic, f"back without its order at no place on the track: {error}", view.name)
+            return
         view.driving = state.driving
         if self._goal is None:
             self._goal = self._plan_goal
-        self.log.write({"t": self._now(), "event": "restart", "vehicle": view.name, "at": str(view.restart)})
+        at = self._track.name(view.restart)
+        self.log.write({"t": self._now(), "event": "restart", "vehicle": view.name, "at": at})
         logger.warning("master: %s is back without its order, at %s: re-planning", view.name, view.restart)
         self._maybe_replan()
 
@@ -497,14 +499,17 @@ class LiveMaster:
             for v, view in enumerate(views)
         ):
             return
-        start = Configuration(*(view.standing(self.graph) for view in views))
+        start = self._track.start_of(tuple(view.standing(self.graph) for view in views))
+        fresh = (views[0].restart is not None, views[1].restart is not None)
         for view in views:
             view.restart = None
         goal, self._goal = self._goal, None
-        verified = schedule_from_rest(self.graph, self.limits, start, goal, method=self.method, margin=0.0)
+        verified = self._track.plan_from_rest(
+            self.limits, start, goal, method=self.method, margin=0.0, names=self.names
+        )
         self._counts["replans"] += 1
-        self.log.write({"t": self._now(), "event": "replan", "goal": str(goal)})
-        self._adopt(verified, first=False)
+        self.log.write({"t": self._now(), "event": "replan", "goal": self._track.name(goal)})
+        self._adopt(verified, first=False, fresh=fresh)
         for v in (0, 1):
             self._send(v, 0, self._rule.released[v])
         self._check_end()
@@ -554,18 +559,6 @@ class LiveMaster:
         """Disconnect."""
         self.link.close()
 
-    def _failure(self, outcome: LiveOutcome) -> str | None:
-        if outcome is LiveOutcome.BROKER_FAILED:
-            return self.link.failure
-        if outcome is LiveOutcome.ORDER_NOT_TAKEN:
-            return self._gave_up
-        if outcome is LiveOutcome.TIMED_OUT and not self.link.ever_connected:
-            return f"master: the broker {self.broker.url} was never reached (retried until the time limit)"
-        silent = [view for view in self._views if not view.heard]
-        if outcome is LiveOutcome.TIMED_OUT and self._started_at is None and silent:
-            return f"master: no order was sent: {never_heard_message(silent)}"
-        return None
-
     def result(self) -> LiveRun:
         """The run so far (see :class:`LiveRun`); logs its end."""
         with self._lock:
@@ -589,7 +582,14 @@ class LiveMaster:
                 self._counts["replans"],
                 latency,
                 dict(self._provenance),
-                self._failure(outcome),
+                run_failure(
+                    outcome,
+                    self.link,
+                    gave_up=self._gave_up,
+                    broker_url=self.broker.url,
+                    sent=self._started_at is not None,
+                    silent=[view for view in self._views if not view.heard],
+                ),
                 self._waits(),
             )
             end = {"t": self._now(), "event": "end", "outcome": outcome.value, "makespan_s": run.makespan}

@@ -16,13 +16,14 @@ import threading
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
-from topology import StarGraph
+from topology import StarGraph, TrackGraph
 from trajgen.errors import InputError
 from trajgen.execution.goals import schedule_for_execution
 from trajgen.live.clock import RunClock
 from trajgen.live.geometry import position_xy, track_position
 from trajgen.live.master import RELEASE_SPACING, LiveMaster, LiveRun
 from trajgen.live.mqtt import DEFAULT_INTERFACE, DEFAULT_VERSION, BrokerSettings, VehicleIdentity
+from trajgen.live.places import snapshot_point, start_place
 from trajgen.live.runlog import RunLog
 from trajgen.live.vehicle import SimulatedVehicle, StopFault, VehicleSnapshot
 from trajgen.verification import VerifiedSchedule
@@ -171,12 +172,13 @@ class LiveDemo:
         url = self.broker_url if self.broker_url is not None else self.broker.url
         settings = BrokerSettings.from_url(url)
         ids = identities(scenario.names)
-        starts = (scenario.start.first, scenario.start.second)
+        starts = [start_place(scenario.track, position) for position in _starts(scenario)]
         self.vehicles = tuple(
             SimulatedVehicle(
                 ids[v],
                 scenario.limits.vehicles[v],
-                position_xy(scenario.track, starts[v]),
+                starts[v][0],
+                start_node=starts[v][1],
                 broker=settings,
                 clock=self.clock,
                 faults=self.faults[v],
@@ -256,13 +258,13 @@ class ClosestApproach:
 
     Parameters
     ----------
-    graph : StarGraph
+    graph : StarGraph or TrackGraph
     """
 
     #: Snapshots kept per vehicle while the other has not reached their moment.
     MAX_WAITING = 1000
 
-    def __init__(self, graph: StarGraph) -> None:
+    def __init__(self, graph: StarGraph | TrackGraph) -> None:
         self.graph = graph
         self.closest = math.inf
         self.compared = 0
@@ -274,6 +276,12 @@ class ClosestApproach:
         """Snapshots kept, waiting for the other vehicle's of the same moment."""
         with self._lock:
             return len(self._waiting[0]) + len(self._waiting[1])
+
+    def _place(self, snapshot: VehicleSnapshot):
+        """Where a snapshot puts its vehicle on the track: by its x/y on a junction, its nodes on a graph."""
+        if isinstance(self.graph, TrackGraph):
+            return snapshot_point(self.graph, snapshot.node, snapshot.next_node, snapshot.along)
+        return track_position(self.graph, snapshot.x, snapshot.y)
 
     def observer(self, vehicle: int) -> Callable[[VehicleSnapshot], None]:
         """What vehicle ``vehicle`` (0 or 1) calls with each cycle's snapshot."""
@@ -291,9 +299,12 @@ class ClosestApproach:
                 return
             for old in [m for m in self._waiting[1 - vehicle] if m < moment]:
                 del self._waiting[1 - vehicle][old]  # never matched now: the vehicles step together
-            graph = self.graph
-            distance = graph.distance(
-                track_position(graph, snapshot.x, snapshot.y), track_position(graph, other.x, other.y)
-            )
+            distance = self.graph.distance(self._place(snapshot), self._place(other))
             self.closest = min(self.closest, distance)
             self.compared += 1
+
+
+def _starts(scenario) -> tuple:
+    """Both vehicles' starts: Positions on a junction, EdgePoints on a track graph."""
+    start = scenario.start
+    return (start.first, start.second) if hasattr(start, "first") else tuple(start)

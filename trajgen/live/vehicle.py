@@ -11,12 +11,15 @@ a last will of CONNECTIONBROKEN.
 
 Positions are the order's node positions (metres, the map's x/y), interpolated
 along each edge: the vehicle knows no more of the track than its orders say.
+Where an order gives no position (a track graph without coordinates, a curved
+edge) it drives by the edges' ``length`` and reports where it is by its last
+node and ``distanceSinceLastNode`` alone, as a line-guided vehicle does
+(:mod:`trajgen.live.driven_path`).
 """
 
 from __future__ import annotations
 
 import contextlib
-import itertools
 import logging
 import math
 import queue
@@ -29,6 +32,7 @@ from limits import VehicleLimits
 from topology.validation import short_repr
 from trajgen.errors import InputError
 from trajgen.live.clock import RunClock
+from trajgen.live.driven_path import NODE_TOLERANCE, DrivenPath
 from trajgen.live.faults import StopFault
 from trajgen.live.link import BrokerLink
 from trajgen.live.mqtt import BrokerSettings, Topic, VehicleIdentity, make_client
@@ -37,12 +41,8 @@ __all__ = ["SimulatedVehicle", "StopFault", "VehicleSnapshot"]
 
 logger = logging.getLogger(__name__)
 
-#: A node is reached within this of its position along the path, metres.
-NODE_TOLERANCE = 1e-6
 #: Slower than this is at rest, m/s.
 AT_REST = 1e-6
-#: Cosine below which the directions of two edges meeting at a node are opposite: a reversal.
-_REVERSAL_COSINE = -0.999
 #: How far ahead of its decision point the vehicle asks for more base (``newBaseRequest``), metres.
 _BASE_REQUEST_DISTANCE = 2.0
 #: Wall seconds the drive loop sleeps between its catch-ups.
@@ -58,13 +58,18 @@ class VehicleSnapshot:
     time : float
         Seconds of the run.
     x, y : float
-        Metres, map coordinates.
+        Metres, map coordinates (NaN where its orders give none).
     velocity : float
         Along its path, m/s (>= 0).
     last_node : int
         How many nodes of its current order it has passed (0: at its first node).
     finished : bool
         At rest at the last node of an order with no horizon left.
+    node, next_node : str
+        The ids of the last node it passed (its start node before any order) and of the next
+        (``""`` at the end of its order).
+    along : float
+        Metres driven past ``node`` towards ``next_node``.
     """
 
     time: float
@@ -73,65 +78,9 @@ class VehicleSnapshot:
     velocity: float
     last_node: int
     finished: bool
-
-
-class _Path:
-    """The nodes and edges of the current order (merged with its updates), with arc lengths."""
-
-    def __init__(self, nodes: list, edges: list) -> None:
-        self.nodes: list = []
-        self.edges: list = []
-        self.arcs = [0.0]
-        self.extend(0, nodes, edges, first=True)
-
-    def extend(self, stitch: int, nodes: list, edges: list, *, first: bool = False) -> None:
-        """Replace everything after node ``stitch`` by ``nodes[1:]`` and ``edges`` (``first``: all)."""
-        self.nodes = list(nodes) if first else self.nodes[: stitch + 1] + list(nodes[1:])
-        self.edges = list(edges) if first else self.edges[:stitch] + list(edges)
-        self.arcs = self.arcs[: stitch + 1]
-        for a, b in itertools.pairwise(self.nodes[stitch:]):
-            pa, pb = a.node_position, b.node_position
-            self.arcs.append(self.arcs[-1] + math.hypot(pb.x - pa.x, pb.y - pa.y))
-
-    @property
-    def base_end(self) -> int:
-        """Index of the decision point (the last released node)."""
-        return max(k for k, node in enumerate(self.nodes) if node.released)
-
-    def reversal(self, k: int) -> bool:
-        """Whether the path turns back at node ``k``."""
-        if not 0 < k < len(self.nodes) - 1:
-            return False
-        incoming = self._direction(k - 1, k)
-        outgoing = self._direction(k, k + 1)
-        if incoming is None or outgoing is None:
-            return False
-        return incoming[0] * outgoing[0] + incoming[1] * outgoing[1] < _REVERSAL_COSINE
-
-    def _direction(self, a: int, b: int) -> tuple[float, float] | None:
-        # an edge of zero length (at the junction) has the direction of its neighbours
-        while a >= 0 and b < len(self.nodes):
-            pa, pb = self.nodes[a].node_position, self.nodes[b].node_position
-            length = math.hypot(pb.x - pa.x, pb.y - pa.y)
-            if length > NODE_TOLERANCE:
-                return ((pb.x - pa.x) / length, (pb.y - pa.y) / length)
-            a, b = (a - 1, b) if a > 0 else (a, b + 1)
-        return None
-
-    def point(self, p: float) -> tuple[float, float, float]:
-        """``(x, y, theta)`` at arc length ``p``."""
-        k = 0
-        while k + 1 < len(self.arcs) - 1 and self.arcs[k + 1] <= p:
-            k += 1
-        if len(self.nodes) == 1:
-            position = self.nodes[0].node_position
-            return position.x, position.y, 0.0
-        a, b = self.nodes[k].node_position, self.nodes[k + 1].node_position
-        length = self.arcs[k + 1] - self.arcs[k]
-        f = 0.0 if length <= 0.0 else min(max((p - self.arcs[k]) / length, 0.0), 1.0)
-        direction = self._direction(k, k + 1)
-        theta = math.atan2(direction[1], direction[0]) if direction is not None else 0.0
-        return a.x + f * (b.x - a.x), a.y + f * (b.y - a.y), theta
+    node: str = ""
+    next_node: str = ""
+    along: float = 0.0
 
 
 class SimulatedVehicle:
@@ -142,8 +91,8 @@ class SimulatedVehicle:
     identity : VehicleIdentity
     limits : VehicleLimits
         Its own velocity, acceleration and jerk limits (SI).
-    start : (float, float)
-        Where it stands, metres (map x, y).
+    start : (float, float) or None
+        Where it stands, metres (map x, y); ``None``: a line-guided vehicle that knows its node only.
     broker : BrokerSettings
     clock : RunClock, optional
         The run's clock (shared with others in the process to compare their times).
@@ -158,13 +107,15 @@ class SimulatedVehicle:
         Keep a :class:`VehicleSnapshot` of every cycle (:attr:`trace`; for tests: it grows with the run).
     observer : callable, optional
         Called with each cycle's :class:`VehicleSnapshot` (in the vehicle's thread).
+    start_node : str, optional
+        The id of the node it stands at (its ``lastNodeId`` until its first order; ``""``: none).
     """
 
     def __init__(
         self,
         identity: VehicleIdentity,
         limits: VehicleLimits,
-        start: tuple[float, float],
+        start: tuple[float, float] | None,
         *,
         broker: BrokerSettings,
         clock: RunClock | None = None,
@@ -174,6 +125,7 @@ class SimulatedVehicle:
         map_id: str = "trajgen",
         record: bool = False,
         observer: Callable[[VehicleSnapshot], None] | None = None,
+        start_node: str = "",
     ) -> None:
         from ruckig import InputParameter, OutputParameter, Ruckig
 
@@ -191,7 +143,8 @@ class SimulatedVehicle:
         self.map_id = map_id
         self.record = record
         self.observer = observer
-        self._start = (float(start[0]), float(start[1]))
+        self._start = (math.nan, math.nan) if start is None else (float(start[0]), float(start[1]))
+        self._start_node = start_node
         self._otg = Ruckig(1, self.period)
         self._input = InputParameter(1)
         self._output = OutputParameter(1)
@@ -200,7 +153,7 @@ class SimulatedVehicle:
         self._input.max_jerk = [limits.max_jerk]
         self._t = 0.0
         self._p = self._v = self._a = 0.0
-        self._path: _Path | None = None
+        self._path: DrivenPath | None = None
         self._last = 0
         self._order = None  # the accepted order, merged with its updates (vda5050 Order)
         self._state = None  # the last state published (vda5050 State)
@@ -210,7 +163,7 @@ class SimulatedVehicle:
         self._event = True
         self._next_state = 0.0
         self._lock = threading.Lock()
-        self._snapshot = VehicleSnapshot(0.0, *self._start, 0.0, 0, False)
+        self._snapshot = VehicleSnapshot(0.0, *self._start, 0.0, 0, False, start_node)
         self._trace: list[VehicleSnapshot] = []
         self._halt = threading.Event()
         self._thread: threading.Thread | None = None
@@ -370,9 +323,14 @@ class SimulatedVehicle:
         ):
             self._reject("orderError", "the order names another vehicle", references)
             return
-        if any(node.node_position is None for node in order.nodes):
+        if any(node.node_position is None for node in order.nodes) and any(
+            edge.length is None for edge in order.edges
+        ):
             self._reject(
-                "orderError", "a node has no nodePosition: this vehicle drives by positions", references
+                "orderError",
+                "a node has no nodePosition and an edge no length: this vehicle drives by positions or "
+                "by edge lengths",
+                references,
             )
             return
         session = VehicleSession(
@@ -392,12 +350,13 @@ class SimulatedVehicle:
         if result.decision is AcceptanceDecision.ACCEPT_NEW:
             if self._first_order is None:
                 self._first_order = self._t
-            self._path = _Path(list(order.nodes), list(order.edges))
+            self._path = DrivenPath(list(order.nodes), list(order.edges))
             self._order = order
             self._last = 0
             self._p = self._v = self._a = 0.0
-            x, y, _ = self._path.point(0.0)
-            self._start = (x, y)
+            here = self._path.point(0.0)
+            self._start = (math.nan, math.nan) if here is None else here[:2]
+            self._start_node = order.nodes[0].node_id
         else:
             stitch = next(
                 k for k, node in enumerate(self._path.nodes) if node.sequence_id == order.nodes[0].sequence_id
@@ -488,9 +447,17 @@ class SimulatedVehicle:
             and abs(self._v) <= AT_REST
         )
 
+    def _where(self) -> tuple[float, float, float] | None:
+        """``(x, y, theta)`` now, ``None`` where its orders give no position."""
+        if self._path is not None:
+            return self._path.point(self._p)
+        return None if math.isnan(self._start[0]) else (*self._start, 0.0)
+
     def _update_snapshot(self) -> None:
-        x, y, _ = self._path.point(self._p) if self._path is not None else (*self._start, 0.0)
-        snapshot = VehicleSnapshot(self._t, x, y, self._v, self._last, self._finished())
+        x, y, _ = self._where() or (math.nan, math.nan, 0.0)
+        path = self._path
+        place = path.place(self._p, self._last) if path is not None else (self._start_node, "", 0.0)
+        snapshot = VehicleSnapshot(self._t, x, y, self._v, self._last, self._finished(), *place)
         with self._lock:
             self._snapshot = snapshot
             if self.record:
@@ -503,7 +470,8 @@ class SimulatedVehicle:
 
         path = self._path
         self._headers[Topic.STATE] += 1
-        x, y, theta = path.point(self._p) if path is not None else (*self._start, 0.0)
+        where = self._where()
+        theta = where[2] if where is not None else 0.0
         nodes = path.nodes if path is not None else []
         edges = path.edges if path is not None else []
         last = nodes[self._last] if nodes else None
@@ -516,7 +484,7 @@ class SimulatedVehicle:
             serial_number=self.identity.serial_number,
             order_id=self._order.order_id if self._order is not None else "",
             order_update_id=self._order.order_update_id if self._order is not None else 0,
-            last_node_id=last.node_id if last is not None else "",
+            last_node_id=last.node_id if last is not None else self._start_node,
             last_node_sequence_id=last.sequence_id if last is not None else 0,
             node_states=[
                 {"node_id": n.node_id, "sequence_id": n.sequence_id, "released": n.released}
@@ -526,10 +494,12 @@ class SimulatedVehicle:
                 {"edge_id": e.edge_id, "sequence_id": e.sequence_id, "released": e.released}
                 for e in edges[self._last :]
             ],
-            agv_position={
+            agv_position=None
+            if where is None
+            else {
                 "position_initialized": True,
-                "x": x,
-                "y": y,
+                "x": where[0],
+                "y": where[1],
                 "theta": theta,
                 "map_id": self.map_id,
             },

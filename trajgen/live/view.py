@@ -2,8 +2,10 @@
 
 from __future__ import annotations
 
-from topology import JUNCTION_INDEX, Position
+from topology import JUNCTION_INDEX, EdgePoint, Position
+from trajgen.export.vda5050.graph_path import GraphPathNode
 from trajgen.live.mqtt import Topic, VehicleIdentity
+from trajgen.live.outcome import LiveOutcome
 
 __all__ = [
     "GIVE_UP_AFTER_S",
@@ -15,6 +17,7 @@ __all__ = [
     "never_heard_message",
     "not_taken_message",
     "reported_order",
+    "run_failure",
 ]
 
 #: Wall seconds between re-sends to a vehicle whose states show it lacks the latest order (at first;
@@ -53,6 +56,23 @@ def never_heard_message(silent) -> str:
     return f"{names} never came online (nothing on {topics}; are they started, with these serial numbers?)"
 
 
+def run_failure(outcome, link, *, gave_up: str | None, broker_url: str, sent: bool, silent) -> str | None:
+    """Why a live run ended early (its :class:`~trajgen.live.outcome.LiveOutcome`), or ``None``.
+
+    ``link``: the master's BrokerLink; ``gave_up``: why it gave a vehicle up; ``sent``: whether the
+    first orders went out; ``silent``: the views of vehicles never heard.
+    """
+    if outcome is LiveOutcome.BROKER_FAILED:
+        return link.failure
+    if outcome is LiveOutcome.ORDER_NOT_TAKEN:
+        return gave_up
+    if outcome is LiveOutcome.TIMED_OUT and not link.ever_connected:
+        return f"master: the broker {broker_url} was never reached (retried until the time limit)"
+    if outcome is LiveOutcome.TIMED_OUT and not sent and silent:
+        return f"master: no order was sent: {never_heard_message(silent)}"
+    return None
+
+
 class VehicleView:
     """What the master knows of one vehicle."""
 
@@ -79,12 +99,31 @@ class VehicleView:
         self.rejoined = False  # back online: its first state tells whether it kept its order
         self.restart: Position | None = None  # where it stands after a restart without its order
 
-    def standing(self, graph) -> Position:
-        """Where it stands: where it restarted, else the last node of its path it reached."""
+    def standing(self, graph) -> Position | EdgePoint:
+        """Where it stands: where it restarted, else the last node of its path it reached.
+
+        A Position on a junction, an EdgePoint on a track graph.
+        """
         if self.restart is not None:
             return self.restart
         node = self.path.nodes[self.node]
+        if isinstance(node, GraphPathNode):
+            return node.point
         return Position(None, 0.0) if node.leg == JUNCTION_INDEX else Position(graph.names[node.leg], node.s)
+
+    def state_record(self, state, j: int, t: float) -> dict:
+        """The run log's record of ``state``, which says it reached node ``j``, at run time ``t``."""
+        position = state.agv_position
+        return {
+            "t": t,
+            "event": "state",
+            "vehicle": self.name,
+            "x": position.x if position else None,
+            "y": position.y if position else None,
+            "node": self.node + self.offset // 2,
+            "along_m": self.arcs[j] + (state.distance_since_last_node or 0.0),
+            "driving": state.driving,
+        }
 
     def new_errors(self, state) -> list[tuple[str, str]]:
         """``(errorType, errorDescription)`` of the state's errors not reported before (each once)."""

@@ -71,6 +71,9 @@ class BuiltinScenario(Option):
     #: a 4-way crossing N/W/S/E of 10 m legs: two AGVs at the ends of N and S cross straight over,
     #: so one waits in a side leg while the other passes (``examples/crossing.toml``)
     CROSSING = "crossing"
+    #: an H of two Y junctions joined by an 8 m middle edge, a track graph: two AGVs swap the ends
+    #: A and D, one waits in a side edge while the other passes (``examples/graphs/h.toml``)
+    H = "h"
 
     @classmethod
     def lookup(cls, name: object) -> BuiltinScenario:
@@ -98,6 +101,8 @@ class BuiltinScenario(Option):
         """What happens in it, for people."""
         if self is BuiltinScenario.SWAP:
             return "two AGVs swap ends of legs A and B"
+        if self is BuiltinScenario.H:
+            return "a track graph, an H of two junctions: two AGVs swap its ends A and D"
         return "a 4-way crossing: two AGVs cross from N to S and S to N, one waits in a side leg"
 
 
@@ -504,13 +509,13 @@ def _parse_text(text: str, source: str, folder: Path | None = None) -> Scenario 
     return parse_scenario(data, source=source, folder=folder)
 
 
-def builtin_scenario(name: BuiltinScenario | str = BuiltinScenario.SWAP) -> Scenario:
+def builtin_scenario(name: BuiltinScenario | str = BuiltinScenario.SWAP) -> Scenario | GraphScenario:
     """A scenario shipped with trajgen, by name (:class:`BuiltinScenario`).
 
     Parameters
     ----------
     name : BuiltinScenario or str, optional
-        ``"swap"`` (default, :func:`default_scenario`) or ``"crossing"``.
+        ``"swap"`` (default, :func:`default_scenario`), ``"crossing"``, or ``"h"`` (a track graph).
 
     Raises
     ------

@@ -30,7 +30,7 @@ from trajgen.model.paths import MOVE_RESOLUTION
 from trajgen.model.pieces import kinematics_polynomials, shift
 from trajgen.model.polynomials import derivative, extrema
 
-__all__ = ["GraphOrderPath", "GraphPathEdge", "GraphPathNode", "graph_vehicle_path"]
+__all__ = ["GraphOrderPath", "GraphPathEdge", "GraphPathNode", "graph_vehicle_path", "point_id"]
 
 #: A claim: stretches ``(edge, low, high)`` of track edges, metres from each edge's ``from`` node.
 Claim = tuple[tuple[int, float, float], ...]
@@ -165,11 +165,7 @@ class GraphOrderPath:
         places keep distinct ids.
         """
         point = self.nodes[index].point
-        node = self.track.node_at(point)
-        if node is not None:
-            return self.track.nodes[node]
-        metres = f"{point.s:.{self._decimals(point.edge)}f}".rstrip("0").rstrip(".")
-        return f"{self.track.edges[point.edge].name}:{metres}"
+        return point_id(self.track, point, decimals=self._decimals(point.edge))
 
     def _decimals(self, edge: int) -> int:
         """Decimal places of the metres in the ids of the path's nodes on ``edge``: 6, or 9 if needed."""
@@ -349,3 +345,22 @@ def graph_vehicle_path(
             )
         )
     return GraphOrderPath(schedule.track, tuple(nodes), tuple(order_edges))
+
+
+def point_id(track: TrackGraph, point: EdgePoint, *, decimals: int = 6) -> str:
+    """The VDA 5050 node id of ``point``: a track node's name, or ``"<edge>:<metres>"``.
+
+    The metres to ``decimals`` places (1 µm by default), trailing zeros dropped; parsed back by
+    :meth:`~topology.TrackGraph.point`.
+
+    Examples
+    --------
+    >>> track = TrackGraph.from_edges({"a": ("J", "A", 6.0), "b": ("J", "B", 6.5)})
+    >>> point_id(track, EdgePoint(1, 6.5)), point_id(track, EdgePoint(0, 3.25))
+    ('B', 'a:3.25')
+    """
+    node = track.node_at(point)
+    if node is not None:
+        return track.nodes[node]
+    metres = f"{point.s:.{decimals}f}".rstrip("0").rstrip(".")
+    return f"{track.edges[point.edge].name}:{metres}"

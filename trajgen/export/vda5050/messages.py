@@ -34,6 +34,7 @@ __all__ = [
     "node_id",
     "order_document",
     "order_elements",
+    "path_node_id",
     "render_manifest",
     "render_orders",
 ]
@@ -181,8 +182,8 @@ def _graph_edge(path: GraphOrderPath, index: int, sequence: int, released: bool)
     )
 
 
-def _node_name(graph: StarGraph | TrackGraph, path: OrderPath | GraphOrderPath, index: int) -> str:
-    """The id of node ``index`` of ``path``."""
+def path_node_id(graph: StarGraph | TrackGraph, path: OrderPath | GraphOrderPath, index: int) -> str:
+    """The id of node ``index`` of ``path`` (a junction's ``graph``; a graph path knows its track)."""
     if isinstance(path, GraphOrderPath):
         return path.node_id(index)
     node = path.nodes[index]
@@ -430,7 +431,7 @@ def _manifest(
     graph = _layout(schedule)
 
     def node_ref(vehicle: int, index: int) -> dict:
-        return {"node_id": _node_name(graph, plan.paths[vehicle], index), "sequence_id": 2 * index}
+        return {"node_id": path_node_id(graph, plan.paths[vehicle], index), "sequence_id": 2 * index}
 
     entries = []
     for message in messages:
@@ -461,7 +462,7 @@ def _manifest(
             "manufacturer": options.manufacturers[vehicle],
             "serial_number": options.serial_number(vehicle, names),
             "order_id": f"{options.order_id}-{name}",
-            "nodes": [_node_name(graph, path, index) for index in range(len(path.nodes))],
+            "nodes": [path_node_id(graph, path, index) for index in range(len(path.nodes))],
             "messages": sum(1 for m in messages if m.vehicle == vehicle),
         }
     return {

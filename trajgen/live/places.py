@@ -1,0 +1,87 @@
+"""Where live vehicles stand and go, on a junction or a track graph: goals, restarts, start nodes.
+
+On a junction a vehicle says where it is by its map x/y (``agvPosition``: the legs drawn at their
+angles, :mod:`trajgen.live.geometry`); on a track graph, whose edges may curve and whose nodes may
+have no coordinates, by its ``lastNodeId``: a node's name or ``"EDGE:s"``, a position on the track
+(:func:`~trajgen.export.vda5050.graph_path.point_id`).
+"""
+
+from __future__ import annotations
+
+from topology import Configuration, EdgePoint, StarGraph, TrackGraph
+from trajgen.errors import InputError
+from trajgen.export.vda5050.graph_path import point_id
+from trajgen.live.geometry import position_xy, track_position
+
+__all__ = ["live_goal", "restart_place", "snapshot_point", "start_place"]
+
+
+def live_goal(graph: StarGraph | TrackGraph, goal) -> Configuration | tuple[EdgePoint, EdgePoint]:
+    """``goal`` checked on the track: a Configuration on a junction, a pair of EdgePoints on a graph.
+
+    Raises
+    ------
+    InputError
+        Not a goal for both vehicles, or a position not on the track.
+    """
+    if isinstance(graph, TrackGraph):
+        if not isinstance(goal, tuple | list) or len(goal) != 2:
+            raise InputError(f"live goal must be two positions on the track, got {goal!r:.80}")
+        return (graph.point(goal[0]), graph.point(goal[1]))
+    if not isinstance(goal, Configuration):
+        raise InputError(f"live goal must be a Configuration, got {type(goal).__name__}")
+    return Configuration(graph.check(goal.first), graph.check(goal.second))
+
+
+def restart_place(graph: StarGraph | TrackGraph, state):
+    """Where a vehicle back without its order stands (its VDA 5050 ``state``).
+
+    Raises
+    ------
+    InputError
+        Its ``lastNodeId`` names no place on the track graph.
+    """
+    if isinstance(graph, TrackGraph):
+        return graph.point(state.last_node_id)
+    return track_position(graph, state.agv_position.x, state.agv_position.y)
+
+
+def start_place(graph: StarGraph | TrackGraph, position) -> tuple[tuple[float, float] | None, str]:
+    """What a simulated vehicle standing at ``position`` knows: its map x/y and its node's id.
+
+    On a junction its x/y (and no node id); on a track graph its node id alone (no x/y: the
+    first order's first node must be that node, as VDA 5050 takes it).
+    """
+    if isinstance(graph, TrackGraph):
+        return None, point_id(graph, graph.point(position))
+    return position_xy(graph, position), ""
+
+
+def snapshot_point(track: TrackGraph, node: str, next_node: str, along: float) -> EdgePoint:
+    """The point ``along`` metres past node id ``node`` towards ``next_node`` on ``track``.
+
+    Consecutive nodes of a path lie on one track edge (every track node a path passes is a node of
+    it). Of parallel edges joining two track nodes, the first long enough is taken: the release
+    nodes split every edge longer than their spacing, so only edges that short are ambiguous.
+
+    Raises
+    ------
+    InputError
+        A node id that names no place on the track.
+    """
+    here = track.point(node)
+    if not next_node or along <= 0.0:
+        return here
+    there = track.point(next_node)
+    edges = [here.edge] if here.edge == there.edge else []
+    edges += [
+        k
+        for k in range(track.edge_count)
+        if track.position_on(here, k) is not None and track.position_on(there, k) is not None
+    ]
+    if not edges:
+        raise InputError(f"nodes {node!r} and {next_node!r} share no edge of the track")
+    spans = [(k, track.position_on(here, k), track.position_on(there, k)) for k in edges]
+    k, low, high = next((span for span in spans if abs(span[2] - span[1]) >= along - 1e-9), spans[0])
+    step = min(along, abs(high - low))
+    return track.point(EdgePoint(k, low + step if high >= low else low - step))
