@@ -12,7 +12,7 @@ import time
 from datetime import datetime
 
 from tests.support.helpers import execution_plan
-from tests.test_live import Tap
+from tests.support.live import Tap
 from trajgen.live.faults import StopFault
 from trajgen.live.outcome import LiveOutcome
 from trajgen.live.session import LiveDemo
