@@ -22,8 +22,10 @@ run = outcome.run
 print(f"outcome: {run.outcome.value} after {run.makespan:.1f} s of the run (plan {run.planned:.1f} s)")
 print(f"{run.orders} orders and order updates, {run.ignored} messages ignored")
 print(f"closest approach on the true places: {outcome.closest:.3f} m (separation 1.5 m)")
-for name, vehicle in zip(scenario.names, outcome.vehicles, strict=True):
+# where each vehicle truly stands, from its last node and the metres past it (no x/y on a curve)
+for name, vehicle, goal in zip(scenario.names, outcome.vehicles, scenario.goal, strict=True):
     snapshot = vehicle.snapshot
     place = snapshot_point(scenario.track, snapshot.node, snapshot.next_node, snapshot.along)
-    print(f"{name} stands at {scenario.track.name(place)} (its last node {snapshot.node})")
+    away = scenario.track.distance(place, goal)
+    print(f"{name} stands at {scenario.track.name(place)}, {away:.3f} m from its goal")
 outcome.log.close()

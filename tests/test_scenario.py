@@ -60,7 +60,7 @@ def test_example_file_is_the_built_in_scenario_and_ships_as_package_data(legs):
 
 def test_builtin_scenario_refuses_an_unknown_name():
     with pytest.raises(
-        InputError, match=r"built-in scenario 'ring' is unknown: expected one of \['swap', 'crossing'\]"
+        InputError, match=r"built-in scenario 'ring' is unknown: expected one of \['swap', 'crossing', 'h'\]"
     ):
         builtin_scenario("ring")
 
