@@ -31,6 +31,8 @@ from trajgen.live.vehicle import StopFault
 from trajgen.scenario import load_scenario
 
 H = EXAMPLES / "h.toml"
+#: What a command says of a place on an edge the H does not have.
+NOT_ON_THE_H = "edge 'zz' is not on the track: expected one of ['a', 'b', 'm', 'c', 'e']"
 
 
 @functools.cache
@@ -248,7 +250,9 @@ def test_serve_drives_two_vehicle_processes_through_the_h_over_a_real_broker(tmp
 def test_a_goal_off_the_graph_is_refused_before_serve_connects(capsys):
     status = main(["serve", str(H), "--broker", "mqtt://127.0.0.1:1", "--goal-at", "5=C,zz:1"])
     assert status == 2
-    assert "zz" in capsys.readouterr().err
+    assert (
+        "edge 'zz' is not on the track: expected one of ['a', 'b', 'm', 'c', 'e']" in capsys.readouterr().err
+    )
 
 
 def test_demo_live_runs_the_built_in_h(tmp_path, capsys):
@@ -260,3 +264,11 @@ def test_demo_live_runs_the_built_in_h(tmp_path, capsys):
     assert status == 0, out
     assert "goals-reached" in out
     assert (tmp_path / "live-run.png").read_bytes()[:4] == b"\x89PNG"
+
+
+def test_a_vehicle_started_off_the_graph_is_refused_before_it_connects(capsys):
+    status = main(["vehicle", str(H), "agv1", "--broker", "mqtt://127.0.0.1:1", "--start", "zz:1"])
+    assert status == 2
+    assert (
+        "edge 'zz' is not on the track: expected one of ['a', 'b', 'm', 'c', 'e']" in capsys.readouterr().err
+    )
