@@ -11,6 +11,7 @@ import pytest
 
 from limits import Limits, VehicleLimits
 from tests.support.graph_cases import EXAMPLES
+from tests.support.helpers import stop_bound
 from topology import EdgePoint, TrackGraph
 from trajgen.cli import main
 from trajgen.errors import InputError
@@ -30,15 +31,6 @@ def plan(name: str, method: str):
     """The example ``name``'s scenario and its verified plan for execution by ``method``, once."""
     scenario = load_scenario(EXAMPLES / f"{name}.toml")
     return scenario, schedule_for_execution(scenario, method=method)
-
-
-def stop_bound(scenario, duration: float) -> float:
-    """What a stop of ``duration`` seconds may cost at most: D + 3 max_i(v_i/a_i + a_i/j_i) + 1 s."""
-    slack = max(
-        v.max_velocity / v.max_acceleration + v.max_acceleration / v.max_jerk
-        for v in scenario.limits.vehicles
-    )
-    return duration + 3.0 * slack + 1.0
 
 
 @pytest.mark.parametrize("method", ["exact", "toppra"])

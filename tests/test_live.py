@@ -17,8 +17,8 @@ import time
 
 import pytest
 
-from tests.support.helpers import REPO, execution_plan, scenario_vehicle
-from tests.support.live import FAST, HOP_S, Tap, new_broker, serve_with_vehicle_processes
+from tests.support.helpers import REPO, execution_plan, scenario_vehicle, stop_bound
+from tests.support.live import FAST, HOP_S, Tap, logged_serve, new_broker, serve_with_vehicle_processes
 from tests.support.vda5050_reference import schema_errors
 from topology import Configuration, Position
 from trajgen.cli import main
@@ -179,12 +179,8 @@ def test_a_stop_fault_makes_the_other_wait_and_costs_at_most_the_online_bound():
     assert stopped.run.outcome is LiveOutcome.GOALS_REACHED
     assert math.isfinite(stopped.closest)
     assert stopped.closest >= scenario.limits.min_separation - 1e-9
-    slack = max(
-        v.max_velocity / v.max_acceleration + v.max_acceleration / v.max_jerk
-        for v in scenario.limits.vehicles
-    )
     latency = 2 * HOP_S * FAST["time_scale"]  # seconds of the run: a state and an update, scaled
-    assert stopped.run.makespan <= free.makespan + duration + 3.0 * slack + 1.0 + latency
+    assert stopped.run.makespan <= free.makespan + stop_bound(scenario, duration) + latency
 
 
 def test_a_new_goal_mid_run_stops_both_at_their_bases_and_replans_from_there():
@@ -486,17 +482,7 @@ def test_serve_drives_two_vehicle_processes_and_commits_its_log_and_picture(tmp_
             str(REPO / "examples" / "swap.toml"),
             ["--broker", broker.url, "--time-scale", "25"],
             vehicle=["--state-rate", "1", "--exit-at-goal"],
-            serve=[
-                "--method",
-                "exact",
-                "--log",
-                str(tmp_path / "run.jsonl"),
-                "--plot",
-                str(tmp_path / "run.png"),
-                "--timeout",
-                "300",
-                "--json",
-            ],
+            serve=logged_serve(tmp_path),
         )
     assert status == 0
     summary = json.loads(capsys.readouterr().out)

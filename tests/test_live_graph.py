@@ -17,7 +17,8 @@ from types import SimpleNamespace
 import pytest
 
 from tests.support.graph_cases import EXAMPLES
-from tests.support.live import FAST, HOP_S, Tap, new_broker, serve_with_vehicle_processes
+from tests.support.helpers import stop_bound
+from tests.support.live import FAST, HOP_S, Tap, logged_serve, new_broker, serve_with_vehicle_processes
 from tests.support.vda5050_reference import schema_errors
 from topology import EdgePoint, TrackGraph
 from trajgen.cli import main
@@ -169,12 +170,8 @@ def test_a_stop_fault_on_the_h_makes_the_other_wait_and_costs_at_most_the_online
     assert stopped.run.outcome is LiveOutcome.GOALS_REACHED
     assert math.isfinite(stopped.closest)
     assert stopped.closest >= scenario.limits.min_separation - 1e-6
-    slack = max(
-        v.max_velocity / v.max_acceleration + v.max_acceleration / v.max_jerk
-        for v in scenario.limits.vehicles
-    )
     latency = 2 * HOP_S * FAST["time_scale"]
-    assert stopped.run.makespan <= free.run.makespan + duration + 3.0 * slack + 1.0 + latency
+    assert stopped.run.makespan <= free.run.makespan + stop_bound(scenario, duration) + latency
     assert stopped.run.makespan > free.run.makespan + 0.5 * duration  # the stop did hold the run up
 
 
@@ -213,17 +210,7 @@ def test_serve_drives_two_vehicle_processes_through_the_h_over_a_real_broker(tmp
                 str(H),
                 ["--broker", broker.url, "--time-scale", "25"],
                 vehicle=["--state-rate", "2", "--exit-at-goal", "--timeout", "600"],
-                serve=[
-                    "--method",
-                    "exact",
-                    "--log",
-                    str(tmp_path / "run.jsonl"),
-                    "--plot",
-                    str(tmp_path / "run.png"),
-                    "--timeout",
-                    "300",
-                    "--json",
-                ],
+                serve=logged_serve(tmp_path),
             )
         finally:
             tap.close()

@@ -19,7 +19,7 @@ from ruckig import ControlInterface, InputParameter, Ruckig, Trajectory
 
 from limits import ILLUSTRATIVE_LIMITS, Limits, VehicleLimits
 from tests.conftest import REPO
-from tests.support.helpers import execution_plan
+from tests.support.helpers import execution_plan, stop_bound
 from topology import JUNCTION_INDEX, Configuration, Position, StarGraph, YGraph
 from topology.indexed import separation as indexed_separation
 from trajgen import builtin_scenario, certify, default_scenario, load_scenario, make_schedule
@@ -334,17 +334,6 @@ def test_a_stop_that_runs_past_a_goal_at_the_junction_is_not_certified(tmp_path)
 
 
 # -- the executor: undisturbed, every method plays its plan -------------------------------------
-
-STOP_BOUND_SLACK = 1.0  # seconds: the "+ 1 s" of the bound D + 3 max(v/a + a/j) + 1 s
-
-
-def stop_bound(scenario, duration: float) -> float:
-    """What a stop of ``duration`` seconds may cost at most: D + 3 max_i(v_i/a_i + a_i/j_i) + 1 s."""
-    slack = max(
-        v.max_velocity / v.max_acceleration + v.max_acceleration / v.max_jerk
-        for v in scenario.limits.vehicles
-    )
-    return duration + 3.0 * slack + STOP_BOUND_SLACK
 
 
 @pytest.fixture(scope="module")

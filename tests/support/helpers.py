@@ -74,3 +74,16 @@ def scenario_vehicle(scenario, v: int, identity, *, broker, clock, **options):
         clock=clock,
         **options,
     )
+
+
+#: The "+ 1 s" of the online stop bound D + 3 max_i(v_i/a_i + a_i/j_i) + 1 s, seconds.
+STOP_BOUND_SLACK = 1.0
+
+
+def stop_bound(scenario, duration: float) -> float:
+    """What a stop of ``duration`` seconds may cost at most: D + 3 max_i(v_i/a_i + a_i/j_i) + 1 s."""
+    slack = max(
+        v.max_velocity / v.max_acceleration + v.max_acceleration / v.max_jerk
+        for v in scenario.limits.vehicles
+    )
+    return duration + 3.0 * slack + STOP_BOUND_SLACK

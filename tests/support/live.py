@@ -73,3 +73,9 @@ def serve_with_vehicle_processes(
     finally:
         outputs = [p.communicate(timeout=30) for p in processes]
     return status, outputs, processes
+
+
+def logged_serve(folder, *, method: str = "exact") -> list[str]:
+    """``trajgen serve`` options of a test run: its plan's method, a run log and picture in ``folder``."""
+    log, picture = str(folder / "run.jsonl"), str(folder / "run.png")
+    return ["--method", method, "--log", log, "--plot", picture, "--timeout", "300", "--json"]
