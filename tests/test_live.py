@@ -808,3 +808,33 @@ def test_a_retained_online_of_an_earlier_run_sends_no_second_order():
             master.stop()
             fake.close()
     assert sorted(order["serialNumber"] for order in fake.orders) == sorted(scenario.names)
+
+
+def test_nothing_is_released_to_a_vehicle_back_online_before_its_first_state_says_it_kept_its_order():
+    """A release to or for a vehicle back online waits for its first state.
+
+    A restarted vehicle takes any order before its first state (it cannot yet say where it is): a
+    release sent then would start where it no longer stands.
+    """
+    scenario, verified = execution_plan("swap", "exact")
+    with _master_and_fakes(scenario, verified) as (master, fake):
+        _until(lambda: len(fake.orders) >= 2, 5.0)
+        v = _releasing_vehicle(verified, master.spacing)
+        other = 1 - v
+        orders = {o["serialNumber"]: o for o in fake.orders}
+        first, theirs = orders[scenario.names[v]], orders[scenario.names[other]]
+        fake.publish(other, fake.state(other, theirs, 0))
+        for state in ("OFFLINE", "ONLINE"):  # the other drops off and comes back
+            fake.publish(
+                other,
+                connection_message(fake.ids[other], state),
+                topic=fake.ids[other].topic(Topic.CONNECTION),
+            )
+        time.sleep(0.2)
+        sent = len(fake.orders)
+        fake.publish(v, fake.state(v, first, _last_base(first)))  # at its decision point: a release is due
+        time.sleep(0.5)
+        assert len(fake.orders) == sent  # held: the other has not said yet whether it kept its order
+        fake.publish(other, fake.state(other, theirs, 0, headerId=1))  # it did (its headers count afresh)
+        assert _until(lambda: len(fake.orders) > sent, 5.0)
+    assert master.result().ignored == 0

@@ -25,7 +25,8 @@ from trajgen.cli import main
 from trajgen.errors import InputError
 from trajgen.export.vda5050.graph_path import point_id
 from trajgen.live.driven_path import DrivenPath
-from trajgen.live.master import LiveOutcome
+from trajgen.live.master import LiveMaster, LiveOutcome
+from trajgen.live.mqtt import BrokerSettings, VehicleIdentity
 from trajgen.live.places import live_goal, restart_place, snapshot_point, start_place
 from trajgen.live.session import LiveDemo, live_plan
 from trajgen.live.vehicle import StopFault
@@ -259,3 +260,39 @@ def test_a_vehicle_started_off_the_graph_is_refused_before_it_connects(capsys):
     assert (
         "edge 'zz' is not on the track: expected one of ['a', 'b', 'm', 'c', 'e']" in capsys.readouterr().err
     )
+
+
+def test_a_start_within_a_micrometre_of_a_node_is_that_node_as_the_master_reads_it_back():
+    """A vehicle reports the node id its place reads back as.
+
+    ``--start west:0.0000004`` was reported as ``west:0``, which the master reads back as node W and
+    starts its order there: the vehicle refused every order as not reachable.
+    """
+    track = load_scenario(EXAMPLES / "passing-loop.toml").track
+    for text in ("west:0.0000004", "west:0", "W", "west:2.5"):
+        _, node = start_place(track, text)
+        assert point_id(track, track.point(node)) == node, text
+    assert start_place(track, "west:0.0000004")[1] == "W"
+
+
+def test_a_bad_goal_at_on_a_graph_says_the_graphs_form(capsys):
+    assert main(["serve", str(H), "--broker", "mqtt://127.0.0.1:1", "--goal-at", "C,b:2"]) == 2
+    assert (
+        "expected T=EDGE:S,EDGE:S (T seconds of the run >= 0, then both vehicles' new goals, e.g. 20=C,b:2)"
+        in (capsys.readouterr().err)
+    )
+
+
+def test_a_live_goal_too_close_is_refused_naming_the_separation_the_plan_keeps():
+    scenario, verified = h_plan()
+
+    ids = (VehicleIdentity("unspecified", "agv1"), VehicleIdentity("unspecified", "agv2"))
+    master = LiveMaster(
+        verified, scenario.names, identities=ids, broker=BrokerSettings.from_url("mqtt://127.0.0.1:1")
+    )
+    with pytest.raises(
+        InputError,
+        match=r"goal \(C, c:5\) leaves the vehicles 1\.000 m apart: expected at least 1\.600 m "
+        r"\(the separation the plan keeps\)",
+    ):
+        master.request_goal(("C", "c:5"))

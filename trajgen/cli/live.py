@@ -42,9 +42,12 @@ def _goal(text: str, track) -> tuple[float, Configuration | tuple[EdgePoint, Edg
     except ValueError:
         at = float("nan")
     if not match or not at >= 0.0 or at == float("inf"):
+        form, example = (
+            ("EDGE:S,EDGE:S", "20=C,b:2") if isinstance(track, TrackGraph) else ("LEG:S,LEG:S", "20=C:8,A:10")
+        )
         raise InputError(
-            f"--goal-at {short_repr(text)} cannot be read: expected T=LEG:S,LEG:S (T seconds of the run "
-            ">= 0, then both vehicles' new goals, e.g. 20=C:8,A:10)"
+            f"--goal-at {short_repr(text)} cannot be read: expected T={form} (T seconds of the run "
+            f">= 0, then both vehicles' new goals, e.g. {example})"
         )
     if isinstance(track, TrackGraph):  # checked here: a goal off the track is refused before connecting
         return at, (track.point(match["first"].strip()), track.point(match["second"].strip()))

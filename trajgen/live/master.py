@@ -17,7 +17,7 @@ message therefore only delays a release; it never makes one unsafe. Messages
 that cannot be trusted (malformed, another vehicle's, older than one already
 taken, or naming a node the vehicle cannot have reached) are logged and
 ignored. While a vehicle is offline (its last will, or OFFLINE) nothing is
-released to either vehicle; when it is back, the latest order is sent again.
+released to either vehicle, nor once it is back until its first state says whether it kept its order.
 After a broker restart the client reconnects and re-sends every vehicle's
 latest order (a vehicle ignores one it already has).
 
@@ -432,7 +432,8 @@ class LiveMaster:
         if self._goal is not None:
             self._maybe_replan()
             return 0
-        if not all(view.online is not False for view in self._views):
+        # offline, or back and its first state not yet in (did it keep its order?): none released
+        if not all(view.online is not False and not view.rejoined for view in self._views):
             return 0
         count = 0
         for v, view in enumerate(self._views):
@@ -465,7 +466,7 @@ class LiveMaster:
         goal = live_goal(self.graph, goal)
         refusal = self._track.goal_refusal(goal, self.limits.min_separation)
         if refusal is not None:
-            raise InputError(f"{refusal} (the separation)")
+            raise InputError(f"{refusal} (the separation the plan keeps)")
         with self._lock:
             self._goal = goal
             self._done.clear()
@@ -487,7 +488,7 @@ class LiveMaster:
             self._goal = self._plan_goal
         at = self._track.name(view.restart)
         self.log.write({"t": self._now(), "event": "restart", "vehicle": view.name, "at": at})
-        logger.warning("master: %s is back without its order, at %s: re-planning", view.name, view.restart)
+        logger.warning("master: %s is back without its order, at %s: re-planning", view.name, at)
         self._maybe_replan()
 
     def _maybe_replan(self) -> None:

@@ -53,7 +53,10 @@ def start_place(graph: StarGraph | TrackGraph, position) -> tuple[tuple[float, f
     first order's first node must be that node, as VDA 5050 takes it).
     """
     if isinstance(graph, TrackGraph):
-        return None, point_id(graph, graph.point(position))
+        # the id of the place its id reads back as: 0.4 µm from a node reads as the node, and the
+        # master's order from there starts at the node's name
+        written = point_id(graph, graph.point(position))
+        return None, point_id(graph, graph.point(written))
     return position_xy(graph, position), ""
 
 

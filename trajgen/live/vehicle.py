@@ -333,6 +333,8 @@ class SimulatedVehicle:
                 references,
             )
             return
+        if self._state is None:  # no state sent yet: the acceptance must still know where it stands
+            self._state_message()
         session = VehicleSession(
             key=VehicleKey(self.identity.manufacturer, self.identity.serial_number),
             order=self._order,
