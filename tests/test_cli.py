@@ -106,6 +106,12 @@ def test_schedule_writes_verified_csv_and_plots_that_check_passes(tmp_path, caps
         assert summary["route"]["class"] == ROUTE_CLASS[legs]
     # and the files pass ``trajgen check``
     jerk = ["--ignore-jerk"] if method == "toppra" else []  # toppra does not limit the jerk
+    if method == "toppra":  # held to the jerk limit they fail, and the verdict names the flag
+        assert main(["check", scenario, "--csv", str(csv_dir)]) == EXIT_FAILURE
+        held = capsys.readouterr().out
+        assert "jerk" in held
+        assert "note: a schedule timed by toppra does not limit jerk; check its files for the " in held
+        assert held.rstrip().endswith("with --ignore-jerk\nFAIL")
     assert main(["check", scenario, "--csv", str(csv_dir), *jerk]) == EXIT_OK
     text = capsys.readouterr().out
     if legs in ROUTE_CLASS:
