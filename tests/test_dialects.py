@@ -501,6 +501,22 @@ def test_checking_a_dialects_file_without_the_flag_names_the_dialects_it_reads_a
     assert main(["check", SWAP, "--csv", str(exported / name), "--dialect", name]) == EXIT_OK
 
 
+@pytest.mark.parametrize("name", ["twincat-cam", "siemens-xy", "velocity-profile", "logix-time-cam"])
+def test_a_generic_csv_checked_as_a_table_dialect_is_called_a_generic_csv(tmp_path, name, capsys):
+    """It was "line 1: 9 field(s) separated by ';', expected 2" (issue 38, item 6)."""
+    out = tmp_path / "generic"
+    assert main(["schedule", SWAP, "--csv", str(out), "--method", "exact"]) == EXIT_OK
+    capsys.readouterr()
+    assert main(["check", SWAP, "--csv", str(out), "--dialect", name]) == EXIT_BAD_INPUT
+    err = capsys.readouterr().err
+    assert (
+        f"agv1.csv is a generic CSV (trajgen's own columns t_s, axis_m, v, a, j, ...), not a {name} table"
+        in err
+    )
+    assert "check it with --dialect generic, the default" in err
+    assert "field(s)" not in err
+
+
 def test_a_file_no_dialect_reads_gets_the_generic_message_alone(tmp_path, capsys):
     folder = tmp_path / "junk"
     folder.mkdir()

@@ -267,12 +267,25 @@ def _generic_columns(
 
 
 def _read(dialect: Dialect, text, source: str):
-    """``dialect.read``; a file the generic reader refuses names the dialects that do read it."""
+    """``dialect.read``; a file the dialect refuses names what does read it.
+
+    A generic CSV read as a table is called one (not "9 fields, expected 2"); a table the generic
+    reader refuses names the dialects that read it.
+    """
     try:
         return dialect.read(text, source=source)
     except ProfileFileError as error:
         if dialect.name is not DialectName.GENERIC:
-            raise
+            generic = next(other for other in DIALECTS if other.name is DialectName.GENERIC)
+            try:
+                generic.read(text, source=source)
+            except (ProfileFileError, ValueError):
+                raise error from None
+            raise ProfileFileError(
+                f"{source} is a generic CSV (trajgen's own columns t_s, axis_m, v, a, j, ...), not a "
+                f"{dialect.name.value} table: check it with --dialect generic, the default "
+                "(in Python: dialect='generic')"
+            ) from None
         readers = []
         for other in DIALECTS:
             named_like = not isinstance(other, TableDialect) or other.suffix == ".csv"
