@@ -517,6 +517,22 @@ def test_a_generic_csv_checked_as_a_table_dialect_is_called_a_generic_csv(tmp_pa
     assert "field(s)" not in err
 
 
+def test_a_generic_csv_cut_at_a_line_boundary_is_first_said_to_end_early(tmp_path, capsys):
+    """It was reported as acceleration and jerk violations and a goal off by metres (issue 38, item 6)."""
+    out = tmp_path / "cut"
+    assert main(["schedule", SWAP, "--csv", str(out), "--method", "exact"]) == EXIT_OK
+    capsys.readouterr()
+    lines = (out / "agv1.csv").read_bytes().split(b"\r\n")[:-1]  # CRLF after every line
+    rows = len(lines) - 1  # below the header
+    kept = 2 * rows // 5  # mid-motion
+    (out / "agv1.csv").write_bytes(b"".join(line + b"\r\n" for line in lines[: kept + 1]))
+    assert main(["check", SWAP, "--csv", str(out)]) == EXIT_FAILURE
+    violations = [line for line in capsys.readouterr().out.splitlines() if line.startswith("violation: ")]
+    assert "agv1.csv: the file ends early: its last row " in violations[0]
+    assert f"(row {kept:,} of {rows:,} in the other vehicle's file, t = " in violations[0]
+    assert "is not at rest (1 m/s), where a schedule ends at rest at its goal" in violations[0]
+
+
 def test_a_file_no_dialect_reads_gets_the_generic_message_alone(tmp_path, capsys):
     folder = tmp_path / "junk"
     folder.mkdir()

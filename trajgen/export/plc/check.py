@@ -361,4 +361,22 @@ def check_profiles(
     if parsed[0].columns is not None:
         for vehicle in range(2):
             problems += _generic_columns(parsed[vehicle], vehicle, best, scenario, jerk)
+        # said first: a file cut short fails everything after it, and that is the news
+        problems = _early_ends(parsed, files) + problems
     return ProfileCheck(dialect, files, tuple(problems), tables, best)
+
+
+def _early_ends(parsed, files) -> list[str]:
+    """A generic CSV whose last row is not at rest ends early (a schedule ends at rest at its goal)."""
+    most = max(profile.table.times.size for profile in parsed)
+    ends = []
+    for profile, path in zip(parsed, files, strict=True):
+        rows, velocity = profile.table.times.size, float(profile.columns["v"][-1])
+        if abs(velocity) > 1e-6:
+            of = f" of {most:,} in the other vehicle's file" if most > rows else ""
+            ends.append(
+                f"{path}: the file ends early: its last row (row {rows:,}{of}, t = "
+                f"{float(profile.table.times[-1]):.3f} s) is not at rest ({velocity:.6g} m/s), where a "
+                "schedule ends at rest at its goal"
+            )
+    return ends
