@@ -12,7 +12,7 @@ import pytest
 
 import trajgen.cli
 from tests.conftest import REPO
-from tests.support.helpers import legs_id
+from tests.support.helpers import RUN_FILES, legs_id
 from tests.support.star_scenarios import CROSSING
 from trajgen import builtin_scenario
 from trajgen.cli import EXIT_BAD_INPUT, EXIT_FAILURE, EXIT_OK, main
@@ -173,14 +173,7 @@ def test_demo_runs_a_built_in_scenario_end_to_end(tmp_path, capsys, legs):
     assert "verified: True" in out
     if class_line is not None:
         assert class_line in out
-    assert sorted(p.name for p in output.iterdir()) == [
-        "agv1.csv",
-        "agv2.csv",
-        "configuration.png",
-        "coordination.png",
-        "separation.png",
-        "speed.png",
-    ]
+    assert sorted(p.name for p in output.iterdir()) == RUN_FILES
     for picture in ("configuration.png", "speed.png"):
         assert (output / picture).read_bytes().startswith(b"\x89PNG\r\n\x1a\n")
     verdict = check_profiles(builtin_scenario(name), output)

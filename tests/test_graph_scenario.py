@@ -9,6 +9,7 @@ import pytest
 
 from tests.conftest import REPO
 from tests.support.grid_oracle import GridTrack, shortest_route
+from tests.support.helpers import RUN_FILES
 from topology import TrackGraph
 from trajgen.cli import main
 from trajgen.errors import ScenarioError
@@ -170,11 +171,4 @@ def test_demo_runs_the_built_in_h_end_to_end(tmp_path, capsys):
     assert "   2  agv2: D -> A along e, m, a, 20.5 m (the other at c:1.5)" in out  # the route's moves
     assert "method: exact  duration: 51.500 s  verified: True" in out
     written = sorted(path.name for path in tmp_path.iterdir())
-    assert written == [
-        "agv1.csv",
-        "agv2.csv",
-        "configuration.png",
-        "coordination.png",
-        "separation.png",
-        "speed.png",
-    ]
+    assert written == RUN_FILES

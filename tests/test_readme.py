@@ -11,6 +11,7 @@ import re
 import pytest
 
 from tests.conftest import REPO
+from tests.support.helpers import RUN_FILES
 
 
 def _python_block() -> str:
@@ -36,14 +37,7 @@ def test_readme_python_example_runs_and_its_comments_hold(tmp_path, monkeypatch)
     assert (tmp_path / "out" / "agv1.csv").is_file()
     assert (tmp_path / "out" / "agv2.csv").is_file()
     assert namespace["result"].summary()["duration_s"] == pytest.approx(27.51, abs=0.01)
-    assert sorted(p.name for p in (tmp_path / "run").iterdir()) == [
-        "agv1.csv",
-        "agv2.csv",
-        "configuration.png",
-        "coordination.png",
-        "separation.png",
-        "speed.png",
-    ]
+    assert sorted(p.name for p in (tmp_path / "run").iterdir()) == RUN_FILES
 
 
 def test_readme_python_section_needs_at_most_two_import_lines():

@@ -10,6 +10,9 @@ from topology import Configuration, Position, YGraph, plan
 from trajgen import Optimal, Schedule, load_scenario
 from trajgen.execution.goals import schedule_for_execution
 
+#: The files a run with CSV and plots into one folder writes (sorted): the demo's, the README's.
+RUN_FILES = ["agv1.csv", "agv2.csv", "configuration.png", "coordination.png", "separation.png", "speed.png"]
+
 SLOW = VehicleLimits(max_velocity=0.7, max_acceleration=0.35, max_jerk=0.6)
 AGV = VehicleLimits(max_velocity=1.0, max_acceleration=0.5, max_jerk=1.0)
 LIMITS = Limits(vehicles=(AGV, AGV), min_separation=1.5)
@@ -56,15 +59,10 @@ def animation_gif(verified, **options) -> bytes:
 
 def scenario_vehicle(scenario, v: int, identity, *, broker, clock, **options):
     """Vehicle ``v`` of ``scenario`` simulated at its start, not started (``options``: SimulatedVehicle's)."""
-    from trajgen.live.places import start_place
+    from trajgen.live.places import scenario_starts, start_place
     from trajgen.live.vehicle import SimulatedVehicle
 
-    start = (
-        scenario.start[v]
-        if isinstance(scenario.start, tuple)
-        else (scenario.start.first, scenario.start.second)[v]
-    )
-    xy, node = start_place(scenario.track, start)
+    xy, node = start_place(scenario.track, scenario_starts(scenario)[v])
     return SimulatedVehicle(
         identity,
         scenario.limits.vehicles[v],

@@ -301,7 +301,12 @@ def simulate(
             raise FaultError(
                 f"fault {fault.spec!r}: jump beyond the position margin {margin!r} m kept in this scenario"
             )
-    given = verified
+    # a plan handed in without a method: the method asked for is the one that computed it
+    asked = (
+        verified.schedule.method.name
+        if method is None and verified is not None
+        else for_execution(method).name
+    )
     if verified is None:
         verified = schedule_for_execution(scenario, method=method, position_margin=position_margin)
     executor = Executor(
@@ -435,9 +440,6 @@ def simulate(
         schedule=verified,
         position_margin=margin,
         unapplied_faults=unapplied,
-        # a plan handed in without a method: the method asked for is the one that computed it
-        method=for_execution(method).name
-        if method is not None or given is None
-        else given.schedule.method.name,
+        method=asked,
     )
     return result, spool

@@ -10,6 +10,7 @@ changes (the order drives the edges after a reversal backward: ``orientation`` p
 
 from __future__ import annotations
 
+import bisect
 import math
 
 __all__ = ["NODE_TOLERANCE", "DrivenPath"]
@@ -87,10 +88,7 @@ class DrivenPath:
 
     def segment(self, p: float) -> int:
         """Index of the edge holding arc length ``p`` (the last one past the end)."""
-        k = 0
-        while k + 1 < len(self.arcs) - 1 and self.arcs[k + 1] <= p:
-            k += 1
-        return k
+        return min(max(bisect.bisect_right(self.arcs, p) - 1, 0), max(len(self.arcs) - 2, 0))
 
     def point(self, p: float) -> tuple[float, float, float] | None:
         """``(x, y, theta)`` at arc length ``p``; ``None`` where the order gives no straight line."""

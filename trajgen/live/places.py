@@ -13,7 +13,7 @@ from trajgen.errors import InputError
 from trajgen.export.vda5050.graph_path import point_id
 from trajgen.live.geometry import position_xy, track_position
 
-__all__ = ["live_goal", "restart_place", "snapshot_point", "start_place"]
+__all__ = ["live_goal", "restart_place", "scenario_starts", "snapshot_point", "start_place"]
 
 
 def live_goal(graph: StarGraph | TrackGraph, goal) -> Configuration | tuple[EdgePoint, EdgePoint]:
@@ -44,6 +44,12 @@ def restart_place(graph: StarGraph | TrackGraph, state):
     if isinstance(graph, TrackGraph):
         return graph.point(state.last_node_id)
     return track_position(graph, state.agv_position.x, state.agv_position.y)
+
+
+def scenario_starts(scenario) -> tuple:
+    """Both vehicles' starts in ``scenario``: Positions on a junction, EdgePoints on a track graph."""
+    start = scenario.start
+    return (start.first, start.second) if isinstance(start, Configuration) else tuple(start)
 
 
 def start_place(graph: StarGraph | TrackGraph, position) -> tuple[tuple[float, float] | None, str]:

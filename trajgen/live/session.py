@@ -23,7 +23,7 @@ from trajgen.live.clock import RunClock
 from trajgen.live.geometry import position_xy, track_position
 from trajgen.live.master import RELEASE_SPACING, LiveMaster, LiveRun
 from trajgen.live.mqtt import DEFAULT_INTERFACE, DEFAULT_VERSION, BrokerSettings, VehicleIdentity
-from trajgen.live.places import snapshot_point, start_place
+from trajgen.live.places import scenario_starts, snapshot_point, start_place
 from trajgen.live.runlog import RunLog
 from trajgen.live.vehicle import SimulatedVehicle, StopFault, VehicleSnapshot
 from trajgen.verification import VerifiedSchedule
@@ -172,7 +172,7 @@ class LiveDemo:
         url = self.broker_url if self.broker_url is not None else self.broker.url
         settings = BrokerSettings.from_url(url)
         ids = identities(scenario.names)
-        starts = [start_place(scenario.track, position) for position in _starts(scenario)]
+        starts = [start_place(scenario.track, position) for position in scenario_starts(scenario)]
         self.vehicles = tuple(
             SimulatedVehicle(
                 ids[v],
@@ -302,9 +302,3 @@ class ClosestApproach:
             distance = self.graph.distance(self._place(snapshot), self._place(other))
             self.closest = min(self.closest, distance)
             self.compared += 1
-
-
-def _starts(scenario) -> tuple:
-    """Both vehicles' starts: Positions on a junction, EdgePoints on a track graph."""
-    start = scenario.start
-    return (start.first, start.second) if hasattr(start, "first") else tuple(start)

@@ -276,9 +276,8 @@ def _read(dialect: Dialect, text, source: str):
         return dialect.read(text, source=source)
     except ProfileFileError as error:
         if dialect.name is not DialectName.GENERIC:
-            generic = next(other for other in DIALECTS if other.name is DialectName.GENERIC)
             try:
-                generic.read(text, source=source)
+                DIALECTS.lookup(DialectName.GENERIC.value).read(text, source=source)
             except (ProfileFileError, ValueError):
                 raise error from None
             raise ProfileFileError(
