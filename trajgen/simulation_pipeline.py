@@ -223,6 +223,14 @@ def format_simulation(summary: dict, *, min_separation: float) -> str:
         f"violations: {summary['violations']} (separation {summary['separation_violations']}, "
         f"limits {summary['limit_violations']}) in {summary['cycles']} cycles",
     ]
+    plans = summary.get("plans", ())
+    if len(plans) > 1:  # a re-plan: each plan's part, so the time lost is read against the plan driven
+        lines += [
+            f"plan {k} of {len(plans)}: {plan['started_s']:.3f} to {plan['ended_s']:.3f} s, "
+            f"planned {plan['planned_s']:.3f} s of its {plan['duration_s']:.3f} s, "
+            f"lost {plan['lost_s']:.3f} s" + (" (left for a new goal)" if k < len(plans) else "")
+            for k, plan in enumerate(plans, start=1)
+        ]
     unapplied = set(summary.get("unapplied_faults", ()))
     lines += [
         f"fault: {spec}"

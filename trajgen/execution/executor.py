@@ -216,6 +216,11 @@ class Executor:
         return self._travel[0], self._travel[1]
 
     @property
+    def axis_signs(self) -> tuple[int, int]:
+        """Each vehicle's own axis against the plan's (+1 or -1): the plan's velocity times this is its."""
+        return self._axis_sign[0], self._axis_sign[1]
+
+    @property
     def frontiers(self) -> tuple[float, float]:
         """Each vehicle's frontier at the last cycle, metres of its travel (``inf``: none binds it)."""
         return self._frontiers

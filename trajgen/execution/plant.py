@@ -6,9 +6,12 @@ names (on a track graph: a node onto the edge the setpoint is on or names next),
 and is stopped by the end of a leg. Faults
 (:mod:`trajgen.execution.faults`) act here only; the executor sees their effects
 through the measurements. A stop (or the executor's emergency brake) brakes at
-the vehicle's emergency deceleration; a drive that is off its setpoint (after
-a jump, a stop) closes the gap gradually: its speed is the setpoint's plus
-twice the gap per second, at most ``0.2 * max_velocity`` more or less.
+the vehicle's emergency deceleration (the brake engages within a cycle); every
+other change of speed is the drive's, within its ``max_acceleration``: a drive
+released from a stop, slowed by a cap, or off its setpoint (after a jump, a
+stop) ramps; off its setpoint it closes the gap gradually, aiming for the
+setpoint's speed plus twice the gap per second, at most ``0.2 * max_velocity``
+more or less. A lagging drive replays its setpoints late, as a delay line.
 """
 
 from __future__ import annotations
@@ -35,11 +38,12 @@ _GAIN = 2.0
 class Body:
     """One vehicle's true state in the plant."""
 
-    __slots__ = ("a", "axis", "branch", "j", "leg", "orientation", "s", "v")
+    __slots__ = ("a", "axis", "branch", "j", "leg", "orientation", "ramping", "s", "v")
 
     def __init__(self, leg: int, s: float, orientation: int, axis: float, branch: int) -> None:
         self.leg, self.s, self.orientation, self.axis, self.branch = leg, s, orientation, axis, branch
         self.v = self.a = self.j = 0.0
+        self.ramping = False  # off its setpoints: closing the gap within the limits
 
     def move(self, d_axis: float, lengths: tuple[float, ...]) -> None:
         """Drive ``d_axis`` metres along the axis, through the junction onto ``branch``.
@@ -94,12 +98,13 @@ class GraphBody:
     stops it.
     """
 
-    __slots__ = ("a", "ahead", "axis", "j", "leg", "orientation", "s", "v")
+    __slots__ = ("a", "ahead", "axis", "j", "leg", "orientation", "ramping", "s", "v")
 
     def __init__(self, edge: int, s: float, orientation: int, axis: float) -> None:
         self.leg, self.s, self.orientation, self.axis = edge, s, orientation, axis
         self.ahead = (edge, edge)
         self.v = self.a = self.j = 0.0
+        self.ramping = False  # off its setpoints: closing the gap within the limits
 
     def steer(self, setpoint) -> None:
         """Take the edges ``setpoint`` is on and names next, for the next node it passes."""
@@ -223,10 +228,11 @@ class Plant:
                 d = math.copysign(
                     0.5 * (speed + new) * dt if new > 0.0 else speed * speed / (2 * decel), body.v
                 )
-                a_new = -math.copysign(decel, body.v) if speed > 0.0 else 0.0
+                a_new = -math.copysign(decel, body.v) if new > 0.0 else 0.0  # at rest the brake holds
                 body.j = (a_new - body.a) / dt
                 body.a = a_new
                 body.v = math.copysign(new, body.v)
+                body.ramping = True  # released, the drive takes up its setpoints again within its limits
                 body.move(d, self.lengths)
                 continue
             lag = self._active(FaultKind.LAG, v, t)
@@ -247,25 +253,52 @@ class Plant:
             cap = slow.value if slow is not None else math.inf  # a throttled drive's top speed
             wanted = axis - body.axis
             gap = wanted - velocity * dt  # beyond the setpoint's own motion this cycle
-            on_track = abs(gap) <= abs(acceleration) * dt * dt + abs(jerk) * dt**3 + 1e-12
+            vehicle = self.limits.vehicles[v]
+            if body.ramping:
+                # back on its setpoints where it takes them up within its acceleration limit (the gap
+                # and the speed each within half a cycle's reach): else a drive creeping after a
+                # vanishing gap would stay off them for ever
+                on_track = (
+                    abs(gap) <= 0.25 * vehicle.max_acceleration * dt * dt
+                    and abs(velocity - body.v) <= 0.5 * vehicle.max_acceleration * dt
+                )
+            else:
+                on_track = abs(gap) <= abs(acceleration) * dt * dt + abs(jerk) * dt**3 + 1e-12
             if on_track and abs(velocity) <= cap:
                 body.j, body.a, body.v = jerk, acceleration, velocity
+                body.ramping = False
                 body.move(wanted, self.lengths)
                 continue
-            # off its setpoint (after a fault) or throttled: the drive closes the gap gradually,
-            # within its top speed, and never runs past the setpoint
-            correction = _CORRECTION * self.limits.vehicles[v].max_velocity
-            v_new = velocity + max(-correction, min(correction, _GAIN * gap))
-            # throttled below its speed, a drive brakes down to it, at most at its emergency deceleration
-            top = max(cap, abs(body.v) - self.limits.vehicles[v].emergency_braking * dt)
-            v_new = max(-top, min(top, v_new))
-            step = v_new * dt
-            if wanted * (wanted - step) < 0.0:
-                step, v_new = wanted, min(max(velocity, -top), top)
-            a_new = (v_new - body.v) / dt
-            body.j = (a_new - body.a) / dt
-            body.a, body.v = a_new, v_new
-            body.move(step, self.lengths)
+            self._ramp(v, body, wanted, velocity, cap, limited=lag is None)
+
+    def _ramp(
+        self, v: int, body: Body | GraphBody, wanted: float, velocity: float, cap: float, *, limited: bool
+    ) -> None:
+        """The drive off its setpoint, or throttled: it closes the gap, its acceleration within its limit.
+
+        The speed it aims for is the setpoint's plus twice the gap per second (at most
+        ``0.2 * max_velocity`` more or less), at most ``cap``; its speed changes toward that at most
+        ``max_acceleration`` (a drive's current limit: its acceleration steps, its jerk is not
+        limited), and it never runs past the setpoint. It is back on its setpoints (:meth:`advance`)
+        once it is within one cycle's reach of them in position and speed. A lagging drive
+        (``limited`` false) replays its late setpoints as a delay line would: its speed follows them
+        at once.
+        """
+        dt = self.period
+        vehicle = self.limits.vehicles[v]
+        reach = vehicle.max_acceleration * dt if limited else math.inf
+        gap = wanted - velocity * dt
+        correction = _CORRECTION * vehicle.max_velocity
+        aim = max(-cap, min(cap, velocity + max(-correction, min(correction, _GAIN * gap))))
+        v_new = max(body.v - reach, min(body.v + reach, aim))
+        step = 0.5 * (body.v + v_new) * dt
+        if wanted * (wanted - step) < 0.0:  # it would pass its setpoint: it stops there
+            step, v_new = wanted, max(body.v - reach, min(body.v + reach, max(-cap, min(cap, velocity))))
+        a_new = (v_new - body.v) / dt
+        body.ramping = True
+        body.j = (a_new - body.a) / dt
+        body.a, body.v = a_new, v_new
+        body.move(step, self.lengths)
 
 
 def _graph_body(path: GraphVehiclePath) -> GraphBody:

@@ -33,6 +33,7 @@ from trajgen.execution.messages import Command, Event, Mode, VehicleState
 from trajgen.execution.plant import Plant
 from trajgen.execution.trace import PLOT_SAMPLES, Decimated, Trace
 from trajgen.export.csv import CsvOptions
+from trajgen.model.coordination import schedule_paths
 from trajgen.model.graph_vehicle_path import GraphMetric
 from trajgen.model.schedule import TimingMethod
 from trajgen.model.summary import provenance
@@ -40,7 +41,7 @@ from trajgen.model.values import frozen
 from trajgen.scenario import GraphScenario, Scenario
 from trajgen.verification import VerifiedSchedule
 
-__all__ = ["PLOT_SAMPLES", "SimulationResult", "Trace", "parse_faults", "simulate"]
+__all__ = ["PLOT_SAMPLES", "ExecutedPlan", "SimulationResult", "Trace", "parse_faults", "simulate"]
 
 logger = logging.getLogger(__name__)
 
@@ -48,8 +49,45 @@ logger = logging.getLogger(__name__)
 _AT_REST = 1e-3
 #: True track distance below the minimum separation that counts as a violation, metres (1 µm).
 _VIOLATION_TOLERANCE = 1e-6
+#: Travel short of a point that counts as having reached it, metres (the executor's positions).
+_TRAVEL_TOLERANCE = 1e-6
 #: Relative tolerance on the commanded limits (Ruckig's jerk phases are exactly at the limit).
 _LIMIT_TOLERANCE = 1e-6
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class ExecutedPlan:
+    """One plan a run drove: the undisturbed one, then one per re-plan for a new goal.
+
+    Attributes
+    ----------
+    schedule : Schedule or GraphSchedule
+        The plan (the first is the run's undisturbed plan; each later one was verified when it was made).
+    started_s, ended_s : float
+        When the run took it up and when it left it (for a new goal) or ended, seconds of the run.
+    planned_s : float
+        How long the part of it the run drove takes undisturbed, seconds: the whole plan if the run
+        drove it to its end, else the plan's time at which both vehicles got as far along their
+        paths as they were when the run left it.
+    travel_before : tuple of 2 float
+        Each vehicle's travel along the earlier plans' paths when the run took this one up, metres
+        (where its paths start on the run's travel axes).
+    axis_signs : tuple of 2 int
+        Each vehicle's own axis against the plan's (+1 or -1): the plan's velocity times this is the
+        vehicle's.
+    """
+
+    schedule: object = field(repr=False)
+    started_s: float
+    ended_s: float
+    planned_s: float
+    travel_before: tuple[float, float]
+    axis_signs: tuple[int, int]
+
+    @property
+    def lost_s(self) -> float:
+        """Time the run took on this plan beyond its undisturbed time, seconds."""
+        return self.ended_s - self.started_s - self.planned_s
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -63,9 +101,11 @@ class SimulationResult:
     makespan_s : float
         When they got there, seconds (the time limit if they did not).
     planned_s : float
-        Duration of the undisturbed schedule, seconds.
+        How long the plans the run drove take undisturbed, seconds: the undisturbed schedule's
+        duration without a re-plan; with re-plans for new goals the sum of each plan's part driven
+        (:attr:`plans`), so a new goal's plan is not measured against the old goal's.
     time_lost_s : float
-        ``makespan_s - planned_s``.
+        ``makespan_s - planned_s``: what faults, and stopping for new goals, cost.
     min_separation_m : float
         Smallest true track distance at the cycles, metres.
     certified_separation_m : float
@@ -86,7 +126,8 @@ class SimulationResult:
     cycles : int
     plot : dict
         Decimated samples for the plot (read-only arrays): ``t`` (n,), ``speed`` (2, n) m/s,
-        ``separation`` (n,) m, ``travel`` (2, n) each vehicle's travel along its path, m, and
+        ``separation`` (n,) m, ``travel`` (2, n) each vehicle's travel along its paths, m (across
+        re-plans: each plan's paths continue where the earlier ones were left), and
         ``frontier`` (2, n) its frontier, m of travel (``inf`` where none binds it).
     schedule : VerifiedSchedule
         The undisturbed plan.
@@ -97,6 +138,8 @@ class SimulationResult:
     method : str
         The timing method asked for the plan (its ``computed_by`` is the schedule's own, ``exact``
         after a fallback).
+    plans : tuple of ExecutedPlan
+        The plans the run drove, in order: the undisturbed one, then one per re-plan.
     """
 
     reached_goal: bool
@@ -122,6 +165,7 @@ class SimulationResult:
     position_margin: float = 0.0
     unapplied_faults: tuple[Fault, ...] = ()
     method: str = "optimal"
+    plans: tuple[ExecutedPlan, ...] = ()
 
     @property
     def violations(self) -> int:
@@ -152,6 +196,16 @@ class SimulationResult:
             "faults": [fault.spec for fault in self.faults],
             "unapplied_faults": [fault.spec for fault in self.unapplied_faults],
             "events": [{"t_s": round(e.time, 6), "kind": e.kind, "detail": e.detail} for e in self.events],
+            "plans": [
+                {
+                    "started_s": round(plan.started_s, 6),
+                    "ended_s": round(plan.ended_s, 6),
+                    "planned_s": round(plan.planned_s, 6),
+                    "lost_s": round(plan.lost_s, 6),
+                    "duration_s": round(plan.schedule.duration, 6),
+                }
+                for plan in self.plans
+            ],
         }
 
 
@@ -238,6 +292,35 @@ def _graph_between(before, bodies, first: float, second: float, bend: float) -> 
         return min(first, second) - (bend if turns else 0.0)
     moved = sum(abs(b.axis - old[5]) for old, b in zip(before, bodies, strict=True))
     return 0.5 * (first + second - moved)
+
+
+def _time_reached(schedule, travel: tuple[float, float]) -> float:
+    """The earliest time of ``schedule`` at which each vehicle has travelled ``travel``, seconds.
+
+    Each vehicle's travel grows with time; between two instants of :func:`schedule_paths` a
+    vehicle does not turn, so its travel there is the one before plus how far its axis moved.
+    Bisection to 1e-9 s.
+    """
+    _, times, along = schedule_paths(schedule)
+    reached = 0.0
+    for v in (0, 1):
+        wanted = travel[v] - _TRAVEL_TOLERANCE
+        if wanted <= 0.0:
+            continue
+        k = int(np.searchsorted(along[v], wanted))
+        if k >= len(times):
+            reached = max(reached, float(times[-1]))
+            continue
+        low, high = float(times[max(k - 1, 0)]), float(times[k])
+        base, origin = along[v][max(k - 1, 0)], schedule.state(low).axis[v]
+        while high - low > 1e-9:
+            middle = 0.5 * (low + high)
+            if base + abs(schedule.state(middle).axis[v] - origin) >= wanted:
+                high = middle
+            else:
+                low = middle
+        reached = max(reached, high)
+    return reached
 
 
 def _time_limit(
@@ -347,6 +430,9 @@ def simulate(
     if spool is not None:
         spool.add(0.0, bodies)
     plot.add((0.0, bodies[0].v, bodies[1].v, separation, 0.0, 0.0, math.inf, math.inf))
+    plans: list[ExecutedPlan] = []
+    driving = (verified.schedule, 0.0, (0.0, 0.0), executor.axis_signs)  # plan, taken up at, travel before
+    travel = (0.0, 0.0)  # along the plan's paths at the last cycle
     cycle = 0
     t = 0.0
     makespan = None
@@ -363,6 +449,14 @@ def simulate(
             command = executor.step(*measured)
             if observer is not None:
                 observer(executor, measured, command)
+            if executor.replans > len(plans):  # left for a new goal where both stood at rest
+                schedule, started, offset, signs = driving
+                plans.append(
+                    ExecutedPlan(schedule, started, t, _time_reached(schedule, travel), offset, signs)
+                )
+                offset = (offset[0] + travel[0], offset[1] + travel[1])
+                driving = (executor.schedule, t, offset, executor.axis_signs)
+            travel = executor.travel
             for v, setpoint in enumerate(command.setpoints):
                 vehicle = limits.vehicles[v]
                 ratios = (
@@ -394,7 +488,19 @@ def simulate(
             separation = now
             if spool is not None:
                 spool.add(t, bodies)
-            plot.add((t, bodies[0].v, bodies[1].v, now, *executor.travel, *command.frontiers))
+            offset = driving[2]
+            plot.add(
+                (
+                    t,
+                    bodies[0].v,
+                    bodies[1].v,
+                    now,
+                    offset[0] + travel[0],
+                    offset[1] + travel[1],
+                    offset[0] + command.frontiers[0],
+                    offset[1] + command.frontiers[1],
+                )
+            )
             # both at their goals: the run ends, also before a stop or slow-down that would come later
             done = command.mode is Mode.DONE and not pending and all(abs(b.v) <= _AT_REST for b in bodies)
             if done:
@@ -414,6 +520,9 @@ def simulate(
     }
     reached = makespan is not None
     makespan = makespan if reached else t
+    schedule, started, offset, signs = driving
+    plans.append(ExecutedPlan(schedule, started, makespan, schedule.duration, offset, signs))
+    planned = sum(plan.planned_s for plan in plans)
     unapplied = tuple(f for f in faults if f.time > makespan + 1e-9)
     for fault in unapplied:
         logger.info("fault %s never applied: the run ended at %.3f s", fault.spec, makespan)
@@ -441,5 +550,6 @@ def simulate(
         position_margin=margin,
         unapplied_faults=unapplied,
         method=asked,
+        plans=tuple(plans),
     )
     return result, spool

@@ -8,7 +8,7 @@ import numpy as np
 
 from topology.validation import short_repr
 from trajgen.errors import InputError
-from trajgen.plots.figure import drawing_area, finished, polygon_patch, time_label
+from trajgen.plots.figure import drawing_area, finished, polygon_patch
 from trajgen.plots.speed import VEHICLE_COLOURS
 
 __all__ = ["plot_simulation"]
@@ -17,14 +17,57 @@ __all__ = ["plot_simulation"]
 FAULT_COLOUR = "tab:gray"
 
 
-def _mark_faults(axis, marks: list[tuple[float, float | None, str]]) -> None:
-    """Each fault ``(time s, duration s or None, spec)``: a shaded span or a dotted line, labelled."""
-    for time, duration, spec in marks:
+#: Colour of the re-plan marks.
+REPLAN_COLOUR = "black"
+
+
+def _marks(result) -> list[tuple[float, float | None, str, str]]:
+    """Every fault and re-plan, in time order: ``(time s, duration s or None, text, colour)``."""
+    marks = [
+        (f.time, f.end - f.time if math.isfinite(f.end) and f.end > f.time else None, f.spec, FAULT_COLOUR)
+        for f in result.faults
+    ]
+    marks += [(plan.started_s, None, "re-plan for the new goal", REPLAN_COLOUR) for plan in result.plans[1:]]
+    return sorted(marks, key=lambda mark: mark[0])
+
+
+def _mark_times(axis, marks) -> None:
+    """Each mark as a shaded span or a dotted line, numbered just above the panel (outside its data)."""
+    for number, (time, duration, _, colour) in enumerate(marks, start=1):
         if duration is not None:
-            axis.axvspan(time, time + duration, color=FAULT_COLOUR, alpha=0.2, linewidth=0)
+            axis.axvspan(time, time + duration, color=colour, alpha=0.2, linewidth=0)
         else:
-            axis.axvline(time, color=FAULT_COLOUR, linestyle=":", linewidth=1.2)
-        time_label(axis, time, 0.98, spec, colour="dimgray")
+            axis.axvline(time, color=colour, linestyle=":", linewidth=1.2)
+        axis.annotate(
+            str(number),
+            (time, 1.0),
+            xycoords=axis.get_xaxis_transform(),
+            xytext=(0, 1.5),  # just above the frame: over no data
+            textcoords="offset points",
+            ha="center",
+            va="bottom",
+            fontsize=7,
+            color="dimgray" if colour == FAULT_COLOUR else colour,
+            annotation_clip=False,
+        )
+
+
+def _mark_key(marks) -> list:
+    """Legend entries naming each numbered mark: its number, then its fault spec or what it is."""
+    from matplotlib.lines import Line2D
+
+    return [
+        Line2D(
+            [],
+            [],
+            linestyle="none",
+            marker=f"${number}$",
+            markersize=6,
+            color="dimgray" if colour == FAULT_COLOUR else colour,
+            label=text,
+        )
+        for number, (_, _, text, colour) in enumerate(marks, start=1)
+    ]
 
 
 def _progress(axis, result, names) -> None:
@@ -44,32 +87,59 @@ def _progress(axis, result, names) -> None:
     axis.set_title(
         "progress and frontiers (dotted: the farthest a vehicle may come to rest; | it waits there)",
         fontsize=9,
+        pad=12,
     )
-    axis.legend(loc="upper left", fontsize=7)
+    axis.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=7)
 
 
 def _coordination(axis, result, names, min_separation: float) -> None:
-    """The plan's conflicts in the plane of both vehicles' travel, the plan's curve and the executed one."""
+    """Each plan's conflicts in the plane of both vehicles' travel, each plan's curve and the executed one.
+
+    After a re-plan for a new goal the new plan's paths continue where the vehicles stood: its
+    conflicts and curve are drawn from that point on, the old plan's up to it.
+    """
+    from matplotlib.transforms import Bbox, TransformedBbox
+
     from trajgen.model.coordination import CoordinationDiagram, schedule_paths
 
-    schedule = result.schedule.schedule
-    paths, times, travel = schedule_paths(schedule)
-    diagram = CoordinationDiagram(paths, min_separation + result.position_margin, schedule, times)
-    for conflict in diagram.conflicts:
-        colour = VEHICLE_COLOURS[conflict.leader]
-        for polygon in conflict.polygons:
-            axis.add_patch(polygon_patch(polygon, facecolor=colour, alpha=0.25, edgecolor="none"))
-    axis.plot(travel[0], travel[1], color="black", linestyle="--", linewidth=0.9, label="plan")
-    replanned = [event.time for event in result.events if event.kind == "replan"]
-    t = np.asarray(result.plot["t"])
-    before = t < (replanned[0] if replanned else math.inf)  # travel is along the plan's paths until then
-    executed = result.plot["travel"][:, before]
+    plans = result.plans
+    ends = [plan.travel_before for plan in plans[1:]]
+    corner = (0.0, 0.0)
+    for k, plan in enumerate(plans):
+        paths, times, travel = schedule_paths(plan.schedule)
+        origin = plan.travel_before
+        far = ends[k] if k < len(ends) else (origin[0] + paths[0].length, origin[1] + paths[1].length)
+        corner = (max(corner[0], far[0]), max(corner[1], far[1]))
+        # what the run drove of this plan: from where it took it up to where it left it
+        box = TransformedBbox(Bbox([[origin[0], origin[1]], [far[0], far[1]]]), axis.transData)
+        diagram = CoordinationDiagram(paths, min_separation + result.position_margin, plan.schedule, times)
+        for conflict in diagram.conflicts:
+            colour = VEHICLE_COLOURS[conflict.leader]
+            for polygon in conflict.polygons:
+                patch = polygon_patch(
+                    np.asarray(polygon) + np.asarray(origin), facecolor=colour, alpha=0.25, edgecolor="none"
+                )
+                axis.add_patch(patch)
+                patch.set_clip_box(box)
+        (curve,) = axis.plot(
+            origin[0] + travel[0],
+            origin[1] + travel[1],
+            color="black",
+            linestyle="--",
+            linewidth=0.9,
+            label="plan" if k == 0 else None,
+        )
+        curve.set_clip_box(box)
+        if k > 0:
+            axis.plot(*origin, marker="o", color="black", markersize=5, fillstyle="none")
+            axis.annotate(
+                "re-plan", origin, xytext=(4, -10), textcoords="offset points", fontsize=7, color="black"
+            )
+    executed = result.plot["travel"]
     axis.plot(executed[0], executed[1], color="tab:purple", linewidth=1.3, label="executed")
     for vehicle in range(2):
         limit = np.where(
-            np.isfinite(result.plot["frontier"][vehicle][before]),
-            result.plot["frontier"][vehicle][before],
-            np.nan,
+            np.isfinite(result.plot["frontier"][vehicle]), result.plot["frontier"][vehicle], np.nan
         )
         if np.isfinite(limit).any():
             last = int(np.nonzero(np.isfinite(limit))[0][-1])
@@ -77,9 +147,9 @@ def _coordination(axis, result, names, min_separation: float) -> None:
             axis.plot(
                 *point, marker=">" if vehicle == 0 else "^", color=VEHICLE_COLOURS[vehicle], markersize=7
             )
-    for limits, length in ((axis.set_xlim, paths[0].length), (axis.set_ylim, paths[1].length)):
+    for set_limits, length in ((axis.set_xlim, corner[0]), (axis.set_ylim, corner[1])):
         pad = 0.02 * max(length, 1e-6)  # a plan that waits runs along the frame: keep it visible
-        limits(-pad, length + pad)
+        set_limits(-pad, length + pad)
     axis.set_xlabel(f"{names[0]} travel [m]")
     axis.set_ylabel(f"{names[1]} travel [m]")
     axis.set_title(
@@ -87,19 +157,36 @@ def _coordination(axis, result, names, min_separation: float) -> None:
         "(the other waits at its frontier; arrows: each vehicle's last frontier)",
         fontsize=9,
     )
-    axis.legend(loc="lower right", fontsize=7)
+    axis.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=7)
+
+
+def _planned_velocity(result, t: np.ndarray) -> np.ndarray:
+    """Each vehicle's planned velocity at ``t``, m/s, shape (2, n): each plan from when the run took it up."""
+    planned = np.full((2, t.size), np.nan)
+    for plan in result.plans:
+        inside = (t >= plan.started_s) & (t <= plan.ended_s)
+        if not inside.any():
+            continue
+        local = np.clip(t[inside] - plan.started_s, 0.0, plan.schedule.duration)
+        velocity = plan.schedule.state(local).velocity
+        for v in (0, 1):
+            planned[v, inside] = plan.axis_signs[v] * velocity[v]
+    return planned
 
 
 def plot_simulation(result, *, names: tuple[str, str], min_separation: float, figure=None):
     """A simulated run: speeds, separation, progress with frontiers, coordination diagram.
 
-    Left: each vehicle's velocity along its axis, m/s, planned (the undisturbed schedule, dashed)
-    and executed (the plant's true motion); below, the true track distance, m, with the minimum
-    separation. Right: each vehicle's travel along its path with its frontier (where the executor
-    lets it come to rest at the latest, so a user sees why a vehicle waits), and the coordination
-    diagram: the plan's conflicts (shaded in the colour of the vehicle that passes first), the
-    plan's curve and the executed one. Every fault is marked on the time axes, labelled with its
-    spec: a ``stop`` or a ``slow`` for a while as a shaded span, the others as a dotted line.
+    Left: each vehicle's velocity along its axis, m/s, planned (each plan the run drove, from when
+    it took it up, dashed) and executed (the plant's true motion); below, the true track distance,
+    m, with the minimum separation. Right: each vehicle's travel along its paths with its frontier
+    (where the executor lets it come to rest at the latest, so a user sees why a vehicle waits),
+    and the coordination diagram: each plan's conflicts (shaded in the colour of the vehicle that
+    passes first) and curve over the part the run drove of it, and the executed curve. Across a
+    re-plan for a new goal the travel continues (the new plan's paths start where the vehicles
+    stood). Every fault and re-plan is marked on the time axes (a ``stop`` or a ``slow`` for a
+    while as a shaded span, the others as a dotted line) and numbered just above the panel; the
+    speed panel's legend names each number. Legends stand beside the panels, over no data.
 
     Parameters
     ----------
@@ -134,7 +221,7 @@ def plot_simulation(result, *, names: tuple[str, str], min_separation: float, fi
     ):
         raise InputError(f"min_separation (m) must be a finite number >= 0, got {short_repr(min_separation)}")
     t = np.asarray(result.plot["t"])
-    planned = result.schedule.schedule.state(t).velocity
+    planned = _planned_velocity(result, t)
     area = drawing_area(figure, figsize=(15, 8.5))
     grid = area.add_gridspec(2, 2, width_ratios=(1.25, 1.0))
     speed_axis = area.add_subplot(grid[0, 0])
@@ -153,7 +240,6 @@ def plot_simulation(result, *, names: tuple[str, str], min_separation: float, fi
         )
         speed_axis.plot(t, result.plot["speed"][vehicle], color=colour, label=f"{names[vehicle]} executed")
     speed_axis.set_ylabel("v [m/s]")
-    speed_axis.legend(loc="upper left", fontsize=7)
     separation_axis.plot(t, result.plot["separation"], color="tab:green", label="true track distance")
     separation_axis.axhline(
         min_separation, color="tab:red", linestyle="--", label=f"minimum {min_separation:g} m"
@@ -162,21 +248,23 @@ def plot_simulation(result, *, names: tuple[str, str], min_separation: float, fi
     separation_axis.set_ylim(bottom=0)
     separation_axis.set_ylabel("separation [m]")
     separation_axis.set_xlabel("t [s]")
-    separation_axis.legend(loc="upper left", fontsize=7)
+    separation_axis.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=7)
     _progress(progress_axis, result, names)
     _coordination(coordination_axis, result, names, min_separation)
-    marks = [
-        (f.time, f.end - f.time if math.isfinite(f.end) and f.end > f.time else None, f.spec)
-        for f in result.faults
-    ]
+    marks = _marks(result)
     for axis in (speed_axis, separation_axis, progress_axis):
-        _mark_faults(axis, marks)
+        _mark_times(axis, marks)
         axis.grid(True, alpha=0.3)
+    handles, _ = speed_axis.get_legend_handles_labels()
+    speed_axis.legend(
+        handles=handles + _mark_key(marks), loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=7
+    )
     coordination_axis.grid(True, alpha=0.3)
     outcome = "reached the goal" if result.reached_goal else "did NOT reach the goal"
     speed_axis.set_title(
         f"simulation: {outcome} at {result.makespan_s:.2f} s (planned {result.planned_s:.2f} s), "
-        f"{result.violations} violations\n(dashed: the undisturbed plan; grey: faults)",
+        f"{result.violations} violations\n(dashed: the plans; grey: faults, numbered as in the legend)",
         fontsize=10,
+        pad=12,
     )
     return finished(area, laid_out=figure is None)
