@@ -533,6 +533,27 @@ def test_a_generic_csv_cut_at_a_line_boundary_is_first_said_to_end_early(tmp_pat
     assert "is not at rest (1 m/s), where a schedule ends at rest at its goal" in violations[0]
 
 
+def test_both_generic_csvs_cut_where_the_vehicles_rest_between_moves_are_said_to_end_early(tmp_path, capsys):
+    """Cut at a row where both stand between two moves, the last row is at rest, short of the goal."""
+    out = tmp_path / "cut"
+    assert main(["schedule", SWAP, "--csv", str(out), "--method", "exact"]) == EXIT_OK
+    capsys.readouterr()
+    files = {name: (out / name).read_bytes().split(b"\r\n")[:-1] for name in ("agv1.csv", "agv2.csv")}
+    fields = {name: [line.split(b";") for line in lines[1:]] for name, lines in files.items()}
+    # the first row after the first move where both vehicles rest: the exact plan moves one at a time
+    kept = next(
+        k + 1
+        for k in range(len(fields["agv1.csv"]) // 10, len(fields["agv1.csv"]))
+        if all(float(fields[name][k][2]) == 0.0 == float(fields[name][k][3]) for name in files)
+    )
+    for name, lines in files.items():
+        (out / name).write_bytes(b"".join(line + b"\r\n" for line in lines[: kept + 1]))
+    assert main(["check", SWAP, "--csv", str(out)]) == EXIT_FAILURE
+    violations = [line for line in capsys.readouterr().out.splitlines() if line.startswith("violation: ")]
+    assert "agv1.csv: the file ends early: its last row (row " in violations[0]
+    assert "is at rest after 0.000 m of the 20.000 m its route drives to its goal" in violations[0]
+
+
 def test_a_file_no_dialect_reads_gets_the_generic_message_alone(tmp_path, capsys):
     folder = tmp_path / "junk"
     folder.mkdir()

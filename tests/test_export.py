@@ -24,6 +24,8 @@ def read_profile(path, options: CsvOptions):
     assert raw.endswith(b"\r\n")
     lines = raw.decode("ascii").split("\r\n")[:-1]
     assert all("\n" not in line and "\r" not in line for line in lines)
+    if lines[0].startswith("#"):  # a schedule without jerk limits records so on the first line
+        lines = lines[1:]
     header = lines[0].split(options.delimiter)
     rows = [
         [field.replace(options.decimal, ".") for field in line.split(options.delimiter)] for line in lines[1:]

@@ -74,7 +74,9 @@ class ScenarioFile:
 
 
 def read_rows(text: str) -> tuple[list[str], list[list[str]]]:
-    """Header and rows of a generic CSV (``;``-separated, ``.`` decimals)."""
+    """Header and rows of a generic CSV (``;``-separated, ``.`` decimals), after its record line if any."""
+    if text.startswith("#"):  # a schedule without jerk limits records so on the first line
+        text = text.split("\n", 1)[1]
     rows = list(csv.reader(io.StringIO(text), delimiter=";"))
     return rows[0], rows[1:]
 

@@ -3,23 +3,29 @@
 Renderers return bytes and take only a :class:`~trajgen.verification.VerifiedSchedule`;
 :func:`write_profiles` commits both files together
 (:func:`~trajgen.export.atomic.commit_files`). Numbers are formatted with numpy
-(:mod:`trajgen.export.numbers`), a block of :data:`ROWS_PER_CHUNK` rows at a time.
+(:mod:`trajgen.export.numbers`), a block of :data:`ROWS_PER_CHUNK` rows at a time; the velocity,
+acceleration and (where the schedule limits it) jerk columns are held to their limits as written
+(:func:`~trajgen.export.limited.limited_columns`). The file of a schedule that does not limit jerk
+records so on a line before its header (:class:`ScheduleRecord`), which ``trajgen check`` reads.
 """
 
 from __future__ import annotations
 
 import math
+import re
 from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
+from limits import VehicleLimits
 from topology import JUNCTION_INDEX, Option, StarGraph
 from topology.validation import short_repr
 from trajgen.errors import InputError, OptionError, OutputLimitError
 from trajgen.export.atomic import commit_files
 from trajgen.export.graph_rows import check_edge_names, format_graph_block, graph_header
+from trajgen.export.limited import limited_columns
 from trajgen.export.numbers import format_number_rows
 from trajgen.model.graph_schedule import GraphSchedule
 from trajgen.model.schedule import Schedule, ScheduleState, check_period, sample_block, sample_rows
@@ -31,6 +37,7 @@ __all__ = [
     "HEADER_NAMES",
     "ROWS_PER_CHUNK",
     "CsvOptions",
+    "ScheduleRecord",
     "Units",
     "check_row_limit",
     "format_block",
@@ -76,6 +83,55 @@ HEADER_NAMES = {
     Units.METRES: ("t_s", "axis_m", "v_mps", "a_mps2", "j_mps3", "leg", "s_m", "x_m", "y_m"),
     Units.MILLIMETRES: ("t_s", "axis_mm", "v_mmps", "a_mmps2", "j_mmps3", "leg", "s_mm", "x_mm", "y_mm"),
 }
+
+
+#: The record line of a generic CSV: ``# schedule timed by METHOD: jerk not limited ...`` (or ``limited``).
+_RECORD = re.compile(r"# schedule timed by (?P<method>[^:]+): jerk (?P<jerk>not limited|limited)(?: \(.*\))?")
+
+
+@dataclass(frozen=True, slots=True)
+class ScheduleRecord:
+    """What a generic CSV records of its schedule, on a line before its header.
+
+    trajgen writes the line for a schedule that does not limit jerk (``toppra``)::
+
+        # schedule timed by toppra: jerk not limited (velocity and acceleration are)
+
+    A file without it is of a jerk-limited schedule (every file before 0.7 too); a line saying
+    ``jerk limited`` claims so explicitly. ``trajgen check`` reads it: a file of a schedule that
+    does not limit jerk is not held to the jerk limits.
+
+    Attributes
+    ----------
+    method : str
+        The timing method's name (ASCII, no ``:``).
+    jerk_limited : bool
+        Whether the schedule limits jerk.
+    """
+
+    method: str
+    jerk_limited: bool
+
+    def line(self) -> str:
+        """The record line, without its line end."""
+        if self.jerk_limited:
+            return f"# schedule timed by {self.method}: jerk limited"
+        return f"# schedule timed by {self.method}: jerk not limited (velocity and acceleration are)"
+
+    @classmethod
+    def of(cls, schedule: Schedule | GraphSchedule) -> ScheduleRecord:
+        """The record of ``schedule``: its method's name (made ASCII without ``:``) and its jerk."""
+        name = str(getattr(schedule.method, "name", "unknown"))
+        name = "".join(c if c.isascii() and c.isprintable() and c != ":" else "?" for c in name).strip()
+        return cls(name or "unknown", bool(schedule.jerk_limited))
+
+    @classmethod
+    def parse(cls, line: str) -> ScheduleRecord | None:
+        """The record a line states, or ``None`` if it is no record line."""
+        found = _RECORD.fullmatch(line.strip())
+        if found is None:
+            return None
+        return cls(found["method"].strip(), found["jerk"] == "limited")
 
 
 @dataclass(frozen=True, slots=True)
@@ -141,18 +197,24 @@ def _xy(graph: StarGraph, state: ScheduleState, vehicle: int) -> tuple[np.ndarra
 
 
 def _columns(
-    graph: StarGraph, state: ScheduleState, vehicle: int, options: CsvOptions
+    graph: StarGraph,
+    state: ScheduleState,
+    vehicle: int,
+    options: CsvOptions,
+    limits: VehicleLimits | None,
+    jerk_limited: bool,
 ) -> list[tuple[np.ndarray, int | None]]:
     """The nine columns of a vehicle's rows and their decimal places (``None``: the integer leg)."""
     scale = options.units.scale
     decimals = options.units.decimals
     x, y = _xy(graph, state, vehicle)
+    velocity, acceleration, jerk = limited_columns(state, vehicle, scale, decimals, limits, jerk_limited)
     return [
         (state.t, 6),
         (state.axis[vehicle] * scale, decimals),
-        (state.velocity[vehicle] * scale, decimals),
-        (state.acceleration[vehicle] * scale, decimals),
-        (state.jerk[vehicle] * scale, decimals),
+        (velocity, decimals),
+        (acceleration, decimals),
+        (jerk, decimals),
         (state.leg[vehicle] + 1, None),  # 1-based, 0 at the junction
         (state.s[vehicle] * scale, decimals),
         (x * scale, decimals),
@@ -160,12 +222,22 @@ def _columns(
     ]
 
 
-def format_block(graph: StarGraph, state: ScheduleState, vehicle: int, options: CsvOptions) -> bytes:
+def format_block(
+    graph: StarGraph,
+    state: ScheduleState,
+    vehicle: int,
+    options: CsvOptions,
+    *,
+    limits: VehicleLimits | None = None,
+    jerk_limited: bool = True,
+) -> bytes:
     """Rows of one vehicle's CSV profile for the sampled ``state`` on ``graph``: ASCII, CRLF after each row.
 
     Numbers as :func:`~trajgen.export.numbers.fixed_point_text` writes them (time with 6 decimals,
     lengths with ``options.units.decimals``), the decimal mark and delimiter of ``options``; formatted
-    with numpy (:func:`~trajgen.export.numbers.format_number_rows`).
+    with numpy (:func:`~trajgen.export.numbers.format_number_rows`). With ``limits`` the velocity,
+    acceleration and (if ``jerk_limited``) jerk are held to them as written
+    (:func:`~trajgen.export.limited.limited_columns`).
 
     Parameters
     ----------
@@ -176,6 +248,10 @@ def format_block(graph: StarGraph, state: ScheduleState, vehicle: int, options: 
     vehicle : int
         0 or 1.
     options : CsvOptions
+    limits : VehicleLimits, optional
+        The vehicle's limits (a schedule's export); ``None``: the values as they are (executed motion).
+    jerk_limited : bool, optional
+        Whether the jerk column is held to ``limits`` too (default True).
 
     Returns
     -------
@@ -183,7 +259,8 @@ def format_block(graph: StarGraph, state: ScheduleState, vehicle: int, options: 
         n rows.
     """
     separators = (options.delimiter,) * (len(HEADER_NAMES[options.units]) - 1) + ("\r\n",)
-    return format_number_rows(_columns(graph, state, vehicle, options), separators, decimal=options.decimal)
+    columns = _columns(graph, state, vehicle, options, limits, jerk_limited)
+    return format_number_rows(columns, separators, decimal=options.decimal)
 
 
 def format_rows(graph: StarGraph, state: ScheduleState, vehicle: int, options: CsvOptions) -> list[str]:
@@ -261,6 +338,9 @@ def _checked(
 def _chunks(
     schedule: Schedule | GraphSchedule, vehicle: int, options: CsvOptions, rows: int, blocks: _SampledBlocks
 ) -> Iterator[bytes]:
+    limits, jerk_limited = schedule.limits.vehicles[vehicle], schedule.jerk_limited
+    if not jerk_limited:  # said in the file, so that a check of it knows (a jerk-limited one: as before 0.7)
+        yield (ScheduleRecord.of(schedule).line() + "\r\n").encode("ascii")
     if isinstance(schedule, GraphSchedule):  # the edge by name, x/y only with node coordinates
         header = graph_header(schedule.track, options.units.value)
         yield (options.delimiter.join(header) + "\r\n").encode("ascii")
@@ -273,17 +353,25 @@ def _chunks(
                 decimal=options.decimal,
                 scale=options.units.scale,
                 decimals=options.units.decimals,
+                limits=limits,
+                jerk_limited=jerk_limited,
             )
         return
     yield (options.delimiter.join(HEADER_NAMES[options.units]) + "\r\n").encode("ascii")
     for first in range(0, rows, ROWS_PER_CHUNK):
-        yield format_block(schedule.route.graph, blocks.block(first), vehicle, options)
+        block = blocks.block(first)
+        yield format_block(
+            schedule.route.graph, block, vehicle, options, limits=limits, jerk_limited=jerk_limited
+        )
 
 
 def profile_chunks(
     verified: VerifiedSchedule, vehicle: int, options: CsvOptions | None = None
 ) -> Iterator[bytes]:
     """One vehicle's CSV profile as chunks of ASCII bytes: header, one row per sample, CRLF after every line.
+
+    The file of a schedule that does not limit jerk begins with its record line
+    (:class:`ScheduleRecord`), before the header.
 
     Memory is bounded by :data:`ROWS_PER_CHUNK` rows, whatever the duration.
 

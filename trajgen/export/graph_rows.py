@@ -9,9 +9,11 @@ from __future__ import annotations
 
 import numpy as np
 
+from limits import VehicleLimits
 from topology import TrackGraph
 from topology.validation import short_repr
 from trajgen.errors import OptionError
+from trajgen.export.limited import limited_columns
 from trajgen.export.numbers import format_number_rows
 from trajgen.model.graph_schedule import GraphState
 
@@ -61,6 +63,8 @@ def format_graph_block(
     decimal: str,
     scale: float,
     decimals: int,
+    limits: VehicleLimits | None = None,
+    jerk_limited: bool = True,
 ) -> bytes:
     """Rows of one vehicle's generic CSV on ``track`` for the sampled ``state``: ASCII, CRLF after each.
 
@@ -77,13 +81,19 @@ def format_graph_block(
         Multiplier from metres of the length unit.
     decimals : int
         Decimal places of lengths (time has 6).
+    limits : VehicleLimits, optional
+        The vehicle's limits: its velocity, acceleration and (if ``jerk_limited``) jerk are held to
+        them as written (:func:`~trajgen.export.limited.limited_columns`); ``None``: as they are.
+    jerk_limited : bool, optional
+        Whether the jerk is held to ``limits`` too (default True).
     """
+    velocity, acceleration, jerk = limited_columns(state, vehicle, scale, decimals, limits, jerk_limited)
     before = [
         (state.t, 6),
         (state.axis[vehicle] * scale, decimals),
-        (state.velocity[vehicle] * scale, decimals),
-        (state.acceleration[vehicle] * scale, decimals),
-        (state.jerk[vehicle] * scale, decimals),
+        (velocity, decimals),
+        (acceleration, decimals),
+        (jerk, decimals),
     ]
     after = [(state.s[vehicle] * scale, decimals)]
     xy = state.xy(track)

@@ -33,6 +33,12 @@ How, per column of a block of rows:
 
 Values at or above the limit and non-finite ones (no schedule has them) are
 written by the Python expression itself, each in its own slot.
+
+The writers hold a limited quantity (a velocity, acceleration or jerk column) to
+its limit as written before formatting it (:func:`within_limit`): a value above
+the largest number of ``places`` decimals that does not exceed the limit
+(:func:`limit_cap`), but within the verifier's tolerance of the limit, becomes
+that number; so no number written exceeds its limit once rounded.
 """
 
 from __future__ import annotations
@@ -45,7 +51,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["exact_limit", "fixed_point_text", "format_number_rows"]
+__all__ = ["exact_limit", "fixed_point_text", "format_number_rows", "limit_cap", "within_limit"]
 
 #: Byte that fills a slot left of its field; no field or separator contains it.
 _PAD = 0
@@ -103,6 +109,75 @@ def exact_limit(places: int) -> float:
     if not 0 <= places <= 15:
         raise ValueError(f"decimal places must be 0 to 15, got {places!r}")
     return 2.0 ** (math.ceil(53 - places * math.log2(10)) - 2)
+
+
+def limit_cap(limit: float, places: int) -> float:
+    """The largest number of ``places`` decimals whose text, read back, is at most ``limit``.
+
+    Rounding is monotone, so every value at most this cap is written (by :func:`fixed_point_text`)
+    as a number at most ``limit``; a limit of more decimals than ``places`` gets the number below it.
+
+    Parameters
+    ----------
+    limit : float
+        A positive limit in the unit the numbers are written in (e.g. mm/s).
+    places : int
+        Decimal places written (0 to 15).
+
+    Returns
+    -------
+    float
+
+    Examples
+    --------
+    >>> limit_cap(1.2, 9), limit_cap(0.1234567896, 9), limit_cap(1000.0, 6)
+    (1.2, 0.123456789, 1000.0)
+    """
+    step = 10.0**-places
+    cap = round(float(limit), places)
+    while float(fixed_point_text(cap, places)) > limit:
+        lower = round(cap - step, places)
+        if not lower < cap:  # a limit too large for ``places`` decimals of a double: as close as it gets
+            break
+        cap = lower
+    return cap
+
+
+def within_limit(values: np.ndarray, limit: float, places: int, *, tolerance: float) -> np.ndarray:
+    """``values`` whose magnitude exceeds :func:`limit_cap` by at most ``tolerance``, set to the cap.
+
+    The numbers a limited column is written with: a value above the cap only by the round-off
+    the verifier allows (``|v| <= limit * (1 + tolerance)``, plus one unit of the last decimal)
+    is written as the cap, with its sign; a value further above it is left as it is (it is no
+    round-off: a check of the file reports it).
+
+    Parameters
+    ----------
+    values : ndarray, shape (n,)
+        In the unit of ``limit``.
+    limit : float
+        The quantity's limit (positive), in that unit.
+    places : int
+        Decimal places the values are written with.
+    tolerance : float
+        Relative round-off allowed above the limit (the verifier's: ``1e-6``).
+
+    Returns
+    -------
+    ndarray, shape (n,)
+        A new array if any value changed, else ``values``.
+
+    Examples
+    --------
+    >>> within_limit(np.array([1.2000000061, -1.2000000061, 0.5, 1.3]), 1.2, 9, tolerance=1e-6)
+    array([ 1.2, -1.2,  0.5,  1.3])
+    """
+    cap = limit_cap(limit, places)
+    magnitude = np.abs(values)
+    above = (magnitude > cap) & (magnitude <= limit * (1.0 + tolerance) + 10.0**-places)
+    if not above.any():
+        return values
+    return np.where(above, np.copysign(cap, values), values)
 
 
 def _split(values: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

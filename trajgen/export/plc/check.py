@@ -4,7 +4,10 @@ The files alone are read with their dialect's reader (a file that cannot be
 read is bad input) and verified as the controllers interpolate them
 (:func:`trajgen.export.plc.table_check.check_tables`): the separation along the track
 between the two vehicles, the limits, the start and goal, the homotopy class,
-plus what their format requires (line ends, header, point count). The files
+plus what their format requires (line ends, header, point count). A generic
+CSV of a schedule that does not limit jerk records so before its header
+(:class:`~trajgen.export.csv.ScheduleRecord`): files that both record it are
+not held to the jerk limits (the verdict says so). The files
 do not say which homotopy class they take, so both of the planner's classes
 are tried (on a Y both ways round the configuration circle; on 4 to 8 legs
 the shortest and the second-shortest route on the retract graph ``G_k``, the
@@ -23,7 +26,7 @@ from topology import GraphRoute, Homotopy, Route, plan, plan_graph_classes
 from topology.indexed import track_distance
 from topology.validation import short_repr
 from trajgen.errors import OptionError, ProfileFileError
-from trajgen.export.csv import profile_paths
+from trajgen.export.csv import ScheduleRecord, profile_paths
 from trajgen.export.plc.dialects import DIALECTS, Dialect, DialectName, TableDialect
 from trajgen.export.plc.files import table_paths
 from trajgen.export.plc.table_check import TableCheck, check_tables
@@ -38,6 +41,8 @@ __all__ = ["MAX_FILE_BYTES", "ProfileCheck", "check_profiles", "profile_files"]
 MAX_FILE_BYTES = 256 << 20
 #: Most points (rows) per file the checker reads.
 MAX_POINTS = 1_000_000
+#: Travel short of its route's that a generic CSV at rest in its last row ends early by, metres.
+_SHORT_OF_GOAL = 1e-3
 #: How profile files are read (:func:`~trajgen.scenario.reading.read_bounded`).
 PROFILE_FILE = FileKind("a profile file", "a profile file", MAX_FILE_BYTES, ProfileFileError)
 
@@ -56,6 +61,12 @@ class ProfileCheck:
         The tables as read.
     check : TableCheck
         The tables' verdict along the route of the class that fits them best.
+    jerk_checked : bool
+        Whether the files were held to the jerk limits (not if asked not to, nor if both are generic
+        CSVs that record a schedule without jerk limits).
+    record : ScheduleRecord or None
+        What the files record of their schedule (a generic CSV's line before its header), if both
+        record it alike; ``None``: neither does (a table dialect's files never do).
     """
 
     dialect: Dialect
@@ -63,6 +74,8 @@ class ProfileCheck:
     problems: tuple[str, ...]
     tables: tuple[ProfileTable, ProfileTable]
     check: TableCheck
+    jerk_checked: bool = True
+    record: ScheduleRecord | None = None
 
     @property
     def passed(self) -> bool:
@@ -91,6 +104,12 @@ class ProfileCheck:
             "points": [int(table.times.size) for table in self.tables],
             "min_separation_m": self.check.report.min_separation,
             **where,
+            "jerk_checked": self.jerk_checked,
+            "record": (
+                None
+                if self.record is None
+                else {"method": self.record.method, "jerk_limited": self.record.jerk_limited}
+            ),
             "ratios": {k: (list(v) if v is not None else None) for k, v in self.check.ratios.items()},
         }
 
@@ -321,7 +340,8 @@ def check_profiles(
     dialect : Dialect or str, optional
         Default ``generic``.
     jerk : bool, optional
-        Hold the tables to the jerk limits (default True).
+        Hold the tables to the jerk limits (default True), unless both are generic CSVs that record
+        that their schedule does not limit jerk (:attr:`ProfileCheck.jerk_checked` says which).
     max_points : int, optional
         Most points the target takes per table (default: the dialect's limit; ``generic``: none).
 
@@ -343,6 +363,9 @@ def check_profiles(
     ]
     tables = (parsed[0].table, parsed[1].table)
     problems = list(parsed[0].problems + parsed[1].problems)
+    record, unlike = _records(parsed, files)
+    problems += unlike
+    jerk = jerk and (record is None or record.jerk_limited)
     for path, table in zip(files, tables, strict=True):
         if table.times.size > MAX_POINTS:
             raise ProfileFileError(
@@ -352,7 +375,8 @@ def check_profiles(
         if limit is not None and table.times.size > limit:
             problems.append(f"{path}: {table.times.size:,} points, more than the target takes ({limit:,})")
     verdicts = []
-    for route in _routes(scenario):
+    routes = _routes(scenario)
+    for route in routes:
         verdicts.append(check_tables(tables, route, scenario.limits, jerk=jerk))
         if verdicts[-1].passed:
             break
@@ -361,21 +385,55 @@ def check_profiles(
         for vehicle in range(2):
             problems += _generic_columns(parsed[vehicle], vehicle, best, scenario, jerk)
         # said first: a file cut short fails everything after it, and that is the news
-        problems = _early_ends(parsed, files) + problems
-    return ProfileCheck(dialect, files, tuple(problems), tables, best)
+        problems = _early_ends(parsed, files, routes) + problems
+    return ProfileCheck(dialect, files, tuple(problems), tables, best, jerk, record)
 
 
-def _early_ends(parsed, files) -> list[str]:
-    """A generic CSV whose last row is not at rest ends early (a schedule ends at rest at its goal)."""
+def _records(parsed, files) -> tuple[ScheduleRecord | None, list[str]]:
+    """The files' common record of their schedule, and a problem if they say different things of jerk.
+
+    Files of one schedule record it alike; where they do not, neither record counts (the jerk is
+    checked) and that is a problem of the files.
+    """
+    records = [profile.record for profile in parsed]
+    said = [record is not None and not record.jerk_limited for record in records]
+    if said[0] != said[1]:
+        which = 0 if said[0] else 1
+        return None, [
+            f"{files[which]} records that its schedule is not jerk-limited (method "
+            f"{records[which].method}), {files[1 - which]} does not: expected both files of one "
+            "schedule to record it alike (neither record counts)"
+        ]
+    if records[0] is None or records[1] is None:
+        return None, []
+    return records[0], []
+
+
+def _early_ends(parsed, files, routes) -> list[str]:
+    """A generic CSV that ends early: its last row not at rest, or at rest short of its goal.
+
+    A schedule ends at rest at its goal. A file whose vehicle rests at its last row but has
+    travelled less than its route drives (the shortest of ``routes``, the classes the check tries)
+    stops short of the goal: cut where both vehicles stood, between two moves.
+    """
     most = max(profile.table.times.size for profile in parsed)
     ends = []
-    for profile, path in zip(parsed, files, strict=True):
-        rows, velocity = profile.table.times.size, float(profile.columns["v"][-1])
+    for vehicle, (profile, path) in enumerate(zip(parsed, files, strict=True)):
+        table = profile.table
+        rows, velocity = table.times.size, float(profile.columns["v"][-1])
+        of = f" of {most:,} in the other vehicle's file" if most > rows else ""
+        last = f"its last row (row {rows:,}{of}, t = {float(table.times[-1]):.3f} s)"
         if abs(velocity) > 1e-6:
-            of = f" of {most:,} in the other vehicle's file" if most > rows else ""
             ends.append(
-                f"{path}: the file ends early: its last row (row {rows:,}{of}, t = "
-                f"{float(profile.table.times[-1]):.3f} s) is not at rest ({velocity:.6g} m/s), where a "
+                f"{path}: the file ends early: {last} is not at rest ({velocity:.6g} m/s), where a "
                 "schedule ends at rest at its goal"
+            )
+            continue
+        driven = float(np.sum(np.abs(np.diff(table.values)))) if rows > 1 else 0.0
+        needed = min(float(route.travel[vehicle]) for route in routes)
+        if driven < needed - _SHORT_OF_GOAL:
+            ends.append(
+                f"{path}: the file ends early: {last} is at rest after {driven:.3f} m of the "
+                f"{needed:.3f} m its route drives to its goal"
             )
     return ends

@@ -28,7 +28,7 @@ import numpy as np
 from topology import Option
 from topology.validation import short_repr
 from trajgen.errors import OptionError, ProfileFileError
-from trajgen.export.csv import HEADER_NAMES, Units
+from trajgen.export.csv import HEADER_NAMES, ScheduleRecord, Units
 from trajgen.export.graph_rows import GRAPH_HEADER_NAMES
 from trajgen.export.numbers import format_number_rows
 from trajgen.export.plc.tables import Interpolation, ProfileTable
@@ -82,11 +82,15 @@ class ParsedProfile:
         Every column of a ``generic`` file in SI units (``t``, ``axis``, ``v``, ``a``, ``j``,
         ``leg`` (1-based, 0 at the junction), ``s``, ``x``, ``y``), shape (n,) each; on a track
         graph ``edge`` (names, dtype object) instead of ``leg``, and ``x``, ``y`` only if written.
+    record : ScheduleRecord or None
+        What a ``generic`` file records of its schedule on the line before its header (its method,
+        whether it limits jerk); ``None``: no such line (a jerk-limited schedule's file).
     """
 
     table: ProfileTable
     problems: tuple[str, ...]
     columns: dict | None = None
+    record: ScheduleRecord | None = None
 
 
 class Dialect(abc.ABC):
@@ -332,10 +336,26 @@ class GenericDialect(Dialect):
         return Interpolation.HERMITE
 
     def read(self, data: bytes, *, source: str) -> ParsedProfile:
-        """The ``t``, ``axis`` and ``v`` columns; delimiter, decimal mark and unit from the header row."""
+        """The ``t``, ``axis`` and ``v`` columns; delimiter, decimal mark and unit from the header row.
+
+        A first line ``# schedule timed by ...`` is the file's record of its schedule
+        (:class:`~trajgen.export.csv.ScheduleRecord`); the header follows it.
+        """
         lines, problems = _lines(_decode(data, source), source, crlf=True)
         if not lines:
             raise ProfileFileError(f"{source} is empty: expected a header row")
+        record = None
+        if lines[0].startswith("#"):
+            record = ScheduleRecord.parse(lines[0])
+            if record is None:
+                raise ProfileFileError(
+                    f"{source} line 1: {short_repr(lines[0])} is not trajgen's record of its schedule: "
+                    f"expected {ScheduleRecord('METHOD', False).line()!r} (or 'jerk limited'), or the header"
+                )
+            lines = lines[1:]
+            if not lines:
+                raise ProfileFileError(f"{source} has no header row after its record line: expected one")
+        first = 1 if record is None else 2  # the header's line number
         header = lines[0]
         delimiter = header[3:4] if header.startswith("t_s") else ""
         names = header.split(delimiter) if delimiter else []
@@ -346,7 +366,7 @@ class GenericDialect(Dialect):
                 units, graph = unit, True
         if units is None:
             raise ProfileFileError(
-                f"{source} line 1: header {short_repr(header)} is not trajgen's: expected "
+                f"{source} line {first}: header {short_repr(header)} is not trajgen's: expected "
                 f"{';'.join(HEADER_NAMES[Units.METRES])!r} (on a track graph "
                 f"{';'.join(GRAPH_HEADER_NAMES['m'])!r}; any delimiter, or the mm columns)"
             )
@@ -361,7 +381,7 @@ class GenericDialect(Dialect):
             fields = row.split(delimiter)
             if len(fields) != len(names):
                 raise ProfileFileError(
-                    f"{source} line {n + 2}: {len(fields)} field(s) separated by {delimiter!r}, "
+                    f"{source} line {n + first + 1}: {len(fields)} field(s) separated by {delimiter!r}, "
                     f"expected {len(names)} ({short_repr(row)})"
                 )
             for k, field in enumerate(fields):
@@ -370,18 +390,20 @@ class GenericDialect(Dialect):
                     columns[k, n] = 0.0
                     continue
                 columns[k, n], decimals = _number(
-                    field.replace(",", ".") if comma else field, source, n + 2, names[k]
+                    field.replace(",", ".") if comma else field, source, n + first + 1, names[k]
                 )
                 if k == 1:
                     places.append(decimals)
         if columns[0, 0] != 0.0:
             raise ProfileFileError(
-                f"{source} line 2: the first time is {float(columns[0, 0])!r} s, expected 0"
+                f"{source} line {first + 1}: the first time is {float(columns[0, 0])!r} s, expected 0"
             )
         legs = columns[EDGE_COLUMN]
         if not graph and not np.all(legs == np.round(legs)):
             bad = int(np.argmax(legs != np.round(legs)))
-            raise ProfileFileError(f"{source} line {bad + 2}: leg {legs[bad]!r} is not a whole number")
+            raise ProfileFileError(
+                f"{source} line {bad + first + 1}: leg {legs[bad]!r} is not a whole number"
+            )
         resolution = 0.5 * 10.0 ** -max(places) / units.scale
         scaled = {
             name: columns[k] / (1.0 if k in (0, EDGE_COLUMN) else units.scale)
@@ -397,7 +419,7 @@ class GenericDialect(Dialect):
             resolution=resolution,
             velocities=scaled["v"],
         )
-        return ParsedProfile(table, tuple(problems), scaled)
+        return ParsedProfile(table, tuple(problems), scaled, record)
 
 
 class DialectRegistry:

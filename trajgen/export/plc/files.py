@@ -13,9 +13,11 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
+from limits import Limits
 from trajgen.errors import OptionError, VerificationError
 from trajgen.export.atomic import check_output_paths, commit_files
-from trajgen.export.plc.dialects import DIALECTS, TableDialect
+from trajgen.export.numbers import limit_cap
+from trajgen.export.plc.dialects import DECIMALS, DIALECTS, TableDialect
 from trajgen.export.plc.resample import Resampled, resample
 from trajgen.export.plc.table_check import TableCheck, check_tables
 from trajgen.export.plc.tables import Interpolation, limit_ratios, slowdown
@@ -79,6 +81,25 @@ def check_dialect_method(dialect: TableDialect, jerk_limited: bool) -> None:
         )
 
 
+def _written_above(dialect: TableDialect, contents: tuple[bytes, bytes], limits: Limits) -> float:
+    """How far the largest velocity a velocity table writes is above its limit as written (<= 1: not).
+
+    The ratio of the largest written ``|v|`` to the largest number of the file's decimals at most
+    the limit (:func:`~trajgen.export.numbers.limit_cap`, in mm/s), both vehicles; 0 for a
+    position table (it writes no velocity).
+    """
+    if dialect.interpolation is not Interpolation.VELOCITY:
+        return 0.0
+    end = "\r\n" if dialect.crlf else "\n"
+    worst = 0.0
+    for vehicle, data in enumerate(contents):
+        lines = data.decode("ascii").split(end)[(0 if dialect.header is None else 1) : -1]
+        largest = max(abs(float(line.split(dialect.delimiter)[1])) for line in lines)
+        cap = limit_cap(limits.vehicles[vehicle].max_velocity * 1000.0, DECIMALS)
+        worst = max(worst, largest / cap)
+    return worst
+
+
 def table_paths(dialect: TableDialect, names: Sequence[str], directory: str | Path) -> tuple[Path, Path]:
     """``directory/<name><suffix>`` for both vehicles."""
     first, second = check_vehicle_names(names)
@@ -128,9 +149,12 @@ def plc_tables(
             for vehicle, data in enumerate(contents)
         )
         needed = slowdown(limit_ratios(parsed, schedule.limits, jerk=schedule.jerk_limited))
-        if needed <= 1.0 + 1e-9:
+        # and no velocity a velocity table writes above its limit: slowed down, never clipped (the
+        # positions are its integral)
+        above = _written_above(dialect, contents, schedule.limits)
+        if needed <= 1.0 + 1e-9 and above <= 1.0:
             break
-        scale = resampled.time_scale * needed * (1.0 + 1e-6)
+        scale = resampled.time_scale * max(needed, above) * (1.0 + 1e-6)
     check = check_tables(parsed, schedule.route, schedule.limits, jerk=schedule.jerk_limited)
     if not check.passed:
         raise VerificationError(
