@@ -1,9 +1,12 @@
-"""``configuration.png`` drawn: the configuration space of a Y laid flat, with a route and its retraction.
+"""``configuration.png`` drawn: where the two vehicles of a Y can be at once, laid flat, with a route.
 
 The picture is drawn on :class:`trajgen.plots.configuration_layout.ConfigurationLayout`
 (where everything lies, computed apart from the drawing): the regions and the
 boundary circle, the too-close parts, the route, a schedule's path, retraction
-traces and the motion retracted onto the circle, rendered to PNG bytes. A
+traces and the motion retracted onto the circle. Its words are plain: each point is
+(position of vehicle 1, position of vehicle 2), a quadrangle ``Q(A,B)`` is the area
+"agv1 on A, agv2 on B", the boundary circle the rim, the retraction moving out to the rim;
+the paper's notation is mapped to them in docs/planner.md, 'Reading configuration.png'. A
 junction of four or more legs has no flat drawing: it is handed to
 :func:`trajgen.plots.star_configuration.plot_retract_graph`.
 """
@@ -12,11 +15,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from topology import JUNCTION_INDEX, RegionKey, Route, YGraph
+from topology import JUNCTION_INDEX, RegionKey, Route, WayRound, YGraph
 from topology.indexed import IndexedConfiguration
-from trajgen.model.summary import class_label
 from trajgen.plots.configuration_layout import ConfigurationLayout, rotate, route_samples, schedule_samples
-from trajgen.plots.figure import drawing_area, finished
+from trajgen.plots.figure import drawing_area, finished, untangle, wrapped
 from trajgen.plots.star_configuration import configuration_subject, plot_retract_graph
 from trajgen.verification import VerifiedSchedule
 
@@ -33,35 +35,63 @@ _RETRACTION_COLOUR = "tab:orange"
 _OUTSET = 1.07
 #: Retraction traces drawn from the motion.
 _TRACES = 14
+#: The smallest font the labels in the drawing shrink to, points.
+_SMALLEST_LABEL = 5.5
+#: Width of the note under the picture, inches.
+_FOOTNOTE_IN = 7.7
+#: The retraction traces in the legend, in plain words.
+_TRACES_LABEL = "moved out to the rim (the vehicles driven apart)"
+#: How far beyond its triangle a triangle's words are written, outwards, drawing units.
+_GAP = 0.03
+#: Behind the words in the drawing: they stay legible over the lines.
+_TEXT_BOX = {"boxstyle": "round,pad=0.1", "facecolor": "white", "edgecolor": "none", "alpha": 0.7}
 
 
-def _region_name(graph: YGraph, key: RegionKey) -> str:
+def _region_text(graph: YGraph, key: RegionKey, who: tuple[str, str]) -> str:
+    """A region in words: where each vehicle is in it."""
     names = graph.names
     if key.nearer:
-        return f"T({names[key.first_leg]},{key.nearer})"
-    return f"Q({names[key.first_leg]},{names[key.second_leg]})"
+        return f"both on {names[key.first_leg]},\n{who[key.nearer - 1]} nearer O"
+    return f"{who[0]} on {names[key.first_leg]}\n{who[1]} on {names[key.second_leg]}"
 
 
-def _vertex_name(graph: YGraph, c: IndexedConfiguration) -> str:
+def _corner_text(graph: YGraph, c: IndexedConfiguration) -> str:
+    """A corner of the rim: ``(where vehicle 1 is, where vehicle 2 is)``, O or the end of a leg."""
     names = graph.names
-    if c[0] == JUNCTION_INDEX:
-        return f"V1({names[c[2]]})"
-    if c[2] == JUNCTION_INDEX:
-        return f"V2({names[c[0]]})"
-    return f"P({names[c[0]]},{names[c[2]]})"
+    return "({}, {})".format(*("O" if c[k] == JUNCTION_INDEX else names[c[k]] for k in (0, 2)))
 
 
-def _draw_space(axis, layout: ConfigurationLayout) -> None:
-    """The regions, the too-close parts, the rays, the boundary circle and the labels."""
+def _alignment(direction: np.ndarray) -> tuple[str, str]:
+    """How a label is aligned to its anchor so that it lies in ``direction`` (a unit vector) of it."""
+    across = "left" if direction[0] > 0.3 else "right" if direction[0] < -0.3 else "center"
+    return across, "bottom" if direction[1] > 0.3 else "top" if direction[1] < -0.3 else "center"
+
+
+def _draw_space(axis, layout: ConfigurationLayout, who: tuple[str, str]) -> list:
+    """The regions, the too-close parts, the rays, the rim and the labels in plain words (returned)."""
     graph = layout.graph
+    labels = []
     for key in layout.regions:
         polygon = layout.region_polygon(key)
         colour = _TRIANGLE_COLOUR if key.nearer else _QUADRANGLE_COLOUR
         axis.fill(*polygon.T, facecolor=colour, edgecolor="0.55", linewidth=0.8, zorder=1)
-        centre = polygon.mean(axis=0) if key.nearer else 0.55 * layout.peak(key.first_leg, key.second_leg)
-        axis.text(
-            *centre, _region_name(graph, key), ha="center", va="center", fontsize=9, color="0.25", zorder=2
+        if key.nearer:  # beside its triangle, outwards, clear of it: the triangle is too small for the words
+            out = polygon.mean(axis=0) / np.hypot(*polygon.mean(axis=0))
+            place = polygon.mean(axis=0) + (np.max((polygon - polygon.mean(axis=0)) @ out) + _GAP) * out
+            size, align = 7, _alignment(out)
+        else:
+            place, size, align = 0.55 * layout.peak(key.first_leg, key.second_leg), 8.5, ("center", "center")
+        text = axis.text(
+            *place,
+            _region_text(graph, key, who),
+            ha=align[0],
+            va=align[1],
+            fontsize=size,
+            color="0.25",
+            zorder=2,
+            bbox=_TEXT_BOX,
         )
+        labels.append(text)
     for k, polygon in enumerate(layout.too_close_polygons()):
         axis.fill(
             *polygon.T,
@@ -70,7 +100,7 @@ def _draw_space(axis, layout: ConfigurationLayout) -> None:
             edgecolor="none",
             hatch="////",
             zorder=2,
-            label=f"too close (< {layout.min_separation:g} m along the track)" if k == 0 else None,
+            label=f"too close: under {layout.min_separation:g} m apart along the track" if k == 0 else None,
         )
     for k, c in enumerate(graph.cycle.vertex_tuples):
         vertex = layout.vertices[k]
@@ -81,23 +111,25 @@ def _draw_space(axis, layout: ConfigurationLayout) -> None:
                 linewidth=0.9,
                 linestyle="--",
                 zorder=2,
-                label="rays (one vehicle at O)" if k == 1 else None,
+                label="one vehicle at the junction O" if k == 1 else None,
             )
             place = vertex + 0.17 * rotate(vertex / np.hypot(*vertex), -0.6)
         else:
             place = 1.1 * vertex
-        axis.text(*place, _vertex_name(graph, c), ha="center", va="center", fontsize=8, zorder=3)
+        labels.append(
+            axis.text(*place, _corner_text(graph, c), ha="center", va="center", fontsize=8, zorder=3)
+        )
     star = np.vstack([layout.vertices, layout.vertices[:1]])
     axis.plot(
         *star.T,
         color="black",
         linewidth=2.0,
         zorder=3,
-        label=f"boundary circle (12-cycle, {graph.perimeter:g} m round)",
+        label=f"the rim: a vehicle at a leg's end ({graph.perimeter:g} m round)",
     )
     axis.plot([0.0], [0.0], "o", markersize=11, markerfacecolor="white", markeredgecolor="black", zorder=6)
-    axis.annotate(
-        "deleted point\n(both at O)",
+    centre = axis.annotate(
+        "both at O:\nnever allowed",
         (0.0, 0.0),
         xytext=(0, -14),
         textcoords="offset points",
@@ -105,7 +137,9 @@ def _draw_space(axis, layout: ConfigurationLayout) -> None:
         va="top",
         fontsize=8,
         zorder=6,
+        bbox=_TEXT_BOX,
     )
+    return [*labels, centre]
 
 
 def _draw_paths(
@@ -132,9 +166,7 @@ def _draw_retraction(
         trace = layout.retraction(c, regions[int(index)])
         if len(trace) < 2:
             continue
-        axis.plot(
-            *trace.T, color="0.35", linewidth=0.8, zorder=4, label="retraction traces" if first else None
-        )
+        axis.plot(*trace.T, color="0.35", linewidth=0.8, zorder=4, label=_TRACES_LABEL if first else None)
         axis.annotate(
             "",
             xy=trace[-1],
@@ -166,17 +198,23 @@ def _draw_retraction(
 def plot_configuration(
     subject: Route | VerifiedSchedule, *, names: tuple[str, str] | None = None, figure=None
 ):
-    """The configuration space drawn flat with the route, the motion and its retraction.
+    """Where the two vehicles can be at once, drawn flat, with the route, the motion and the rim.
 
-    Four or more legs: the retract graph ``G_k`` with the route on it instead
+    Four or more legs: the places where the vehicles wait, with the route between them, instead
     (:func:`trajgen.plots.star_configuration.plot_retract_graph`): the space has no flat drawing.
 
-    Drawn: the six quadrangles and six triangles (folded out beside their valleys, see
-    :class:`~trajgen.plots.configuration_layout.ConfigurationLayout`) round the deleted point, the
-    too-close parts, the rays, the boundary circle with its peaks and valleys named, the route (the planner's
-    waypoints), for a schedule also its path, the start (hollow) and goal (solid),
-    retraction traces from the motion (the schedule's path, else the route) and the motion
-    retracted onto the boundary circle (drawn just outside it, with its direction).
+    Each point of the drawing is a pair (where vehicle 1 is, where vehicle 2 is): the paper's
+    configuration space (docs/planner.md, 'Reading configuration.png', names its parts). Drawn, in
+    plain words: six areas, each vehicle on another leg (folded out beside them: six small
+    triangles, both on one leg), round the centre where both would be at the junction; the too-close
+    parts; the dashed lines where one vehicle is at the junction; the rim, where a vehicle is at
+    the end of a leg, its corners named as pairs of places (``(A, B)``: vehicle 1 at the end of
+    ``A``, vehicle 2 at the end of ``B``; ``O`` is the junction); the route (the planner's
+    waypoints), for a schedule also its path, the start (hollow) and goal (solid); grey arrows from
+    some points of the motion (the schedule's path, else the route) moved out to the rim, and the
+    whole motion moved out to the rim (drawn just outside it, with its direction): which way round
+    the centre the route goes. The title and the legend say what each means for the vehicles; no
+    two of the words overlap.
 
     Parameters
     ----------
@@ -184,7 +222,7 @@ def plot_configuration(
         A route from :func:`topology.plan`, or a schedule from :func:`trajgen.certify`
         (its route and its path are drawn).
     names : pair of str, optional
-        The vehicles' names, for the title (default: "vehicle 1", "vehicle 2").
+        The vehicles' names, used throughout (default: "vehicle 1", "vehicle 2").
     figure : matplotlib Figure or SubFigure, optional
         Where to draw (default: a new Figure of 8.6 x 9.6 inches).
 
@@ -207,14 +245,14 @@ def plot_configuration(
     if graph.cycle is None:  # four or more legs: no flat drawing, the retract graph G_k instead
         return plot_retract_graph(subject, names=names, figure=figure)
     layout = ConfigurationLayout.of(graph, min_separation=required)
-    who = "vehicle 1 and vehicle 2" if names is None else f"{names[0]} (vehicle 1) and {names[1]} (vehicle 2)"
+    who = ("vehicle 1", "vehicle 2") if names is None else (names[0], names[1])
     area = drawing_area(figure, figsize=(8.6, 9.6))
-    axis = area.add_axes((0.02, 0.265, 0.96, 0.655))
+    axis = area.add_axes((0.02, 0.255, 0.96, 0.645))
     axis.set_aspect("equal")
     axis.set_axis_off()
     axis.set_xlim(-1.32, 1.32)
     axis.set_ylim(-1.22, 1.22)
-    _draw_space(axis, layout)
+    labels = _draw_space(axis, layout, who)
     route_configurations, route_regions = route_samples(route)
     _draw_paths(
         axis,
@@ -242,7 +280,7 @@ def plot_configuration(
         layout,
         motion,
         motion_regions,
-        f"the {what} retracted onto the circle: {abs(route.arc_length):.4g} m {way} round",
+        f"the {what} moved out to the rim: {abs(route.arc_length):.4g} m {way} round",
     )
     start, goal = route.indexed_waypoints[0], route.indexed_waypoints[-1]
     start_region = route.region_keys[0] if route.region_keys else None
@@ -266,28 +304,34 @@ def plot_configuration(
         label=f"goal {route.goal}",
     )
     axis.legend(loc="upper center", bbox_to_anchor=(0.5, -0.01), ncols=2, fontsize=8.5, frameon=False)
-    regions = " ".join(_region_name(graph, key) for key in route.region_keys) or "(one ray)"
-    axis.set_title(
-        f"Configuration space of {who}, drawn flat\nroute: {class_label(route)}; regions {regions}",
+    round_the_centre = (
+        f"the route goes {route.way_round.value} round the centre"
+        if route.way_round in (WayRound.CLOCKWISE, WayRound.COUNTERCLOCKWISE)
+        else "the route does not go round the centre"
+    )
+    area.suptitle(
+        f"Where {who[0]} and {who[1]} can be at the same time (drawn flat, not to scale)\n"
+        f"each point is (position of {who[0]}, position of {who[1]}); hatched: closer than {required:g} m\n"
+        f"{round_the_centre} (both at the junction O: never allowed)",
         fontsize=11,
+        y=0.985,
     )
-    area.text(
-        0.05,
-        0.015,
-        "\n".join(
-            (
-                "Q(i,j): vehicle 1 on leg i, vehicle 2 on leg j (a quadrangle).  T(k,r): both on leg k,",
-                "vehicle r nearer O (a triangle, glued to the base along its ray; drawn folded out beside",
-                "that ray's valley, the ray drawn again outwards from the valley).  P(i,j): vehicle 1 at the",
-                "end of leg i, vehicle 2 at the end of leg j; V1(j): vehicle 1 at O, vehicle 2 at the end of",
-                "j; V2(i): vehicle 2 at O, vehicle 1 at the end of i.  Not to scale: the angle round the",
-                "deleted point is proportional to arc length on the boundary circle (a swap of the vehicles",
-                "is drawn opposite); a point of a quadrangle lies on the line from the deleted point to its",
-                "retraction, max(s1/L_i, s2/L_j) of the way.",
-            )
-        ),
-        fontsize=8,
-        va="bottom",
-        family="sans-serif",
-    )
+    untangle(labels, smallest=_SMALLEST_LABEL)  # long names: smaller words, none over another
+    footnote = wrapped(_footnote(graph, who), width_in=_FOOTNOTE_IN, fontsize=8)
+    area.text(0.05, 0.012, footnote, fontsize=8, va="bottom", family="sans-serif")
     return finished(area, laid_out=False)  # its axes are placed by hand
+
+
+def _footnote(graph: YGraph, who: tuple[str, str]) -> str:
+    """How to read the picture, in plain words (the paper's notation is in docs/planner.md)."""
+    a, b = graph.names[0], graph.names[1]
+    return (
+        f"How to read it: a point in the area '{who[0]} on {a}, {who[1]} on {b}' has {who[0]} somewhere "
+        f"on leg {a} and {who[1]} on leg {b}; the farther from the centre, the farther out along their legs. "
+        f"A corner of the rim names both places: ({a}, {b}) is {who[0]} at the end of {a} and {who[1]} at "
+        f"the end of {b}; (O, {b}) is {who[0]} at the junction O. The small triangles are both vehicles on "
+        "one leg, folded out beside the corner where they meet the rest. Every point moves out to the rim "
+        "without the vehicles coming closer, so a route is told by which way round the centre it goes. "
+        f"Not to scale: once round the rim is {graph.perimeter:g} m of travel, and a swap of the vehicles "
+        "is drawn opposite. The paper's names for these parts: docs/planner.md."
+    )

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import textwrap
 from collections.abc import Mapping
 
 import numpy as np
@@ -14,12 +13,17 @@ from trajgen.model.coordination import CoordinationDiagram, schedule_paths
 from trajgen.model.graph_cells import too_close_polygons
 from trajgen.model.graph_schedule import GraphSchedule
 from trajgen.model.summary import class_label
-from trajgen.plots.figure import drawing_area, finished, polygon_patch
+from trajgen.plots.figure import drawing_area, finished, polygon_patch, wrapped
 from trajgen.plots.speed import VEHICLE_COLOURS, plot_period
 from trajgen.verification import VerifiedSchedule, require_verified
 
 __all__ = ["METHOD_COLOURS", "plot_coordination"]
 
+#: Width of a panel, inches, and of what its title may take: its axes' width, about, so that a title
+#: centred over them stays inside the figure.
+_PANEL_IN = 5.2
+_TITLE_IN = 4.1
+_TITLE_POINTS = 9
 _PALETTE = ("tab:blue", "tab:green", "tab:red", "tab:purple", "tab:brown", "tab:pink", "tab:olive")
 #: Curve colour of each registered method, in registry order.
 METHOD_COLOURS = {name: _PALETTE[k % len(_PALETTE)] for k, name in enumerate(METHODS.names)}
@@ -60,7 +64,8 @@ def plot_coordination(verified: Mapping[str, VerifiedSchedule], *, figure=None):
     verified : mapping of method name to VerifiedSchedule
         At least one: the schedules to compare (the pipeline's ``Outputs(compare=...)``).
     figure : matplotlib Figure or SubFigure, optional
-        Where to draw the panels (default: a new Figure, 5.2 inches wide per panel).
+        Where to draw the panels (default: a new Figure, 5.2 inches wide per panel; each panel's
+        title is broken into lines that fit over its axes).
 
     Returns
     -------
@@ -79,7 +84,7 @@ def plot_coordination(verified: Mapping[str, VerifiedSchedule], *, figure=None):
     for name, distance in distances.items():
         key = tuple(np.round(distance[:, -1], 6))  # same paths drive the same distances
         groups.setdefault(key, []).append(name)
-    area = drawing_area(figure, figsize=(5.2 * len(groups), 5.4 if len(groups) > 1 else 5.0))
+    area = drawing_area(figure, figsize=(_PANEL_IN * len(groups), 5.4 if len(groups) > 1 else 5.0))
     panels = area.subplots(1, len(groups), squeeze=False)[0]
     for axis, names in zip(panels, groups.values(), strict=True):
         reference = schedules[names[0]]
@@ -104,8 +109,13 @@ def plot_coordination(verified: Mapping[str, VerifiedSchedule], *, figure=None):
         axis.margins(0.04)  # a curve along a path's end (one vehicle waits) stays clear of the frame
         axis.set_xlabel("vehicle 1 travelled [m]")
         axis.set_ylabel("vehicle 2 travelled [m]")
-        title = textwrap.fill(f"paths of {', '.join(names)}: class {class_label(reference.route)}", 64)
-        axis.set_title(f"{title}\n(shaded: closer than {required:g} m)", fontsize=9)
+        title = f"paths of {', '.join(names)}: class {class_label(reference.route)}"
+        axis.set_title(
+            wrapped(
+                f"{title}\n(shaded: closer than {required:g} m)", width_in=_TITLE_IN, fontsize=_TITLE_POINTS
+            ),
+            fontsize=_TITLE_POINTS,
+        )
         axis.legend(loc="best", fontsize=7)
         axis.grid(True, alpha=0.3)
     if len(groups) > 1:

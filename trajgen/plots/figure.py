@@ -19,6 +19,8 @@ __all__ = [
     "png_bytes",
     "polygon_patch",
     "root_figure",
+    "untangle",
+    "wrapped",
 ]
 
 #: Resolution of the PNGs, dots per inch.
@@ -67,11 +69,98 @@ def finished(area, *, laid_out: bool):
     return figure
 
 
+def wrapped(text: str, *, width_in: float, fontsize: float) -> str:
+    """``text`` broken between words into lines at most ``width_in`` inches wide at ``fontsize`` points.
+
+    Measured as the PNGs draw text (Agg at :data:`PNG_DPI`); a word wider than the width stays on
+    a line of its own; the line breaks already in ``text`` are kept.
+    """
+    from matplotlib.backends.backend_agg import RendererAgg
+    from matplotlib.font_manager import FontProperties
+
+    renderer = RendererAgg(1, 1, PNG_DPI)
+    font = FontProperties(size=fontsize)
+    limit = width_in * PNG_DPI
+
+    def fits(line: str) -> bool:
+        return renderer.get_text_width_height_descent(line, font, ismath=False)[0] <= limit
+
+    lines = []
+    for paragraph in text.split("\n"):
+        line = ""
+        for word in paragraph.split(" "):
+            candidate = f"{line} {word}" if line else word
+            if line and not fits(candidate):
+                lines.append(line)
+                line = word
+            else:
+                line = candidate
+        lines.append(line)
+    return "\n".join(lines)
+
+
+def untangle(texts, *, smallest: float, step: float = 0.5, padding_px: float = 2.0) -> bool:
+    """Make the font of each text that overlaps another smaller, until none overlap or all are ``smallest``.
+
+    Boxes are measured as drawn (Agg at the figure's dpi), ``padding_px`` apart; the texts of a
+    pair that overlap both shrink by ``step`` points a round, none below ``smallest`` points.
+
+    Parameters
+    ----------
+    texts : sequence of matplotlib Text
+        Of one figure, placed.
+    smallest : float
+        Points.
+
+    Returns
+    -------
+    bool
+        Whether no two overlap now.
+    """
+    from matplotlib.backends.backend_agg import RendererAgg
+
+    texts = [text for text in texts if text.get_visible() and text.get_text().strip()]
+    if not texts:
+        return True
+    figure = root_figure(texts[0])
+    renderer = RendererAgg(int(figure.bbox.width) + 1, int(figure.bbox.height) + 1, figure.dpi)
+    for axis in figure.axes:  # where an equal-aspect axis really lies is settled when it is drawn
+        axis.apply_aspect()
+    while True:
+        boxes = [text.get_window_extent(renderer).padded(padding_px) for text in texts]
+        clashing = {
+            k
+            for i, a in enumerate(boxes)
+            for j in range(i + 1, len(boxes))
+            if a.overlaps(boxes[j])
+            for k in (i, j)
+        }
+        shrinking = [texts[k] for k in sorted(clashing) if texts[k].get_fontsize() > smallest]
+        if not shrinking:
+            return not clashing
+        for text in shrinking:
+            text.set_fontsize(max(smallest, text.get_fontsize() - step))
+
+
 def polygon_patch(vertices, *, facecolor, alpha: float, edgecolor, label: str | None = None):
     """A closed polygon patch through ``vertices`` (array of shape (n, 2)), labelled for a legend."""
     from matplotlib.patches import Polygon
 
     return Polygon(vertices, closed=True, facecolor=facecolor, alpha=alpha, edgecolor=edgecolor, label=label)
+
+
+def clip_to_data_box(artist, axis, lower: tuple[float, float], upper: tuple[float, float]) -> None:
+    """Draw ``artist`` only inside the box from ``lower`` to ``upper`` (data units of ``axis``)."""
+    from matplotlib.transforms import Bbox, TransformedBbox
+
+    artist.set_clip_box(TransformedBbox(Bbox([list(lower), list(upper)]), axis.transData))
+
+
+def numbered_handle(number: int, *, colour, label: str):
+    """A legend entry showing ``number`` (as drawn on a panel) before ``label``."""
+    from matplotlib.lines import Line2D
+
+    return Line2D([], [], linestyle="none", marker=f"${number}$", markersize=6, color=colour, label=label)
 
 
 def png_bytes(figure) -> bytes:
@@ -100,21 +189,31 @@ def frame_painter(figure, animated):
     import matplotlib
     import numpy as np
     from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from PIL import Image
 
-    unhinted = {"text.hinting": "none"}
     canvas = FigureCanvasAgg(figure)
     for artist in animated:
         artist.set_animated(True)
-    with matplotlib.rc_context(unhinted):
+    with matplotlib.rc_context({"text.hinting": "none"}):
         canvas.draw()
     background = canvas.copy_from_bbox(figure.bbox)
 
     def paint():
         canvas.restore_region(background)
-        with matplotlib.rc_context(unhinted):
+        # the one setting for the artists drawn here, put back at once (a whole rc_context per frame
+        # copies every setting)
+        hinting = matplotlib.rcParams["text.hinting"]
+        matplotlib.rcParams["text.hinting"] = "none"
+        try:
             for artist in animated:
                 figure.draw_artist(artist)
-        return np.array(np.asarray(canvas.buffer_rgba())[:, :, :3])
+        finally:
+            matplotlib.rcParams["text.hinting"] = hinting
+        rgba = np.asarray(canvas.buffer_rgba())
+        height, width = rgba.shape[:2]
+        # Pillow drops the alpha channel about three times faster than a strided numpy copy
+        rgb = Image.frombuffer("RGBA", (width, height), rgba, "raw", "RGBA", 0, 1).convert("RGB")
+        return np.array(rgb)
 
     return paint
 

@@ -75,6 +75,10 @@ class _Palette:
         self.sorted = packed[self.order]
         #: the global colour table: 256 entries of 3 bytes
         self.table = self.colours.astype(np.uint8).tobytes() + b"\0" * (3 * (256 - len(packed)))
+        #: colours not in the table met so far (sorted) and the index of the nearest one of each: frame
+        #: after frame the same edges of text and lines come back
+        self.seen = np.zeros(0, dtype=packed.dtype)
+        self.seen_index = np.zeros(0, dtype=np.intp)
 
     def indices(self, packed: np.ndarray) -> np.ndarray:
         """Palette index of each pixel, uint8, of the shape of ``packed`` (colours of :func:`_pack`)."""
@@ -84,12 +88,22 @@ class _Palette:
         indices = self.order[position]
         if not found.all():  # colours not in the table: the nearest one (few distinct colours)
             missing, inverse = np.unique(flat[~found], return_inverse=True)
-            wanted = np.stack([(missing >> 16) & 255, (missing >> 8) & 255, missing & 255], 1).astype(
-                np.int32
-            )
-            distance = ((wanted[:, None, :] - self.colours[None, :, :]) ** 2).sum(axis=2)
-            indices[~found] = np.argmin(distance, axis=1)[inverse.ravel()]
+            indices[~found] = self._nearest(missing)[inverse.ravel()]
         return indices.astype(np.uint8).reshape(packed.shape)
+
+    def _nearest(self, missing: np.ndarray) -> np.ndarray:
+        """The index of the nearest table colour to each of ``missing`` (sorted, distinct), remembered."""
+        at = np.minimum(np.searchsorted(self.seen, missing), max(self.seen.size - 1, 0))
+        new = missing[~(self.seen[at] == missing)] if self.seen.size else missing
+        if new.size:
+            wanted = np.stack([(new >> 16) & 255, (new >> 8) & 255, new & 255], 1).astype(np.int32)
+            distance = ((wanted[:, None, :] - self.colours[None, :, :]) ** 2).sum(axis=2)
+            seen = np.concatenate([self.seen, new])
+            order = np.argsort(seen, kind="stable")
+            self.seen = seen[order]
+            self.seen_index = np.concatenate([self.seen_index, np.argmin(distance, axis=1)])[order]
+            at = np.searchsorted(self.seen, missing)
+        return self.seen_index[at]
 
 
 def _delay_units(delay_ms: float) -> int:

@@ -8,7 +8,7 @@ import numpy as np
 
 from topology.validation import short_repr
 from trajgen.errors import InputError
-from trajgen.plots.figure import drawing_area, finished, polygon_patch
+from trajgen.plots.figure import clip_to_data_box, drawing_area, finished, numbered_handle, polygon_patch
 from trajgen.plots.speed import VEHICLE_COLOURS
 
 __all__ = ["plot_simulation"]
@@ -54,18 +54,8 @@ def _mark_times(axis, marks) -> None:
 
 def _mark_key(marks) -> list:
     """Legend entries naming each numbered mark: its number, then its fault spec or what it is."""
-    from matplotlib.lines import Line2D
-
     return [
-        Line2D(
-            [],
-            [],
-            linestyle="none",
-            marker=f"${number}$",
-            markersize=6,
-            color="dimgray" if colour == FAULT_COLOUR else colour,
-            label=text,
-        )
+        numbered_handle(number, colour="dimgray" if colour == FAULT_COLOUR else colour, label=text)
         for number, (_, _, text, colour) in enumerate(marks, start=1)
     ]
 
@@ -98,8 +88,6 @@ def _coordination(axis, result, names, min_separation: float) -> None:
     After a re-plan for a new goal the new plan's paths continue where the vehicles stood: its
     conflicts and curve are drawn from that point on, the old plan's up to it.
     """
-    from matplotlib.transforms import Bbox, TransformedBbox
-
     from trajgen.model.coordination import CoordinationDiagram, schedule_paths
 
     plans = result.plans
@@ -111,7 +99,6 @@ def _coordination(axis, result, names, min_separation: float) -> None:
         far = ends[k] if k < len(ends) else (origin[0] + paths[0].length, origin[1] + paths[1].length)
         corner = (max(corner[0], far[0]), max(corner[1], far[1]))
         # what the run drove of this plan: from where it took it up to where it left it
-        box = TransformedBbox(Bbox([[origin[0], origin[1]], [far[0], far[1]]]), axis.transData)
         diagram = CoordinationDiagram(paths, min_separation + result.position_margin, plan.schedule, times)
         for conflict in diagram.conflicts:
             colour = VEHICLE_COLOURS[conflict.leader]
@@ -120,7 +107,7 @@ def _coordination(axis, result, names, min_separation: float) -> None:
                     np.asarray(polygon) + np.asarray(origin), facecolor=colour, alpha=0.25, edgecolor="none"
                 )
                 axis.add_patch(patch)
-                patch.set_clip_box(box)
+                clip_to_data_box(patch, axis, origin, far)
         (curve,) = axis.plot(
             origin[0] + travel[0],
             origin[1] + travel[1],
@@ -129,7 +116,7 @@ def _coordination(axis, result, names, min_separation: float) -> None:
             linewidth=0.9,
             label="plan" if k == 0 else None,
         )
-        curve.set_clip_box(box)
+        clip_to_data_box(curve, axis, origin, far)
         if k > 0:
             axis.plot(*origin, marker="o", color="black", markersize=5, fillstyle="none")
             axis.annotate(

@@ -1,32 +1,25 @@
 """``configuration.png`` for four to eight legs: the retract graph ``G_k`` drawn as a table, with the route.
 
-With four or more legs the configuration space has no flat drawing like the
-Y's (:mod:`trajgen.plots.configuration_layout`): it deforms onto the graph ``G_k``
-(docs/star.md, 'The retract graph G_k'), which this module draws instead.
+With four or more legs the configuration space has no flat drawing like the Y's
+(:mod:`trajgen.plots.configuration_layout`): it deforms onto the graph ``G_k`` (docs/star.md,
+'The retract graph G_k'), drawn here. The layout (:class:`RetractGraphLayout`, pure geometry) is a
+table of where each vehicle waits, vehicle 1 down the rows, vehicle 2 across the columns, each at
+the junction ``O`` (the first row and column) or at the far end ``E_i`` of a leg (counterclockwise):
 
-The drawing (:class:`RetractGraphLayout`, pure geometry, no drawing) is a table
-of where each vehicle is, vehicle 1 down the rows, vehicle 2 across the
-columns, each either at the junction ``O`` (the first row and column) or at the
-far end ``E_i`` of a leg (the legs in counterclockwise order):
+- the peak ``P(i, j)`` is the cell of row ``i``, column ``j``; the valley ``V1(j)`` (vehicle 1 at
+  ``O``) is in the first row, ``V2(i)`` in the first column; the corner (both at ``O``) is the
+  deleted point and the diagonal (both at one leg's end) holds no configuration;
+- the edge ``P(i, j) - V1(j)`` (vehicle 1 drives leg ``i``) runs up column ``j``, the edge
+  ``P(i, j) - V2(i)`` (vehicle 2 drives leg ``j``) along row ``i``, each a parabolic arc bowed
+  towards the deleted point, its bow proportional to its length in cells: the arcs from one valley
+  are scaled copies of each other and never cross. A point ``f`` of an edge's length from the peak
+  is drawn ``f`` of the way along the arc (measured along the chord);
+- a route is drawn through the points of ``G_k`` it passes: the start's retraction, the vertices
+  of the route on ``G_k``, the goal's retraction.
 
-- the peak ``P(i, j)`` (vehicle 1 at ``E_i``, vehicle 2 at ``E_j``) is the
-  cell of row ``i``, column ``j``; the valley ``V1(j)`` (vehicle 1 at ``O``)
-  is in the first row, ``V2(i)`` (vehicle 2 at ``O``) in the first column; the
-  corner (both at ``O``) is the deleted point and the diagonal (both at one
-  leg's end) holds no configuration;
-- the edge ``P(i, j) - V1(j)`` (vehicle 1 drives leg ``i``, vehicle 2 waits at
-  ``E_j``) runs up column ``j``, the edge ``P(i, j) - V2(i)`` (vehicle 2 drives
-  leg ``j``) along row ``i``. Edges sharing a valley would overlap as straight
-  lines, so each is drawn as a parabolic arc bowed towards the deleted point,
-  its bow proportional to its length in cells: the arcs from one valley are
-  scaled copies of each other about it and never cross. A point of an edge
-  ``f`` of its length from the peak is drawn ``f`` of the way along the arc
-  (measured along the straight chord);
-- a route is drawn through the points of ``G_k`` it passes: the start's
-  retraction, the vertices of the route on ``G_k``, the goal's retraction.
-
-Not to scale: every vertical edge in row ``i`` is ``L_i`` long, every
-horizontal edge in column ``j`` is ``L_j`` long (the headers give the lengths).
+The picture says all this in plain words (a vertex is ``(N, S)``: where each vehicle waits); the
+notation stays in the code and the docs. Not to scale: every vertical edge in row ``i`` is
+``L_i`` long, every horizontal edge in column ``j`` is ``L_j`` long (the headers give them).
 """
 
 from __future__ import annotations
@@ -42,9 +35,8 @@ from topology import JUNCTION_INDEX, GraphPoint, Homotopy, Instruction, Route, S
 from topology.cycle import retract_indexed
 from topology.indexed import IndexedConfiguration, step
 from trajgen.errors import InputError
-from trajgen.model.summary import class_label
 from trajgen.model.values import ArrayValue, readonly
-from trajgen.plots.figure import drawing_area, finished
+from trajgen.plots.figure import drawing_area, finished, untangle, wrapped
 from trajgen.plots.speed import VEHICLE_COLOURS, plot_period
 from trajgen.verification import VerifiedSchedule, require_verified
 
@@ -53,6 +45,7 @@ __all__ = [
     "RULE_WORDS",
     "RetractGraphLayout",
     "instruction_text",
+    "place_name",
     "plot_retract_graph",
     "point_name",
     "route_points",
@@ -86,12 +79,20 @@ def vertex_name(graph: StarGraph, c: IndexedConfiguration) -> str:
     return f"P({names[c[0]]},{names[c[2]]})"
 
 
-def point_name(graph: StarGraph, point: GraphPoint) -> str:
-    """A point of ``G_k`` for people: a vertex's name, or the edge and the metres from its peak."""
-    retract = graph.retract_graph
+def place_name(graph: StarGraph, c: IndexedConfiguration) -> str:
+    """A vertex in plain words: ``(N, S)``, where vehicle 1 and vehicle 2 wait (``O``: the junction)."""
+    return "({}, {})".format(*("O" if c[k] == JUNCTION_INDEX else graph.names[c[k]] for k in (0, 2)))
+
+
+def point_name(graph: StarGraph, point: GraphPoint, *, plain: bool = False) -> str:
+    """A point of ``G_k`` for people: a vertex's name, or the metres from its peak towards its valley.
+
+    ``plain``: the vertices named by :func:`place_name` (``(N, S)``), else by :func:`vertex_name`.
+    """
+    name, retract = place_name if plain else vertex_name, graph.retract_graph
     if point.vertex >= 0:
-        return vertex_name(graph, retract.vertices[point.vertex])
-    peak, valley = (vertex_name(graph, retract.vertices[v]) for v in retract.edges[point.edge])
+        return name(graph, retract.vertices[point.vertex])
+    peak, valley = (name(graph, retract.vertices[v]) for v in retract.edges[point.edge])
     return f"{point.offset:.3g} m from {peak} towards {valley}"
 
 
@@ -266,24 +267,29 @@ _SCHEDULE_COLOUR = "black"
 _EDGE_ALPHA = 0.45
 #: Size of the picture, inches.
 _WIDTH_IN, _HEIGHT_IN = 8.6, 10.6
-#: The lines of the note under the picture.
+#: Width of the note under the picture, inches.
+_FOOTNOTE_IN = 8.0
+
+
+#: How to read the picture, in plain words (the paper's notation is in docs/star.md); ``{0}``, ``{1}``:
+#: the vehicles' names.
 _FOOTNOTE = (
-    "A vertex of G_k is where the vehicles wait: vehicle 1 down the rows, vehicle 2 across the columns "
-    "(O: at the junction,",
-    "a leg's name: at its far end).  On an edge one vehicle drives its leg while the other waits at a leg's "
-    "end: vehicle 1",
-    "along a column (blue), vehicle 2 along a row (orange).  O,O (both at the junction) is deleted; × (both "
-    "at one leg's end)",
-    "is no configuration.  Every configuration retracts onto G_k (docs/star.md): the route is the start's",
-    "retraction, a route on G_k, the goal's retraction undone.  Edges are arcs, not to scale: one from row i "
-    "up to O is L_i long,",
-    "one from column j across to O is L_j long (the headers give the lengths).",
+    "How to read it: each point is a pair of places where {0} and {1} wait, {0} down the rows, {1} "
+    "across the columns (O: at the junction; a leg's name: at its far end). Along a line one vehicle "
+    "drives its leg while the other waits at a leg's end: {0} along a column (blue), {1} along a row "
+    "(orange). (O, O), both at the junction, is never allowed; × (both at one leg's end) is no place. "
+    "Every position of the two moves out onto these lines without the vehicles coming closer: the route "
+    "is the start moved out, a route along the lines, and the goal moved out, played backwards. Lines "
+    "are arcs, not to scale: one from row i up to O is as long as leg i, one from column j across to O "
+    "as long as leg j (the headers give the lengths). The paper's names for these parts: docs/star.md."
 )
-#: Route vertex names per line of the legend.
-_NAMES_PER_LINE = 6
+#: Width of the places the route passes, in the legend, inches (clear of the drawing of the track).
+_LEGEND_IN = 5.0
+#: The smallest font the words in the table shrink to, points.
+_SMALLEST_LABEL = 5.5
 
 
-def _draw_table(axis, layout: RetractGraphLayout, *, named: set[int]) -> None:
+def _draw_table(axis, layout: RetractGraphLayout, who: tuple[str, str], *, named: set[int]) -> None:
     """Headers, the deleted point, the empty diagonal, the edges, the vertices (``named``: with names)."""
     graph = layout.graph
     k = graph.leg_count
@@ -315,27 +321,17 @@ def _draw_table(axis, layout: RetractGraphLayout, *, named: set[int]) -> None:
     axis.text(
         0.5 * (k + 1),
         0.95,
-        "vehicle 2 at:  O (the junction) or the end of leg …",
+        f"{who[1]} at:  O (the junction) or the end of leg …",
         ha="center",
         va="bottom",
         fontsize=10,
         color=VEHICLE_COLOURS[1],
     )
-    axis.text(
-        -1.0,
-        -0.5 * (k + 1),
-        "vehicle 1 at:  O (the junction) or the end of leg …",
-        ha="right",
-        va="center",
-        rotation=90,
-        fontsize=10,
-        color=VEHICLE_COLOURS[0],
-    )
     axis.plot([0.0], [0.0], "o", markersize=10, markerfacecolor="white", markeredgecolor="0.3", zorder=3)
     peaks = np.array([layout.vertices[v] for v, c in enumerate(retract.vertices) if JUNCTION_INDEX not in c])
     valleys = np.array([layout.vertices[v] for v, c in enumerate(retract.vertices) if JUNCTION_INDEX in c])
     size = 4 if small else 5
-    axis.plot(*peaks.T, "o", color="0.25", markersize=size, zorder=3, label="peak P(i,j): both at leg ends")
+    axis.plot(*peaks.T, "o", color="0.25", markersize=size, zorder=3, label="both at leg ends")
     axis.plot(
         *valleys.T,
         "s",
@@ -343,12 +339,12 @@ def _draw_table(axis, layout: RetractGraphLayout, *, named: set[int]) -> None:
         markeredgecolor="0.25",
         markersize=size + 1,
         zorder=3,
-        label="valley V1(j) / V2(i): vehicle 1 / vehicle 2 at O",
+        label="one at the junction O, the other at a leg's end",
     )
     for v in sorted(named):
         x, y = layout.vertices[v]
         axis.text(
-            x + 0.07, y - 0.09, vertex_name(graph, retract.vertices[v]), ha="left", va="top", fontsize=7,
+            x + 0.07, y - 0.09, place_name(graph, retract.vertices[v]), ha="left", va="top", fontsize=7,
             color="0.35",
         )  # fmt: skip
 
@@ -376,19 +372,21 @@ def _arrow(axis, line: np.ndarray) -> None:
 
 
 def _route_label(graph: StarGraph, points: tuple[GraphPoint, ...], route: Route) -> str:
-    """The legend's words on the route: its length on G_k and the vertices it passes, numbered."""
-    k = graph.leg_count
+    """The legend's words on the route: its length along the lines and the places it passes, numbered."""
     vertices = [graph.retract_graph.vertices[p.vertex] for p in points if p.vertex >= 0]
-    steps = [f"{n} {vertex_name(graph, c)}" for n, c in enumerate(vertices, start=1)]
-    lines = [
-        f"route on G_{k}: {route.arc_length:.4g} m ({route.length:.4g} m of travel in all), passing",
-        *("   " + ", ".join(steps[n : n + _NAMES_PER_LINE]) for n in range(0, len(steps), _NAMES_PER_LINE)),
-    ]
-    return "\n".join(lines) if steps else f"route on G_{k}: {route.arc_length:.4g} m, through no vertex"
+    # no-break spaces within a step: the lines break between steps only
+    steps = [f"{n} {place_name(graph, c)}".replace(" ", "\u00a0") for n, c in enumerate(vertices, start=1)]
+    passing = wrapped(", ".join(steps), width_in=_LEGEND_IN, fontsize=8).replace("\n", "\n   ")
+    head = f"route along the lines: {route.arc_length:.4g} m"
+    return (
+        f"{head} ({route.length:.4g} m of travel in all), passing\n   {passing}"
+        if steps
+        else f"{head}, through no place"
+    )
 
 
-def _draw_route(axis, layout: RetractGraphLayout, points: tuple[GraphPoint, ...], label: str) -> None:
-    """The route on G_k: a thick line, an arrow on each piece, its vertices numbered in order."""
+def _draw_route(axis, layout: RetractGraphLayout, points: tuple[GraphPoint, ...], label: str) -> list:
+    """The route on G_k: a thick line, an arrow on each piece, its vertices numbered in order (returned)."""
     axis.plot(
         *layout.path(points).T,
         color=_ROUTE_COLOUR,
@@ -404,11 +402,12 @@ def _draw_route(axis, layout: RetractGraphLayout, points: tuple[GraphPoint, ...]
     graph = layout.graph
     named = graph.leg_count <= _NAMED_UP_TO
     vertices = [p.vertex for p in points if p.vertex >= 0]
+    numbers = []
     for number, v in enumerate(vertices, start=1):
         c = graph.retract_graph.vertices[v]
-        name = vertex_name(graph, c)
+        name = place_name(graph, c)
         above = JUNCTION_INDEX not in c  # clear of the vertex's edges and the headers: valleys below right
-        axis.annotate(
+        numbered = axis.annotate(
             f"{number} {name}" if named else str(number),
             tuple(layout.vertices[v]),
             xytext=(6, 6 if above else -6),
@@ -421,6 +420,8 @@ def _draw_route(axis, layout: RetractGraphLayout, points: tuple[GraphPoint, ...]
             bbox={"boxstyle": "round,pad=0.15", "facecolor": "white", "edgecolor": "none", "alpha": 0.85},
             zorder=8,
         )
+        numbers.append((numbered, str(number)))
+    return numbers
 
 
 def _draw_track(figure, graph: StarGraph, route: Route, box: tuple[float, float, float, float]) -> None:
@@ -445,7 +446,7 @@ def _draw_track(figure, graph: StarGraph, route: Route, box: tuple[float, float,
     limit = 1.4 * reach
     axis.set_xlim(-limit, limit)
     axis.set_ylim(-limit, limit)
-    axis.text(0.5, -0.02, "the track: start ring, goal dot", transform=axis.transAxes, ha="center", va="top",
+    axis.text(0.5, -0.06, "the track: start ring, goal dot", transform=axis.transAxes, ha="center", va="top",
               fontsize=7.5)  # fmt: skip
 
 
@@ -528,7 +529,7 @@ def plot_retract_graph(
     layout = RetractGraphLayout.of(graph)
     points = route_points(route)
     passed = {p.vertex for p in points if p.vertex >= 0}
-    who = "vehicle 1 and vehicle 2" if names is None else f"{names[0]} (vehicle 1) and {names[1]} (vehicle 2)"
+    who = ("vehicle 1", "vehicle 2") if names is None else (names[0], names[1])
     area = drawing_area(figure, figsize=(_WIDTH_IN, _HEIGHT_IN))
     axis = area.add_axes((0.02, 0.27, 0.96, 0.655))
     axis.set_aspect("equal")
@@ -536,10 +537,11 @@ def plot_retract_graph(
     axis.set_xlim(-1.5, k + 0.55)
     axis.set_ylim(-(k + 0.45), 1.3)
     unnamed = set() if k > _NAMED_UP_TO else set(range(len(layout.vertices))) - passed
-    _draw_table(axis, layout, named=unnamed)
-    axis.plot([], [], color=VEHICLE_COLOURS[0], alpha=_EDGE_ALPHA, label="edge: vehicle 1 drives its leg")
-    axis.plot([], [], color=VEHICLE_COLOURS[1], alpha=_EDGE_ALPHA, label="edge: vehicle 2 drives its leg")
-    _draw_route(axis, layout, points, _route_label(graph, points, route))
+    _draw_table(axis, layout, who, named=unnamed)
+    for v in range(2):
+        label = f"{who[v]} drives its leg, {who[1 - v]} waits"
+        axis.plot([], [], color=VEHICLE_COLOURS[v], alpha=_EDGE_ALPHA, label=label)
+    numbers = _draw_route(axis, layout, points, _route_label(graph, points, route))
     if verified is not None:
         schedule = verified.schedule
         axis.plot(
@@ -548,7 +550,7 @@ def plot_retract_graph(
             linewidth=1.2,
             linestyle="--",
             zorder=5,
-            label=f"{schedule.method.name} schedule's path ({schedule.duration:.2f} s) retracted onto G_{k}",
+            label=f"{schedule.method.name} schedule's path ({schedule.duration:.2f} s), moved to the lines",
         )
     axis.plot(
         *layout.point(points[0]),
@@ -558,7 +560,7 @@ def plot_retract_graph(
         markeredgecolor="black",
         markeredgewidth=2,
         zorder=7,
-        label=f"start {route.start} retracts to {point_name(graph, points[0])}",
+        label=f"start {route.start}, moved out to {point_name(graph, points[0], plain=True)}",
     )
     axis.plot(
         *layout.point(points[-1]),
@@ -566,14 +568,21 @@ def plot_retract_graph(
         markersize=8,
         color="black",
         zorder=7,
-        label=f"goal {route.goal} retracts to {point_name(graph, points[-1])}",
+        label=f"goal {route.goal}, moved out to {point_name(graph, points[-1], plain=True)}",
     )
     axis.legend(loc="upper left", bbox_to_anchor=(0.0, -0.005), fontsize=8, frameon=False)
     _draw_track(area, graph, route, (0.8, 0.11, 0.18, 0.13))
+    places = f"{len(layout.vertices)} places, {len(layout.edges)} lines between them: {k} legs"
     axis.set_title(
-        f"Retract graph G_{k} of {who}: {len(layout.vertices)} vertices, {len(layout.edges)} edges\n"
-        f"class {class_label(route)}\n{instruction_text(route)}",
+        f"Where {who[0]} and {who[1]} wait ({places})\neach point is (position of {who[0]}: its row, "
+        f"position of {who[1]}: its column)\n{instruction_text(route)}",
         fontsize=11,
     )
-    area.text(0.03, 0.012, "\n".join(_FOOTNOTE), fontsize=7.5, va="bottom", family="sans-serif")
+    words = [*axis.texts, *area.axes[-1].texts]  # the table's and the track's
+    if not untangle(words, smallest=_SMALLEST_LABEL):  # long names: the route's places by number only
+        for text, number in numbers:
+            text.set_text(number)
+        untangle(words, smallest=_SMALLEST_LABEL)
+    footnote = wrapped(_FOOTNOTE.format(*who), width_in=_FOOTNOTE_IN, fontsize=7.5)
+    area.text(0.03, 0.012, footnote, fontsize=7.5, va="bottom", family="sans-serif")
     return finished(area, laid_out=False)  # its axes are placed by hand
