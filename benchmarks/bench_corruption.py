@@ -82,7 +82,7 @@ def main() -> None:
                         warnings.simplefilter("ignore", RuntimeWarning)
                         files = exported(mutant)
                 except VerificationError as error:
-                    key = "named" if names(str(error), array_path) else "unnamed"
+                    key = "named" if names("; ".join(error.details), array_path) else "unnamed"
                     counts[key] += 1
                     if key == "unnamed":
                         examples.append(f"unnamed: {array_path} ({kind}): {str(error)[:200]}")

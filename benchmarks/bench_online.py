@@ -13,7 +13,8 @@
    position jumps within the margin, new goals), simulated closed loop: goals reached, deadlocks
    (a run that never reaches its goals), separation violations computed from the true positions,
    limit violations, emergency brakes, the braking check's holds, and the time lost against the
-   undisturbed plan (median, worst). Scenarios are spread over ``--workers`` processes.
+   plans driven (the undisturbed plan, or across a new goal the old plan's part and the new plan:
+   ``SimulationResult.planned_s``; median, worst). Scenarios are spread over ``--workers`` processes.
 3. With ``--fault-free``, each scenario also runs without faults: the makespan against the plan.
 4. With ``--graph``, the scenarios are random track graphs instead
    (:func:`trajgen.scenario.graph_sampling.graph_online_campaign`: trees and graphs with loops),
@@ -251,7 +252,7 @@ def main() -> None:
     )
     if lost:
         print(
-            f"  time lost against the undisturbed plan: median {statistics.median(lost):.2f} s "
+            f"  time lost against the plans driven: median {statistics.median(lost):.2f} s "
             f"({100 * statistics.median(relative):.0f} % of the plan), worst {max(lost):.2f} s"
         )
     if args.fault_free:

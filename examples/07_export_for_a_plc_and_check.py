@@ -36,7 +36,10 @@ print(*(folder / "agv1.csv").read_text().splitlines()[:3], sep="\n")  # x = time
 verdict = check_profiles(scenario, folder, dialect="siemens-xy")
 print(f"as written: passed {verdict.passed}, closest approach {verdict.check.report.min_separation:.4f} m")
 
-# Someone moves one point of agv1 by 1 cm (10 mm): the checker names what breaks.
+# Someone moves one point of agv1 by 1 cm (10 mm): the checker says what breaks, in plain words
+# (the quantity, its value and limit, when and where on the track). Where each failure lies in the
+# schedule read back from the tables is in ``edited.check.report.details`` (``trajgen check
+# --verbose`` prints it).
 path = folder / "agv1.csv"
 lines = path.read_bytes().decode("ascii").split("\r\n")
 x, y = lines[300].split(";")

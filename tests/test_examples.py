@@ -71,6 +71,8 @@ def test_example_runs(script, tmp_path, monkeypatch, capsys):
     runpy.run_path(str(script), run_name="__main__")
     out = capsys.readouterr().out
     _check_figure(script, out)
+    # what a user reads names no array of a schedule (those are in the details, and --verbose)
+    assert re.search(r"\bsections\[\d+\]|\.kinematics\.", out) is None, out
     for line in out.splitlines():  # what it wrote, named by absolute paths, is kept in the folder given
         if line.startswith("wrote "):
             path = line.removeprefix("wrote ").split(" (")[0]

@@ -150,7 +150,7 @@ def test_check_reads_a_graphs_generic_csv_and_its_tables_from_the_command_line(t
     capsys.readouterr()
     assert main(["check", scenario_file, "--csv", str(tmp_path / "generic")]) == 0
     out = capsys.readouterr().out
-    assert "class: agv1 A -> c:1.5; agv2 D -> A; agv1 c:1.5 -> D" in out
+    assert "class: planned (agv1 A -> c:1.5; agv2 D -> A; agv1 c:1.5 -> D)" in out
     assert "PASS" in out
     assert (
         main(["check", scenario_file, "--csv", str(tmp_path / "cam"), "--dialect", "twincat-cam", "--json"])

@@ -160,8 +160,8 @@ def test_the_schedule_command_lists_each_class_and_its_makespan(capsys):
     assert summary["verified"]
     assert main(["schedule", str(path), "--method", "optimal"]) == 0
     text = capsys.readouterr().out
-    assert "class agv1 west:1 -> main:8.5; agv2 east:9 -> W; agv1 main:8.5 -> E (planned):" in text
-    assert "(other):" in text
+    assert "class planned (agv1 west:1 -> main:8.5; agv2 east:9 -> W; agv1 main:8.5 -> E):" in text
+    assert "class other (" in text
 
 
 def test_toppra_on_seeded_random_graphs_is_verified_and_never_slower_than_exact_without_jerk():

@@ -265,7 +265,7 @@ def test_verifier_catches_the_other_homotopy_class(legs):
         report = verify(relabelled)
         assert not report.passed
         assert not report.regions_match
-        failure = next(f for f in report.failures if "homotopy class differs" in f)
+        failure = next(f for f in report.failures if "another class than their route" in f)
     assert OTHER_CLASS_FAILURES[legs] in failure
     assert verify(schedule).passed  # each a fine schedule of its own route
     assert verify(detour).passed

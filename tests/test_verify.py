@@ -70,9 +70,13 @@ def test_non_finite_values_fail_and_are_never_certified(value, column, name):
     report = verify(schedule)
     assert not report.passed
     expected = f"{entry} is {value!r}: expected a finite number"
-    assert report.failures == (expected,), report.failures
-    with pytest.raises(VerificationError, match=re.escape(expected)):
+    assert len(report.details) == 1, report.details
+    assert report.details[0].endswith(f": {expected}"), report.details
+    with pytest.raises(
+        VerificationError, match=re.escape(f"hold {value!r}: expected finite numbers")
+    ) as caught:
         certify(schedule)
+    assert caught.value.details == report.details
 
 
 def test_a_non_finite_duration_fails_naming_the_knot():
@@ -81,7 +85,8 @@ def test_a_non_finite_duration_fails_naming_the_knot():
     times = np.array(schedule.sections[-1].kinematics.vehicles[0].times)
     times[-1] = math.nan
     report = verify(corrupted(schedule, path, times))
-    assert report.failures == (f"{path}[{times.size - 1}] is nan: expected a finite number",)
+    assert len(report.details) == 1
+    assert report.details[0].endswith(f": {path}[{times.size - 1}] is nan: expected a finite number")
 
 
 @pytest.mark.parametrize(

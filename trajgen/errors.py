@@ -13,6 +13,8 @@ True
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+
 from limits.errors import LimitsError
 from topology.errors import (
     InfeasibleError,
@@ -71,7 +73,27 @@ class ScheduleError(TrajgenError, RuntimeError):
 
 
 class VerificationError(ScheduleError):
-    """A schedule failed the independent verifier and must not leave the library."""
+    """A schedule failed the independent verifier and must not leave the library.
+
+    The message says what is wrong in plain words (the quantity, its value and limit, the vehicle,
+    when and where on the track); ``details`` holds where each failure lies in the schedule's arrays.
+
+    Parameters
+    ----------
+    message : str
+    details : sequence of str, optional
+        Each failure followed by the arrays of the schedule it lies in
+        (``sections[2].kinematics.vehicles[0].{times,initial,jerk} interval 4, ...``): for debugging,
+        printed by ``trajgen --verbose``.
+
+    Attributes
+    ----------
+    details : tuple of str
+    """
+
+    def __init__(self, message: str, *, details: Sequence[str] = ()) -> None:
+        super().__init__(message)
+        self.details = tuple(details)
 
 
 class SolverError(ScheduleError):

@@ -12,7 +12,7 @@ import logging
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from topology import GraphRoute, Route
+from topology import GraphRoute, Homotopy, Route, class_signature
 from trajgen.errors import InputError, VerificationError
 from trajgen.export.atomic import check_output_paths, commit_files
 from trajgen.export.csv import CsvOptions, check_row_limit, profile_chunk_pair, profile_paths
@@ -123,6 +123,10 @@ class RunResult:
         What the run did beyond the schedule's own notes (e.g. a method left out of a plot).
     tables : PlcTables or None
         The PLC tables written, for a table dialect.
+    planned_class : bool
+        Whether the schedule's route is in the class of the planner's route (``optimal`` may take
+        another: on a track graph, where the other vehicle yields). The summary names the class
+        ``planned`` or ``other`` by it.
     """
 
     scenario: Scenario | GraphScenario
@@ -132,6 +136,7 @@ class RunResult:
     files: tuple[Path, ...]
     notes: tuple[str, ...] = ()
     tables: PlcTables | None = None
+    planned_class: bool = True
 
     def summary(self) -> dict:
         """The JSON-ready summary printed by ``trajgen schedule --json``."""
@@ -147,6 +152,10 @@ class RunResult:
             "solver": None if schedule.info is None else schedule.info.summary(),
             "route": (
                 graph_route_summary(self.route, self.scenario.names)
+                | {
+                    "homotopy": (Homotopy.PLANNED if self.planned_class else Homotopy.OTHER).value,
+                    "planned_class": self.planned_class,
+                }
                 if isinstance(self.route, GraphRoute)
                 else route_summary(self.route)
             ),
@@ -265,5 +274,11 @@ def run(
         else:
             files[configuration] = png_bytes(plot_configuration(verified, names=scenario.names))
     written = commit_files(files) if files else ()
-    # the schedule's route: optimal may have taken the other homotopy class
-    return RunResult(scenario, chosen, verified.schedule.route, verified, written, tuple(notes), tables)
+    # the schedule's route: optimal may have taken another class than the planner's route
+    taken = verified.schedule.route
+    planned = (
+        class_signature(taken) == class_signature(route)
+        if isinstance(taken, GraphRoute)
+        else taken.homotopy is Homotopy.PLANNED
+    )
+    return RunResult(scenario, chosen, taken, verified, written, tuple(notes), tables, planned)

@@ -24,7 +24,7 @@ from trajgen.export.atomic import check_output_paths, commit_files
 from trajgen.export.csv import CsvOptions, profile_paths
 from trajgen.methods import METHODS
 from trajgen.model.schedule import TimingMethod
-from trajgen.model.summary import format_provenance
+from trajgen.model.summary import closest_text, format_provenance
 from trajgen.plots import plot_simulation, png_bytes
 from trajgen.scenario import GraphScenario, Scenario
 
@@ -215,8 +215,8 @@ def format_simulation(summary: dict, *, min_separation: float) -> str:
         f"reached goal: {reached}  makespan: {summary['makespan_s']:.3f} s "
         f"(planned {summary['planned_s']:.3f} s, lost {summary['time_lost_s']:.3f} s)",
         f"plan: {format_provenance(summary)}",
-        f"separation: min {summary['min_separation_m']:.4f} m, certified between cycles "
-        f"{summary['certified_separation_m']:.4f} m (required {min_separation:g} m)",
+        f"separation: min {closest_text(summary['min_separation_m'])}, certified between cycles "
+        f"{closest_text(summary['certified_separation_m'])} (required {min_separation:g} m)",
         f"worst setpoints: |v|/limit {summary['velocity_ratio']:.6f}, |a|/limit "
         f"{summary['acceleration_ratio']:.6f}, |j|/limit {summary['jerk_ratio']:.6f}",
         f"replans: {summary['replans']}  rejected goals: {summary['rejected_goals']}",

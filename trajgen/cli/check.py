@@ -7,6 +7,7 @@ import json
 
 from trajgen.cli.options import add_dialect_options, scenario_from
 from trajgen.cli.parser import EXIT_FAILURE, EXIT_OK
+from trajgen.model.summary import closest_text
 
 __all__ = ["SHOWN_FAILURES", "register"]
 
@@ -29,27 +30,57 @@ def _command_check(args: argparse.Namespace) -> int:
         print(f"files ({summary['dialect']}): {', '.join(summary['files'])}")
         print(
             f"points: {summary['points'][0]} and {summary['points'][1]}; closest approach "
-            f"{summary['min_separation_m']:.4f} m (minimum {scenario.limits.min_separation:g} m); "
-            + (
-                f"homotopy class: {summary['homotopy']}"
-                + (f" ({summary['class']})" if "class" in summary else "")
-                if "homotopy" in summary
-                else f"class: {summary['class']}"
-            )
+            f"{closest_text(summary['min_separation_m'])} (minimum {scenario.limits.min_separation:g} m); "
+            f"class: {_class(verdict.check.route, scenario)}"
         )
         failures = summary["failures"]
         for failure in failures[:SHOWN_FAILURES]:
             print(f"violation: {failure}")
         if len(failures) > SHOWN_FAILURES:
             print(f"... and {len(failures) - SHOWN_FAILURES} more (--json lists all)")
-        if not verdict.passed and not args.ignore_jerk and any("jerk" in failure for failure in failures):
-            # a toppra schedule's files fail here by design: say how to check them for what it keeps
-            print(
-                "note: a schedule timed by toppra does not limit jerk; check its files for the "
-                "separation, velocity and acceleration alone with --ignore-jerk"
-            )
-        print("PASS: the files keep the separation and the limits" if verdict.passed else "FAIL")
+        for note in _jerk_notes(verdict, args.ignore_jerk):
+            print(f"note: {note}")
+        if not verdict.passed:
+            print("FAIL")
+        elif verdict.jerk_checked:
+            print("PASS: the files keep the separation and the limits")
+        else:
+            print("PASS: the files keep the separation and the velocity and acceleration limits")
     return EXIT_OK if verdict.passed else EXIT_FAILURE
+
+
+def _class(route, scenario) -> str:
+    """The class the files were checked along, in the words of every summary (``planned (...)``)."""
+    from topology import GraphRoute, class_signature
+    from trajgen.model.summary import class_label
+
+    planned = None
+    if isinstance(route, GraphRoute):  # the planner's route's class, or one where the other yields
+        planned = class_signature(route) == class_signature(scenario.route())
+    return class_label(route, planned=planned)
+
+
+def _jerk_notes(verdict, ignored: bool) -> list[str]:
+    """What the verdict's jerk check was, where it is news: not checked, or failed."""
+    record = verdict.record
+    if record is not None and not record.jerk_limited:
+        return [
+            f"the files record that their schedule is not jerk-limited (method {record.method}): "
+            "jerk not checked"
+        ]
+    if verdict.passed or ignored or not any("max_jerk" in failure for failure in verdict.failures):
+        return []
+    if record is not None:  # they claim a jerk-limited schedule: no flag to offer
+        return [
+            f"the files record that their schedule is jerk-limited (method {record.method}): "
+            "they are held to the jerk limits"
+        ]
+    # files of a schedule without jerk limits that do not say so (a table dialect's, or older)
+    return [
+        "the files are held to the jerk limits (they do not both record a schedule without jerk "
+        "limits); a schedule timed by toppra does not limit jerk: check its files for the "
+        "separation, velocity and acceleration alone with --ignore-jerk"
+    ]
 
 
 def register(commands) -> None:
@@ -65,6 +96,11 @@ def register(commands) -> None:
         dialect="dialect of the files",
         points="most points per table the target takes (default: the dialect's limit)",
     )
-    check.add_argument("--ignore-jerk", action="store_true", help="do not hold the files to the jerk limits")
+    check.add_argument(
+        "--ignore-jerk",
+        action="store_true",
+        help="do not hold the files to the jerk limits (a generic CSV that records a schedule\n"
+        "without jerk limits, as toppra's do, is not held to them anyway)",
+    )
     check.add_argument("--json", action="store_true", help="print a machine-readable verdict")
     check.set_defaults(run=_command_check)

@@ -4,6 +4,10 @@ Exit status: 0 on success, 2 on bad input (message on stderr, nothing
 written), 1 on an internal failure (nothing written). ``trajgen simulate``
 also exits 1 when the simulated run missed its goal or had violations (its
 trace and plot are written: they are the evidence).
+
+``-v``/``--verbose``, before or after the command's name, logs progress to stderr, and with a
+failed verification where each failure lies in the schedule's arrays (its details); without
+it, messages say what is wrong in plain words only.
 """
 
 from __future__ import annotations
@@ -16,7 +20,7 @@ import sys
 from collections.abc import Sequence
 
 from trajgen.cli.parser import EXIT_BAD_INPUT, EXIT_FAILURE, CommandParser
-from trajgen.errors import InputError, LiveError
+from trajgen.errors import InputError, LiveError, VerificationError
 
 __all__ = ["COMMANDS", "Commands", "LogFormatter", "build_parser", "command_parsers", "console_main", "main"]
 
@@ -72,6 +76,11 @@ def _log_to_stderr(level: int) -> None:
     if root.getEffectiveLevel() > level:
         root.setLevel(level)
 
+
+#: The help of ``-v``/``--verbose``, an option of ``trajgen`` and of each of its commands.
+VERBOSE_HELP = (
+    "log progress to stderr, and where a failed verification lies in the schedule's arrays (its details)"
+)
 
 #: Every sub-command, in help order: its one-line help and the module whose ``register(commands)``
 #: adds its parser. A run imports only its own command's module: ``trajgen schedule`` loads no
@@ -129,6 +138,10 @@ class Commands:
         """Add the sub-command ``name`` (one of :data:`COMMANDS`, with its help) and return its parser."""
         summary = COMMANDS[name][0]
         parser = self._action.add_parser(name, help=summary, formatter_class=formatter_class)
+        # after the command's name too; unset unless given, so that ``trajgen -v COMMAND`` stays verbose
+        parser.add_argument(
+            "-v", "--verbose", action="store_true", default=argparse.SUPPRESS, help=VERBOSE_HELP
+        )
         self.parsers[name] = (summary, parser)
         return parser
 
@@ -145,7 +158,7 @@ def _build(command: str | None = None) -> tuple[argparse.ArgumentParser, Command
         prog="trajgen",
         description="Collision-free schedules for two AGVs on a junction of 3 to 8 legs (a Y, a crossing).",
     )
-    parser.add_argument("-v", "--verbose", action="store_true", help="log progress to stderr")
+    parser.add_argument("-v", "--verbose", action="store_true", help=VERBOSE_HELP)
     commands = Commands(parser.add_subparsers(dest="command", required=True, parser_class=CommandParser))
     registered: set[str] = set()
     for name, (_, module) in COMMANDS.items():
@@ -185,12 +198,21 @@ def console_main() -> int:
     return status
 
 
+def _details(error: Exception, verbose: bool) -> None:
+    """With ``--verbose``, where each failure of a failed verification lies in the schedule's arrays."""
+    if verbose and isinstance(error, VerificationError):
+        for detail in error.details:
+            print(f"trajgen: detail: {detail}", file=sys.stderr)
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the command line; returns the exit status."""
+    verbose = False
     try:
         argv = sys.argv[1:] if argv is None else list(argv)
         args = _build(_chosen(argv))[0].parse_args(argv)
-        _log_to_stderr(logging.INFO if args.verbose else logging.WARNING)
+        verbose = bool(args.verbose)
+        _log_to_stderr(logging.INFO if verbose else logging.WARNING)
         return args.run(args)
     except InputError as error:
         print(f"trajgen: error: {error}", file=sys.stderr)
@@ -201,4 +223,5 @@ def main(argv: Sequence[str] | None = None) -> int:
     except Exception as error:
         logger.debug("internal failure", exc_info=True)
         print(f"trajgen: internal failure: {type(error).__name__}: {error}", file=sys.stderr)
+        _details(error, verbose)
         return EXIT_FAILURE

@@ -26,6 +26,7 @@ from trajgen.cli.options import add_method, method_from, scenario_from
 from trajgen.cli.parser import EXIT_FAILURE, EXIT_OK
 from trajgen.errors import InputError
 from trajgen.live.mqtt import require_live
+from trajgen.model.summary import closest_text
 
 __all__ = ["live_demo", "register"]
 
@@ -149,7 +150,7 @@ def _report(run, args: argparse.Namespace, *, planning: float, closest: float | 
             f"({summary['resent']} sent again), {summary['ignored']} messages ignored, "
             f"{summary['replans']} re-plans"
             + (f"; release latency {latency:.2f} ms median" if latency is not None else "")
-            + (f"; closest approach {closest:.3f} m" if closest is not None else "")
+            + (f"; closest approach {closest_text(closest)}" if closest is not None else "")
         )
     if summary.get("error"):
         print(f"trajgen: error: {summary['error']}", file=sys.stderr)

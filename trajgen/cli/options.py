@@ -98,10 +98,11 @@ def add_method(
     parser.add_argument(
         "--homotopy",
         metavar="|".join(c.value for c in HomotopyChoice),
-        help="optimal only: 'fastest' (default) solves two homotopy classes and keeps the faster:\n"
-        "on a Y both ways round the configuration circle, on 4 to 8 legs the shortest and\n"
-        "the second-shortest route on the retract graph G_k; 'planned' keeps the class of\n"
-        "the planner's instruction (the paper's on a Y)",
+        help="optimal only: 'fastest' (default) solves the planned class and the other and keeps\n"
+        "the faster: on a Y both ways round the configuration circle, on 4 to 8 legs the\n"
+        "shortest and the second-shortest route on the retract graph G_k, on a track graph\n"
+        "also where the other vehicle yields; 'planned' keeps the planned class (the class of\n"
+        "the planner's route; on a Y the paper's instruction)",
     )
 
 
@@ -126,7 +127,7 @@ def method_from(args: argparse.Namespace) -> TimingMethod:
         raise OptionError(
             f"--homotopy {args.homotopy!r} applies to the method 'optimal' only, "
             f"got --method {method.name!r} "
-            "(exact and toppra always take the paper's class)"
+            "(exact and toppra always take the planned class)"
         )
     return dataclasses.replace(method, homotopy=choice)
 

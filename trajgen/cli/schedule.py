@@ -20,6 +20,7 @@ from trajgen.cli.parser import EXIT_OK
 from trajgen.errors import OutputError, VerificationError
 from trajgen.export.atomic import check_output_paths, commit_files
 from trajgen.model.summary import (
+    closest_text,
     format_graph_route,
     format_route,
     format_run,
@@ -52,7 +53,7 @@ def _command_plan(args: argparse.Namespace) -> int:
         summary |= {"verified": True, "closest_approach_m": report.closest}
         text = format_graph_route(route, scenario.names) + (
             f"\nverified: every move keeps {route.min_separation:g} m; "
-            f"closest approach {report.closest:.4f} m"
+            f"closest approach {closest_text(report.closest)}"
         )
     else:
         summary, text = route_summary(route), format_route(route)

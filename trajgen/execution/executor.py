@@ -339,12 +339,8 @@ class Executor:
         """The plan's axis (in the vehicle's own axis), velocity, acceleration and jerk at ``t``."""
         axis, velocity, acceleration, jerk = self._plan.state(v, t)
         sign = self._axis_sign[v]
-        return (
-            self._axis_base[v] + sign * (axis - self._plan_axis0[v]),
-            sign * velocity,
-            sign * acceleration,
-            sign * jerk,
-        )
+        moved = self._axis_base[v] + sign * (axis - self._plan_axis0[v])
+        return moved, sign * velocity, sign * acceleration, sign * jerk
 
     def _stops_by(self, v: int, state: PathState, limit: float, *, jerk_limited: bool = True) -> bool:
         """Whether service braking from ``state`` comes to rest by travel ``limit``.

@@ -34,7 +34,7 @@ from trajgen.model.graph_schedule import GraphSchedule
 from trajgen.model.graph_vehicle_path import GraphMetric, GraphVehiclePath
 from trajgen.model.paths import VehiclePath
 from trajgen.model.schedule import TimingMethod
-from trajgen.model.summary import class_name
+from trajgen.model.summary import class_label
 from trajgen.verification import VerifiedSchedule
 
 __all__ = ["GraphTrack", "JunctionTrack", "LoadedPlan", "execution_track"]
@@ -155,8 +155,8 @@ class JunctionTrack:
         return str(what)
 
     def describe(self, route: Route) -> str:
-        """The route's class, as the events name it."""
-        return f"way round {route.way_round.value}" if route.graph.cycle is not None else class_name(route)
+        """The route's class, as every summary names it (``class planned (counterclockwise)``)."""
+        return f"class {class_label(route)}"
 
 
 class GraphTrack:

@@ -1,19 +1,27 @@
 """Machine-readable (JSON-ready) and human-readable summaries of routes and runs.
 
-A route's homotopy class is named for people by :func:`class_name`: on a Y
-(three legs) the way round the boundary circle of the configuration space;
-on a junction of four to eight legs, which route on the retract graph
-``G_k`` it is (docs/star.md): the planner's shortest route (its
-instruction), or the second-shortest, in another class.
+Every summary names a route's class in the same words (:func:`class_label`): ``planned`` (the
+class of the planner's route) or ``other``, and which it is in brackets: on a Y (three legs) its
+way round the boundary circle of the configuration space (``planned (counterclockwise)``); on a
+junction of four to eight legs which route on the retract graph ``G_k`` it is (docs/star.md:
+``other (second-shortest route on G_4)``); on a track graph its moves, in order
+(``planned (agv1 A -> c:1.5; agv2 D -> A; agv1 c:1.5 -> D)``). :func:`class_name` is the part in
+brackets.
 """
 
 from __future__ import annotations
 
+import math
+
 from topology import GraphRoute, Homotopy, Instruction, Route, WayRound
 
 __all__ = [
+    "DISTANCE_PLACES",
+    "ROUND_OFF_M",
     "class_label",
     "class_name",
+    "class_words",
+    "closest_text",
     "format_graph_route",
     "format_provenance",
     "format_route",
@@ -21,7 +29,14 @@ __all__ = [
     "graph_route_summary",
     "provenance",
     "route_summary",
+    "summary_class_label",
 ]
+
+#: Decimal places of a closest approach and its margin, in the summaries and on the plots (metres).
+DISTANCE_PLACES = 4
+#: Round-off forgiven before a distance is rounded down, metres: the verifier's POSITION_TOLERANCE
+#: (a separation it accepts as kept is not shown below the minimum).
+ROUND_OFF_M = 1e-9
 
 #: Four or more legs: the class of the planner's route by its instruction (``{graph}``: ``G_k``).
 _PLANNER_CLASS = {
@@ -32,7 +47,7 @@ _PLANNER_CLASS = {
 
 
 def class_name(route: Route) -> str:
-    """The route's homotopy class for people, without whose it is.
+    """Which class the route is in, in words: the part in brackets of :func:`class_label`.
 
     Three legs: its way round the boundary circle (``counterclockwise``,
     ``clockwise`` or ``none``). Four to eight legs: which route on ``G_k`` it
@@ -57,6 +72,45 @@ def class_name(route: Route) -> str:
     return _PLANNER_CLASS[route.instruction].format(graph=graph)
 
 
+def closest_text(metres: float) -> str:
+    """A closest approach (or a separation margin) for people: ``1.5000 m``, rounded down.
+
+    Rounded down to :data:`DISTANCE_PLACES` places, so the figure shown is never above the value
+    (1.49996 m is ``1.4999 m``, not ``1.5000 m``, which would hide that it is below a 1.5 m
+    minimum), after forgiving :data:`ROUND_OFF_M` of round-off (1.4999999999 m, a separation
+    kept exactly, is ``1.5000 m``). A value that is not finite is written as Python writes it.
+
+    Examples
+    --------
+    >>> closest_text(1.5000009912), closest_text(1.49996), closest_text(-0.00004)
+    ('1.5000 m', '1.4999 m', '-0.0001 m')
+    """
+    if not math.isfinite(metres):
+        return f"{metres} m"
+    scale = 10**DISTANCE_PLACES
+    shown = math.floor((metres + ROUND_OFF_M) * scale) / scale + 0.0  # + 0.0: no "-0.0000"
+    return f"{shown:.{DISTANCE_PLACES}f} m"
+
+
+def class_words(homotopy: str, name: str) -> str:
+    """A class as every summary names it: ``planned (counterclockwise)``, ``other (...)``.
+
+    Parameters
+    ----------
+    homotopy : str
+        ``"planned"`` (the class of the planner's route) or ``"other"``
+        (:class:`topology.Homotopy` values).
+    name : str
+        Which class it is (:func:`class_name`, or a track graph's moves).
+
+    Examples
+    --------
+    >>> class_words("other", "clockwise")
+    'other (clockwise)'
+    """
+    return f"{Homotopy(homotopy).value} ({name})"
+
+
 def graph_class_label(route: GraphRoute) -> str:
     """A route's class on a track graph in words: its moves in order, by the vehicles' names."""
     track, names = route.track, route.names
@@ -68,14 +122,31 @@ def graph_class_label(route: GraphRoute) -> str:
     )
 
 
-def class_label(route: Route | GraphRoute) -> str:
-    """The route's homotopy class for people: :func:`class_name` and whether it is the planner's.
+def class_label(route: Route | GraphRoute, *, planned: bool | None = None) -> str:
+    """The route's class as every summary names it: ``planned`` or ``other``, and which (:func:`class_words`).
 
-    On a track graph: its moves in order (:func:`graph_class_label`).
+    Parameters
+    ----------
+    route : Route or GraphRoute
+    planned : bool, optional
+        A track graph's route only: whether it is in the class of the planner's route (a
+        :class:`~topology.GraphRoute` does not know; ``optimal`` may take another). Not given: its
+        moves alone (:func:`graph_class_label`).
+
+    Examples
+    --------
+    >>> from topology import Configuration, Position, YGraph, plan
+    >>> track = YGraph({"A": 10.0, "B": 10.0, "C": 10.0})
+    >>> start = Configuration(Position("A", 10.0), Position("B", 10.0))
+    >>> class_label(plan(track, start, start.swapped(), min_separation=1.5))
+    'planned (counterclockwise)'
+    >>> class_label(plan(track, start, start.swapped(), min_separation=1.5, homotopy="other"))
+    'other (clockwise)'
     """
     if isinstance(route, GraphRoute):
-        return graph_class_label(route)
-    return _class_text(class_name(route), route.homotopy is Homotopy.PLANNED, route.graph.cycle is not None)
+        moves = graph_class_label(route)
+        return moves if planned is None else class_words("planned" if planned else "other", moves)
+    return class_words(route.homotopy.value, class_name(route))
 
 
 def _class_makespan(comparison: dict) -> str:
@@ -84,12 +155,6 @@ def _class_makespan(comparison: dict) -> str:
     if comparison["failure"]:
         return f"failed ({comparison['failure']})"
     return "not solved (its lower bound cannot beat exact)"
-
-
-def _class_text(name: str, paper: bool, circle: bool = True) -> str:
-    """``name (whose)``: the paper's instruction on a Y (``circle``), the planner's on more legs."""
-    whose = "the paper's" if circle else "the planner's"
-    return f"{name} ({whose} instruction)" if paper else f"{name} (not {whose}: faster)"
 
 
 def route_summary(route: Route) -> dict:
@@ -173,8 +238,7 @@ def format_route(route: Route) -> str:
     instructions = Instruction.of_track(graph)
     lines = [
         f"instruction: {route.instruction.value}",
-        f"homotopy class: {class_label(route)}, regions "
-        f"{' '.join(str(r) for r in route.regions) or '(one ray)'}",
+        f"class: {class_label(route)}, regions {' '.join(str(r) for r in route.regions) or '(one ray)'}",
         f"travel: vehicle 1 {route.travel[0]:g} m, vehicle 2 {route.travel[1]:g} m",
         "waypoints (vehicle 1, vehicle 2):",
     ]
@@ -188,16 +252,16 @@ def format_route(route: Route) -> str:
     return "\n".join(lines)
 
 
-def _route_class_text(route: dict) -> str:
-    """The class line of a run's route summary (:func:`route_summary`)."""
-    circle = "class" not in route
-    return _class_text(route["way_round"] if circle else route["class"], route["planned_class"], circle)
+def summary_class_label(route: dict) -> str:
+    """The class of a run's route summary (``summary["route"]``), in :func:`class_label`'s words.
 
-
-def _graph_class_text(route: dict) -> str:
-    """The class line of a route on a track graph: its moves in order (who goes where, who waits)."""
-    moves = "; ".join(f"{m['vehicle']} {m['from']} -> {m['to']}" for m in route["moves"]) or "no move"
-    return f"the planned route's, every conflict passed in its order ({moves})"
+    A junction's (:func:`route_summary`): ``planned (counterclockwise)``; a track graph's
+    (:func:`graph_route_summary` with ``homotopy``): ``planned (agv1 A -> B; ...)``.
+    """
+    if "moves" in route:  # a track graph: its moves in order (who goes where, who waits)
+        moves = "; ".join(f"{m['vehicle']} {m['from']} -> {m['to']}" for m in route["moves"]) or "no move"
+        return moves if "homotopy" not in route else class_words(route["homotopy"], moves)
+    return class_words(route["homotopy"], route.get("class", route["way_round"]))
 
 
 def _chosen_mark(comparison: dict, *, fallback: bool) -> str:
@@ -248,17 +312,15 @@ def format_run(summary: dict) -> str:
         f"scenario: {summary['scenario']}",
         f"method: {format_provenance(summary)}  duration: {summary['duration_s']:.3f} s  "
         f"verified: {summary['verified']}",
-        f"worst margins: separation {margins['min_separation_m']:.4f} m "
-        f"(margin {round(margins['separation_margin_m'], 4) + 0.0:.4f} m), "
+        f"worst margins: separation {closest_text(margins['min_separation_m'])} "
+        f"(margin {closest_text(margins['separation_margin_m'])}), "
         f"|v|/limit {max(margins['velocity_ratio']):.6f}, "
         f"|a|/limit {max(margins['acceleration_ratio']):.6f}{jerk}",
-        f"homotopy class: {_route_class_text(summary['route'])}"
-        if "moves" not in summary["route"]
-        else f"class: {_graph_class_text(summary['route'])}",
+        f"class: {summary_class_label(summary['route'])}",
     ]
     if summary["solver"] is not None:
         lines += [
-            f"class {c.get('class', c['way_round'])} ({c['homotopy']}): "
+            f"class {class_words(c['homotopy'], c.get('class', c['way_round']))}: "
             + _class_makespan(c)
             + f", lower bound {c['lower_bound_s']:.3f} s"
             + _chosen_mark(c, fallback=summary["fallback_reason"] is not None)
@@ -277,7 +339,7 @@ def format_run(summary: dict) -> str:
             f"(limit {export['point_limit']:,}, {export['interpolation']}), worst error "
             f"{1e3 * max(export['position_error_m']):.3g} mm and "
             f"{1e3 * max(export['velocity_error_mps']):.3g} mm/s{slower}; verified as interpolated: "
-            f"separation {export['min_separation_m']:.4f} m"
+            f"separation {closest_text(export['min_separation_m'])}"
         )
     if summary["fallback_reason"]:
         lines.append(f"warning: fell back to the exact schedule ({summary['fallback_reason']})")

@@ -18,15 +18,18 @@ number of pieces, not with the duration. It checks:
   ``smoothness`` says) to round-off (:data:`CONTINUITY_TOLERANCE`), and the
   pieces tile ``[0, duration]``;
 - the start and the goal are the route's, to 1e-9 m, at rest (1e-6 m/s);
-- the sequence of regions visited (the homotopy class) is the route's;
+- the sequence of regions visited (the route's class: which way the vehicles go round each other) is
+  the route's;
 - the braking rule (:mod:`trajgen.verification.braking_rule`): each vehicle that follows at a
   conflict can always stop short of its frontier, so what is planned is what
   the online executor plays;
 - every number is finite, every knot sequence increases, and every array
   derived from others agrees with them (:mod:`trajgen.verification.integrity`).
 
-A failure names the arrays where it occurs, by their paths from the schedule
-(``sections[2].kinematics.vehicles[0].{times,initial,jerk} interval 4``).
+A failure says in plain words what is wrong: the quantity, its value and limit, the vehicle,
+when (seconds) and where on the track. Where it lies in the schedule's arrays, by their paths
+(``sections[2].kinematics.vehicles[0].{times,initial,jerk} interval 4``), is in the report's
+``details`` (and :class:`~trajgen.errors.VerificationError`'s), for debugging.
 
 :func:`verify` is a pure function of the (immutable) schedule: it keeps nothing.
 :func:`certify` turns a passing schedule into a :class:`VerifiedSchedule`, the
@@ -61,11 +64,14 @@ from trajgen.verification.piecewise import (
     check_piece_separation,
     check_piece_track,
     piece_arrays,
+    place,
+    places,
 )
 from trajgen.verification.report import (
     POSITION_TOLERANCE,
     REST_TOLERANCE,
     TRACK_END_TOLERANCE,
+    Finding,
     VerificationReport,
 )
 
@@ -131,12 +137,13 @@ def verify(schedule: Schedule) -> VerificationReport:
         1e3 * (time.perf_counter() - began),
         "passed" if report.passed else "FAILED",
     )
+    if not report.passed:  # with where in the schedule's arrays: what ``trajgen --verbose`` shows
+        logger.info("schedule (%s) failed verification: %s", schedule.method, "; ".join(report.details))
     return report
 
 
-def _failed(schedule: Schedule, failures: list[str], pieces: int = 0) -> VerificationReport:
+def _failed(failures: list[str], pieces: int = 0) -> VerificationReport:
     """A failed report for a schedule that cannot even be taken apart."""
-    logger.info("schedule (%s) failed verification: %s", schedule.method, "; ".join(failures))
     return VerificationReport.failed(tuple(failures), pieces=pieces)
 
 
@@ -162,18 +169,38 @@ def _check_ends(schedule: Schedule, pieces: Pieces, state, failures: list[str]) 
                 residue += abs(state.acceleration[vehicle, index])
             if not residue <= REST_TOLERANCE:
                 failures.append(
-                    f"vehicle {vehicle + 1} is not at rest at the {label} (|v| + |a| = {residue:.3g}): "
-                    f"{piece_arrays(schedule, pieces, piece, (vehicle,))}"
+                    Finding(
+                        f"vehicle {vehicle + 1} is not at rest at the {label} "
+                        f"(t={float(state.t[index]):.6f} s, |v| + |a| = {residue:.3g}): "
+                        f"expected at most {REST_TOLERANCE:g}",
+                        piece_arrays(schedule, pieces, piece, (vehicle,)),
+                    )
                 )
         tolerance = POSITION_TOLERANCE if schedule.end_tolerance is None else schedule.end_tolerance
         if not error <= tolerance:
+            at = float(state.t[index])
             failures.append(
-                f"{label} is off the route's {label} by {error:.3g} m (expected <= {tolerance:g} m): "
-                f"{piece_arrays(schedule, pieces, piece)}"
+                Finding(
+                    f"{label} is off the route's {label} by {error:.3g} m at t={at:.6f} s (expected "
+                    f"<= {tolerance:g} m): {_where(state, index, graph)} (the route's: "
+                    + ", ".join(str(p) for p in expected)
+                    + ")",
+                    piece_arrays(schedule, pieces, piece),
+                )
             )
         errors.append(error)
     start_gap = float(track_distance(state.leg[0, 0], state.s[0, 0], state.leg[1, 0], state.s[1, 0]))
     return errors[0], errors[1], start_gap
+
+
+def _where(state, index: int, graph) -> str:
+    """Both vehicles' places in ``state`` at ``index``, as positions are written (``A:9.8``, ``O``)."""
+    names = []
+    for vehicle in range(2):
+        leg = int(state.leg[vehicle, index])
+        at = "O" if leg == JUNCTION_INDEX else f"{graph.names[leg]}:{float(state.s[vehicle, index]):.4g}"
+        names.append(f"vehicle {vehicle + 1} at {at}")
+    return ", ".join(names)
 
 
 def _check_exported_ends(
@@ -196,9 +223,11 @@ def _check_exported_ends(
             gap = float(track_distance(state.leg[vehicle, index], state.s[vehicle, index], leg, s))
             if not gap <= allowance(schedule, vehicle, "position"):
                 failures.append(
-                    f"vehicle {vehicle + 1} is {gap:.3g} m from where its motion puts it at the {label}: "
-                    "the schedule reports a position its motion does not reach: "
-                    f"{piece_arrays(schedule, pieces, 0 if index == 0 else pieces.count - 1, (vehicle,))}"
+                    Finding(
+                        f"vehicle {vehicle + 1} is {gap:.3g} m from where its motion puts it at the "
+                        f"{label}: the schedule reports a position its motion does not reach",
+                        piece_arrays(schedule, pieces, 0 if index == 0 else pieces.count - 1, (vehicle,)),
+                    )
                 )
 
 
@@ -212,9 +241,12 @@ def _check_tiling(schedule: Schedule, pieces: Pieces, failures: list[str]) -> No
     k = int(np.argmax(gaps))
     if not gaps[k] <= 1e-9 * max(1.0, duration):
         section = int(pieces.section[min(k, pieces.count - 1)])
+        at = float(ends[k - 1]) if k else 0.0
         failures.append(
-            f"the motion has a gap of {gaps[k]:.3g} s in time (piece {k}): expected none: "
-            f"sections[{section}].start_time; {piece_arrays(schedule, pieces, min(k, pieces.count - 1))}"
+            Finding(
+                f"the motion has a gap of {gaps[k]:.3g} s in time at t={at:.6f} s: expected none",
+                f"sections[{section}].start_time; {piece_arrays(schedule, pieces, min(k, pieces.count - 1))}",
+            )
         )
 
 
@@ -227,31 +259,32 @@ def _for_execution(schedule: Schedule) -> bool:
 def _verify(schedule: Schedule) -> VerificationReport:
     own = array_failures(schedule)
     if own:  # the motion is read from these numbers: broken ones make every other check meaningless
-        return _failed(schedule, own)
+        return _failed(own)
     duration = schedule.duration
     if not math.isfinite(duration) or duration < 0.0:
-        return _failed(schedule, [f"schedule duration is {duration!r} s: expected finite, >= 0"])
+        return _failed([f"schedule duration is {duration!r} s: expected finite, >= 0"])
     route = schedule.route
     required = max(schedule.limits.min_separation, route.min_separation)
     try:
         with np.errstate(invalid="ignore", over="ignore"):  # non-finite numbers are reported below
             pieces = schedule_pieces(schedule)
     except UncheckableKinematicsError as error:
-        return _failed(schedule, [f"cannot be checked: {error}"])
+        return _failed([f"cannot be checked: {error}"])
     if not (np.all(np.isfinite(pieces.axis)) and np.all(np.isfinite(pieces.start))):
         bad = int(np.argmax(~np.all(np.isfinite(pieces.axis), axis=(0, 2)) | ~np.isfinite(pieces.start)))
         return _failed(
-            schedule,
             [
-                f"the motion is not finite in piece {bad} (from t={pieces.start[bad]!r} s): expected finite: "
-                f"{piece_arrays(schedule, pieces, bad)}"
+                Finding(
+                    f"the motion is not finite from t={pieces.start[bad]!r} s: expected finite numbers",
+                    piece_arrays(schedule, pieces, bad),
+                )
             ],
             pieces.count,
         )
     failures: list[str] = []
     check_maps(schedule, failures)
     if failures:  # the pieces are read through the maps: a broken map makes them meaningless
-        return _failed(schedule, failures, pieces.count)
+        return _failed(failures, pieces.count)
     ends = schedule.state([0.0, duration])
     track = pieces.track()
     start_error, goal_error, start_gap = _check_ends(schedule, pieces, ends, failures)
@@ -279,20 +312,27 @@ def _verify(schedule: Schedule) -> VerificationReport:
                 else "its margin stays too thin to certify"
             )
             failures.append(
-                f"vehicle {failure.vehicle + 1} cannot stop short of its frontier at t={failure.time:.6f} s: "
-                f"{what} (the braking rule; expected at most {BRAKING_RULE_TOLERANCE:g} m past it): "
-                f"{piece_arrays(schedule, pieces, k)}"
+                Finding(
+                    f"vehicle {failure.vehicle + 1} cannot stop short of its frontier at "
+                    f"t={failure.time:.6f} s ({place(schedule, pieces, failure.vehicle, k, failure.time)}): "
+                    f"{what} (the braking rule; expected at most {BRAKING_RULE_TOLERANCE:g} m past it)",
+                    piece_arrays(schedule, pieces, k),
+                )
             )
     expected = route.region_keys
     sequence = reduce_regions(regions)
     if sequence != expected:
         show = lambda keys: " ".join(str(Region.from_key(route.graph, key)) for key in keys)  # noqa: E731
+        k = _first_departure(regions, expected)
+        at = float(pieces.start[k]) if pieces.count else 0.0
         failures.append(
-            f"homotopy class differs: schedule visits [{show(sequence)}], route [{show(expected)}]: "
-            f"{piece_arrays(schedule, pieces, _first_departure(regions, expected))}"
+            Finding(
+                f"the vehicles go round each other in another class than their route's, from t={at:.6f} s "
+                f"({places(schedule, pieces, k, at)}): schedule visits [{show(sequence)}], "
+                f"route [{show(expected)}]",
+                piece_arrays(schedule, pieces, k),
+            )
         )
-    if failures:
-        logger.info("schedule (%s) failed verification: %s", schedule.method, "; ".join(failures))
     return VerificationReport(
         passed=not failures,
         failures=tuple(failures),

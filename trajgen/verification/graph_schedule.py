@@ -527,7 +527,7 @@ def _check_class(
             failures.append(
                 "the schedule passes a conflict in another order than the route (at travel "
                 f"{point[0]:.3f} m, "
-                f"{point[1]:.3f} m the route lets {first} pass first): a different homotopy class"
+                f"{point[1]:.3f} m the route lets {first} pass first): another class than the route's"
             )
             return False
     return True

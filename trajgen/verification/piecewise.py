@@ -3,8 +3,9 @@
 On each piece both vehicles' signed axes are single polynomials and each
 vehicle is on one leg, so every check takes the extrema at the ends and at the
 roots of a derivative: nothing hides between samples. Each check appends what
-fails to ``failures``, naming the arrays that define the piece
-(:func:`piece_arrays`).
+fails to ``failures`` as a :class:`~trajgen.verification.report.Finding`: in plain words (the
+vehicle, the quantity, when and where on the track), with the arrays that define the piece
+(:func:`piece_arrays`) as its details.
 """
 
 from __future__ import annotations
@@ -21,6 +22,7 @@ from trajgen.verification.report import (
     POSITION_TOLERANCE,
     RELATIVE_TOLERANCE,
     TRACK_END_TOLERANCE,
+    Finding,
 )
 
 __all__ = [
@@ -33,6 +35,8 @@ __all__ = [
     "check_piece_track",
     "continuity_allowance",
     "piece_arrays",
+    "place",
+    "places",
     "time_resolution",
 ]
 
@@ -45,6 +49,25 @@ def piece_arrays(schedule: Schedule, pieces: Pieces, k: int, vehicles: tuple[int
     return "; ".join(
         motion_arrays(schedule, section, vehicle, int(pieces.interval[vehicle, k])) for vehicle in vehicles
     )
+
+
+def place(schedule: Schedule, pieces: Pieces, vehicle: int, k: int, time: float) -> str:
+    """Where a vehicle is at ``time`` (seconds, in piece ``k``), in words: its leg and metres out.
+
+    For example ``on leg 'A', 3.205 m from the junction`` or ``in the junction``.
+    """
+    leg = int(pieces.leg[vehicle, k])
+    if leg == JUNCTION_INDEX:
+        return "in the junction"
+    tau = np.array([time - float(pieces.start[k])])
+    axis = float(polynomials.evaluate(pieces.axis[vehicle, k : k + 1], tau)[0])
+    s = float(pieces.s_offset[vehicle, k] + pieces.s_sign[vehicle, k] * axis)
+    return f"on leg {schedule.route.graph.names[leg]!r}, {s:.3f} m from the junction"
+
+
+def places(schedule: Schedule, pieces: Pieces, k: int, time: float) -> str:
+    """Where both vehicles are at ``time`` (seconds, in piece ``k``), in words."""
+    return " and ".join(f"vehicle {v + 1} {place(schedule, pieces, v, k, time)}" for v in range(2))
 
 
 def time_resolution(schedule: Schedule) -> float:
@@ -113,9 +136,12 @@ def check_piece_limits(pieces: Pieces, schedule: Schedule, failures: list[str]) 
             if peak.size and not peak[k] <= limit + allowance(schedule, vehicle, name):
                 when = pieces.start[k] + (t_high[k] if abs(high[k]) >= abs(low[k]) else t_low[k])
                 failures.append(
-                    f"vehicle {vehicle + 1} {name} reaches {peak[k]:.9g} {unit} at t={when:.6f} s "
-                    f"exceeds its {limit_name} {limit:g} {unit}: "
-                    f"{piece_arrays(schedule, pieces, k, (vehicle,))}"
+                    Finding(
+                        f"vehicle {vehicle + 1} {name} reaches {peak[k]:.9g} {unit} at t={when:.6f} s "
+                        f"({place(schedule, pieces, vehicle, k, when)}) exceeds its {limit_name} "
+                        f"{limit:g} {unit}",
+                        piece_arrays(schedule, pieces, k, (vehicle,)),
+                    )
                 )
             c = pieces.axis[vehicle]
     return ratios
@@ -139,17 +165,28 @@ def check_piece_track(
         if over.size:
             k = int(over[0])
             failures.append(
-                f"vehicle {vehicle + 1} is {high[k] - length[k]:.3g} m past the end of leg "
-                f"{graph.names[pieces.leg[vehicle, k]]!r} at t={pieces.start[k] + t_high[k]:.6f} s: "
-                f"{piece_arrays(schedule, pieces, k, (vehicle,))}"
+                Finding(
+                    f"vehicle {vehicle + 1} is {high[k] - length[k]:.3g} m past the end of leg "
+                    f"{graph.names[pieces.leg[vehicle, k]]!r} ({length[k]:g} m long) at "
+                    f"t={pieces.start[k] + t_high[k]:.6f} s: expected at most {past_end:g} m",
+                    piece_arrays(schedule, pieces, k, (vehicle,)),
+                )
             )
         under = np.nonzero(low < -TRACK_END_TOLERANCE)[0]
         if under.size:
             k = int(under[0])
+            where = (
+                "the junction"
+                if pieces.leg[vehicle, k] == JUNCTION_INDEX
+                else f"leg {graph.names[pieces.leg[vehicle, k]]!r}"
+            )
             failures.append(
-                f"vehicle {vehicle + 1} passes the junction inside a piece (s = {low[k]:.3g} m) "
-                f"at t={pieces.start[k] + t_low[k]:.6f} s: its position map does not cover it: "
-                f"{piece_arrays(schedule, pieces, k, (vehicle,))}"
+                Finding(
+                    f"vehicle {vehicle + 1} runs {-low[k]:.3g} m through the junction while the schedule "
+                    f"keeps it on {where}, at t={pieces.start[k] + t_low[k]:.6f} s: expected it to "
+                    "change leg at the junction",
+                    piece_arrays(schedule, pieces, k, (vehicle,)),
+                )
             )
         axis_low, _, axis_high, _ = polynomials.extrema(pieces.axis[vehicle], pieces.length)
         outside = np.nonzero(
@@ -159,9 +196,13 @@ def check_piece_track(
         if outside.size:
             k = int(outside[0])
             failures.append(
-                f"vehicle {vehicle + 1} leaves the range of its position map at t={pieces.start[k]:.6f} s "
-                f"(axis {axis_low[k]:.6g} to {axis_high[k]:.6g} m, map {pieces.axis_low[vehicle, k]:.6g} to "
-                f"{pieces.axis_high[vehicle, k]:.6g} m): {piece_arrays(schedule, pieces, k, (vehicle,))}"
+                Finding(
+                    f"vehicle {vehicle + 1} travels beyond the stretch of track its schedule places it on "
+                    f"at t={pieces.start[k]:.6f} s: its axis runs {axis_low[k]:.6g} to "
+                    f"{axis_high[k]:.6g} m, expected within {pieces.axis_low[vehicle, k]:.6g} to "
+                    f"{pieces.axis_high[vehicle, k]:.6g} m",
+                    piece_arrays(schedule, pieces, k, (vehicle,)),
+                )
             )
 
 
@@ -188,14 +229,22 @@ def check_piece_separation(
         return float("inf"), regions
     k = int(np.argmin(closest))
     if crossing[k]:
+        leg = schedule.route.graph.names[int(pieces.leg[0, k])]
         failures.append(
-            f"vehicles pass each other on one leg between t={pieces.start[k]:.6f} s and the next piece: "
-            f"{piece_arrays(schedule, pieces, k)}"
+            Finding(
+                f"the vehicles pass each other on leg {leg!r} between t={pieces.start[k]:.6f} s and "
+                f"t={pieces.start[k] + pieces.length[k]:.6f} s: expected them never to",
+                piece_arrays(schedule, pieces, k),
+            )
         )
     elif closest[k] < required - POSITION_TOLERANCE:
+        at = pieces.start[k] + when[k]
         failures.append(
-            f"separation {closest[k]:.9g} m at t={pieces.start[k] + when[k]:.6f} s is below the minimum "
-            f"{required:g} m: {piece_arrays(schedule, pieces, k)}"
+            Finding(
+                f"separation {closest[k]:.9g} m at t={at:.6f} s is below the minimum {required:g} m "
+                f"({places(schedule, pieces, k, at)})",
+                piece_arrays(schedule, pieces, k),
+            )
         )
     return float(closest[k]), regions
 
@@ -239,11 +288,14 @@ def check_piece_continuity(
             jumps = np.nonzero(~(values <= tolerance))[0]
             if jumps.size:
                 k = int(jumps[0])
+                at = float(pieces.start[k + 1])
                 failures.append(
-                    f"vehicle {vehicle + 1} {name} jumps by {values[k]:.3g} {unit} "
-                    f"at t={pieces.start[k + 1]:.6f} s (tolerance {tolerance:.3g} {unit}): between "
-                    f"{piece_arrays(schedule, pieces, k, (vehicle,))} and "
-                    f"{piece_arrays(schedule, pieces, k + 1, (vehicle,))}"
+                    Finding(
+                        f"vehicle {vehicle + 1} {name} jumps by {values[k]:.3g} {unit} at t={at:.6f} s "
+                        f"({place(schedule, pieces, vehicle, k + 1, at)}, tolerance {tolerance:.3g} {unit})",
+                        f"between {piece_arrays(schedule, pieces, k, (vehicle,))} and "
+                        f"{piece_arrays(schedule, pieces, k + 1, (vehicle,))}",
+                    )
                 )
 
 
@@ -251,25 +303,39 @@ def check_maps(schedule: Schedule, failures: list[str]) -> None:
     """Each section's position maps are well formed: known legs, unit slopes, contiguous sub-ranges."""
     legs = len(schedule.route.graph.lengths)
     for index, section in enumerate(schedule.sections):
+        start = float(section.start_time)
+        window = f"t={start:.3f} to {start + float(section.duration):.3f} s"
         for vehicle, axis_map in enumerate(section.maps):
             where = f"sections[{index}].maps[{vehicle}]"
+            who = f"vehicle {vehicle + 1}'s track map (where its axis lies on the track) for {window}"
             if not np.all(np.isin(axis_map.outward, (-1, 0, 1))):
                 failures.append(
-                    f"{where}.outward: map slopes {axis_map.outward.tolist()} are not -1, 0 or +1"
+                    Finding(
+                        f"{who}: map slopes {axis_map.outward.tolist()} are not -1, 0 or +1",
+                        f"{where}.outward",
+                    )
                 )
             if not np.all((axis_map.legs >= JUNCTION_INDEX) & (axis_map.legs < legs)):
                 failures.append(
-                    f"{where}.legs: map legs {axis_map.legs.tolist()} are not track legs: expected "
-                    f"{JUNCTION_INDEX} (the junction) or a leg index 0 to {legs - 1} ({legs} legs)"
+                    Finding(
+                        f"{who}: map legs {axis_map.legs.tolist()} are not track legs: expected "
+                        f"{JUNCTION_INDEX} (the junction) or a leg index 0 to {legs - 1} ({legs} legs)",
+                        f"{where}.legs",
+                    )
                 )
                 continue
             at_junction = axis_map.legs == JUNCTION_INDEX
             if np.any(at_junction & ((axis_map.outward != 0) | (axis_map.s_start != 0.0))):
                 failures.append(
-                    f"{where}.{{legs,outward,s_start}}: a map sub-range at the junction moves or lies off it"
+                    Finding(
+                        f"{who}: a map sub-range at the junction moves or lies off it",
+                        f"{where}.{{legs,outward,s_start}}",
+                    )
                 )
             if np.any(~at_junction & (axis_map.s_start < -TRACK_END_TOLERANCE)):
-                failures.append(f"{where}.s_start: a map sub-range starts before the junction (s < 0)")
+                failures.append(
+                    Finding(f"{who}: a map sub-range starts before the junction (s < 0)", f"{where}.s_start")
+                )
             if axis_map.legs.size > 1:
                 s_end = axis_map.s_start + axis_map.outward * (axis_map.axis_end - axis_map.axis_start)
                 scale = max(1.0, float(np.max(np.abs(axis_map.axis_end))))
@@ -280,8 +346,10 @@ def check_maps(schedule: Schedule, failures: list[str]) -> None:
                 )
                 if np.any(gaps > 1e-12 * scale) or np.any(broken > TRACK_END_TOLERANCE):
                     failures.append(
-                        f"{where}.{{axis_start,axis_end,s_start}}: map sub-ranges do not join "
-                        "(axis or track gap)"
+                        Finding(
+                            f"{who}: map sub-ranges do not join (axis or track gap)",
+                            f"{where}.{{axis_start,axis_end,s_start}}",
+                        )
                     )
 
 
@@ -298,6 +366,10 @@ def check_parked(pieces: Pieces, schedule: Schedule, failures: list[str]) -> Non
         if moving.any():
             k = int(np.nonzero(parked)[0][np.argmax(moving)])
             failures.append(
-                f"vehicle {vehicle + 1} moves at t={pieces.start[k]:.6f} s where its map says it stands: "
-                f"{piece_arrays(schedule, pieces, k, (vehicle,))}"
+                Finding(
+                    f"vehicle {vehicle + 1} moves at t={pieces.start[k]:.6f} s "
+                    f"({place(schedule, pieces, vehicle, k, float(pieces.start[k]))}) where its schedule "
+                    "says it stands still",
+                    piece_arrays(schedule, pieces, k, (vehicle,)),
+                )
             )

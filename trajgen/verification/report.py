@@ -5,6 +5,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from trajgen.errors import VerificationError
+from trajgen.model.summary import closest_text
 
 __all__ = [
     "CONTINUITY_TOLERANCE",
@@ -12,6 +13,7 @@ __all__ = [
     "RELATIVE_TOLERANCE",
     "REST_TOLERANCE",
     "TRACK_END_TOLERANCE",
+    "Finding",
     "VerificationReport",
 ]
 
@@ -28,6 +30,44 @@ TRACK_END_TOLERANCE = 1e-6
 CONTINUITY_TOLERANCE = 1e-12
 
 
+class Finding(str):
+    """One failed check: the plain message (the string itself) and where it lies in the schedule's arrays.
+
+    The checks append findings to their lists of failures; :class:`VerificationReport` keeps the
+    plain messages as ``failures`` and each with its arrays as ``details``.
+
+    Parameters
+    ----------
+    message : str
+        What is wrong in an engineer's words: the quantity, its value and limit, the vehicle, when
+        (seconds) and where on the track.
+    arrays : str
+        The arrays of the schedule it lies in, by their paths
+        (``sections[2].kinematics.vehicles[0].{times,initial,jerk} interval 4, ...``).
+
+    Examples
+    --------
+    >>> finding = Finding("vehicle 1 velocity reaches 1.2 m/s", "sections[0].maps[0]")
+    >>> str(finding), finding.detail
+    ('vehicle 1 velocity reaches 1.2 m/s', 'vehicle 1 velocity reaches 1.2 m/s: sections[0].maps[0]')
+    """
+
+    def __new__(cls, message: str, arrays: str = "") -> Finding:
+        """The finding ``message``, lying in ``arrays``."""
+        finding = super().__new__(cls, message)
+        finding.arrays = arrays
+        return finding
+
+    @property
+    def detail(self) -> str:
+        """The message followed by the arrays it lies in (the message alone if none are named)."""
+        return f"{self}: {self.arrays}" if self.arrays else str(self)
+
+
+def _detail(failure: str) -> str:
+    return failure.detail if isinstance(failure, Finding) else str(failure)
+
+
 @dataclass(frozen=True, slots=True)
 class VerificationReport:
     """Outcome of :func:`verify`.
@@ -37,7 +77,8 @@ class VerificationReport:
     passed : bool
         Whether every check passed.
     failures : tuple of str
-        One message per failed check, naming the quantity, value and limit.
+        One message per failed check in plain words: the quantity, its value and limit, the
+        vehicle, when (seconds) and where on the track.
     pieces : int
         Number of polynomial pieces checked.
     min_separation : float
@@ -52,6 +93,11 @@ class VerificationReport:
         Track distance of the schedule's first and last positions from the route's, metres.
     regions_match : bool
         Whether the sampled region sequence equals the route's.
+    details : tuple of str
+        Per failure, its message followed by where it lies in the schedule's arrays
+        (``sections[2].kinematics.vehicles[0].{times,initial,jerk} interval 4, ...``), for debugging;
+        by default (or for a failure that names none) the message alone. Given ``failures`` that
+        are :class:`Finding` objects, taken from them.
     """
 
     passed: bool
@@ -65,6 +111,15 @@ class VerificationReport:
     start_error: float
     goal_error: float
     regions_match: bool
+    details: tuple[str, ...] = ()
+
+    def __post_init__(self) -> None:
+        failures = tuple(self.failures)
+        if not self.details or len(self.details) != len(failures):
+            object.__setattr__(self, "details", tuple(_detail(failure) for failure in failures))
+        else:
+            object.__setattr__(self, "details", tuple(str(detail) for detail in self.details))
+        object.__setattr__(self, "failures", tuple(str(failure) for failure in failures))
 
     def __repr__(self) -> str:
         """One line: the verdict, the closest approach and the worst ratios, or the first failure."""
@@ -77,7 +132,8 @@ class VerificationReport:
         ratios += [] if self.jerk_ratio is None else [max(self.jerk_ratio)]
         return (
             f"<VerificationReport: passed, {self.pieces} pieces, "
-            f"closest approach {self.min_separation:.4f} m, worst ratio to the limits {max(ratios):.6f}>"
+            f"closest approach {closest_text(self.min_separation)}, "
+            f"worst ratio to the limits {max(ratios):.6f}>"
         )
 
     @classmethod
@@ -99,9 +155,11 @@ class VerificationReport:
         )
 
     def raise_if_failed(self) -> None:
-        """Raise VerificationError listing the failures, if any."""
+        """Raise VerificationError listing the failures in plain words (with ``details``), if any."""
         if not self.passed:
-            raise VerificationError("schedule failed verification: " + "; ".join(self.failures))
+            raise VerificationError(
+                "schedule failed verification: " + "; ".join(self.failures), details=self.details
+            )
 
     def summary(self) -> dict:
         """JSON-ready worst margins."""

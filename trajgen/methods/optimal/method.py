@@ -35,7 +35,7 @@ from trajgen.methods.optimal.transcription import ParameterLayout
 from trajgen.methods.optimal.units import ProblemUnits
 from trajgen.model.analysis import class_lower_bound
 from trajgen.model.schedule import FallbackReason, Schedule, TimingMethod, check_request
-from trajgen.model.summary import class_name
+from trajgen.model.summary import class_label, class_name
 from trajgen.verification import verify
 
 __all__ = [
@@ -341,12 +341,11 @@ class Optimal(TimingMethod):
             )
 
         unsolved_notes = tuple(
-            f"class {class_name(routes[k])} ({routes[k].homotopy.value}) not solved "
-            f"({solved[k].failure.value}): {solved[k].detail}"
+            f"class {class_label(routes[k])} not solved ({solved[k].failure.value}): {solved[k].detail}"
             for k in wanted
             if solved[k].failure is not None
         ) + tuple(
-            f"class {class_name(routes[k])} ({routes[k].homotopy.value}): the time limit "
+            f"class {class_label(routes[k])}: the time limit "
             f"({self.time_limit:g} s, a safety stop) ended its refinement after pass {len(solved[k].passes)}"
             for k in wanted
             if solved[k].cut_short and solved[k].passes
