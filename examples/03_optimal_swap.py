@@ -16,6 +16,7 @@ from pathlib import Path
 
 from trajgen import METHODS, certify, load_scenario, lower_bound, make_schedule
 from trajgen.export import commit_files
+from trajgen.model.summary import class_label, class_words
 from trajgen.plots import plot_coordination, plot_speed, png_bytes
 
 here = Path(__file__).resolve().parent
@@ -27,7 +28,7 @@ scratch = None if kept else tempfile.TemporaryDirectory(prefix="trajgen-example-
 output = Path(kept or scratch.name).resolve()
 
 route = scenario.route()
-print("homotopy class:", " -> ".join(str(region) for region in route.regions))
+print(f"class {class_label(route)}:", " -> ".join(str(region) for region in route.regions))
 
 # Every registered method, each schedule certified by the verifier (it raises if one fails).
 verified = {m.name: certify(make_schedule(route, scenario.limits, method=m())) for m in METHODS}
@@ -44,7 +45,9 @@ ratio = optimal.duration / verified["exact"].schedule.duration
 print(f"optimal / exact = {ratio:.4f}; solver: {optimal.info.status}")
 for item in optimal.info.classes:  # the two classes it solved, and which it chose
     makespan = "not solved" if item.makespan is None else f"{item.makespan:.3f} s"
-    print(f"  class {item.way_round.value} ({item.homotopy.value}): {makespan}, chosen {item.chosen}")
+    print(
+        f"  class {class_words(item.homotopy.value, item.way_round.value)}: {makespan}, chosen {item.chosen}"
+    )
 
 # How deep does the waiting vehicle park? (exact parks it at the end of leg C)
 state = optimal.sample(0.01)

@@ -11,6 +11,7 @@ planner's instruction (counterclockwise for a swap) and the other way round
 from limits import Limits, VehicleLimits
 from topology import Configuration, Position, YGraph, plan
 from trajgen import Exact, Optimal, certify, make_schedule
+from trajgen.model.summary import class_label
 
 track = YGraph({"A": 12.0, "B": 8.0, "C": 15.0})  # metres, counterclockwise order
 start = Configuration(Position("A", 12.0), Position("B", 8.0))
@@ -21,7 +22,7 @@ limits = Limits(vehicles=(agv, agv), min_separation=1.5)
 paper = plan(track, start, start.swapped(), min_separation=1.5)
 other = plan(track, start, start.swapped(), min_separation=1.5, homotopy="other")
 for route in (paper, other):
-    print(f"{route.homotopy.value:>5}: {route.way_round.value}, regions {' '.join(map(str, route.regions))}")
+    print(f"{class_label(route)}: regions {' '.join(map(str, route.regions))}")
 
 # exact: one vehicle moves at a time along the planner's route; optimal: both at once, either class.
 exact = certify(make_schedule(paper, limits, method=Exact()))
@@ -29,8 +30,8 @@ optimal = certify(make_schedule(paper, limits, method=Optimal()))
 for verified in (exact, optimal):
     schedule, report = verified.schedule, verified.report
     print(
-        f"{schedule.method.name:>7}: {schedule.duration:6.2f} s in the "
-        f"{schedule.route.homotopy.value} class, closest approach {report.min_separation:.3f} m"
+        f"{schedule.method.name:>7}: {schedule.duration:6.2f} s in "
+        f"class {class_label(schedule.route)}, closest approach {report.min_separation:.3f} m"
     )
 
 # The waiting vehicle parks only as deep in a leg as the separation needs.

@@ -10,6 +10,7 @@ class gives it the short one, and ``optimal`` finds that it is faster.
 from limits import Limits, VehicleLimits
 from topology import Configuration, Position, YGraph, plan
 from trajgen import Optimal, certify, make_schedule
+from trajgen.model.summary import class_label
 
 track = YGraph({"A": 12.0, "B": 8.0, "C": 15.0})
 start = Configuration(Position("A", 12.0), Position("B", 8.0))
@@ -21,8 +22,8 @@ route = plan(track, start, start.swapped(), min_separation=1.5)
 # Keep the paper's class, then let optimal choose between the two shortest classes.
 in_planned_class = certify(make_schedule(route, limits, method=Optimal(homotopy="planned")))
 fastest = certify(make_schedule(route, limits, method=Optimal()))
-print(f"paper's class: {in_planned_class.schedule.duration:.2f} s")
-print(f"chosen class: {fastest.schedule.route.homotopy.value}, {fastest.schedule.duration:.2f} s")
+print(f"class {class_label(in_planned_class.schedule.route)}: {in_planned_class.schedule.duration:.2f} s")
+print(f"chosen: class {class_label(fastest.schedule.route)}, {fastest.schedule.duration:.2f} s")
 
 # Each vehicle keeps its own limits (the verifier's worst ratios, per vehicle).
 report = fastest.report

@@ -25,6 +25,7 @@ import numpy as np
 
 from trajgen import Optimal, certify, load_scenario, make_schedule
 from trajgen.export import commit_files
+from trajgen.model.summary import class_label
 from trajgen.plots import animate, encode_gif, plot_configuration, png_bytes
 from trajgen.plots.animation_layout import frame_geometry, playback
 
@@ -40,7 +41,7 @@ output = Path(kept or scratch.name).resolve()
 route = scenario.route()
 verified = certify(make_schedule(route, scenario.limits, method=Optimal()))
 duration = verified.schedule.duration
-print(f"optimal swap: {duration:.2f} s, class {verified.schedule.route.way_round.value}")
+print(f"optimal swap: {duration:.2f} s, class {class_label(verified.schedule.route)}")
 
 # 2. How it will be played: which instants become frames, and how fast.
 play = playback(duration, fps=10, max_frames=300)

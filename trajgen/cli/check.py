@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import sys
 
 from trajgen.cli.options import add_dialect_options, scenario_from
 from trajgen.cli.parser import EXIT_FAILURE, EXIT_OK
@@ -41,6 +42,9 @@ def _command_check(args: argparse.Namespace) -> int:
         for note in _jerk_notes(verdict, args.ignore_jerk):
             print(f"note: {note}")
         if not verdict.passed:
+            if getattr(args, "verbose", False):  # where each failure lies in the tables' arrays
+                for detail in verdict.check.report.details:
+                    print(f"trajgen: detail: {detail}", file=sys.stderr)
             print("FAIL")
         elif verdict.jerk_checked:
             print("PASS: the files keep the separation and the limits")

@@ -120,7 +120,7 @@ def plot_coordination(verified: Mapping[str, VerifiedSchedule], *, figure=None):
         axis.grid(True, alpha=0.3)
     if len(groups) > 1:
         area.suptitle(
-            "one panel per pair of paths: the methods drive different paths (another homotopy class, "
+            "one panel per pair of paths: the methods drive different paths (the other class, "
             "or parking less deep),\nso each panel has its own axes and its own too-close region",
             fontsize=9,
         )
