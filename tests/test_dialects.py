@@ -394,7 +394,7 @@ def test_a_value_written_without_decimals_does_not_widen_the_allowance(exported,
             r"velocity column .* disagrees with its positions",
         ),
         (7, lambda v, row: f"{float(v) + 1.0:.9f}", r"x, y do not lie at leg"),
-        (3, lambda v, row: "9.0" if row == 50 else v, r"acceleration column reaches 9 at"),
+        (3, lambda v, row: "9.0" if row == 50 else v, r"acceleration column reaches 9 m/s\^2 at"),
     ],
     ids=["leg", "velocity", "x", "acceleration"],
 )
@@ -527,10 +527,25 @@ def test_a_generic_csv_cut_at_a_line_boundary_is_first_said_to_end_early(tmp_pat
     kept = 2 * rows // 5  # mid-motion
     (out / "agv1.csv").write_bytes(b"".join(line + b"\r\n" for line in lines[: kept + 1]))
     assert main(["check", SWAP, "--csv", str(out)]) == EXIT_FAILURE
-    violations = [line for line in capsys.readouterr().out.splitlines() if line.startswith("violation: ")]
+    printed = capsys.readouterr().out
+    violations = [line for line in printed.splitlines() if line.startswith("violation: ")]
     assert "agv1.csv: the file ends early: its last row " in violations[0]
     assert f"(row {kept:,} of {rows:,} in the other vehicle's file, t = " in violations[0]
     assert "is not at rest (1 m/s), where a schedule ends at rest at its goal" in violations[0]
+    assert "--ignore-jerk" not in printed  # the jerk at the cut is the cut's: no flag to offer
+
+
+def test_a_generic_csv_cut_within_a_line_is_said_to_end_early(tmp_path, capsys):
+    """It was "line 313: 8 field(s) separated by ';', expected 9" (the review of issue 38)."""
+    out = tmp_path / "cut"
+    assert main(["schedule", SWAP, "--csv", str(out), "--method", "exact"]) == EXIT_OK
+    capsys.readouterr()
+    data = (out / "agv1.csv").read_bytes()
+    (out / "agv1.csv").write_bytes(data[: data.index(b";1;", 30_000)])  # within a row, before its leg
+    assert main(["check", SWAP, "--csv", str(out)]) == EXIT_BAD_INPUT
+    err = capsys.readouterr().err
+    assert "agv1.csv: the file ends early: its last line (line " in err
+    assert ") is cut short, 5 of 9 fields and no line end" in err
 
 
 def test_both_generic_csvs_cut_where_the_vehicles_rest_between_moves_are_said_to_end_early(tmp_path, capsys):

@@ -143,6 +143,16 @@ def test_a_velocity_table_written_a_hair_above_its_limit_is_slowed_down(monkeypa
     assert tables.check.passed
 
 
+def test_a_velocity_table_still_above_its_limit_after_every_resampling_is_never_written(monkeypatch):
+    from trajgen.errors import VerificationError
+    from trajgen.export.plc import files, plc_tables
+
+    verified = bench("swap", "exact")[1]
+    monkeypatch.setattr(files, "_written_above", lambda *args: 1.000001)  # however slow, 1e-6 above
+    with pytest.raises(VerificationError, match=r"write a velocity 1\.000001 times its limit after 3 "):
+        plc_tables(verified, "velocity-profile")
+
+
 def test_a_graph_csv_holds_a_velocity_a_hair_above_its_limit_to_the_limit():
     from trajgen.export.graph_rows import format_graph_block
 

@@ -916,7 +916,7 @@ def test_two_panels_say_why_each_has_its_own_axes(swap_by_method):
     assert len(figure.axes) == 2
     why = figure.get_suptitle()
     assert "different paths" in why
-    assert "homotopy class" in why
+    assert "the other class" in why
     assert all("class " in axis.get_title() for axis in figure.axes)
     one = plot_coordination({"exact": swap_by_method["exact"]})
     assert one.get_suptitle() == ""

@@ -71,5 +71,34 @@ def test_the_plant_changes_speed_at_most_at_its_limit_and_brakes_only_in_a_stop(
             # the brake acts within one cycle; everything else is the drive, within its acceleration
             limit = vehicle.emergency_braking if braking[k][v] else vehicle.max_acceleration
             assert change <= limit * (1 + 1e-6) + 1e-9, (v, k * PERIOD, change, limit)
+            assert abs(speeds[k + 1][v]) <= vehicle.max_velocity * (1 + 1e-6), (v, k * PERIOD)
             moved_at_speed |= braking[k][v] and abs(speeds[k][v]) > 0.5 * vehicle.max_velocity
     assert moved_at_speed or not any(f.kind is FaultKind.STOP for f in faults)  # a stop came at speed
+
+
+@pytest.mark.parametrize(
+    ("specs", "window"),
+    [
+        (("lag:agv1@0.5=100", "stop:agv1@{1}+2"), (2.0, 4.0)),  # from its release on
+        (("lag:agv1@0.5=150", "slow:agv1@{1}+3=0.3"), (0.0, 3.0)),  # while it is throttled
+    ],
+    ids=["released-from-a-stop", "throttled"],
+)
+def test_a_lagging_drive_released_from_a_stop_or_throttled_ramps_too(specs, window):
+    """A lag replays late setpoints as they come (a delay line); a brake's release or a cap still ramps."""
+    scenario, verified = _plan("swap")
+    at_speed = _at_speed(verified.schedule)
+    faults = parse_faults(scenario, [spec.format(None, *at_speed) for spec in specs])
+    speeds: list[float] = []
+    result, _ = simulate(
+        scenario,
+        faults,
+        verified=verified,
+        observer=lambda e, measured, c: speeds.append(measured[0].velocity),
+    )
+    assert result.reached_goal
+    assert result.violations == 0
+    start = round((float(at_speed[0]) + window[0]) / PERIOD)
+    changes = np.abs(np.diff(speeds[start : round((float(at_speed[0]) + window[1]) / PERIOD)])) / PERIOD
+    assert changes.max() <= scenario.limits.vehicles[0].max_acceleration * (1 + 1e-6)
+    assert np.ptp(speeds[start : start + round(1.0 / PERIOD)]) > 0.1  # it did change speed there

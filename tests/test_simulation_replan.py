@@ -79,6 +79,20 @@ def test_time_lost_across_a_new_goal_is_measured_against_the_plans_driven():
     assert "(left for a new goal)" in text
 
 
+def test_a_goal_that_comes_after_both_reached_theirs_counts_the_wait_as_idle_not_lost():
+    _, result = _run("swap", ("goal:agv2@75=B:5",))  # the exact plan ends at 67.5 s
+    first, second = result.plans
+    assert first.planned_s == first.schedule.duration
+    assert first.ended_s == pytest.approx(first.schedule.duration, abs=0.05)  # when both were at rest there
+    assert second.started_s == pytest.approx(75.0)
+    assert result.idle_s == pytest.approx(second.started_s - first.ended_s, abs=1e-9)
+    assert abs(result.time_lost_s) < 0.05  # nothing went wrong: nothing lost
+    assert result.time_lost_s == pytest.approx(result.makespan_s - result.planned_s - result.idle_s)
+    text = format_simulation(result.summary(), min_separation=1.5)
+    assert "s at the goals waiting for a new one" in text
+    assert "(at its goals, then a new goal at 75.000 s)" in text
+
+
 def test_a_run_without_a_new_goal_is_one_plan_measured_whole():
     _, result = _run("swap", ("stop:agv2@20+3",))
     (only,) = result.plans
@@ -152,9 +166,11 @@ def _extents(figure):
         ("swap", NEW_GOAL),
         ("swap", ("slow:agv1@3+8=0.4", "stop:agv2@5+2", "jump:agv1@12=0.03", "stop:agv1@20+1")),
         ("crossing", ("stop:agv1@1+1", "stop:agv2@1.5+1", "slow:agv1@2+3=0.3", "jump:agv2@4=-0.02")),
+        # a goal that comes after both reached theirs: its re-plan in the same cycle, numbered apart
+        ("swap", ("stop:agv1@5+1", "stop:agv2@5.2+1", "goal:agv2@40=B:5", "slow:agv1@45+2=0.5")),
         ("h", ("goal:agv1@8=C", "stop:agv2@2+2")),
     ],
-    ids=["new-goal", "four-faults", "faults-close-together", "graph-new-goal"],
+    ids=["new-goal", "four-faults", "faults-close-together", "goal-after-the-goals", "graph-new-goal"],
 )
 def test_no_legend_or_mark_hides_a_curve_of_simulation_png(name, specs):
     scenario, result = _run(name, specs)
@@ -170,3 +186,5 @@ def test_no_legend_or_mark_hides_a_curve_of_simulation_png(name, specs):
         assert whole.contains(box.x1, box.y1)
     for k, box in enumerate(legends):
         assert not any(box.overlaps(other) for other in legends[k + 1 :] + numbers)
+    for k, box in enumerate(numbers):  # marks close together are numbered one above the other
+        assert not any(box.overlaps(other) for other in numbers[k + 1 :]), (k, box)

@@ -200,6 +200,15 @@ def _event_lines(events: list[dict]) -> list[str]:
     return lines
 
 
+def _plan_end(plan: dict, following: dict | None) -> str:
+    """How a plan of a run with re-plans ended: left for a new goal, or driven to its goals first."""
+    if following is None:
+        return ""
+    if following["started_s"] > plan["ended_s"] + 1e-9:
+        return f" (at its goals, then a new goal at {following['started_s']:.3f} s)"
+    return " (left for a new goal)"
+
+
 def format_simulation(summary: dict, *, min_separation: float) -> str:
     """Human-readable lines of a simulation's summary (:meth:`SimulationResult.summary`).
 
@@ -213,7 +222,9 @@ def format_simulation(summary: dict, *, min_separation: float) -> str:
     reached = "yes" if summary["reached_goal"] else "no"
     lines = [
         f"reached goal: {reached}  makespan: {summary['makespan_s']:.3f} s "
-        f"(planned {summary['planned_s']:.3f} s, lost {summary['time_lost_s']:.3f} s)",
+        f"(planned {summary['planned_s']:.3f} s, lost {summary['time_lost_s']:.3f} s"
+        + (f", {summary['idle_s']:.3f} s at the goals waiting for a new one" if summary.get("idle_s") else "")
+        + ")",
         f"plan: {format_provenance(summary)}",
         f"separation: min {closest_text(summary['min_separation_m'])}, certified between cycles "
         f"{closest_text(summary['certified_separation_m'])} (required {min_separation:g} m)",
@@ -228,7 +239,7 @@ def format_simulation(summary: dict, *, min_separation: float) -> str:
         lines += [
             f"plan {k} of {len(plans)}: {plan['started_s']:.3f} to {plan['ended_s']:.3f} s, "
             f"planned {plan['planned_s']:.3f} s of its {plan['duration_s']:.3f} s, "
-            f"lost {plan['lost_s']:.3f} s" + (" (left for a new goal)" if k < len(plans) else "")
+            f"lost {plan['lost_s']:.3f} s" + _plan_end(plan, plans[k] if k < len(plans) else None)
             for k, plan in enumerate(plans, start=1)
         ]
     unapplied = set(summary.get("unapplied_faults", ()))

@@ -74,6 +74,8 @@ def _jerk_notes(verdict, ignored: bool) -> list[str]:
         ]
     if verdict.passed or ignored or not any("max_jerk" in failure for failure in verdict.failures):
         return []
+    if any("the file ends early" in failure for failure in verdict.failures):
+        return []  # its jerk at the cut is the cut's: no flag to offer
     if record is not None:  # they claim a jerk-limited schedule: no flag to offer
         return [
             f"the files record that their schedule is jerk-limited (method {record.method}): "

@@ -7,11 +7,13 @@ and is stopped by the end of a leg. Faults
 (:mod:`trajgen.execution.faults`) act here only; the executor sees their effects
 through the measurements. A stop (or the executor's emergency brake) brakes at
 the vehicle's emergency deceleration (the brake engages within a cycle); every
-other change of speed is the drive's, within its ``max_acceleration``: a drive
-released from a stop, slowed by a cap, or off its setpoint (after a jump, a
-stop) ramps; off its setpoint it closes the gap gradually, aiming for the
-setpoint's speed plus twice the gap per second, at most ``0.2 * max_velocity``
-more or less. A lagging drive replays its setpoints late, as a delay line.
+other change of speed is the drive's, within its ``max_acceleration`` and never
+beyond ``max_velocity``: a drive released from a stop, slowed by a cap, or off
+its setpoint (after a jump, a stop) ramps; off its setpoint it closes the gap
+gradually, aiming for the setpoint's speed plus twice the gap per second, at
+most ``0.2 * max_velocity`` more or less. The one exception is a lag: a lagging
+drive replays its setpoints late as a delay line, their steps included (released
+from a stop or throttled, it ramps too).
 """
 
 from __future__ import annotations
@@ -38,12 +40,13 @@ _GAIN = 2.0
 class Body:
     """One vehicle's true state in the plant."""
 
-    __slots__ = ("a", "axis", "branch", "j", "leg", "orientation", "ramping", "s", "v")
+    __slots__ = ("a", "axis", "braked", "branch", "j", "leg", "orientation", "ramping", "s", "v")
 
     def __init__(self, leg: int, s: float, orientation: int, axis: float, branch: int) -> None:
         self.leg, self.s, self.orientation, self.axis, self.branch = leg, s, orientation, axis, branch
         self.v = self.a = self.j = 0.0
         self.ramping = False  # off its setpoints: closing the gap within the limits
+        self.braked = False  # released from a brake and not yet back on its setpoints
 
     def move(self, d_axis: float, lengths: tuple[float, ...]) -> None:
         """Drive ``d_axis`` metres along the axis, through the junction onto ``branch``.
@@ -98,13 +101,14 @@ class GraphBody:
     stops it.
     """
 
-    __slots__ = ("a", "ahead", "axis", "j", "leg", "orientation", "ramping", "s", "v")
+    __slots__ = ("a", "ahead", "axis", "braked", "j", "leg", "orientation", "ramping", "s", "v")
 
     def __init__(self, edge: int, s: float, orientation: int, axis: float) -> None:
         self.leg, self.s, self.orientation, self.axis = edge, s, orientation, axis
         self.ahead = (edge, edge)
         self.v = self.a = self.j = 0.0
         self.ramping = False  # off its setpoints: closing the gap within the limits
+        self.braked = False  # released from a brake and not yet back on its setpoints
 
     def steer(self, setpoint) -> None:
         """Take the edges ``setpoint`` is on and names next, for the next node it passes."""
@@ -232,7 +236,7 @@ class Plant:
                 body.j = (a_new - body.a) / dt
                 body.a = a_new
                 body.v = math.copysign(new, body.v)
-                body.ramping = True  # released, the drive takes up its setpoints again within its limits
+                body.ramping = body.braked = True  # released, it takes up its setpoints within its limits
                 body.move(d, self.lengths)
                 continue
             lag = self._active(FaultKind.LAG, v, t)
@@ -266,10 +270,12 @@ class Plant:
                 on_track = abs(gap) <= abs(acceleration) * dt * dt + abs(jerk) * dt**3 + 1e-12
             if on_track and abs(velocity) <= cap:
                 body.j, body.a, body.v = jerk, acceleration, velocity
-                body.ramping = False
+                body.ramping = body.braked = False
                 body.move(wanted, self.lengths)
                 continue
-            self._ramp(v, body, wanted, velocity, cap, limited=lag is None)
+            # a lag replays its setpoints as they come; released from a brake or throttled, the drive ramps
+            limited = lag is None or body.braked or slow is not None
+            self._ramp(v, body, wanted, velocity, cap, limited=limited)
 
     def _ramp(
         self, v: int, body: Body | GraphBody, wanted: float, velocity: float, cap: float, *, limited: bool
@@ -277,23 +283,25 @@ class Plant:
         """The drive off its setpoint, or throttled: it closes the gap, its acceleration within its limit.
 
         The speed it aims for is the setpoint's plus twice the gap per second (at most
-        ``0.2 * max_velocity`` more or less), at most ``cap``; its speed changes toward that at most
-        ``max_acceleration`` (a drive's current limit: its acceleration steps, its jerk is not
-        limited), and it never runs past the setpoint. It is back on its setpoints (:meth:`advance`)
-        once it is within one cycle's reach of them in position and speed. A lagging drive
-        (``limited`` false) replays its late setpoints as a delay line would: its speed follows them
-        at once.
+        ``0.2 * max_velocity`` more or less), never beyond ``max_velocity`` or ``cap``; its speed
+        changes toward that at most ``max_acceleration`` (a drive's current limit: its acceleration
+        steps, its jerk is not limited), and it never runs past the setpoint: a step that would
+        ends on it, at the speed nearest the setpoint's it can reach. It is back on its setpoints
+        (:meth:`advance`) once it is within half a cycle's reach of them in position and speed.
+        Not ``limited``: a lagging drive replaying its late setpoints as a delay line takes their
+        speeds as they come.
         """
         dt = self.period
         vehicle = self.limits.vehicles[v]
         reach = vehicle.max_acceleration * dt if limited else math.inf
+        top = min(cap, vehicle.max_velocity)
         gap = wanted - velocity * dt
         correction = _CORRECTION * vehicle.max_velocity
-        aim = max(-cap, min(cap, velocity + max(-correction, min(correction, _GAIN * gap))))
+        aim = max(-top, min(top, velocity + max(-correction, min(correction, _GAIN * gap))))
         v_new = max(body.v - reach, min(body.v + reach, aim))
         step = 0.5 * (body.v + v_new) * dt
         if wanted * (wanted - step) < 0.0:  # it would pass its setpoint: it stops there
-            step, v_new = wanted, max(body.v - reach, min(body.v + reach, max(-cap, min(cap, velocity))))
+            step, v_new = wanted, max(body.v - reach, min(body.v + reach, max(-top, min(top, velocity))))
         a_new = (v_new - body.v) / dt
         body.ramping = True
         body.j = (a_new - body.a) / dt

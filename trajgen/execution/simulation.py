@@ -50,7 +50,7 @@ _AT_REST = 1e-3
 #: True track distance below the minimum separation that counts as a violation, metres (1 µm).
 _VIOLATION_TOLERANCE = 1e-6
 #: Travel short of a point that counts as having reached it, metres (the executor's positions).
-_TRAVEL_TOLERANCE = 1e-6
+_TRAVEL_TOLERANCE = 1e-9
 #: Relative tolerance on the commanded limits (Ruckig's jerk phases are exactly at the limit).
 _LIMIT_TOLERANCE = 1e-6
 
@@ -64,11 +64,13 @@ class ExecutedPlan:
     schedule : Schedule or GraphSchedule
         The plan (the first is the run's undisturbed plan; each later one was verified when it was made).
     started_s, ended_s : float
-        When the run took it up and when it left it (for a new goal) or ended, seconds of the run.
+        When the run took it up, and when both came to rest at its goals, or the run left it (for a
+        new goal) or ended, seconds of the run.
     planned_s : float
         How long the part of it the run drove takes undisturbed, seconds: the whole plan if the run
-        drove it to its end, else the plan's time at which both vehicles got as far along their
-        paths as they were when the run left it.
+        drove it to its end, or if it is the run's last (the goal the run ended at, reached or
+        not), else the plan's time at which both vehicles got as far along their paths as they
+        were when the run left it.
     travel_before : tuple of 2 float
         Each vehicle's travel along the earlier plans' paths when the run took this one up, metres
         (where its paths start on the run's travel axes).
@@ -105,7 +107,7 @@ class SimulationResult:
         duration without a re-plan; with re-plans for new goals the sum of each plan's part driven
         (:attr:`plans`), so a new goal's plan is not measured against the old goal's.
     time_lost_s : float
-        ``makespan_s - planned_s``: what faults, and stopping for new goals, cost.
+        ``makespan_s - planned_s - idle_s``: what faults, and stopping for new goals, cost.
     min_separation_m : float
         Smallest true track distance at the cycles, metres.
     certified_separation_m : float
@@ -140,6 +142,9 @@ class SimulationResult:
         after a fallback).
     plans : tuple of ExecutedPlan
         The plans the run drove, in order: the undisturbed one, then one per re-plan.
+    idle_s : float
+        Seconds both vehicles stood at their goals waiting for a new goal (a goal that came after a
+        plan was driven to its end): no plan's time, and not lost.
     """
 
     reached_goal: bool
@@ -166,6 +171,7 @@ class SimulationResult:
     unapplied_faults: tuple[Fault, ...] = ()
     method: str = "optimal"
     plans: tuple[ExecutedPlan, ...] = ()
+    idle_s: float = 0.0
 
     @property
     def violations(self) -> int:
@@ -180,6 +186,7 @@ class SimulationResult:
             "makespan_s": round(self.makespan_s, 6),
             "planned_s": round(self.planned_s, 6),
             "time_lost_s": round(self.time_lost_s, 6),
+            "idle_s": round(self.idle_s, 6),
             "min_separation_m": round(self.min_separation_m, 6),
             "certified_separation_m": round(self.certified_separation_m, 6),
             "velocity_ratio": round(self.velocity_ratio, 6),
@@ -433,6 +440,8 @@ def simulate(
     plans: list[ExecutedPlan] = []
     driving = (verified.schedule, 0.0, (0.0, 0.0), executor.axis_signs)  # plan, taken up at, travel before
     travel = (0.0, 0.0)  # along the plan's paths at the last cycle
+    arrived = None  # when both came to rest at the plan's goals, if they have
+    idle = 0.0  # seconds both stood at their goals waiting for a new one
     cycle = 0
     t = 0.0
     makespan = None
@@ -451,11 +460,15 @@ def simulate(
                 observer(executor, measured, command)
             if executor.replans > len(plans):  # left for a new goal where both stood at rest
                 schedule, started, offset, signs = driving
-                plans.append(
-                    ExecutedPlan(schedule, started, t, _time_reached(schedule, travel), offset, signs)
-                )
+                if arrived is None:
+                    part = ExecutedPlan(schedule, started, t, _time_reached(schedule, travel), offset, signs)
+                else:  # driven to its end: the wait at the goals for the new one is no plan's
+                    part = ExecutedPlan(schedule, started, arrived, schedule.duration, offset, signs)
+                    idle += t - arrived
+                plans.append(part)
                 offset = (offset[0] + travel[0], offset[1] + travel[1])
                 driving = (executor.schedule, t, offset, executor.axis_signs)
+                arrived = None
             travel = executor.travel
             for v, setpoint in enumerate(command.setpoints):
                 vehicle = limits.vehicles[v]
@@ -501,9 +514,11 @@ def simulate(
                     offset[1] + command.frontiers[1],
                 )
             )
+            at_goals = command.mode is Mode.DONE and all(abs(b.v) <= _AT_REST for b in bodies)
+            if at_goals and arrived is None:
+                arrived = t
             # both at their goals: the run ends, also before a stop or slow-down that would come later
-            done = command.mode is Mode.DONE and not pending and all(abs(b.v) <= _AT_REST for b in bodies)
-            if done:
+            if at_goals and not pending:
                 makespan = t
                 break
     except BaseException:
@@ -530,7 +545,7 @@ def simulate(
         reached_goal=reached,
         makespan_s=makespan,
         planned_s=planned,
-        time_lost_s=makespan - planned,
+        time_lost_s=makespan - planned - idle,
         min_separation_m=smallest,
         certified_separation_m=certified,
         velocity_ratio=worst[0],
@@ -551,5 +566,6 @@ def simulate(
         unapplied_faults=unapplied,
         method=asked,
         plans=tuple(plans),
+        idle_s=idle,
     )
     return result, spool

@@ -31,9 +31,28 @@ def _marks(result) -> list[tuple[float, float | None, str, str]]:
     return sorted(marks, key=lambda mark: mark[0])
 
 
-def _mark_times(axis, marks) -> None:
+#: Marks nearer than this share of the time axis are numbered one above the other.
+MARK_SPACING = 0.025
+#: Height of a row of mark numbers, points.
+MARK_ROW = 8.0
+
+
+def _mark_rows(marks, span: float) -> list[int]:
+    """The row of each mark's number: the lowest whose last number is far enough along the time axis."""
+    last: list[float] = []  # the time of each row's last number
+    rows = []
+    for time, *_ in marks:
+        row = next((k for k, before in enumerate(last) if time - before >= MARK_SPACING * span), len(last))
+        if row == len(last):
+            last.append(time)
+        last[row] = time
+        rows.append(row)
+    return rows
+
+
+def _mark_times(axis, marks, rows: list[int]) -> None:
     """Each mark as a shaded span or a dotted line, numbered just above the panel (outside its data)."""
-    for number, (time, duration, _, colour) in enumerate(marks, start=1):
+    for number, ((time, duration, _, colour), row) in enumerate(zip(marks, rows, strict=True), start=1):
         if duration is not None:
             axis.axvspan(time, time + duration, color=colour, alpha=0.2, linewidth=0)
         else:
@@ -42,7 +61,7 @@ def _mark_times(axis, marks) -> None:
             str(number),
             (time, 1.0),
             xycoords=axis.get_xaxis_transform(),
-            xytext=(0, 1.5),  # just above the frame: over no data
+            xytext=(0, 1.5 + MARK_ROW * row),  # just above the frame: over no data
             textcoords="offset points",
             ha="center",
             va="bottom",
@@ -60,7 +79,7 @@ def _mark_key(marks) -> list:
     ]
 
 
-def _progress(axis, result, names) -> None:
+def _progress(axis, result, names, *, pad: float) -> None:
     """Each vehicle's travel along its path over time, and its frontier (dashed) where one binds it."""
     t = np.asarray(result.plot["t"])
     for vehicle in range(2):
@@ -77,7 +96,7 @@ def _progress(axis, result, names) -> None:
     axis.set_title(
         "progress and frontiers (dotted: the farthest a vehicle may come to rest; | it waits there)",
         fontsize=9,
-        pad=12,
+        pad=pad,
     )
     axis.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=7)
 
@@ -236,11 +255,13 @@ def plot_simulation(result, *, names: tuple[str, str], min_separation: float, fi
     separation_axis.set_ylabel("separation [m]")
     separation_axis.set_xlabel("t [s]")
     separation_axis.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=7)
-    _progress(progress_axis, result, names)
-    _coordination(coordination_axis, result, names, min_separation)
     marks = _marks(result)
+    rows = _mark_rows(marks, max(float(t[-1] - t[0]), 1e-9) if t.size else 1.0)
+    above = MARK_ROW * max(rows, default=0)  # the titles stand above the rows of numbers
+    _progress(progress_axis, result, names, pad=12 + above)
+    _coordination(coordination_axis, result, names, min_separation)
     for axis in (speed_axis, separation_axis, progress_axis):
-        _mark_times(axis, marks)
+        _mark_times(axis, marks, rows)
         axis.grid(True, alpha=0.3)
     handles, _ = speed_axis.get_legend_handles_labels()
     speed_axis.legend(
@@ -252,6 +273,6 @@ def plot_simulation(result, *, names: tuple[str, str], min_separation: float, fi
         f"simulation: {outcome} at {result.makespan_s:.2f} s (planned {result.planned_s:.2f} s), "
         f"{result.violations} violations\n(dashed: the plans; grey: faults, numbered as in the legend)",
         fontsize=10,
-        pad=12,
+        pad=12 + above,
     )
     return finished(area, laid_out=figure is None)

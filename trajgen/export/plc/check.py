@@ -271,16 +271,19 @@ def _generic_columns(
                 f"{name} velocity column {columns['v'][k]:.9g} m/s at t={table.times[k]:.6f} s disagrees "
                 f"with its positions ({central[k - 1]:.9g} m/s between its neighbours)"
             )
-    stated = [("velocity", "v", limits.max_velocity), ("acceleration", "a", limits.max_acceleration)]
+    stated = [
+        ("velocity", "v", limits.max_velocity, "m/s"),
+        ("acceleration", "a", limits.max_acceleration, "m/s^2"),
+    ]
     if jerk:
-        stated.append(("jerk", "j", limits.max_jerk))
-    for quantity, column, limit in stated:
+        stated.append(("jerk", "j", limits.max_jerk, "m/s^3"))
+    for quantity, column, limit, unit in stated:
         peak = np.abs(columns[column])
         k = int(np.argmax(peak))
         if peak[k] > limit * (1.0 + 1e-6) + 1e-9:
             failures.append(
-                f"{name} {quantity} column reaches {peak[k]:.9g} at t={table.times[k]:.6f} s, exceeds its "
-                f"max_{quantity} {limit:g}"
+                f"{name} {quantity} column reaches {peak[k]:.9g} {unit} at t={table.times[k]:.6f} s, "
+                f"exceeds its max_{quantity} {limit:g} {unit}"
             )
     return failures
 

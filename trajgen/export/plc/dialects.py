@@ -380,6 +380,11 @@ class GenericDialect(Dialect):
         for n, row in enumerate(rows):
             fields = row.split(delimiter)
             if len(fields) != len(names):
+                if n == len(rows) - 1 and len(fields) < len(names) and not data.endswith(b"\n"):
+                    raise ProfileFileError(
+                        f"{source}: the file ends early: its last line (line {n + first + 1}) is cut short, "
+                        f"{len(fields)} of {len(names)} fields and no line end ({short_repr(row)})"
+                    )
                 raise ProfileFileError(
                     f"{source} line {n + first + 1}: {len(fields)} field(s) separated by {delimiter!r}, "
                     f"expected {len(names)} ({short_repr(row)})"

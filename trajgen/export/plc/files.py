@@ -155,11 +155,17 @@ def plc_tables(
         if needed <= 1.0 + 1e-9 and above <= 1.0:
             break
         scale = resampled.time_scale * max(needed, above) * (1.0 + 1e-6)
+    if above > 1.0:  # never written: a number above its limit, however little
+        raise VerificationError(
+            f"the {dialect.name.value} tables write a velocity {above:.12g} times its limit after "
+            f"{SCALE_ATTEMPTS} slower resamplings: expected at most the limit"
+        )
     check = check_tables(parsed, schedule.route, schedule.limits, jerk=schedule.jerk_limited)
     if not check.passed:
         raise VerificationError(
             f"the {dialect.name.value} tables ({points} points) fail as their controllers interpolate "
-            f"them: {'; '.join(check.failures[:3])} (more points may help: max_points=... or --max-points)"
+            f"them: {'; '.join(check.failures[:3])} (more points may help: max_points=... or --max-points)",
+            details=check.report.details,
         )
     logger.info(
         "%s tables: %s points, position error %.3g m, verified",
