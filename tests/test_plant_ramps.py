@@ -80,12 +80,12 @@ def test_the_plant_changes_speed_at_most_at_its_limit_and_brakes_only_in_a_stop(
     ("specs", "window"),
     [
         (("lag:agv1@0.5=100", "stop:agv1@{1}+2"), (2.0, 4.0)),  # from its release on
-        (("lag:agv1@0.5=150", "slow:agv1@{1}+3=0.3"), (0.0, 3.0)),  # while it is throttled
+        (("lag:agv1@0.5=180", "stop:agv1@{1}+1"), (1.0, 3.0)),
     ],
-    ids=["released-from-a-stop", "throttled"],
+    ids=["lag-100-ms", "lag-180-ms"],
 )
-def test_a_lagging_drive_released_from_a_stop_or_throttled_ramps_too(specs, window):
-    """A lag replays late setpoints as they come (a delay line); a brake's release or a cap still ramps."""
+def test_a_lagging_drive_released_from_a_stop_ramps_too(specs, window):
+    """A lag replays late setpoints as they come (a delay line); released from a brake it still ramps."""
     scenario, verified = _plan("swap")
     at_speed = _at_speed(verified.schedule)
     faults = parse_faults(scenario, [spec.format(None, *at_speed) for spec in specs])
@@ -102,3 +102,25 @@ def test_a_lagging_drive_released_from_a_stop_or_throttled_ramps_too(specs, wind
     changes = np.abs(np.diff(speeds[start : round((float(at_speed[0]) + window[1]) / PERIOD)])) / PERIOD
     assert changes.max() <= scenario.limits.vehicles[0].max_acceleration * (1 + 1e-6)
     assert np.ptp(speeds[start : start + round(1.0 / PERIOD)]) > 0.1  # it did change speed there
+
+
+def test_a_throttled_lagging_drive_is_a_delay_line_and_reaches_its_goal():
+    """Campaign seed 11, scenario 40: a lag of 165 ms and a cap.
+
+    Held to the ramp while throttled, the lagging drive ran 0.09 m off its path at a reversal and
+    the executor braked for good (43,364 cycles; the default method falls back to exact there).
+    """
+    from trajgen.execution.goals import execution_margin
+    from trajgen.scenario.sampling import campaign_faults, online_campaign
+
+    scenario = online_campaign(41, seed=11)[40]
+    verified = schedule_for_execution(scenario, method="exact")
+    specs = campaign_faults(
+        scenario, verified.schedule.duration, seed=1040, margin=execution_margin(scenario, 0.05)
+    )
+    assert any(spec.startswith("lag:") for spec in specs)
+    assert any(spec.startswith("slow:") for spec in specs)
+    result, _ = simulate(scenario, parse_faults(scenario, specs), verified=verified)
+    assert result.reached_goal
+    assert result.emergency_brakes == 0
+    assert result.violations == 0

@@ -13,7 +13,7 @@ its setpoint (after a jump, a stop) ramps; off its setpoint it closes the gap
 gradually, aiming for the setpoint's speed plus twice the gap per second, at
 most ``0.2 * max_velocity`` more or less. The one exception is a lag: a lagging
 drive replays its setpoints late as a delay line, their steps included (released
-from a stop or throttled, it ramps too).
+from a stop, it ramps too).
 """
 
 from __future__ import annotations
@@ -273,8 +273,8 @@ class Plant:
                 body.ramping = body.braked = False
                 body.move(wanted, self.lengths)
                 continue
-            # a lag replays its setpoints as they come; released from a brake or throttled, the drive ramps
-            limited = lag is None or body.braked or slow is not None
+            # a lag replays its setpoints as they come; released from a brake, the drive ramps
+            limited = lag is None or body.braked
             self._ramp(v, body, wanted, velocity, cap, limited=limited)
 
     def _ramp(
