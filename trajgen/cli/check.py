@@ -4,10 +4,9 @@ from __future__ import annotations
 
 import argparse
 import json
-import sys
 
 from trajgen.cli.options import add_dialect_options, scenario_from
-from trajgen.cli.parser import EXIT_FAILURE, EXIT_OK
+from trajgen.cli.parser import EXIT_FAILURE, EXIT_OK, print_details
 from trajgen.model.summary import closest_text
 
 __all__ = ["SHOWN_FAILURES", "register"]
@@ -43,8 +42,7 @@ def _command_check(args: argparse.Namespace) -> int:
             print(f"note: {note}")
         if not verdict.passed:
             if getattr(args, "verbose", False):  # where each failure lies in the tables' arrays
-                for detail in verdict.check.report.details:
-                    print(f"trajgen: detail: {detail}", file=sys.stderr)
+                print_details(verdict.check.report.details)
             print("FAIL")
         elif verdict.jerk_checked:
             print("PASS: the files keep the separation and the limits")

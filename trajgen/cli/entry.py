@@ -19,7 +19,7 @@ import os
 import sys
 from collections.abc import Sequence
 
-from trajgen.cli.parser import EXIT_BAD_INPUT, EXIT_FAILURE, CommandParser
+from trajgen.cli.parser import EXIT_BAD_INPUT, EXIT_FAILURE, CommandParser, print_details
 from trajgen.errors import InputError, LiveError, VerificationError
 
 __all__ = ["COMMANDS", "Commands", "LogFormatter", "build_parser", "command_parsers", "console_main", "main"]
@@ -201,8 +201,7 @@ def console_main() -> int:
 def _details(error: Exception, verbose: bool) -> None:
     """With ``--verbose``, where each failure of a failed verification lies in the schedule's arrays."""
     if verbose and isinstance(error, VerificationError):
-        for detail in error.details:
-            print(f"trajgen: detail: {detail}", file=sys.stderr)
+        print_details(error.details)
 
 
 def main(argv: Sequence[str] | None = None) -> int:

@@ -3,10 +3,12 @@
 from __future__ import annotations
 
 import argparse
+import sys
+from collections.abc import Iterable
 
 from trajgen.errors import InputError
 
-__all__ = ["EXIT_BAD_INPUT", "EXIT_FAILURE", "EXIT_OK", "CommandParser"]
+__all__ = ["EXIT_BAD_INPUT", "EXIT_FAILURE", "EXIT_OK", "CommandParser", "print_details"]
 
 EXIT_OK = 0
 EXIT_FAILURE = 1
@@ -19,3 +21,9 @@ class CommandParser(argparse.ArgumentParser):
     def error(self, message: str):
         """Raise InputError with the usage message (argparse would exit)."""
         raise InputError(f"{self.prog}: {message}")
+
+
+def print_details(details: Iterable[str]) -> None:
+    """Print where each failure of a failed verification lies in the arrays (``--verbose``), to stderr."""
+    for detail in details:
+        print(f"trajgen: detail: {detail}", file=sys.stderr)
