@@ -115,7 +115,7 @@ SLOW_LEGS = {
 
 
 def pytest_configure(config) -> None:
-    """Give the run its own store of compiled NLPs (in the process that starts the others).
+    """Give the run its own store of compiled NLPs and vehicle places (in the process that starts the others).
 
     The optimal method keeps the NLPs it builds in a disk store (``$TRAJGEN_CACHE_DIR``, else the
     user's cache folder). The run points it at a new temporary folder, which every worker and
@@ -129,6 +129,8 @@ def pytest_configure(config) -> None:
     store = tempfile.TemporaryDirectory(prefix="trajgen-test-nlp-")
     config._trajgen_store = store  # kept alive until pytest_unconfigure
     os.environ["TRAJGEN_CACHE_DIR"] = store.name
+    # the vehicles' remembered places (trajgen.live.memory) too: nothing of the user's home is read
+    os.environ["TRAJGEN_STATE_DIR"] = os.path.join(store.name, "state")
 
 
 def pytest_unconfigure(config) -> None:

@@ -127,6 +127,36 @@ def test_the_claims_gap_equals_the_least_track_distance_between_sampled_points()
         assert gap >= sampled - slack - 1e-9
 
 
+def test_the_claims_gap_is_the_track_graphs_own_distance_at_the_corners_to_the_bit():
+    """The release rule's gaps in plain floats are the track's own distances at the stretches' ends.
+
+    Issue 48: readying a plan (off the master's lock) measures its gaps in plain floats; they are
+    bit for bit what :meth:`TrackGraph.distances` gives, on seeded random graphs.
+    """
+    import random
+
+    from trajgen.scenario.graph_sampling import random_graph_track
+
+    rng = np.random.default_rng(11)
+    for seed in range(20):
+        track = random_graph_track(random.Random(seed), junctions=1 + seed % 4, loops=seed % 3)
+        path = GraphOrderPath(track, (), ())
+        lengths = [edge.length for edge in track.edges]
+        for _ in range(50):
+            claims = []
+            for _ in range(2):
+                edge = int(rng.integers(len(lengths)))
+                low, high = np.sort(rng.uniform(0.0, lengths[edge], 2))
+                claims.append(((edge, float(low), float(high)),))
+            (ea, la, ha), (eb, lb, hb) = claims[0][0], claims[1][0]
+            if ea == eb and la <= hb and lb <= ha:
+                assert path.gap(*claims) == 0.0
+                continue
+            corners = [(sa, sb) for sa in (la, ha) for sb in (lb, hb)]
+            expected = track.distances([ea] * 4, [c[0] for c in corners], [eb] * 4, [c[1] for c in corners])
+            assert path.gap(*claims) == float(expected.min())
+
+
 @pytest.mark.parametrize("method", ["exact", "toppra", pytest.param("optimal", marks=pytest.mark.slow)])
 @pytest.mark.parametrize("name", FEASIBLE)
 def test_the_releases_keep_the_separation_whatever_the_timing_and_never_deadlock(name, method):

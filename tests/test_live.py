@@ -215,9 +215,13 @@ def connection_message(identity: VehicleIdentity, state: str) -> bytes:
 
 
 class FakeVehicles:
-    """A client that publishes states for both vehicles and reads the orders the master sends."""
+    """A client that publishes states for both vehicles and reads the orders the master sends.
 
-    def __init__(self, url: str, ids) -> None:
+    :meth:`stand` says where each stands (its scenario start, no order): the master sends its first
+    orders once every vehicle stands where the plan starts it.
+    """
+
+    def __init__(self, url: str, ids, *, online=(0, 1)) -> None:
         self.ids = ids
         self.orders: list[dict] = []
         self.header = 100
@@ -227,10 +231,26 @@ class FakeVehicles:
         settings = BrokerSettings.from_url(url)
         self._client.connect(settings.host, settings.port)
         self._client.loop_start()
-        for v in (0, 1):  # there, as a vehicle says (retained): the master sends its first orders
+        for v in online:  # there, as a vehicle says (retained)
             self._client.publish(
                 ids[v].topic(Topic.CONNECTION), connection_message(ids[v], "ONLINE"), qos=1, retain=True
             ).wait_for_publish(2.0)
+
+    def stand(self, scenario, master, places=None, *, only=(0, 1)) -> None:
+        """A state of each vehicle (``only`` those) standing at ``places`` (default: its scenario start).
+
+        No order: as a vehicle says where it is before the run; sent once ``master`` listens.
+        """
+        assert _until(lambda: master.link.connected, 5.0)
+        time.sleep(0.1)  # its subscriptions are in place
+        starts = places if places is not None else (scenario.start.first, scenario.start.second)
+        for v, place in enumerate(starts):
+            if v not in only:
+                continue
+            x, y = position_xy(scenario.track, place)
+            order = {"orderId": "", "orderUpdateId": 0, "nodes": [{"nodeId": "", "sequenceId": 0}]}
+            position = {"positionInitialized": True, "x": x, "y": y, "theta": 0.0, "mapId": "trajgen"}
+            self.publish(v, self.state(v, order, 0, agvPosition=position))
 
     def publish(self, v: int, payload: bytes, topic: str | None = None) -> None:
         self._client.publish(topic or self.ids[v].topic(Topic.STATE), payload).wait_for_publish(2.0)
@@ -278,9 +298,10 @@ def _master_and_fakes(scenario, verified, **options):
     with new_broker() as broker:
         fake = FakeVehicles(broker.url, ids)
         master = LiveMaster(
-            verified, scenario.names, identities=ids, broker=BrokerSettings.from_url(broker.url), **options
+            scenario, plan=verified, identities=ids, broker=BrokerSettings.from_url(broker.url), **options
         )
         master.start()
+        fake.stand(scenario, master)
         try:
             yield master, fake
         finally:
@@ -298,40 +319,56 @@ def _releasing_vehicle(verified, spacing: float) -> int:
     raise AssertionError("no first arrival releases anything")
 
 
+#: States the master cannot trust (logged and ignored) or that put their vehicle off its plan (every
+#: release held until a state puts it back): the kind, the state, the event it makes.
 UNTRUSTED = {
-    "malformed": lambda fake, v, order, node: b'{"headerId": "not a number"',
-    "foreign-manufacturer": lambda fake, v, order, node: fake.state(v, order, node, manufacturer="acme"),
-    "out-of-order": lambda fake, v, order, node: fake.state(v, order, node, header=1),
-    "not-its-node": lambda fake, v, order, node: fake.state(v, order, node, lastNodeId="B:7.25"),
-    "odd-sequence-id": lambda fake, v, order, node: fake.state(
-        v, order, node, lastNodeSequenceId=order["nodes"][node]["sequenceId"] + 1
+    "malformed": (lambda fake, v, order, node: b'{"headerId": "not a number"', "ignored"),
+    "foreign-manufacturer": (
+        lambda fake, v, order, node: fake.state(v, order, node, manufacturer="acme"),
+        "ignored",
+    ),
+    "out-of-order": (lambda fake, v, order, node: fake.state(v, order, node, header=1), "ignored"),
+    "not-its-node": (
+        lambda fake, v, order, node: fake.state(v, order, node, lastNodeId="B:7.25"),
+        "off-plan",
+    ),
+    "odd-sequence-id": (
+        lambda fake, v, order, node: fake.state(
+            v, order, node, lastNodeSequenceId=order["nodes"][node]["sequenceId"] + 1
+        ),
+        "off-plan",
     ),
 }
 
 
 @pytest.mark.parametrize("kind", list(UNTRUSTED), ids=list(UNTRUSTED))
-def test_an_untrusted_state_is_logged_and_ignored_and_releases_nothing(kind):
+def test_an_untrusted_or_off_plan_state_is_logged_and_releases_nothing(kind):
     scenario, verified = execution_plan("swap", "exact")
+    state, event = UNTRUSTED[kind]
     with _master_and_fakes(scenario, verified) as (master, fake):
-        _until(lambda: len(fake.orders) >= 2, 5.0)
+        assert _until(lambda: {o["serialNumber"] for o in fake.orders} == set(scenario.names), 5.0)
         v = _releasing_vehicle(verified, master.spacing)
-        first = next(o for o in fake.orders if o["serialNumber"] == scenario.names[v])
+        orders = {o["serialNumber"]: o for o in fake.orders}
+        first = orders[scenario.names[v]]
+        fake.publish(1 - v, fake.state(1 - v, orders[scenario.names[1 - v]], 0))  # the other took its order
+        assert _until(lambda: any(r["event"] == "state" for r in master.log.records()), 5.0)
         sent = len(fake.orders)
         node = _last_base(first)  # at its decision point: that releases base
         before = len(list(master.log.records()))
         # on one connection, so the master takes them in this order (and logs each as it takes it)
         fake.publish(v, fake.state(v, first, 0))  # genuine, at its start: releases nothing
-        fake.publish(v, UNTRUSTED[kind](fake, v, first, node))
+        fake.publish(v, state(fake, v, first, node))
         fake.publish(v, fake.state(v, first, node))  # the genuine report does release
         assert _until(lambda: len(fake.orders) > sent, 5.0)
-        assert master.result().ignored == 1
+        assert master.result().ignored == (event == "ignored")
         records = list(master.log.records())[before:]
     # nothing released before the genuine report at the decision point: not on the untrusted one's account
-    assert [r["event"] for r in records[:4]] == ["state", "ignored", "state", "order"]
+    expected = ["state", event, "state", "order"] if event == "ignored" else ["state", event, "on-plan"]
+    assert [r["event"] for r in records[: len(expected)]] == expected
     assert [r["node"] for r in records if r["event"] == "state"][:2] == [0, node]
-    ignored = [r for r in master.log.records() if r["event"] == "ignored"]
-    assert len(ignored) == 1
-    assert ignored[0]["vehicle"] == scenario.names[v]
+    said = [r for r in master.log.records() if r["event"] == event]
+    assert len(said) == 1
+    assert said[0]["vehicle"] == scenario.names[v]
 
 
 def test_a_state_on_a_topic_of_no_vehicle_of_the_run_never_reaches_the_master():
@@ -381,13 +418,14 @@ def test_the_vehicle_ignores_a_duplicate_order_and_refuses_an_update_that_does_n
         fake = FakeVehicles(broker.url, ids)
         clock = RunClock(FAST["time_scale"])
         vehicle = _first_vehicle(scenario, ids, settings, clock)
-        master = LiveMaster(verified, scenario.names, identities=ids, broker=settings, clock=clock)
+        master = LiveMaster(scenario, plan=verified, identities=ids, broker=settings, clock=clock)
         try:
             states = []
             watcher = _watcher(
                 settings, ids[0].topic(Topic.STATE), lambda m: states.append(json.loads(m.payload))
             )
             master.start()
+            fake.stand(scenario, master, only=(1,))  # agv1 is a simulated vehicle: it says where it stands
             assert _until(lambda: any(o["serialNumber"] == "agv1" for o in fake.orders))
             sent = next(o for o in fake.orders if o["serialNumber"] == "agv1")
             assert _until(lambda: states and states[-1]["orderId"] == sent["orderId"])
@@ -441,15 +479,13 @@ def test_a_vehicle_reports_at_once_when_it_comes_to_rest_and_says_its_last_state
             f"{ids[0].topic(Topic.STATE)[:-5]}#",
             lambda m: heard.append((clock.now(), m.topic.rsplit("/", 1)[1], json.loads(m.payload))),
         )
-        # the other vehicle is there (it never drives): the master sends the first orders
-        watcher.publish(
-            ids[1].topic(Topic.CONNECTION), connection_message(ids[1], "ONLINE"), qos=1, retain=True
-        )
         # a state every 10 s of the run at most: any state sooner after stopping is the event's
         vehicle = _first_vehicle(scenario, ids, settings, clock, state_rate=0.1, observer=observe)
-        master = LiveMaster(verified, scenario.names, identities=ids, broker=settings, clock=clock)
+        master = LiveMaster(scenario, plan=verified, identities=ids, broker=settings, clock=clock)
+        other = FakeVehicles(broker.url, ids, online=(1,))
         try:
             master.start()
+            other.stand(scenario, master, only=(1,))  # it never drives: the master sends the first orders
             assert _until(lambda: rest and clock.now() > rest[0] + 2.0)
             # issue 35, item 10: ONLINE comes first, then its states
             assert heard[0][1] == "connection"
@@ -468,6 +504,7 @@ def test_a_vehicle_reports_at_once_when_it_comes_to_rest_and_says_its_last_state
         finally:
             master.stop()
             vehicle.stop()
+            other.close()
             watcher.disconnect()
             watcher.loop_stop()
 
@@ -563,9 +600,10 @@ def _failing_solve(*_arguments, **_options):
     return SolveResult(None, (SolverAttempt(Solver.FATROP, Outcome.NOT_CONVERGED, 1, "made to fail"),))
 
 
-def test_serve_with_no_broker_retries_says_so_once_and_commits_its_log_without_a_picture(tmp_path, capsys):
-    # issue 35, items 1 and 5: the first connection is retried until --timeout, said once; the log
-    # and the summary are committed, the picture (nothing to draw) skipped with a warning; exit 1
+def test_serve_with_no_broker_retries_says_so_once_and_commits_its_log_and_picture(tmp_path, capsys):
+    # issue 35, items 1 and 5: the first connection is retried until --timeout, said once (on the
+    # timeline, issue 48 item 4); the log and the summary are committed, and a picture saying no
+    # vehicle sent a state (issue 48 item 6); exit 1
     status = main(
         [
             "serve",
@@ -584,29 +622,31 @@ def test_serve_with_no_broker_retries_says_so_once_and_commits_its_log_without_a
     )
     captured = capsys.readouterr()
     assert status == 1
-    assert captured.err.count("cannot reach mqtt://127.0.0.1:1: connection refused; retrying") == 1
+    said = "broker: cannot reach mqtt://127.0.0.1:1: connection refused; retrying"
+    assert captured.out.count(said) == 1
+    assert "cannot reach" not in captured.err  # said once: on the timeline, not again on stderr
     assert "trajgen: error: master: the broker mqtt://127.0.0.1:1 was never reached" in captured.err
-    assert "picture of the run" in captured.err
-    assert "is not drawn" in captured.err
     assert "internal failure" not in captured.err
     assert "live run: timed-out before any order was sent" in captured.out
     records = [json.loads(line) for line in (tmp_path / "run.jsonl").read_text().splitlines()]
     assert records[-1]["event"] == "end"
     assert "never reached" in records[-1]["error"]
-    assert not (tmp_path / "run.png").exists()
+    assert (tmp_path / "run.png").read_bytes().startswith(b"\x89PNG")
+    assert not (tmp_path / "run.jsonl.partial").exists()  # committed: the partial log is gone
 
 
-def test_serve_timeout_counts_after_planning_and_names_vehicles_never_heard(tmp_path, capsys, monkeypatch):
-    # issue 35, item 9: planning (here 1.5 s) is not the run's; a broker with no vehicle on it is said
-    import trajgen.live.session as session
+def test_serve_timeout_counts_from_its_start_and_names_vehicles_never_heard(tmp_path, capsys, monkeypatch):
+    # issue 48, item 4: serve connects while it plans (here 1.5 s), so --timeout counts from its
+    # start; a broker with no vehicle on it is said (issue 35, item 9)
+    import trajgen.live.coordinator as coordinator
 
-    planned = session.live_plan
+    planned = coordinator.schedule_for_execution
 
     def slow_plan(scenario, *, method=None):
         time.sleep(1.5)
         return planned(scenario, method=method)
 
-    monkeypatch.setattr(session, "live_plan", slow_plan)
+    monkeypatch.setattr(coordinator, "schedule_for_execution", slow_plan)
     with new_broker() as broker:
         began = time.monotonic()
         scenario, log = str(REPO / "examples" / "swap.toml"), str(tmp_path / "run.jsonl")
@@ -616,7 +656,7 @@ def test_serve_timeout_counts_after_planning_and_names_vehicles_never_heard(tmp_
     captured = capsys.readouterr()
     summary = json.loads(captured.out)
     assert status == 1
-    assert seconds >= 1.5 + 2.0  # the whole --timeout after planning
+    assert 2.0 <= seconds < 1.5 + 2.0  # --timeout from the start: planning is part of it
     assert summary["planning_s"] >= 1.5
     assert summary["outcome"] == "timed-out"
     assert summary["orders"] == 0
@@ -639,7 +679,7 @@ def test_serve_timeout_counts_after_planning_and_names_vehicles_never_heard(tmp_
         ),
         pytest.param(lambda: RunClock(1000.0), "time scale 1000.0 is out of range", id="time-scale"),
         pytest.param(lambda: StopFault.parse("halt@3"), "vehicle fault 'halt@3' cannot be read", id="fault"),
-        pytest.param(lambda: identities(("agv1", "agv1")), "expected two different ones", id="same-serials"),
+        pytest.param(lambda: identities(("agv1", "agv1")), "expected 2 different ones", id="same-serials"),
         pytest.param(lambda: VehicleIdentity("a/b", "agv1"), "not an MQTT topic level", id="slash-in-level"),
     ],
 )
@@ -762,7 +802,8 @@ def test_a_refusal_that_stands_ends_the_run_as_order_not_taken_naming_the_vehicl
     assert run.outcome is LiveOutcome.ORDER_NOT_TAKEN
     assert 1.5 <= ended < 4.0  # after the time given, not at the run's time limit
     assert run.error.startswith(f"master: {name} has not taken its order in 1.5 s of re-sends")
-    assert f"it reports no order; orderError: {REFUSAL}" in run.error
+    assert f"it reports no order): it says orderError: {REFUSAL}" in run.error
+    assert "ACL" not in run.error  # the vehicle gave its reason: no guess besides it
     end = list(master.log.records())[-1]
     assert (end["event"], end["outcome"], end["error"]) == ("end", "order-not-taken", run.error)
 
@@ -800,7 +841,8 @@ def test_a_retained_online_of_an_earlier_run_sends_no_second_order():
         earlier.disconnect()
         earlier.loop_stop()
         fake = FakeVehicles(broker.url, ids)
-        master = LiveMaster(verified, scenario.names, identities=ids, broker=settings).start()
+        master = LiveMaster(scenario, plan=verified, identities=ids, broker=settings).start()
+        fake.stand(scenario, master)
         try:
             assert _until(lambda: len(fake.orders) >= 2, 5.0)
             time.sleep(1.0)  # time for a redundant order, if one were sent
@@ -838,3 +880,36 @@ def test_nothing_is_released_to_a_vehicle_back_online_before_its_first_state_say
         fake.publish(other, fake.state(other, theirs, 0, headerId=1))  # it did (its headers count afresh)
         assert _until(lambda: len(fake.orders) > sent, 5.0)
     assert master.result().ignored == 0
+
+
+def test_a_vehicle_that_loses_its_order_without_going_offline_is_re_planned_from_where_it_stands():
+    """A vehicle that suddenly holds no order is planned again from where it says it stands.
+
+    Issue 48, item 1: what a vehicle reports is the truth; a restart faster than the broker saw it go
+    leaves no OFFLINE to go by, only a state without the order; the other vehicle is held meanwhile.
+    """
+    scenario, verified = execution_plan("swap", "exact")
+    with _master_and_fakes(scenario, verified) as (master, fake):
+        assert _until(lambda: {o["serialNumber"] for o in fake.orders} == set(scenario.names), 5.0)
+        orders = {o["serialNumber"]: o for o in fake.orders}
+        mine, theirs = orders[scenario.names[0]], orders[scenario.names[1]]
+        fake.publish(1, fake.state(1, theirs, _last_base(theirs)))  # at its decision point, at rest
+        fake.publish(0, fake.state(0, mine, 0))  # agv1 took its order
+        x, y = position_xy(scenario.track, scenario.start.first)
+        position = {"positionInitialized": True, "x": x, "y": y, "theta": 0.0, "mapId": "trajgen"}
+        nothing = {"orderId": "", "orderUpdateId": 0, "nodes": [{"nodeId": "", "sequenceId": 0}]}
+        fake.publish(0, fake.state(0, nothing, 0, agvPosition=position))  # and then holds none
+        assert _until(lambda: any(r["event"] == "restart" for r in master.log.records()), 5.0)
+        sent = len(fake.orders)
+        latest = _orders_of(fake, scenario.names[1])[-1]  # agv1's order may have released more to agv2
+        fake.publish(1, fake.state(1, latest, _last_base(latest)))  # agv2 stands at its decision point
+        assert _until(lambda: any(r["event"] == "replan" for r in master.log.records()), 10.0)
+        assert _until(lambda: len(fake.orders) >= sent + 2, 5.0)
+        theirs = latest
+    events = [r["event"] for r in master.log.records()]
+    assert events.index("restart") < events.index("replan")
+    restart = next(r for r in master.log.records() if r["event"] == "restart")
+    assert (restart["vehicle"], restart["at"]) == (scenario.names[0], str(scenario.start.first))
+    new = {o["serialNumber"]: o for o in fake.orders[sent:]}
+    assert new[scenario.names[0]]["nodes"][0]["sequenceId"] == 0  # a new order, numbered afresh
+    assert new[scenario.names[1]]["nodes"][0]["nodeId"] == theirs["nodes"][_last_base(theirs)]["nodeId"]

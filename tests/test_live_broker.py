@@ -22,7 +22,8 @@ from logging import WARNING
 import paho.mqtt.client as mqtt
 import pytest
 
-import trajgen.live.broker as broker_module
+import trajgen.live.broker_base as broker_base
+import trajgen.live.mosquitto as mosquitto_module
 from tests.conftest import REPO
 from trajgen.errors import InputError, LiveError
 from trajgen.live.broker import (
@@ -242,7 +243,7 @@ def test_two_brokers_get_ports_of_their_own(broker, broker_class, peers):
 
 
 def test_a_taken_port_is_a_live_error_naming_it(broker_class, monkeypatch):
-    monkeypatch.setattr(broker_module, "REBIND_TIMEOUT_S", 0.2)  # how long it waits is not the point here
+    monkeypatch.setattr(broker_base, "REBIND_TIMEOUT_S", 0.2)  # how long it waits is not the point here
     with socket.socket() as taken:
         taken.bind(("127.0.0.1", 0))
         taken.listen()
@@ -267,10 +268,10 @@ def test_mosquitto_is_found_in_sbin_when_the_path_lacks_it(monkeypatch, tmp_path
     fake.write_text("#!/bin/sh\n", encoding="utf-8")
     fake.chmod(0o755)
     monkeypatch.setenv("PATH", "/nonexistent")
-    monkeypatch.setattr(broker_module, "MOSQUITTO_FOLDERS", (str(tmp_path),))
+    monkeypatch.setattr(mosquitto_module, "MOSQUITTO_FOLDERS", (str(tmp_path),))
     assert MosquittoBroker.executable() == str(fake)
     assert mosquitto_available()
-    monkeypatch.setattr(broker_module, "MOSQUITTO_FOLDERS", ())
+    monkeypatch.setattr(mosquitto_module, "MOSQUITTO_FOLDERS", ())
     assert MosquittoBroker.executable() is None
     assert not mosquitto_available()
 

@@ -288,7 +288,7 @@ def test_a_live_goal_too_close_is_refused_naming_the_separation_the_plan_keeps()
 
     ids = (VehicleIdentity("unspecified", "agv1"), VehicleIdentity("unspecified", "agv2"))
     master = LiveMaster(
-        verified, scenario.names, identities=ids, broker=BrokerSettings.from_url("mqtt://127.0.0.1:1")
+        scenario, plan=verified, identities=ids, broker=BrokerSettings.from_url("mqtt://127.0.0.1:1")
     )
     with pytest.raises(
         InputError,

@@ -119,7 +119,7 @@ def test_any_start_order_of_broker_master_and_vehicles_completes_the_run(order):
         )
         for v in (0, 1)
     ]
-    master = LiveMaster(verified, scenario.names, identities=ids, broker=settings, clock=clock)
+    master = LiveMaster(scenario, plan=verified, identities=ids, broker=settings, clock=clock)
     start = {
         "broker": broker.start,
         "master": master.start,

@@ -241,7 +241,7 @@ def test_an_acl_that_forbids_the_masters_orders_is_reported_within_seconds_namin
         for v in (0, 1)
     ]
     master = LiveMaster(
-        verified, scenario.names, identities=ids, broker=login("master"), clock=clock, give_up_after=6.0
+        scenario, plan=verified, identities=ids, broker=login("master"), clock=clock, give_up_after=6.0
     )
     began = time.monotonic()
     master.start()
@@ -268,3 +268,27 @@ def test_an_acl_that_forbids_the_masters_orders_is_reported_within_seconds_namin
     assert re.match(
         r"master: agv[12] has not taken its order in 6 s of re-sends \(it reports no order\)", run.error
     )
+
+
+def test_a_refused_login_is_said_while_the_plan_is_still_being_made(
+    login_broker, tmp_path, capsys, monkeypatch
+):
+    """Issue 48, item 4: serve connects and plans at once; a wrong password does not wait for the plan."""
+    import trajgen.live.coordinator as coordinator
+
+    planned = coordinator.schedule_for_execution
+
+    def slow_plan(scenario, *, method=None):
+        time.sleep(20.0)  # far longer than a connection takes
+        return planned(scenario, method=method)
+
+    monkeypatch.setattr(coordinator, "schedule_for_execution", slow_plan)
+    password = _password_file(tmp_path, "wrong")
+    arguments = ["--broker", f"mqtt://127.0.0.1:{login_broker.port}", "--username", "agv"]
+    status, seconds = _run("serve", [*arguments, "--password-file", password], tmp_path)
+    captured = capsys.readouterr()
+    assert status == 1
+    assert seconds < 5.0, f"{seconds:.1f} s"  # not after the 20 s of planning
+    assert "refused the login" in captured.err
+    assert "no plan made yet" in captured.out
+    assert captured.err.count("trajgen: error:") == 1  # said once

@@ -18,7 +18,7 @@ from trajgen.export.atomic import check_output_paths, commit_files
 from trajgen.export.csv import CsvOptions, check_row_limit, profile_chunk_pair, profile_paths
 from trajgen.export.plc.dialects import DIALECTS, Dialect, TableDialect
 from trajgen.export.plc.files import PlcTables, check_dialect_method, plc_tables, table_paths
-from trajgen.methods import METHODS, make_schedule
+from trajgen.methods import METHODS, make_schedule, method_for
 from trajgen.model.analysis import lower_bound
 from trajgen.model.schedule import TimingMethod
 from trajgen.model.summary import graph_route_summary, provenance, route_summary
@@ -222,8 +222,7 @@ def run(
         raise InputError(f"outputs must be Outputs, got {type(outputs).__name__}")
     if not isinstance(scenario, Scenario | GraphScenario):
         raise InputError(f"run expects a Scenario or a GraphScenario, got {type(scenario).__name__}")
-    graph = isinstance(scenario, GraphScenario)
-    chosen = METHODS.create("exact" if graph and method is None else method)
+    chosen = method_for(method, scenario.track)
     check_output_paths(outputs.paths(scenario.names))
     tabled = outputs.csv_dir is not None and isinstance(outputs.dialect, TableDialect)
     if tabled:
@@ -267,7 +266,7 @@ def run(
         files[speed] = png_bytes(plot_speed(verified, names=scenario.names))
         files[separation] = png_bytes(plot_separation(verified))
         files[coordination] = png_bytes(plot_coordination(compared))
-        if graph:  # the track from above with both vehicles' paths, move by move
+        if isinstance(scenario, GraphScenario):  # the track from above with both paths, move by move
             from trajgen.plots import plot_graph_route
 
             files[configuration] = png_bytes(plot_graph_route(verified.schedule.route, names=scenario.names))

@@ -7,10 +7,15 @@ import subprocess
 import sys
 import threading
 import time
+from collections.abc import Callable
 
 from trajgen.cli import main
+from trajgen.export.vda5050.graph_path import point_id
 from trajgen.live.broker import EmbeddedBroker, MosquittoBroker, mosquitto_available
+from trajgen.live.geometry import track_position
 from trajgen.live.mqtt import BrokerSettings, make_client
+from trajgen.live.places import snapshot_point
+from trajgen.scenario import GraphScenario
 
 #: Time scale, state rate (Hz of the run), control period (s) and node spacing (m) of the runs
 #: that check behaviour under faults: ~100 messages/s through amqtt (a node every metre).
@@ -79,3 +84,73 @@ def logged_serve(folder, *, method: str = "exact") -> list[str]:
     """``trajgen serve`` options of a test run: its plan's method, a run log and picture in ``folder``."""
     log, picture = str(folder / "run.jsonl"), str(folder / "run.png")
     return ["--method", method, "--log", log, "--plot", picture, "--timeout", "300", "--json"]
+
+
+class States:
+    """Every state the vehicles publish, as a third client sees them: ``(serial, place, driving)``.
+
+    Also every state as it came (:attr:`documents`), for what else it says (its action states).
+
+    ``place_of``: where a state puts its vehicle on the track (from its x/y, or its nodes).
+    """
+
+    def __init__(self, url: str, place_of: Callable[[dict], object]) -> None:
+        self.seen: list[tuple[str, object, bool]] = []
+        self.documents: list[dict] = []
+        self._place_of = place_of
+        self._lock = threading.Lock()
+        settings = BrokerSettings.from_url(url)
+        self._client = make_client(settings, f"states-{id(self):x}")
+        self._client.on_connect = lambda client, *_: client.subscribe("uagv/v2/+/+/state")
+        self._client.on_message = self._take
+        self._client.connect(settings.host, settings.port)
+        self._client.loop_start()
+
+    def _take(self, client, userdata, message) -> None:
+        state = json.loads(message.payload)
+        place = self._place_of(state)
+        with self._lock:
+            self.seen.append((state["serialNumber"], place, state["driving"]))
+            self.documents.append(state)
+
+    def last(self, serial: str):
+        with self._lock:
+            return next((s for s in reversed(self.seen) if s[0] == serial), None)
+
+    def close(self) -> None:
+        self._client.disconnect()
+        self._client.loop_stop()
+
+
+def place_reader(scenario) -> tuple[Callable[[dict], object], Callable[[object], str]]:
+    """How a state places its vehicle on ``scenario``'s track, and how ``--start`` writes a place."""
+    track = scenario.track
+    if isinstance(scenario, GraphScenario):
+
+        def on_graph(state: dict):
+            upcoming = state.get("nodeStates") or []
+            following = upcoming[0]["nodeId"] if upcoming else ""
+            return snapshot_point(
+                track, state["lastNodeId"], following, state.get("distanceSinceLastNode") or 0.0
+            )
+
+        return on_graph, lambda place: point_id(track, place)
+
+    def on_junction(state: dict):
+        position = state.get("agvPosition")
+        return None if position is None else track_position(track, position["x"], position["y"])
+
+    return on_junction, lambda place: f"{place.leg}:{place.s:.6f}"
+
+
+def closest_states(scenario, states: States) -> float:
+    """The least track distance between each vehicle's latest reported place, at every state."""
+    latest: dict[str, object] = {}
+    closest = float("inf")
+    for serial, place, _ in states.seen:
+        if place is None:
+            continue
+        latest[serial] = place
+        if len(latest) == 2:
+            closest = min(closest, scenario.track.distance(*(latest[name] for name in scenario.names)))
+    return closest

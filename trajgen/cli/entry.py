@@ -19,62 +19,13 @@ import os
 import sys
 from collections.abc import Sequence
 
+from trajgen.cli.logs import LogFormatter, log_to_stderr
 from trajgen.cli.parser import EXIT_BAD_INPUT, EXIT_FAILURE, CommandParser, print_details
 from trajgen.errors import InputError, LiveError, VerificationError
 
 __all__ = ["COMMANDS", "Commands", "LogFormatter", "build_parser", "command_parsers", "console_main", "main"]
 
 logger = logging.getLogger(__name__)
-
-
-class LogFormatter(logging.Formatter):
-    """The command's log lines: the program's name and the level first, as its error messages.
-
-    Warnings, ``-v`` progress and the solvers' messages all read ``trajgen: warning: optimal: ...``.
-    """
-
-    def format(self, record: logging.LogRecord) -> str:
-        """``trajgen: <level>: <message>``, the traceback below where there is one."""
-        text = f"trajgen: {record.levelname.lower()}: {record.getMessage()}"
-        if record.exc_info:
-            text += "\n" + self.formatException(record.exc_info)
-        return text
-
-
-class StderrHandler(logging.StreamHandler):
-    """A log handler on whatever ``sys.stderr`` is when a record is written (not when it was made).
-
-    :func:`main` run twice in one process (tests, a host program redirecting ``sys.stderr``) logs to
-    the stream of the moment, as ``print(..., file=sys.stderr)`` does.
-    """
-
-    def __init__(self) -> None:
-        super().__init__()
-        self.setFormatter(LogFormatter())
-
-    @property
-    def stream(self):
-        return sys.stderr
-
-    @stream.setter
-    def stream(self, value) -> None:
-        pass
-
-
-def _log_to_stderr(level: int) -> None:
-    """Send log records of ``level`` and above to stderr as ``trajgen: <level>: ...`` lines.
-
-    One handler on the root logger, added next to any there already (a host's, pytest's): the
-    solvers' and libraries' records reach it too. Calling again only changes the level.
-    """
-    root = logging.getLogger()
-    handler = next((each for each in root.handlers if isinstance(each, StderrHandler)), None)
-    if handler is None:
-        handler = StderrHandler()
-        root.addHandler(handler)
-    handler.setLevel(level)
-    if root.getEffectiveLevel() > level:
-        root.setLevel(level)
 
 
 #: The help of ``-v``/``--verbose``, an option of ``trajgen`` and of each of its commands.
@@ -211,7 +162,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         argv = sys.argv[1:] if argv is None else list(argv)
         args = _build(_chosen(argv))[0].parse_args(argv)
         verbose = bool(args.verbose)
-        _log_to_stderr(logging.INFO if verbose else logging.WARNING)
+        log_to_stderr(logging.INFO if verbose else logging.WARNING)
         return args.run(args)
     except InputError as error:
         print(f"trajgen: error: {error}", file=sys.stderr)

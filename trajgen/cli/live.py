@@ -1,15 +1,18 @@
 """``trajgen serve`` and ``trajgen vehicle``: drive vehicles over VDA 5050 on an MQTT broker.
 
-``serve`` plans and verifies a scenario, then drives both vehicles, releasing
-base by the frontier (:mod:`trajgen.live.master`); it commits its run log (and
-picture) when the run ends. ``vehicle`` is a simulated VDA 5050 vehicle
-(:mod:`trajgen.live.vehicle`). ``demo --live`` runs both, with a broker, in
-one process (:func:`live_demo`).
+``serve`` connects and plans a scenario at once, then drives the vehicles,
+releasing base by the frontier (:mod:`trajgen.live.master`), saying each event
+on a line of its own (:mod:`trajgen.cli.timeline`); its run log is streamed to
+``<log>.partial`` as the run goes and committed, with the picture, when the run
+ends (also on SIGINT, SIGTERM and SIGHUP, which stop it in order). ``vehicle``
+is a simulated VDA 5050 vehicle (:mod:`trajgen.live.vehicle`). ``demo --live``
+runs both, with a broker, in one process (:func:`live_demo`).
 """
 
 from __future__ import annotations
 
 import argparse
+import contextlib
 import json
 import logging
 import math
@@ -17,12 +20,12 @@ import re
 import signal
 import sys
 import threading
-import time
 from pathlib import Path
+from typing import ClassVar
 
 from topology import Configuration, EdgePoint, Position, TrackGraph
 from topology.validation import short_repr
-from trajgen.cli.options import add_method, method_from, scenario_from
+from trajgen.cli.options import add_method, scenario_from
 from trajgen.cli.parser import EXIT_FAILURE, EXIT_OK
 from trajgen.errors import InputError
 from trajgen.live.mqtt import require_live
@@ -100,11 +103,11 @@ def _identities(args: argparse.Namespace, scenario):
     )
 
 
-def _commit(log, log_path: str, plot_path: str | None, names) -> None:
-    """The run log and the picture, committed together; a run too short to draw keeps its log.
+def _commit(log, log_path: str, plot_path: str | None, names) -> bool:
+    """The run log and the picture, committed together; whether they were (the log is then closed).
 
-    A picture that cannot be drawn (no vehicle ever reported a state: the broker or the vehicles
-    were never reached) is skipped with a warning; the log is always written.
+    A picture that cannot be drawn is skipped with a warning; the log is always written. A commit
+    that fails keeps the log streamed as the run went (``<log>.partial``) and says where it is.
     """
     from trajgen.export.atomic import commit_files
 
@@ -118,16 +121,24 @@ def _commit(log, log_path: str, plot_path: str | None, names) -> None:
             contents[Path(plot_path)] = png_bytes(figure)
         except InputError as error:
             logger.warning("the picture of the run %s is not drawn: %s", plot_path, error)
-    commit_files(contents)
+    try:
+        commit_files(contents)
+    except Exception:
+        if log.partial is not None:
+            logger.error("the run log could not be committed; it is kept as %s", log.partial)
+        log.close(keep=True)
+        raise
+    log.close()
+    return True
 
 
-def _report(run, args: argparse.Namespace, *, planning: float, closest: float | None = None) -> int:
+def _report(run, args: argparse.Namespace, *, closest_true: float | None = None) -> int:
+    """Print the run's summary (``--json``: the JSON alone on stdout); the exit status of the run."""
     from trajgen.model.summary import format_provenance
 
     summary = run.summary()
-    summary["planning_s"] = planning
-    if closest is not None:
-        summary["closest_m"] = closest
+    if closest_true is not None:
+        summary["closest_true_m"] = closest_true
     if args.json:
         print(json.dumps(summary, indent=2))
     else:
@@ -137,85 +148,180 @@ def _report(run, args: argparse.Namespace, *, planning: float, closest: float | 
             if summary["orders"]
             else "before any order was sent"
         )
-        before = f"planning took {planning:.2f} s" + "".join(
+        before = f"planning took {summary['planning_s']:.2f} s" + "".join(
             f", the {who} {summary[key]:.2f} s of the run"
             for who, key in (("broker", "broker_wait_s"), ("vehicles", "vehicle_wait_s"))
             if summary[key] is not None
         )
+        closest = summary["closest_m"]
+        approach = "" if closest is None else f"; closest approach {closest_text(closest)} (reported places)"
+        if closest_true is not None:
+            approach += f", {closest_text(closest_true)} (true positions)"
+        plan = (
+            f"plan {summary['planned_s']:.3f} s, {format_provenance(summary)}"
+            if "computed_by" in summary
+            else "no plan made yet"
+        )
         print(
-            f"live run: {summary['outcome']} {took} "
-            f"(plan {summary['planned_s']:.3f} s, {format_provenance(summary)}; before the first order, "
-            f"{before}); "
+            f"live run: {summary['outcome']} {took} ({plan}; before the first order, {before}); "
             f"{summary['orders']} orders and updates "
             f"({summary['resent']} sent again), {summary['ignored']} messages ignored, "
             f"{summary['replans']} re-plans"
             + (f"; release latency {latency:.2f} ms median" if latency is not None else "")
-            + (f"; closest approach {closest_text(closest)}" if closest is not None else "")
+            + approach
         )
+    if summary["outcome"] == "interrupted":  # asked for: said, not an error
+        print(f"trajgen: {summary['error']}", file=sys.stderr)
+        return EXIT_FAILURE
     if summary.get("error"):
         print(f"trajgen: error: {summary['error']}", file=sys.stderr)
         return EXIT_FAILURE
     if summary["outcome"] != "goals-reached":
-        print("trajgen: the live run did not reach both goals in time", file=sys.stderr)
+        print("trajgen: the live run did not reach every goal in time", file=sys.stderr)
         return EXIT_FAILURE
     return EXIT_OK
 
 
+class _Signals:
+    """SIGINT, SIGTERM and SIGHUP while a run goes: noted (the first one), never raised.
+
+    The run then stops in order (its vehicles told, its log committed) and the command ends with
+    ``128 + the signal's number`` (130, 143, 129), a status of its own. Outside the main thread
+    (a host program running :func:`~trajgen.cli.main` in a thread) no handler is installed.
+    """
+
+    NAMES: ClassVar[dict[int, str]] = {
+        signal.SIGINT: "SIGINT",
+        signal.SIGTERM: "SIGTERM",
+        signal.SIGHUP: "SIGHUP",
+    }
+
+    def __init__(self) -> None:
+        self.received: int | None = None
+        self._before: dict = {}
+
+    def _take(self, signum, frame) -> None:
+        if self.received is None:
+            self.received = signum
+        else:
+            logger.warning("%s again: the run is already stopping", self.NAMES.get(signum, signum))
+
+    def __enter__(self) -> _Signals:
+        if threading.current_thread() is threading.main_thread():
+            for signum in self.NAMES:
+                self._before[signum] = signal.signal(signum, self._take)
+        return self
+
+    def __exit__(self, *exc) -> None:
+        for signum, handler in self._before.items():
+            signal.signal(signum, handler)
+
+    @property
+    def name(self) -> str | None:
+        """The signal received, by name; ``None``: none."""
+        return None if self.received is None else self.NAMES.get(self.received, str(self.received))
+
+    @property
+    def status(self) -> int:
+        """The exit status of a run stopped by the signal received."""
+        return 128 + int(self.received)
+
+
+#: Wall seconds a stopped run waits for its vehicles to show the ``cancelOrder`` it sent them.
+TELL_WAIT_S = 3.0
+
+
+def _drive(master, goals, *, timeout: float | None, signals: _Signals) -> None:
+    """Run ``master`` until it is over, a signal comes or the time runs out; ask for ``goals`` when due.
+
+    ``timeout``: seconds of the run's clock from the start; ``None``: 60 s plus four times the plan,
+    from when the plan is made.
+    """
+    from trajgen.errors import InputError as GoalRefused
+
+    pending = list(goals)
+    limit = timeout
+    step = master.clock.time_scale * 0.05  # 50 ms of wall time, in seconds of the run
+    while not master.over() and signals.received is None:
+        if limit is None and master.planned_duration is not None:
+            limit = master.elapsed + 4.0 * master.planned_duration + 60.0
+        if limit is not None and master.elapsed >= limit:
+            return
+        run_time = master.run_time
+        while pending and run_time is not None and run_time >= pending[0][0]:
+            at, goal = pending.pop(0)
+            try:
+                master.request_goal(goal)
+            except GoalRefused as error:
+                logger.warning("--goal-at %g: the goal is not taken: %s", at, error)
+        master.wait(timeout=step)
+
+
 def _command_serve(args: argparse.Namespace) -> int:
+    from trajgen.cli.options import scenario_method
+    from trajgen.cli.timeline import Timeline
     from trajgen.export.atomic import check_output_paths
     from trajgen.live.clock import RunClock
     from trajgen.live.master import LiveMaster
-    from trajgen.live.session import live_plan
+    from trajgen.live.runlog import RunLog
 
     require_live("paho", "trajgen serve")
     scenario = scenario_from(args.scenario)
     goals = sorted((_goal(text, scenario.track) for text in args.goal_at), key=lambda goal: goal[0])
+    if args.timeout is not None and not args.timeout > 0.0:
+        raise InputError(f"serve --timeout {args.timeout!r} is not positive: expected run seconds > 0")
     check_output_paths([args.log] + ([args.plot] if args.plot else []))
     settings = _settings(args)
     ids = _identities(args, scenario)
-    began = time.perf_counter()
-    verified = live_plan(scenario, method=method_from(args))
-    planning = time.perf_counter() - began  # reported, never used to decide
-    clock = RunClock(args.time_scale)  # the run's time (and --timeout) starts after planning
+    method = scenario_method(args, scenario)
+    clock = RunClock(args.time_scale)
+    timeline = None if args.json else Timeline(clock)
+    log = RunLog.streamed(args.log, listener=timeline)
     master = LiveMaster(
-        verified,
-        scenario.names,
+        scenario,
         identities=ids,
         broker=settings,
-        method=method_from(args),
+        method=method,
         clock=clock,
         order_id=args.order_id,
         map_id=args.map_id,
+        log=log,
     )
-    timeout = args.timeout if args.timeout is not None else 4.0 * verified.schedule.duration + 60.0
-    try:
-        master.start()
-        for at, goal in goals:
-            if master.wait(timeout=at - clock.now()):
-                break  # both at their goals before it was due: it is never applied
-            master.request_goal(goal)
-        master.wait(timeout=timeout - clock.now())
-    finally:
-        master.stop()
-    run = master.result()
-    _commit(master.log, args.log, args.plot, scenario.names)
-    master.log.close()
-    return _report(run, args, planning=planning)
+    quiet = timeline.quiet_duplicates() if timeline is not None else contextlib.nullcontext()
+    with _Signals() as signals, quiet:
+        try:
+            master.start()  # connects and plans at once
+            _drive(master, goals, timeout=args.timeout, signals=signals)
+            if signals.received is not None:
+                master.interrupt(signals.name)
+                master.wait_told(TELL_WAIT_S)
+        finally:
+            master.stop()
+            run = master.result()  # the end record, whatever ended the run
+    _commit(log, args.log, args.plot, scenario.names)
+    status = _report(run, args)
+    return signals.status if signals.received is not None else status
 
 
-def _start(args: argparse.Namespace, scenario, v: int) -> Position | EdgePoint:
-    """Where the vehicle stands when it starts: ``--start`` (a restart), else its scenario start."""
+def _start(args: argparse.Namespace, scenario, v: int, identity) -> Position | EdgePoint:
+    """Where the vehicle stands at start: ``--start`` (``last``: its memory), else its scenario start."""
+    from trajgen.live.memory import memory_path, remembered_place
+
     track = scenario.track
+    given = args.start.strip() if args.start is not None else None
+    if given == "last":
+        return remembered_place(track, memory_path(identity, _settings(args)))
     if isinstance(track, TrackGraph):
-        return track.point(args.start.strip() if args.start is not None else scenario.start[v])
-    if args.start is None:
+        return track.point(given if given is not None else scenario.start[v])
+    if given is None:
         return (scenario.start.first, scenario.start.second)[v]
-    return track.check(Position.parse(args.start))
+    return track.check(Position.parse(given))
 
 
 def _command_vehicle(args: argparse.Namespace) -> int:
     from trajgen.errors import LiveError
     from trajgen.live.clock import RunClock
+    from trajgen.live.memory import memory_path
     from trajgen.live.places import start_place
     from trajgen.live.vehicle import SimulatedVehicle, StopFault
 
@@ -229,31 +335,39 @@ def _command_vehicle(args: argparse.Namespace) -> int:
     faults = [StopFault.parse(text) for text in args.fault]
     if args.timeout is not None and not args.timeout > 0.0:
         raise InputError(f"vehicle --timeout {args.timeout!r} is not positive: expected run seconds > 0")
+    identity = _identities(args, scenario)[v]
+    settings = _settings(args)
     clock = RunClock(args.time_scale)
-    start, start_node = start_place(scenario.track, _start(args, scenario, v))
+    start, start_node = start_place(scenario.track, _start(args, scenario, v, identity))
     vehicle = SimulatedVehicle(
-        _identities(args, scenario)[v],
+        identity,
         scenario.limits.vehicles[v],
         start,
         start_node=start_node,
-        broker=_settings(args),
+        broker=settings,
         clock=clock,
         state_rate=args.state_rate,
         faults=faults,
         map_id=args.map_id,
+        memory=memory_path(identity, settings),
     )
     stopped = threading.Event()
     for signum in (signal.SIGINT, signal.SIGTERM):
         signal.signal(signum, lambda *_: stopped.set())
     vehicle.start()
     timed_out = False
+    over = None
     try:
         while not stopped.wait(0.1):
             if args.exit_at_goal and vehicle.snapshot.finished:
                 break
+            over = vehicle.over
+            if args.exit_at_goal and over is not None:
+                break
             if vehicle.link.failed.is_set():
                 break
-            if args.timeout is not None and clock.now() >= args.timeout:
+            since = vehicle.since_first_order  # the time out counts from its first order (or its start)
+            if args.timeout is not None and (since if since is not None else clock.now()) >= args.timeout:
                 timed_out = True
                 break
     finally:
@@ -271,6 +385,9 @@ def _command_vehicle(args: argparse.Namespace) -> int:
         + (f"{run_time:.3f} s after its first order" if run_time is not None else "without any order")
         + f" ({'at its goal' if snapshot.finished else 'not at a goal'})"
     )
+    if args.exit_at_goal and over is not None and not snapshot.finished:
+        print(f"trajgen: vehicle {args.name}: {over}, not at its goal", file=sys.stderr)
+        return EXIT_FAILURE
     if timed_out and (args.exit_at_goal or not vehicle.link.ever_connected):
         why = "never reached the broker" if not vehicle.link.ever_connected else "not at its goal"
         print(f"trajgen: vehicle {args.name}: {why} within --timeout {args.timeout:g} s", file=sys.stderr)
@@ -278,27 +395,11 @@ def _command_vehicle(args: argparse.Namespace) -> int:
     return EXIT_OK
 
 
-def _show_progress(record: dict) -> None:
-    """One line per release, connection change, ignored message and re-plan of a live run."""
-    kind, t = record["event"], record["t"]
-    if kind == "order" and not record["resent"]:
-        what = "order" if record["update"] == 0 else f"update {record['update']}"
-        line = f"{record['vehicle']}: {what}, base to {record['frontier_m']:.2f} m along its path"
-    elif kind == "connection":
-        line = f"{record['vehicle']} is {record['state']}"
-    elif kind == "ignored":
-        line = f"ignored a message on {record['topic']}: {record['reason']}"
-    elif kind in ("goal", "replan"):
-        line = f"{kind}: {record['goal']}"
-    else:
-        return
-    print(f"{t:9.2f} s  {line}", flush=True)
-
-
 def live_demo(
-    scenario, *, method, time_scale: float, state_rate: float = 10.0, output: str, json_summary: bool = False
+    scenario, *, method, time_scale: float, state_rate: float = 1.0, output: str, json_summary: bool = False
 ) -> int:
-    """``trajgen demo --live``: a broker, two simulated vehicles and the master in this process."""
+    """``trajgen demo --live``: a broker, the simulated vehicles and the master in this process."""
+    from trajgen.cli.timeline import Timeline
     from trajgen.export.atomic import check_output_paths
     from trajgen.live.runlog import RunLog
     from trajgen.live.session import LiveDemo
@@ -311,20 +412,15 @@ def live_demo(
             f"Live demo: {scenario.source} over VDA 5050 on an MQTT broker in this process, "
             f"{time_scale:g}x real time ..."
         )
-    began = time.perf_counter()
-    demo = LiveDemo(
-        scenario,
-        method=method,
-        time_scale=time_scale,
-        state_rate=state_rate,
-        log=RunLog(listener=None if json_summary else _show_progress),
-    )
-    planning = time.perf_counter() - began  # reported, never used to decide
-    with demo:
-        demo = demo.run()
-    _commit(demo.log, log_path, plot_path, scenario.names)
-    demo.log.close()
-    status = _report(demo.run, argparse.Namespace(json=json_summary), planning=planning, closest=demo.closest)
+    log = RunLog.streamed(log_path)
+    demo = LiveDemo(scenario, method=method, time_scale=time_scale, state_rate=state_rate, log=log)
+    timeline = None if json_summary else Timeline(demo.clock)
+    log.listener = timeline
+    quiet = timeline.quiet_duplicates() if timeline is not None else contextlib.nullcontext()
+    with quiet, demo:
+        outcome = demo.run()
+    _commit(outcome.log, log_path, plot_path, scenario.names)
+    status = _report(outcome.run, argparse.Namespace(json=json_summary), closest_true=outcome.closest)
     if not json_summary:
         print(f"Run log and picture: {log_path}, {plot_path}")
     return status
@@ -339,20 +435,32 @@ def register(commands) -> None:
         "--serial-numbers", metavar="A,B", help="both vehicles' serial numbers (default: their names)"
     )
     add_method(serve, what="timing method of the plan", homotopy=False)
-    serve.add_argument("--order-id", default="trajgen", help="orderId: <prefix>-<vehicle name> (trajgen)")
+    serve.add_argument(
+        "--order-id", default="trajgen", help="orderId: <prefix>-<vehicle name>-<run's UTC time> (trajgen)"
+    )
     serve.add_argument("--map-id", default="trajgen", help="nodePosition.mapId (trajgen)")
     serve.add_argument(
         "--goal-at",
         action="append",
         default=[],
         metavar="T=LEG:S,LEG:S",
-        help="at T s of the run, new goals for both vehicles (repeatable): both stop at\n"
-        "their released base, then are re-planned from there (EDGE:S or a node on a track graph)",
+        help="at T s of the run (from its first orders), new goals for both vehicles (repeatable):\n"
+        "both stop at their released base, then are re-planned from there (EDGE:S or a node on\n"
+        "a track graph)",
     )
     serve.add_argument(
-        "--timeout", type=float, help="seconds of the run, after planning, before giving up (4x plan + 60)"
+        "--timeout",
+        type=float,
+        metavar="S",
+        help="seconds of the run from serve's start (planning included) before giving up;\n"
+        "default: 60 s and four times the plan, from when the plan is made",
     )
-    serve.add_argument("--log", default="trajgen-live.jsonl", help="JSON-lines run log (trajgen-live.jsonl)")
+    serve.add_argument(
+        "--log",
+        default="trajgen-live.jsonl",
+        help="JSON-lines run log (trajgen-live.jsonl), written to FILE.partial as the run goes\n"
+        "and committed with the picture when it ends",
+    )
     serve.add_argument("--plot", metavar="FILE", help="PNG picture of the run: progress, releases, events")
     serve.add_argument("--json", action="store_true", help="print a machine-readable summary")
     serve.set_defaults(run=_command_serve)
@@ -364,7 +472,11 @@ def register(commands) -> None:
     vehicle.add_argument("--serial-numbers", metavar="A,B", help="both vehicles' serial numbers (names)")
     vehicle.add_argument("--map-id", default="trajgen", help="agvPosition.mapId (trajgen)")
     vehicle.add_argument(
-        "--state-rate", type=float, default=10.0, metavar="HZ", help="states per second of the run (10)"
+        "--state-rate",
+        type=float,
+        default=1.0,
+        metavar="HZ",
+        help="states per second of the run besides those on events (each node reached, ...) (1)",
     )
     vehicle.add_argument(
         "--fault",
@@ -374,19 +486,23 @@ def register(commands) -> None:
         help="stop T s after its first order, for D s (repeatable)",
     )
     vehicle.add_argument(
-        "--exit-at-goal", action="store_true", help="end once at the goal of an order (else: until Ctrl-C)"
+        "--exit-at-goal",
+        action="store_true",
+        help="end once at the goal of an order (exit 0), or once its run is over without it: its\n"
+        "order cancelled by the master, or the master gone (exit 1); else: until Ctrl-C",
     )
     vehicle.add_argument(
         "--start",
         metavar="LEG:S",
         help="where it stands at start (a restart mid-run; EDGE:S or a node on a track graph);\n"
+        "'last': where it last said it stood (kept by every vehicle process, see docs/live.md);\n"
         "default: its start in the scenario",
     )
     vehicle.add_argument(
         "--timeout",
         type=float,
         metavar="S",
-        help="end after S s of the run (exit 1 if the broker was never reached or, with\n"
-        "--exit-at-goal, the goal not reached)",
+        help="end S s of the run after its first order (before one: after its start); exit 1 if\n"
+        "the broker was never reached or, with --exit-at-goal, the goal not reached",
     )
     vehicle.set_defaults(run=_command_vehicle)

@@ -145,9 +145,9 @@ def register(commands) -> None:
     demo.add_argument(
         "--state-rate",
         type=float,
-        default=10.0,
+        default=1.0,
         metavar="HZ",
-        help="with --live: each vehicle's states per second of the run, besides those on events (10)",
+        help="with --live: each vehicle's states per second of the run, besides those on events (1)",
     )
     demo.add_argument(
         "--json", action="store_true", help="print a machine-readable summary (of the live run with --live)"

@@ -13,7 +13,7 @@ from __future__ import annotations
 
 from limits import Limits
 from topology import Configuration, EdgePoint, InfeasibleError, StarGraph, TrackGraph, plan, plan_graph
-from trajgen.methods import METHODS, make_schedule
+from trajgen.methods import make_schedule, method_for
 from trajgen.model.schedule import TimingMethod
 from trajgen.scenario import GraphScenario
 from trajgen.verification import VerifiedSchedule, certify
@@ -71,7 +71,7 @@ def schedule_from_rest(
     separation = limits.min_separation + 2.0 * margin
     planned = Limits(limits.vehicles, separation)
     route = plan(graph, start, goal, min_separation=separation)
-    return certify(make_schedule(route, planned, method=for_execution(method)))
+    return certify(make_schedule(route, planned, method=for_execution(method, graph)))
 
 
 def graph_schedule_from_rest(
@@ -95,12 +95,16 @@ def graph_schedule_from_rest(
     """
     separation = limits.min_separation + 2.0 * margin
     route = plan_graph(track, start, goal, min_separation=separation, names=names)
-    return certify(make_schedule(route, Limits(limits.vehicles, separation), method=for_execution(method)))
+    planned = Limits(limits.vehicles, separation)
+    return certify(make_schedule(route, planned, method=for_execution(method, track)))
 
 
-def for_execution(method: TimingMethod | str | None) -> TimingMethod:
-    """``method`` as it plans for execution: ``optimal`` with the braking rule in its problem."""
-    return METHODS.create(method).for_execution()
+def for_execution(method: TimingMethod | str | None, track) -> TimingMethod:
+    """``method`` as it plans for execution: ``optimal`` with the braking rule in its problem.
+
+    ``None``: the default for ``track`` (:func:`~trajgen.methods.method_for`).
+    """
+    return method_for(method, track).for_execution()
 
 
 def schedule_for_execution(

@@ -395,7 +395,7 @@ def simulate(
     asked = (
         verified.schedule.method.name
         if method is None and verified is not None
-        else for_execution(method).name
+        else for_execution(method, scenario.track).name
     )
     if verified is None:
         verified = schedule_for_execution(scenario, method=method, position_margin=position_margin)

@@ -14,11 +14,12 @@ from typing import TYPE_CHECKING
 from trajgen.lazy import lazy_attributes
 
 if TYPE_CHECKING:
-    from trajgen.live.broker import EmbeddedBroker, MosquittoBroker, mosquitto_available
+    from trajgen.live.broker import EmbeddedBroker
     from trajgen.live.clock import RunClock
     from trajgen.live.faults import StopFault
     from trajgen.live.link import BrokerLink, LinkState
     from trajgen.live.master import LiveMaster
+    from trajgen.live.mosquitto import MosquittoBroker, mosquitto_available
     from trajgen.live.mqtt import BrokerSettings, VehicleIdentity
     from trajgen.live.outcome import LiveOutcome, LiveRun
     from trajgen.live.runlog import RunLog, read_run_log
@@ -59,7 +60,7 @@ _SOURCES = {
     "LiveMaster": "trajgen.live.master",
     "LiveOutcome": "trajgen.live.outcome",
     "LiveRun": "trajgen.live.outcome",
-    "MosquittoBroker": "trajgen.live.broker",
+    "MosquittoBroker": "trajgen.live.mosquitto",
     "RunClock": "trajgen.live.clock",
     "RunLog": "trajgen.live.runlog",
     "SimulatedVehicle": "trajgen.live.vehicle",
@@ -68,7 +69,7 @@ _SOURCES = {
     "VehicleSnapshot": "trajgen.live.vehicle",
     "identities": "trajgen.live.session",
     "live_plan": "trajgen.live.session",
-    "mosquitto_available": "trajgen.live.broker",
+    "mosquitto_available": "trajgen.live.mosquitto",
     "read_run_log": "trajgen.live.runlog",
     "run_demo": "trajgen.live.session",
 }

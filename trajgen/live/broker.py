@@ -25,205 +25,27 @@ import asyncio
 import contextlib
 import errno
 import logging
-import os
-import shutil
-import socket
-import subprocess
-import tempfile
 import threading
 import time
-import weakref
-from collections.abc import Callable
-from pathlib import Path
 from typing import Any, Self
 
-from topology.validation import finite_real, short_repr
-from trajgen.errors import InputError, LiveError
+from trajgen.errors import LiveError
+from trajgen.live import broker_base
+from trajgen.live.broker_base import (
+    HOST,
+    POLL_S,
+    START_TIMEOUT_S,
+    STOP_TIMEOUT_S,
+    THREAD_NAME,
+    Broker,
+    wait_until_bindable,
+)
+from trajgen.live.mosquitto import MosquittoBroker, mosquitto_available
 from trajgen.live.mqtt import require_live
 
 __all__ = ["HOST", "THREAD_NAME", "EmbeddedBroker", "MosquittoBroker", "mosquitto_available"]
 
 logger = logging.getLogger(__name__)
-
-#: The address the brokers listen on: this machine only.
-HOST = "127.0.0.1"
-#: Seconds a broker may take to accept connections once started.
-START_TIMEOUT_S = 10.0
-#: Seconds a start waits for its port to become free again (a listening socket still closing).
-REBIND_TIMEOUT_S = 2.0
-#: Seconds a stop waits for the broker to close its connections and end.
-STOP_TIMEOUT_S = 5.0
-#: Seconds between two attempts to reach a starting broker.
-_POLL_S = 0.02
-#: The name of the embedded broker's thread.
-THREAD_NAME = "trajgen-broker"
-#: An MQTT 3.1.1 CONNECT (clean session, keep-alive 10 s, empty client id: the broker names it), the
-#: CONNACK that accepts it, and a DISCONNECT: how a start checks that the broker answers.
-_PROBE_CONNECT = bytes((0x10, 12, 0, 4)) + b"MQTT" + bytes((4, 0x02, 0, 10, 0, 0))
-_PROBE_CONNACK = bytes((0x20, 2, 0, 0))
-_PROBE_DISCONNECT = bytes((0xE0, 0))
-
-#: Debian's and Homebrew's folders of mosquitto, looked in after the ``PATH`` (which often lacks them).
-MOSQUITTO_FOLDERS = ("/usr/sbin", "/usr/local/sbin", "/opt/homebrew/sbin")
-
-
-def mosquitto_available() -> bool:
-    """Whether a ``mosquitto`` executable is installed (see :meth:`MosquittoBroker.executable`)."""
-    return MosquittoBroker.executable() is not None
-
-
-def _reserved_port() -> socket.socket:
-    """A socket bound to a free port of :data:`HOST`, not listening: it holds the port for a broker.
-
-    Only sockets with ``SO_REUSEADDR`` (the brokers') may bind the port then, and no client gets it as
-    its own port: one dialling it before the broker listens could otherwise connect to itself.
-    """
-    reservation = socket.socket(socket.AF_INET, socket.SOCK_STREAM)
-    reservation.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
-    reservation.bind((HOST, 0))
-    return reservation
-
-
-def _wait_until_bindable(port: int, what: str) -> None:
-    """Return once a listening socket with ``SO_REUSEADDR`` could bind ``port``; wait up to 2 s.
-
-    Raises
-    ------
-    LiveError
-        The port is still taken after :data:`REBIND_TIMEOUT_S` seconds (by another program).
-    """
-    deadline = time.monotonic() + REBIND_TIMEOUT_S
-    while True:
-        with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as trial:
-            trial.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
-            try:
-                trial.bind((HOST, port))
-                return
-            except OSError as error:
-                if error.errno != errno.EADDRINUSE or time.monotonic() >= deadline:
-                    raise LiveError(
-                        f"{what} cannot listen on {HOST}:{port}: {error.strerror or error} "
-                        f"(still so after {REBIND_TIMEOUT_S:g} s): expected a free port"
-                    ) from None
-        time.sleep(_POLL_S)
-
-
-def _answers(port: int, timeout: float) -> bool:
-    """Whether an MQTT broker on ``port`` of :data:`HOST` accepts a connection within ``timeout`` s.
-
-    The check connects, sends a CONNECT, waits for the CONNACK accepting it and says
-    DISCONNECT: a bare TCP connection without CONNECT would make the broker log an error.
-    """
-    try:
-        with socket.create_connection((HOST, port), timeout=max(timeout, 0.05)) as probe:
-            probe.sendall(_PROBE_CONNECT)
-            reply = b""
-            while len(reply) < len(_PROBE_CONNACK):
-                chunk = probe.recv(len(_PROBE_CONNACK) - len(reply))
-                if not chunk:
-                    return False
-                reply += chunk
-            if reply != _PROBE_CONNACK:
-                return False
-            probe.sendall(_PROBE_DISCONNECT)
-            return True
-    except OSError:
-        return False
-
-
-class _Broker:
-    """What both brokers share: the address, the context manager and the restart."""
-
-    #: A name for messages.
-    kind = "MQTT broker"
-
-    def __init__(self, *, port: int | None = None) -> None:
-        if port is not None and (isinstance(port, bool) or not isinstance(port, int) or not 0 < port < 65536):
-            raise InputError(
-                f"broker port {short_repr(port)} is out of range: expected 1 to 65535 (None: a free port)"
-            )
-        if port is None:
-            reservation = _reserved_port()
-            port = reservation.getsockname()[1]
-            weakref.finalize(self, reservation.close)
-        self._port = port
-        self._lock = threading.RLock()
-
-    @property
-    def host(self) -> str:
-        """The address the broker listens on, ``"127.0.0.1"``."""
-        return HOST
-
-    @property
-    def port(self) -> int:
-        """The TCP port the broker listens on, the same across restarts."""
-        return self._port
-
-    @property
-    def url(self) -> str:
-        """``mqtt://127.0.0.1:PORT``."""
-        return f"mqtt://{HOST}:{self._port}"
-
-    @property
-    def running(self) -> bool:
-        """Whether the broker is started (and not stopped since)."""
-        raise NotImplementedError
-
-    def start(self) -> Self:
-        """Start the broker; return once it accepts connections (see the subclasses)."""
-        raise NotImplementedError
-
-    def stop(self) -> None:
-        """Stop the broker (see the subclasses)."""
-        raise NotImplementedError
-
-    def restart(self, *, down_for: float = 0.0) -> None:
-        """Stop the broker, wait, and start it again on the same port.
-
-        Every client loses its connection and its session; clients that reconnect by
-        themselves find the broker again once it is back.
-
-        Parameters
-        ----------
-        down_for : float
-            Seconds (wall clock) between the stop and the start, at least 0.
-
-        Raises
-        ------
-        InputError
-            ``down_for`` is negative or not a finite number.
-        LiveError
-            The broker does not start again (see :meth:`start`).
-        """
-        pause = finite_real(down_for, "the time the broker is down, down_for (s),", InputError)
-        if pause < 0:
-            raise InputError(f"the time the broker is down, down_for (s), must be at least 0, got {pause!r}")
-        with self._lock:
-            self.stop()
-            time.sleep(pause)
-            self.start()
-
-    def _wait_until_answering(self, deadline: float, alive: Callable[[], bool]) -> None:
-        """Poll the port until the broker answers; raise :class:`LiveError` at ``deadline``."""
-        while True:
-            if _answers(self._port, deadline - time.monotonic()):
-                return
-            if not alive():
-                raise LiveError(f"the {self.kind} on {self.url} ended before it accepted connections")
-            if time.monotonic() >= deadline:
-                raise LiveError(
-                    f"the {self.kind} on {self.url} did not accept connections within {START_TIMEOUT_S:g} s"
-                )
-            time.sleep(_POLL_S)
-
-    def __enter__(self) -> Self:
-        return self.start()
-
-    def __exit__(self, *exc_info: object) -> None:
-        self.stop()
-
-    def __repr__(self) -> str:
-        return f"{type(self).__name__}(port={self._port}, running={self.running})"
 
 
 def _broker_config(port: int) -> dict[str, Any]:
@@ -350,7 +172,7 @@ def _run_loop(loop: asyncio.AbstractEventLoop) -> None:
             loop.close()
 
 
-class EmbeddedBroker(_Broker):
+class EmbeddedBroker(Broker):
     """An MQTT 3.1.1 broker (amqtt) in a thread of this process, on 127.0.0.1.
 
     amqtt runs on its own asyncio event loop in a daemon thread named
@@ -395,7 +217,7 @@ class EmbeddedBroker(_Broker):
             The port stays taken for 2 s, or the broker does not accept connections
             within 10 s.
         """
-        with self._lock:
+        with self.lock:
             if self.running:
                 return self
             self.stop()  # a thread that ended by itself
@@ -405,14 +227,14 @@ class EmbeddedBroker(_Broker):
             import amqtt.broker
             import amqtt.plugins.authentication  # noqa: F401  (the plugin of _broker_config)
 
-            _wait_until_bindable(self._port, f"the {self.kind}")
+            wait_until_bindable(self.port, f"the {self.kind}")
             loop = asyncio.new_event_loop()
             thread = threading.Thread(target=_run_loop, args=(loop,), name=THREAD_NAME, daemon=True)
             thread.start()
             self._loop, self._thread = loop, thread
             try:
                 self._broker = self._open(loop, deadline)
-                self._wait_until_answering(deadline, thread.is_alive)
+                self.wait_until_answering(deadline, thread.is_alive)
             except BaseException:
                 self.stop()
                 raise
@@ -421,7 +243,7 @@ class EmbeddedBroker(_Broker):
 
     def _open(self, loop: asyncio.AbstractEventLoop, deadline: float) -> Any:
         """Create and start amqtt's broker on ``loop``; retry while the port is taken (up to 2 s)."""
-        rebind_deadline = time.monotonic() + REBIND_TIMEOUT_S
+        rebind_deadline = time.monotonic() + broker_base.REBIND_TIMEOUT_S  # read now: tests shorten it
         while True:
             future = asyncio.run_coroutine_threadsafe(self._serve(), loop)
             try:
@@ -434,13 +256,13 @@ class EmbeddedBroker(_Broker):
             except OSError as error:
                 if error.errno != errno.EADDRINUSE or time.monotonic() >= min(rebind_deadline, deadline):
                     raise LiveError(f"the {self.kind} cannot listen on {self.url}: {error}") from None
-            time.sleep(_POLL_S)
+            time.sleep(POLL_S)
 
     async def _serve(self) -> Any:
         """On the broker's loop: a started amqtt broker (``OSError`` if it cannot bind)."""
         from amqtt.errors import BrokerError
 
-        broker = _tracking_broker(_broker_config(self._port))
+        broker = _tracking_broker(_broker_config(self.port))
         try:
             await broker.start()
         except BrokerError as error:
@@ -456,7 +278,7 @@ class EmbeddedBroker(_Broker):
         Clients see their connection drop (no MQTT DISCONNECT is needed). Does nothing
         if the broker is not running.
         """
-        with self._lock:
+        with self.lock:
             loop, thread, broker = self._loop, self._thread, self._broker
             self._loop = self._thread = self._broker = None
             if loop is None or thread is None:
@@ -485,115 +307,3 @@ class EmbeddedBroker(_Broker):
         except Exception:
             logger.debug("amqtt's shutdown failed; the broker's loop ends regardless", exc_info=True)
         await broker.trajgen_end_connections(share)  # none, unless the shutdown failed
-
-
-def _end_process(process: subprocess.Popen[bytes]) -> None:
-    """Terminate ``process`` and wait for it (kill it after :data:`STOP_TIMEOUT_S` s)."""
-    if process.poll() is None:
-        process.terminate()
-        try:
-            process.wait(STOP_TIMEOUT_S)
-        except subprocess.TimeoutExpired:
-            process.kill()
-            process.wait()
-
-
-class MosquittoBroker(_Broker):
-    """An external ``mosquitto`` as a child process, on 127.0.0.1: the interface of :class:`EmbeddedBroker`.
-
-    Its configuration file (``listener PORT 127.0.0.1``, ``allow_anonymous true``) and
-    its log are written to a temporary folder, removed on :meth:`stop`.
-
-    Parameters
-    ----------
-    port : int or None
-        TCP port, 1 to 65535; ``None``: a free port chosen now, kept across restarts.
-
-    Raises
-    ------
-    InputError
-        A port out of range.
-    """
-
-    kind = "MQTT broker mosquitto"
-
-    def __init__(self, *, port: int | None = None) -> None:
-        super().__init__(port=port)
-        self._process: subprocess.Popen[bytes] | None = None
-        self._folder: tempfile.TemporaryDirectory[str] | None = None
-        self._finalizer: weakref.finalize | None = None
-
-    @staticmethod
-    def executable() -> str | None:
-        """The ``mosquitto`` executable: on the ``PATH``, else in :data:`MOSQUITTO_FOLDERS`; or ``None``."""
-        return shutil.which("mosquitto") or shutil.which("mosquitto", path=os.pathsep.join(MOSQUITTO_FOLDERS))
-
-    @property
-    def running(self) -> bool:
-        """Whether the broker is started (and not stopped since), its process alive."""
-        return self._process is not None and self._process.poll() is None
-
-    def start(self) -> Self:
-        """Start ``mosquitto``; return once it accepts connections (at once if it runs already).
-
-        Returns
-        -------
-        MosquittoBroker
-            This broker.
-
-        Raises
-        ------
-        LiveError
-            ``mosquitto`` is not installed, the port stays taken for 2 s, or it does
-            not accept connections within 10 s (the message quotes its log).
-        """
-        with self._lock:
-            if self.running:
-                return self
-            self.stop()  # a process that ended by itself
-            executable = self.executable()
-            if executable is None:
-                raise LiveError("mosquitto is not installed (PATH, sbin): expected the mosquitto broker")
-            deadline = time.monotonic() + START_TIMEOUT_S
-            _wait_until_bindable(self._port, f"the {self.kind}")
-            self._folder = tempfile.TemporaryDirectory(prefix="trajgen-mosquitto-")
-            folder = Path(self._folder.name)
-            config = folder / "mosquitto.conf"
-            config.write_text(f"listener {self._port} {HOST}\nallow_anonymous true\n", encoding="utf-8")
-            with open(folder / "mosquitto.log", "wb") as log:
-                self._process = subprocess.Popen(
-                    [executable, "-c", str(config)], stdin=subprocess.DEVNULL, stdout=log, stderr=log
-                )
-            # no mosquitto outlives this broker object or the interpreter, stopped or not
-            self._finalizer = weakref.finalize(self, _end_process, self._process)
-            try:
-                self._wait_until_answering(deadline, lambda: self.running)
-            except LiveError as error:
-                text = self._log_tail()
-                self.stop()
-                raise LiveError(f"{error}; its log: {text}" if text else str(error)) from None
-            logger.info("mosquitto listens on %s", self.url)
-            return self
-
-    def _log_tail(self, limit: int = 500) -> str:
-        """The end of mosquitto's log, for a message."""
-        if self._folder is None:
-            return ""
-        try:
-            text = (Path(self._folder.name) / "mosquitto.log").read_text(encoding="utf-8", errors="replace")
-        except OSError:
-            return ""
-        return " ".join(text.split())[-limit:]
-
-    def stop(self) -> None:
-        """Terminate ``mosquitto`` (closing every client connection), wait for it to end; if running."""
-        with self._lock:
-            process, folder, finalizer = self._process, self._folder, self._finalizer
-            self._process = self._folder = self._finalizer = None
-            if finalizer is not None:
-                finalizer.detach()
-            if process is not None:
-                _end_process(process)
-                logger.info("mosquitto on %s stopped", self.url)
-            if folder is not None:
-                folder.cleanup()

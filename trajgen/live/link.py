@@ -69,10 +69,20 @@ class BrokerLink:
         Called with the client on every accepted connection (the first and each reconnection), in
         paho's thread, before :attr:`connected` turns true: subscribe and say hello there, and
         publish anything else only while :attr:`connected`.
+    on_change : callable, optional
+        Called with the new :class:`LinkState` and the sentence the link says of it, on each change it
+        says (connected, connected again, lost, unreachable, failed): the owner's run log. Its log
+        records then carry ``timeline=True`` (a command printing the owner's log lines leaves them out).
     """
 
     def __init__(
-        self, client, settings, *, who: str, on_connected: Callable[[object], None] | None = None
+        self,
+        client,
+        settings,
+        *,
+        who: str,
+        on_connected: Callable[[object], None] | None = None,
+        on_change: Callable[[LinkState, str], None] | None = None,
     ) -> None:
         self.client = client
         self.settings = settings
@@ -80,6 +90,8 @@ class BrokerLink:
         self.failed = threading.Event()
         self.failure: str | None = None
         self._on_connected = on_connected
+        self._on_change = on_change
+        self._extra = {"timeline": on_change is not None}
         self._state = LinkState.CONNECTING
         self._lock = threading.Lock()
         self._closing = threading.Event()
@@ -209,7 +221,13 @@ class BrokerLink:
         again = self._connections > 1
         before = self._change(LinkState.CONNECTED)
         level = logging.WARNING if before in (LinkState.UNREACHABLE, LinkState.LOST) else logging.INFO
-        logger.log(level, "%s: connected%s to %s", self.who, " again" if again else "", self.settings.url)
+        text = f"connected{' again' if again else ''} to {self.settings.url}"
+        logger.log(level, "%s: %s", self.who, text, extra=self._extra)
+        self._said(LinkState.CONNECTED, text)
+
+    def _said(self, state: LinkState, text: str) -> None:
+        if self._on_change is not None:
+            self._on_change(state, text)
 
     def _on_disconnect(self, client, userdata, flags, reason_code, properties) -> None:
         self._answered.set()
@@ -220,9 +238,9 @@ class BrokerLink:
             if lost:
                 self._state = LinkState.LOST
         if lost:
-            logger.warning(
-                "%s: lost the broker %s (%s); reconnecting", self.who, self.settings.url, reason_code
-            )
+            text = f"lost the broker {self.settings.url} ({reason_code}); reconnecting"
+            logger.warning("%s: %s", self.who, text, extra=self._extra)
+            self._said(LinkState.LOST, text)
 
     def _hung_up(self, times: int) -> str:
         if self.settings.tls:
@@ -244,13 +262,9 @@ class BrokerLink:
 
     def _unreachable(self, reason: str, delay: float) -> None:
         if self._change(LinkState.UNREACHABLE) is not LinkState.UNREACHABLE:
-            logger.warning(
-                "%s: cannot reach %s: %s; retrying, every %g s at most",
-                self.who,
-                self.settings.url,
-                reason,
-                RETRY_MAX_S,
-            )
+            text = f"cannot reach {self.settings.url}: {reason}; retrying, every {RETRY_MAX_S:g} s at most"
+            logger.warning("%s: %s", self.who, text, extra=self._extra)
+            self._said(LinkState.UNREACHABLE, text)
         else:
             logger.debug(
                 "%s: %s still unreachable: %s; next try in %g s", self.who, self.settings.url, reason, delay
@@ -262,6 +276,7 @@ class BrokerLink:
         self.failure = f"{self.who}: {message}"
         self._change(LinkState.FAILED)
         logger.debug("%s", self.failure)  # the owner reports it: the run's end, the command's error line
+        self._said(LinkState.FAILED, message)
         self.failed.set()
 
 

@@ -2,9 +2,12 @@
 
 VDA 5050 gives every vehicle its own topics,
 ``<interface>/<major version>/<manufacturer>/<serial number>/<topic>``
-(``uagv/v2/unspecified/agv1/order``). The master publishes ``order``; a vehicle
-publishes ``state`` and, retained, ``connection`` (with a last will of
-``CONNECTIONBROKEN`` that the broker sends when the vehicle drops off).
+(``uagv/v2/unspecified/agv1/order``). The master publishes ``order`` and
+``instantActions`` (``cancelOrder`` when it stops); a vehicle publishes ``state``
+and, retained, ``connection`` (with a last will of ``CONNECTIONBROKEN`` that the
+broker sends when the vehicle drops off). The master says its own connection the
+same way, on the topics of a serial number of its own, :data:`MASTER_SERIAL`
+(``uagv/v2/unspecified/master/connection``): vehicles see its last will.
 The client is paho-mqtt 2.x, driven by its own network thread, which
 reconnects by itself after the broker restarts.
 """
@@ -26,6 +29,7 @@ __all__ = [
     "DEFAULT_INTERFACE",
     "DEFAULT_VERSION",
     "LIVE_EXTRA",
+    "MASTER_SERIAL",
     "BrokerSettings",
     "Topic",
     "VehicleIdentity",
@@ -45,10 +49,15 @@ _LEVEL = re.compile(r"[^/+#\s]+")
 _RECONNECT_MIN_S, _RECONNECT_MAX_S = 0.1, 2.0
 
 
+#: The serial-number level of the master's own topics (its ``connection``): no vehicle may take it.
+MASTER_SERIAL = "master"
+
+
 class Topic:
     """The VDA 5050 topic names used here."""
 
     ORDER = "order"
+    INSTANT_ACTIONS = "instantActions"
     STATE = "state"
     CONNECTION = "connection"
 
@@ -90,6 +99,11 @@ class VehicleIdentity:
     def topic(self, name: str) -> str:
         """The full topic of ``name`` (``"order"``, ``"state"``, ``"connection"``) for this vehicle."""
         return f"{self.interface}/{self.version}/{self.manufacturer}/{self.serial_number}/{name}"
+
+    @property
+    def master(self) -> VehicleIdentity:
+        """The identity of the master of this vehicle: same interface, version and manufacturer."""
+        return VehicleIdentity(self.manufacturer, MASTER_SERIAL, self.interface, self.version)
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)

@@ -27,24 +27,24 @@ def horizon_length(limits: VehicleLimits) -> float:
     return stopping_distance(limits.max_velocity, 0.0, limits)
 
 
-def path_elements(graph, view: VehicleView, *, map_id: str) -> list:
-    """Each node and edge of ``view``'s path as a vda5050-sdk model, as horizon and as base.
+def path_elements(graph, path, *, offset: int, map_id: str) -> list:
+    """Each node and edge of ``path`` (an order path) as a vda5050-sdk model, as horizon and as base.
 
     Returns
     -------
     list
         ``[(nodes, edges) as horizon, (nodes, edges) as base]``, their ``sequenceId`` shifted by
-        the view's ``offset`` (a path stitched after a goal change continues the numbering).
+        ``offset`` (a path stitched after a goal change continues the numbering).
     """
-    last = len(view.path.nodes) - 1
+    last = len(path.nodes) - 1
     return [
         order_elements(
             graph,
-            view.path,
+            path,
             first=0,
             decision_point=last if released else -1,
             map_id=map_id,
-            sequence_offset=view.offset,
+            sequence_offset=offset,
             node_deviation=NODE_DEVIATION,
         )
         for released in (False, True)

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import enum
+import math
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -17,6 +18,10 @@ class LiveOutcome(enum.Enum):
     TIMED_OUT = "timed-out"  #: the time limit passed first
     BROKER_FAILED = "broker-failed"  #: the broker connection failed for good (see ``LiveRun.error``)
     ORDER_NOT_TAKEN = "order-not-taken"  #: a vehicle kept reporting it lacks its order (``LiveRun.error``)
+    #: the master would not drive (or go on): no plan starts where the vehicles stand, or a vehicle
+    #: stood off its plan too long (``LiveRun.error``)
+    REFUSED = "refused"
+    INTERRUPTED = "interrupted"  #: stopped by a signal (SIGINT, SIGTERM); the vehicles were told
 
 
 @dataclass(frozen=True, slots=True)
@@ -51,8 +56,16 @@ class LiveRun:
         order a vehicle never took); ``None`` otherwise.
     waits : dict
         What came before the run's time 0, seconds of the run's clock: ``broker_wait_s`` from the
-        master's start (after planning) to its connection to the broker, ``vehicle_wait_s`` from
-        there to both vehicles heard and the first orders sent (``None``: not reached).
+        master's start to its connection to the broker, ``vehicle_wait_s`` from there to every
+        vehicle placed where the plan starts it and the first orders sent (``None``: not reached).
+    closest : float
+        The smallest track distance between two vehicles' latest reported places, taken at every
+        state the master took, metres (``inf`` before two vehicles said where they are).
+    planning : float
+        Wall seconds the plans of the run took, the first and every re-plan (reported, never used
+        to decide).
+    told : tuple of str
+        The vehicles whose states showed the master's ``cancelOrder`` when the run was stopped.
     """
 
     outcome: LiveOutcome
@@ -66,9 +79,12 @@ class LiveRun:
     plan: dict = field(default_factory=dict)
     error: str | None = None
     waits: dict = field(default_factory=dict)
+    closest: float = math.inf
+    planning: float = 0.0
+    told: tuple = ()
 
     def summary(self) -> dict:
-        """A JSON-ready summary."""
+        """A JSON-ready summary (``closest_m`` ``None`` before two vehicles said where they are)."""
         latency = self.release_latency
         return {
             "outcome": self.outcome.value,
@@ -83,5 +99,8 @@ class LiveRun:
             "release_latency_median_ms": float(np.median(latency) * 1e3) if latency.size else None,
             "broker_wait_s": self.waits.get("broker_wait_s"),
             "vehicle_wait_s": self.waits.get("vehicle_wait_s"),
+            "closest_m": self.closest if math.isfinite(self.closest) else None,
+            "planning_s": self.planning,
+            "told": list(self.told),
             "error": self.error,
         }

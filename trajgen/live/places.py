@@ -8,12 +8,20 @@ have no coordinates, by its ``lastNodeId``: a node's name or ``"EDGE:s"``, a pos
 
 from __future__ import annotations
 
-from topology import Configuration, EdgePoint, StarGraph, TrackGraph
+from topology import JUNCTION_INDEX, Configuration, EdgePoint, Position, StarGraph, TrackGraph
 from trajgen.errors import InputError
-from trajgen.export.vda5050.graph_path import point_id
+from trajgen.export.vda5050.graph_path import GraphOrderPath, point_id
 from trajgen.live.geometry import position_xy, track_position
 
-__all__ = ["live_goal", "restart_place", "scenario_starts", "snapshot_point", "start_place"]
+__all__ = [
+    "live_goal",
+    "path_place",
+    "reported_place",
+    "restart_place",
+    "scenario_starts",
+    "snapshot_point",
+    "start_place",
+]
 
 
 def live_goal(graph: StarGraph | TrackGraph, goal) -> Configuration | tuple[EdgePoint, EdgePoint]:
@@ -44,6 +52,66 @@ def restart_place(graph: StarGraph | TrackGraph, state):
     if isinstance(graph, TrackGraph):
         return graph.point(state.last_node_id)
     return track_position(graph, state.agv_position.x, state.agv_position.y)
+
+
+def reported_place(graph: StarGraph | TrackGraph, state) -> Position | EdgePoint | None:
+    """Where a vehicle's VDA 5050 ``state`` says it is; ``None`` when it says nothing of it.
+
+    On a track graph: ``lastNodeId`` (a node's name or ``"EDGE:s"``), ``distanceSinceLastNode``
+    metres towards the first of its ``nodeStates``. On a junction: ``agvPosition`` (map x/y), or else
+    ``lastNodeId`` (``"O"`` or ``"LEG:s"``).
+
+    Raises
+    ------
+    InputError
+        It names a place that is not on the track (naming it).
+    """
+    if isinstance(graph, TrackGraph):
+        if not state.last_node_id:
+            return None
+        following = state.node_states[0].node_id if state.node_states else ""
+        try:
+            return snapshot_point(graph, state.last_node_id, following, state.distance_since_last_node or 0.0)
+        except InputError as error:
+            raise InputError(
+                f"lastNodeId {state.last_node_id!r} is not a place on the track: {error}"
+            ) from None
+    if state.agv_position is not None:
+        return track_position(graph, state.agv_position.x, state.agv_position.y)
+    if not state.last_node_id:
+        return None
+    if state.last_node_id == "O":
+        return Position(None, 0.0)
+    try:
+        return graph.check(Position.parse(state.last_node_id))
+    except (InputError, ValueError):
+        raise InputError(
+            f"lastNodeId {state.last_node_id!r} is not a place on the junction: expected O or LEG:s"
+        ) from None
+
+
+def path_place(graph: StarGraph | TrackGraph, path, j: int, along: float) -> Position | EdgePoint:
+    """The place ``along`` metres past node ``j`` of an order path, towards node ``j + 1``.
+
+    ``path``: a :class:`~trajgen.export.vda5050.path.OrderPath` on a junction, a
+    :class:`~trajgen.export.vda5050.graph_path.GraphOrderPath` on a track graph.
+    """
+    last = len(path.nodes) - 1
+    if isinstance(path, GraphOrderPath):
+        here = path.nodes[j].point
+        if j >= last or along <= 0.0:
+            return here
+        return _point_between(graph, here, path.nodes[j + 1].point, along)
+    node = path.nodes[j]
+    if j >= last or along <= 0.0:
+        return Position(None, 0.0) if node.leg == JUNCTION_INDEX else Position(graph.names[node.leg], node.s)
+    following = path.nodes[j + 1]
+    leg = path.edges[j].leg
+    if leg == JUNCTION_INDEX:
+        return Position(None, 0.0)
+    step = min(along, abs(following.s - node.s))
+    s = node.s + step if following.s >= node.s else node.s - step
+    return Position(None, 0.0) if s <= 0.0 else Position(graph.names[leg], s)
 
 
 def scenario_starts(scenario) -> tuple:
@@ -81,7 +149,14 @@ def snapshot_point(track: TrackGraph, node: str, next_node: str, along: float) -
     here = track.point(node)
     if not next_node or along <= 0.0:
         return here
-    there = track.point(next_node)
+    return _point_between(track, here, track.point(next_node), along, names=(node, next_node))
+
+
+def _point_between(
+    track: TrackGraph, here: EdgePoint, there: EdgePoint, along: float, *, names: tuple[str, str] = ("", "")
+) -> EdgePoint:
+    """The point ``along`` metres from ``here`` towards ``there``, two places on one edge of ``track``."""
+    node, next_node = names if names[0] else (track.name(here), track.name(there))
     edges = [here.edge] if here.edge == there.edge else []
     edges += [
         k

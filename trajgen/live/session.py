@@ -22,7 +22,13 @@ from trajgen.execution.goals import schedule_for_execution
 from trajgen.live.clock import RunClock
 from trajgen.live.geometry import position_xy, track_position
 from trajgen.live.master import RELEASE_SPACING, LiveMaster, LiveRun
-from trajgen.live.mqtt import DEFAULT_INTERFACE, DEFAULT_VERSION, BrokerSettings, VehicleIdentity
+from trajgen.live.mqtt import (
+    DEFAULT_INTERFACE,
+    DEFAULT_VERSION,
+    MASTER_SERIAL,
+    BrokerSettings,
+    VehicleIdentity,
+)
 from trajgen.live.places import scenario_starts, snapshot_point, start_place
 from trajgen.live.runlog import RunLog
 from trajgen.live.vehicle import SimulatedVehicle, StopFault, VehicleSnapshot
@@ -72,8 +78,13 @@ def identities(
         Not two serial numbers, two equal ones, or a level an MQTT topic cannot carry.
     """
     serials = tuple(names if serial_numbers is None else serial_numbers)
-    if len(serials) != 2 or serials[0] == serials[1]:
-        raise InputError(f"serial numbers {serials!r}: expected two different ones, one per vehicle")
+    if len(serials) != len(names) or len(set(serials)) != len(serials):
+        raise InputError(f"serial numbers {serials!r}: expected {len(names)} different ones, one per vehicle")
+    if MASTER_SERIAL in serials:
+        raise InputError(
+            f"serial numbers {serials!r}: {MASTER_SERIAL!r} is the master's own (its connection topic); "
+            "expected other serial numbers (--serial-numbers)"
+        )
     return tuple(VehicleIdentity(manufacturer, serial, interface, version) for serial in serials)
 
 
@@ -143,7 +154,7 @@ class LiveDemo:
         faults: Sequence[Sequence[StopFault]] = ((), ()),
         broker_url: str | None = None,
         spacing: float = RELEASE_SPACING,
-        state_rate: float = 10.0,
+        state_rate: float = 1.0,
         period: float = 0.02,
         log: RunLog | None = None,
     ) -> None:
@@ -189,11 +200,11 @@ class LiveDemo:
             for v in (0, 1)
         )
         self.master = LiveMaster(
-            self.verified,
-            scenario.names,
+            scenario,
             identities=ids,
             broker=settings,
             method=self.method,
+            plan=self.verified,
             clock=self.clock,
             log=self.log,
             spacing=self.spacing,

@@ -9,6 +9,13 @@ publishes ``state`` at a fixed rate and at once on every event (a node
 reached, an order taken or refused), and ``connection`` ONLINE, retained, with
 a last will of CONNECTIONBROKEN.
 
+The instant action ``cancelOrder`` (VDA 5050 section 6.6.3) stops it at the first node of its
+base it can come to rest at; its state shows the action RUNNING, then FINISHED once it stands,
+with no order left (its ``orderId`` and ``orderUpdateId`` stay, its node counted from there). It
+watches the master's ``connection`` too: when the master is gone (its last will, or OFFLINE) it
+drives on to the end of its released base, which is safe, and says so (:attr:`SimulatedVehicle.over`).
+With a ``memory`` file it keeps where it last said it stands, for a restart (``--start last``).
+
 Positions are the order's node positions (metres, the map's x/y), interpolated
 along each edge: the vehicle knows no more of the track than its orders say.
 Where an order gives no position (a track graph without coordinates, a curved
@@ -20,67 +27,35 @@ node and ``distanceSinceLastNode`` alone, as a line-guided vehicle does
 from __future__ import annotations
 
 import contextlib
+import json
 import logging
 import math
 import queue
 import threading
 import time
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass
+from pathlib import Path
 
 from limits import VehicleLimits
 from topology.validation import short_repr
 from trajgen.errors import InputError
 from trajgen.live.clock import RunClock
+from trajgen.live.drive import AT_REST, Drive, VehicleSnapshot
 from trajgen.live.driven_path import NODE_TOLERANCE, DrivenPath
 from trajgen.live.faults import StopFault
 from trajgen.live.link import BrokerLink
+from trajgen.live.memory import remember
 from trajgen.live.mqtt import BrokerSettings, Topic, VehicleIdentity, make_client
+from trajgen.live.notices import CANCEL_ORDER, VDA5050_VERSION, connection_message
 
 __all__ = ["SimulatedVehicle", "StopFault", "VehicleSnapshot"]
 
 logger = logging.getLogger(__name__)
 
-#: Slower than this is at rest, m/s.
-AT_REST = 1e-6
 #: How far ahead of its decision point the vehicle asks for more base (``newBaseRequest``), metres.
 _BASE_REQUEST_DISTANCE = 2.0
 #: Wall seconds the drive loop sleeps between its catch-ups.
 _LOOP_SLEEP_S = 0.004
-
-
-@dataclass(frozen=True, slots=True)
-class VehicleSnapshot:
-    """Where a simulated vehicle truly is (not what it reported).
-
-    Attributes
-    ----------
-    time : float
-        Seconds of the run.
-    x, y : float
-        Metres, map coordinates (NaN where its orders give none).
-    velocity : float
-        Along its path, m/s (>= 0).
-    last_node : int
-        How many nodes of its current order it has passed (0: at its first node).
-    finished : bool
-        At rest at the last node of an order with no horizon left.
-    node, next_node : str
-        The ids of the last node it passed (its start node before any order) and of the next
-        (``""`` at the end of its order).
-    along : float
-        Metres driven past ``node`` towards ``next_node``.
-    """
-
-    time: float
-    x: float
-    y: float
-    velocity: float
-    last_node: int
-    finished: bool
-    node: str = ""
-    next_node: str = ""
-    along: float = 0.0
 
 
 class SimulatedVehicle:
@@ -97,7 +72,8 @@ class SimulatedVehicle:
     clock : RunClock, optional
         The run's clock (shared with others in the process to compare their times).
     state_rate : float
-        ``state`` messages per second of the run, besides those on events (default 10).
+        ``state`` messages per second of the run, besides those on events (default 1: a node
+        reached, starting and stopping are said at once, so the master needs no more).
     period : float
         Control cycle, seconds of the run (default 0.02).
     faults : sequence of StopFault
@@ -109,6 +85,10 @@ class SimulatedVehicle:
         Called with each cycle's :class:`VehicleSnapshot` (in the vehicle's thread).
     start_node : str, optional
         The id of the node it stands at (its ``lastNodeId`` until its first order; ``""``: none).
+    memory : path, optional
+        A file where it keeps the place of every state it publishes (``lastNodeId``, the next node,
+        ``distanceSinceLastNode``, x/y), replaced whole each time: where it stood if it is killed
+        (:func:`~trajgen.live.memory.remembered_place`).
     """
 
     def __init__(
@@ -119,16 +99,15 @@ class SimulatedVehicle:
         *,
         broker: BrokerSettings,
         clock: RunClock | None = None,
-        state_rate: float = 10.0,
+        state_rate: float = 1.0,
         period: float = 0.02,
         faults: Sequence[StopFault] = (),
         map_id: str = "trajgen",
         record: bool = False,
         observer: Callable[[VehicleSnapshot], None] | None = None,
         start_node: str = "",
+        memory: str | Path | None = None,
     ) -> None:
-        from ruckig import InputParameter, OutputParameter, Ruckig
-
         if not isinstance(state_rate, int | float) or not 0.1 <= state_rate <= 100.0:
             raise InputError(f"state rate {short_repr(state_rate)} Hz is out of range: expected 0.1 to 100")
         if not isinstance(period, int | float) or not 0.001 <= period <= 0.1:
@@ -145,21 +124,20 @@ class SimulatedVehicle:
         self.observer = observer
         self._start = (math.nan, math.nan) if start is None else (float(start[0]), float(start[1]))
         self._start_node = start_node
-        self._otg = Ruckig(1, self.period)
-        self._input = InputParameter(1)
-        self._output = OutputParameter(1)
-        self._input.max_velocity = [limits.max_velocity]
-        self._input.max_acceleration = [limits.max_acceleration]
-        self._input.max_jerk = [limits.max_jerk]
+        self._drive = Drive(limits, self.period, who=identity.serial_number)
         self._t = 0.0
-        self._p = self._v = self._a = 0.0
-        self._path: DrivenPath | None = None
-        self._last = 0
         self._order = None  # the accepted order, merged with its updates (vda5050 Order)
+        self._reported = ("", 0)  # orderId and orderUpdateId its states give (kept after a cancel)
         self._state = None  # the last state published (vda5050 State)
         self._errors: list = []
+        self._actions: dict[str, dict] = {}  # actionId -> its action state (instant actions)
+        self._cancelled = False  # its last order was cancelled (it stands with no order)
+        self._master_state = "ONLINE"  # the master's connection as last said (before any: online)
+        self._master_left = False  # the master went (OFFLINE, its last will) while this vehicle ran
+        self.memory = Path(memory) if memory is not None else None
         self._headers = {Topic.STATE: 0, Topic.CONNECTION: 0}
-        self._inbox: queue.SimpleQueue[tuple[float, bytes]] = queue.SimpleQueue()  # (arrival, payload)
+        # (arrival, topic, payload)
+        self._inbox: queue.SimpleQueue[tuple[float, str, bytes]] = queue.SimpleQueue()
         self._event = True
         self._next_state = 0.0
         self._lock = threading.Lock()
@@ -182,31 +160,50 @@ class SimulatedVehicle:
 
     # ----------------------------------------------------------------- MQTT
     def _connection_message(self, state: str) -> bytes:
-        from vda5050.model.connection import Connection
-
         self._headers[Topic.CONNECTION] += 1
-        message = Connection(
-            header_id=self._headers[Topic.CONNECTION],
-            timestamp=self.clock.timestamp(),
-            version="2.1.0",
-            manufacturer=self.identity.manufacturer,
-            serial_number=self.identity.serial_number,
-            connection_state=state,
-        )
-        return message.to_json().encode()
+        header, stamp = self._headers[Topic.CONNECTION], self.clock.timestamp()
+        return connection_message(self.identity, state, header=header, timestamp=stamp)
 
     def _connected(self, client) -> None:
         client.subscribe(self.identity.topic(Topic.ORDER), qos=0)
+        client.subscribe(self.identity.topic(Topic.INSTANT_ACTIONS), qos=0)
+        client.subscribe(self.identity.master.topic(Topic.CONNECTION), qos=1)
         client.publish(
             self.identity.topic(Topic.CONNECTION), self._connection_message("ONLINE"), qos=1, retain=True
         )
         self._event = True  # a state at once: the master learns where the vehicle is
 
     def _on_message(self, client, userdata, message) -> None:
-        if message.topic != self.identity.topic(Topic.ORDER):  # amqtt may replay others' retained messages
+        topics = (self.identity.topic(Topic.ORDER), self.identity.topic(Topic.INSTANT_ACTIONS))
+        if message.topic == self.identity.master.topic(Topic.CONNECTION):
+            self._take_master(bytes(message.payload), live=not message.retain)
+        elif message.topic in topics:
+            self._inbox.put((self.clock.now(), message.topic, bytes(message.payload)))
+        else:  # amqtt may replay others' retained messages
             logger.debug("vehicle %s: ignored a message on %s", self.identity.serial_number, message.topic)
+
+    def _take_master(self, payload: bytes, *, live: bool) -> None:
+        """The master's connection: once it is gone, the vehicle says so (and drives its base to its end).
+
+        ``live``: the change happened now (a retained message delivered on subscribing is old news:
+        the master of an earlier run).
+        """
+        try:
+            state = json.loads(payload)["connectionState"]
+        except (ValueError, KeyError, TypeError):
+            logger.debug("vehicle %s: an unreadable master connection message", self.identity.serial_number)
             return
-        self._inbox.put((self.clock.now(), bytes(message.payload)))
+        before, self._master_state = self._master_state, state
+        self._master_left = state != "ONLINE" and live
+        cancelled = self._drive.cancel_at is not None
+        driving_an_order = self._order is not None and not cancelled and not self.snapshot.finished
+        if state != "ONLINE" and before == "ONLINE" and driving_an_order:
+            logger.warning(
+                "vehicle %s: the master is gone (%s): it drives on to the end of its released base and "
+                "holds there",
+                self.identity.serial_number,
+                state,
+            )
 
     def start(self) -> SimulatedVehicle:
         """Connect and start driving (in threads of its own); returns itself."""
@@ -278,6 +275,24 @@ class SimulatedVehicle:
         return None if began is None else self.snapshot.time - began
 
     @property
+    def over(self) -> str | None:
+        """Why its run is over without its goal, once it stands: its order cancelled, or the master gone.
+
+        ``None`` while it drives, holds an order from a master that is there, or is at its goal.
+        """
+        with self._lock:
+            snapshot = self._snapshot
+        if snapshot.finished or snapshot.velocity > AT_REST:
+            return None
+        if self._cancelled:
+            return "its order was cancelled by the master"
+        if self._master_state != "ONLINE" and (self._order is not None or self._master_left):
+            gone = f"the master is gone ({self._master_state})"
+            ordered = self._order is not None or self._first_order is not None
+            return gone if ordered else f"{gone} before any order"
+        return None
+
+    @property
     def trace(self) -> tuple[VehicleSnapshot, ...]:
         """Every cycle's snapshot (with ``record=True``; empty otherwise)."""
         with self._lock:
@@ -333,7 +348,7 @@ class SimulatedVehicle:
                 references,
             )
             return
-        if self._state is None:  # no state sent yet: the acceptance must still know where it stands
+        if self._state is None or self._event:  # the acceptance must know where it stands now
             self._state_message()
         session = VehicleSession(
             key=VehicleKey(self.identity.manufacturer, self.identity.serial_number),
@@ -349,29 +364,90 @@ class SimulatedVehicle:
             )
             return
         self._errors.clear()
+        self._reported = (order.order_id, order.order_update_id)
         if result.decision is AcceptanceDecision.ACCEPT_NEW:
             if self._first_order is None:
                 self._first_order = self._t
-            self._path = DrivenPath(list(order.nodes), list(order.edges))
+            self._cancelled = False
+            self._drive.take(DrivenPath(list(order.nodes), list(order.edges)))
             self._order = order
-            self._last = 0
-            self._p = self._v = self._a = 0.0
-            here = self._path.point(0.0)
+            here = self._drive.path.point(0.0)
             self._start = (math.nan, math.nan) if here is None else here[:2]
             self._start_node = order.nodes[0].node_id
         else:
-            stitch = next(
-                k for k, node in enumerate(self._path.nodes) if node.sequence_id == order.nodes[0].sequence_id
-            )
-            self._path.extend(stitch, list(order.nodes), list(order.edges))
-            self._order = order.model_copy(update={"nodes": self._path.nodes, "edges": self._path.edges})
+            path = self._drive.path
+            first = order.nodes[0].sequence_id
+            stitch = next(k for k, node in enumerate(path.nodes) if node.sequence_id == first)
+            path.extend(stitch, list(order.nodes), list(order.edges))
+            self._order = order.model_copy(update={"nodes": path.nodes, "edges": path.edges})
         logger.debug(
             "vehicle %s: took order %s update %d (base to node %d)",
             self.identity.serial_number,
             order.order_id,
             order.order_update_id,
-            self._path.base_end,
+            self._drive.path.base_end,
         )
+
+    def _receive_actions(self, payload: bytes) -> None:
+        """``instantActions``: ``cancelOrder`` stops it; any other is refused as not supported."""
+        from vda5050.errors import MessageValidationError
+        from vda5050.model.instant_actions import InstantActions
+        from vda5050.serialization import decode
+
+        self._event = True
+        try:
+            message = decode(payload, InstantActions)
+        except MessageValidationError as error:
+            self._reject("validationError", str(error)[:200], {"topic": Topic.INSTANT_ACTIONS})
+            return
+        if (message.manufacturer, message.serial_number) != (
+            self.identity.manufacturer,
+            self.identity.serial_number,
+        ):
+            where = {"topic": Topic.INSTANT_ACTIONS}
+            self._reject("validationError", "the instant actions name another vehicle", where)
+            return
+        for action in message.actions:
+            if action.action_type != CANCEL_ORDER:
+                self._action(action.action_id, action.action_type, "FAILED", "not supported by this vehicle")
+                self._reject("actionError", f"instant action {action.action_type!r} is not supported", {})
+            elif action.action_id in self._actions:  # the same cancelOrder again: it is under way
+                continue
+            elif self._order is None:
+                self._action(action.action_id, CANCEL_ORDER, "FAILED", "no order to cancel")
+                where = {"actionId": action.action_id}
+                self._reject("noOrderToCancel", "cancelOrder: no order to cancel", where)
+            else:
+                self._action(action.action_id, CANCEL_ORDER, "RUNNING")
+                ahead = self._drive.cancel() - self._drive.p
+                logger.warning(
+                    "vehicle %s: its order is cancelled: it stops %.3f m ahead, at a node of its base",
+                    self.identity.serial_number,
+                    ahead,
+                )
+
+    def _action(self, action_id: str, action_type: str, status: str, description: str = "") -> None:
+        self._actions[action_id] = {
+            "action_id": action_id,
+            "action_type": action_type,
+            "action_status": status,
+            "result_description": description or None,
+        }
+
+    def _end_cancel(self) -> None:
+        """A cancelled order once the vehicle stands: no order left, its node counted from here."""
+        where = self._where()
+        place = self._drive.path.place(self._drive.p, self._drive.last)
+        self._start = (math.nan, math.nan) if where is None else (where[0], where[1])
+        self._start_node = place[0] if place[2] <= NODE_TOLERANCE else self._start_node
+        for action in self._actions.values():
+            if action["action_type"] == CANCEL_ORDER and action["action_status"] == "RUNNING":
+                action["action_status"] = "FINISHED"
+        self._drive.clear()
+        self._order = None
+        self._cancelled = True
+        self._event = True
+        logger.info("vehicle %s: it stands; its order is cancelled", self.identity.serial_number)
 
     # ----------------------------------------------------------------- driving
     def _held(self, t: float) -> bool:
@@ -396,70 +472,26 @@ class SimulatedVehicle:
                     why,
                 )
 
-    def _next_stop(self) -> float:
-        path = self._path
-        end = path.base_end
-        k = self._last + 1
-        while k < end and not path.reversal(k):
-            k += 1
-        return path.arcs[max(min(k, end), self._last)]
-
     def _step(self) -> None:
-        from ruckig import ControlInterface, Result
-
         self._t += self.period
-        path = self._path
-        if path is None:
-            return
-        inp = self._input
-        inp.current_position = [self._p]
-        inp.current_velocity = [self._v]
-        inp.current_acceleration = [self._a]
-        if self._held(self._t):
-            inp.control_interface = ControlInterface.Velocity
-            inp.target_velocity = [0.0]
-            inp.target_acceleration = [0.0]
-        else:
-            inp.control_interface = ControlInterface.Position
-            inp.target_position = [self._next_stop()]
-            inp.target_velocity = [0.0]
-            inp.target_acceleration = [0.0]
-        result = self._otg.update(inp, self._output)
-        if result not in (Result.Working, Result.Finished):
-            logger.error("vehicle %s: Ruckig failed (%s); braking", self.identity.serial_number, result)
-            self._v = max(0.0, self._v - self.limits.max_acceleration * self.period)
-            self._a = 0.0
-        else:
-            self._p, self._v, self._a = (
-                self._output.new_position[0],
-                self._output.new_velocity[0],
-                self._output.new_acceleration[0],
-            )
-        end = path.base_end
-        while self._last < end and self._p >= path.arcs[self._last + 1] - NODE_TOLERANCE:
-            self._last += 1
-            self._event = True
-
-    def _finished(self) -> bool:
-        path = self._path
-        return (
-            path is not None
-            and self._last == len(path.nodes) - 1
-            and all(node.released for node in path.nodes)
-            and abs(self._v) <= AT_REST
-        )
+        if self._drive.step(held=self._held(self._t)):
+            self._event = True  # a node passed: said at once
+        if self._drive.cancelled_and_standing:
+            self._end_cancel()
 
     def _where(self) -> tuple[float, float, float] | None:
         """``(x, y, theta)`` now, ``None`` where its orders give no position."""
-        if self._path is not None:
-            return self._path.point(self._p)
+        drive = self._drive
+        if drive.path is not None:
+            return drive.path.point(drive.p)
         return None if math.isnan(self._start[0]) else (*self._start, 0.0)
 
     def _update_snapshot(self) -> None:
         x, y, _ = self._where() or (math.nan, math.nan, 0.0)
-        path = self._path
-        place = path.place(self._p, self._last) if path is not None else (self._start_node, "", 0.0)
-        snapshot = VehicleSnapshot(self._t, x, y, self._v, self._last, self._finished(), *place)
+        drive = self._drive
+        standing = (self._start_node, "", 0.0)
+        place = drive.path.place(drive.p, drive.last) if drive.path is not None else standing
+        snapshot = VehicleSnapshot(self._t, x, y, drive.v, drive.last, drive.finished(), *place)
         with self._lock:
             self._snapshot = snapshot
             if self.record:
@@ -470,32 +502,19 @@ class SimulatedVehicle:
     def _state_message(self) -> bytes:
         from vda5050.model.state import State
 
-        path = self._path
+        drive, v = self._drive, self._drive.v
         self._headers[Topic.STATE] += 1
         where = self._where()
         theta = where[2] if where is not None else 0.0
-        nodes = path.nodes if path is not None else []
-        edges = path.edges if path is not None else []
-        last = nodes[self._last] if nodes else None
-        to_decision_point = path.arcs[path.base_end] - self._p if path is not None else 0.0
         state = State(
             header_id=self._headers[Topic.STATE],
             timestamp=self.clock.timestamp(self._t),
-            version="2.1.0",
+            version=VDA5050_VERSION,
             manufacturer=self.identity.manufacturer,
             serial_number=self.identity.serial_number,
-            order_id=self._order.order_id if self._order is not None else "",
-            order_update_id=self._order.order_update_id if self._order is not None else 0,
-            last_node_id=last.node_id if last is not None else self._start_node,
-            last_node_sequence_id=last.sequence_id if last is not None else 0,
-            node_states=[
-                {"node_id": n.node_id, "sequence_id": n.sequence_id, "released": n.released}
-                for n in nodes[self._last + 1 :]
-            ],
-            edge_states=[
-                {"edge_id": e.edge_id, "sequence_id": e.sequence_id, "released": e.released}
-                for e in edges[self._last :]
-            ],
+            order_id=self._reported[0],
+            order_update_id=self._reported[1],
+            **drive.progress(self._start_node, base_request=_BASE_REQUEST_DISTANCE),
             agv_position=None
             if where is None
             else {
@@ -505,21 +524,24 @@ class SimulatedVehicle:
                 "theta": theta,
                 "map_id": self.map_id,
             },
-            velocity={"vx": self._v * math.cos(theta), "vy": self._v * math.sin(theta), "omega": 0.0},
-            driving=abs(self._v) > AT_REST,
+            velocity={"vx": v * math.cos(theta), "vy": v * math.sin(theta), "omega": 0.0},
+            driving=not drive.at_rest,
             paused=self._held(self._t),
-            new_base_request=path is not None
-            and any(not n.released for n in nodes)
-            and to_decision_point < _BASE_REQUEST_DISTANCE,
-            distance_since_last_node=max(0.0, self._p - path.arcs[self._last]) if path is not None else 0.0,
-            action_states=[],
+            action_states=list(self._actions.values()),
             battery_state={"battery_charge": 100.0, "charging": False},
             operating_mode="AUTOMATIC",
             errors=list(self._errors),
             safety_state={"e_stop": "NONE", "field_violation": False},
         )
         self._state = state
+        if self.memory is not None:
+            self._remember(state)
         return state.to_json().encode()
+
+    def _remember(self, state) -> None:
+        """Where the state says it stands, kept in :attr:`memory`; none kept once the file fails."""
+        if not remember(self.memory, state):
+            self.memory = None
 
     def _publish_state(self) -> None:
         if not (self.link.connected and self._client.is_connected()):  # offline, or not yet ONLINE
@@ -538,7 +560,7 @@ class SimulatedVehicle:
             self._update_snapshot()
             # starting and stopping are events: the master learns at once that a vehicle stands
             said_driving = self._state is not None and self._state.driving
-            if self._event or self._t >= self._next_state or (abs(self._v) > AT_REST) != said_driving:
+            if self._event or self._t >= self._next_state or (not self._drive.at_rest) != said_driving:
                 self._publish_state()
 
     def _run(self) -> None:
@@ -549,11 +571,14 @@ class SimulatedVehicle:
                 # drives to that moment without it (else it would act on news from its future)
                 while True:
                     try:
-                        arrival, payload = self._inbox.get_nowait()
+                        arrival, topic, payload = self._inbox.get_nowait()
                     except queue.Empty:
                         break
                     self._advance(min(arrival, now))
-                    self._receive(payload)
+                    if topic == self.identity.topic(Topic.ORDER):
+                        self._receive(payload)
+                    else:
+                        self._receive_actions(payload)
                 self._advance(now)
                 if self._event:
                     self._publish_state()

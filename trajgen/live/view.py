@@ -2,10 +2,12 @@
 
 from __future__ import annotations
 
-from topology import JUNCTION_INDEX, EdgePoint, Position
-from trajgen.export.vda5050.graph_path import GraphPathNode
+from topology import EdgePoint, Position
+from trajgen.errors import InputError
+from trajgen.export.vda5050.messages import path_node_id
 from trajgen.live.mqtt import Topic, VehicleIdentity
 from trajgen.live.outcome import LiveOutcome
+from trajgen.live.places import path_place, reported_place
 
 __all__ = [
     "GIVE_UP_AFTER_S",
@@ -40,13 +42,14 @@ def reported_order(state) -> str:
 
 
 def not_taken_message(state, seconds: float) -> str:
-    """Why a run ends when a vehicle's states showed for ``seconds`` that it lacks its order."""
-    said = dict.fromkeys(f"; {e.error_type}: {e.error_description}" for e in state.errors)  # each once
-    errors = "".join(said)
-    return (
-        f"has not taken its order in {seconds:g} s of re-sends (it reports {reported_order(state)}"
-        f"{errors}): {NOT_TAKEN_WHY}"
-    )
+    """Why a run ends when a vehicle's states showed for ``seconds`` that it lacks its order.
+
+    The vehicle's own reasons (its state's errors) when it gives any; else what may keep an order
+    from it (:data:`NOT_TAKEN_WHY`).
+    """
+    reasons = "; ".join(dict.fromkeys(f"{e.error_type}: {e.error_description}" for e in state.errors))
+    why = f"it says {reasons}" if reasons else NOT_TAKEN_WHY
+    return f"has not taken its order in {seconds:g} s of re-sends (it reports {reported_order(state)}): {why}"
 
 
 def never_heard_message(silent) -> str:
@@ -56,21 +59,17 @@ def never_heard_message(silent) -> str:
     return f"{names} never came online (nothing on {topics}; are they started, with these serial numbers?)"
 
 
-def run_failure(outcome, link, *, gave_up: str | None, broker_url: str, sent: bool, silent) -> str | None:
+def run_failure(outcome, link, *, why: str | None, broker_url: str) -> str | None:
     """Why a live run ended early (its :class:`~trajgen.live.outcome.LiveOutcome`), or ``None``.
 
-    ``link``: the master's BrokerLink; ``gave_up``: why it gave a vehicle up; ``sent``: whether the
-    first orders went out; ``silent``: the views of vehicles never heard.
+    ``link``: the master's BrokerLink; ``why``: the master's own reason (a refusal, a vehicle given
+    up, a signal, what the first orders still waited for).
     """
     if outcome is LiveOutcome.BROKER_FAILED:
         return link.failure
-    if outcome is LiveOutcome.ORDER_NOT_TAKEN:
-        return gave_up
     if outcome is LiveOutcome.TIMED_OUT and not link.ever_connected:
         return f"master: the broker {broker_url} was never reached (retried until the time limit)"
-    if outcome is LiveOutcome.TIMED_OUT and not sent and silent:
-        return f"master: no order was sent: {never_heard_message(silent)}"
-    return None
+    return why
 
 
 class VehicleView:
@@ -83,21 +82,33 @@ class VehicleView:
         self.arcs: list[float] = []  # distance along the whole run at each node of the current path
         self.offset = 0  # sequenceId of the current path's node 0
         self.update = -1  # the latest orderUpdateId sent
+        self.plan_update = 0  # the orderUpdateId of the current plan's first order (update)
         self.order = None  # the latest order (update) sent (vda5050 Order); a re-send gets a new header
         self.resend_after = RESEND_INTERVAL_S  # wall seconds: doubles while re-sends change nothing
         self.sent_at = -float("inf")  # wall time of the latest send
         self.lacking_since: float | None = None  # run time its states began to lack the latest order
         self.header = 0
+        self.action_header = 0  # headerId of its instantActions
         self.state_header: int | None = None
         self.node = 0  # last node reached (index on the current path)
         self.driving = False
         self.online: bool | None = None
-        self.heard = False  # ONLINE or a state came from it: the run can begin
+        self.heard = False  # ONLINE or a state came from it
+        self.place = None  # where its latest state puts it (Position or EdgePoint); None: not said
+        self.unplaced: str | None = None  # why its latest state places it nowhere on the track
+        self.foreign: str | None = None  # the orderId of an earlier run's order it still holds, active
+        self.taken = False  # its states show it holds the current plan's order
+        self.off_plan: str | None = None  # why its latest state puts it off its plan (releases held)
+        self.cancelled: str | None = None  # the actionId of the cancelOrder sent to it
+        self.cancelled_order: str | None = None  # the earlier run's order it was sent to cancel
+        self.cancel_sent_at = -float("inf")  # wall time of the latest cancelOrder sent
+        self.told = False  # its state shows the cancelOrder (running or finished)
+        self.off_plan_since: float | None = None  # run time its states began to put it off its plan
         self.errors: set[str] = set()
         self.record: dict = {}
         self.elements: list = []  # [(nodes, edges) in horizon, (nodes, edges) in base]
         self.rejoined = False  # back online: its first state tells whether it kept its order
-        self.restart: Position | None = None  # where it stands after a restart without its order
+        self.restart: Position | EdgePoint | None = None  # where it stands after a restart without its order
 
     def standing(self, graph) -> Position | EdgePoint:
         """Where it stands: where it restarted, else the last node of its path it reached.
@@ -106,10 +117,75 @@ class VehicleView:
         """
         if self.restart is not None:
             return self.restart
-        node = self.path.nodes[self.node]
-        if isinstance(node, GraphPathNode):
-            return node.point
-        return Position(None, 0.0) if node.leg == JUNCTION_INDEX else Position(graph.names[node.leg], node.s)
+        return path_place(graph, self.path, self.node, 0.0)
+
+    def adopt(self, path, *, offset: int, elements, first: bool) -> None:
+        """Take its path of a new plan (an order path), numbered from ``offset``, its order elements.
+
+        ``first``: the run's first plan (its travel from 0); else the travel goes on from the node it
+        reached.
+        """
+        start = 0.0 if first else self.arcs[self.node]
+        self.offset = offset
+        self.path = path
+        self.arcs = [start]
+        for edge in path.edges:
+            self.arcs.append(self.arcs[-1] + edge.length)
+        self.node = 0
+        self.restart = None
+        self.taken = False
+        self.plan_update = self.update + 1
+        self.elements = elements
+
+    def base_node(self, graph, state, released: int) -> int | None:
+        """The index on its path (on ``graph``) of the node its ``state`` says it reached, if on its base.
+
+        ``None``: the state's last node (``lastNodeId``, ``lastNodeSequenceId``) is not a node of its
+        path up to node ``released`` (it stands off its plan).
+        """
+        j, odd = divmod(state.last_node_sequence_id - self.offset, 2)
+        on = 0 <= j <= released and not odd and state.last_node_id == path_node_id(graph, self.path, j)
+        return j if on else None
+
+    def connection(self, online: bool, *, running: bool) -> bool:
+        """Its connection state said: ONLINE (``online``) or not; whether it changed.
+
+        Back online while the run goes (``running``), its next state tells whether it kept its order;
+        a vehicle that restarted counts its headers afresh.
+        """
+        if online == self.online:
+            return False
+        back = self.online is False  # None: the first news (a retained message), after the first order
+        self.online = online
+        if online:
+            self.state_header = None
+            self.rejoined = back and running
+            self.heard = True
+        return True
+
+    def take_place(self, graph, state, order_id: str):
+        """Before the run: where its ``state`` puts it (or ``None``), whether it drives, an earlier order.
+
+        ``order_id``: this run's for it: an active order under another id is an earlier run's
+        (:attr:`foreign`). A place the track does not have leaves :attr:`place` ``None`` and says why
+        in :attr:`unplaced`.
+        """
+        self.driving = state.driving
+        active = bool(state.node_states or state.edge_states)
+        self.foreign = state.order_id if state.order_id and active and state.order_id != order_id else None
+        try:
+            place = reported_place(graph, state)
+        except InputError as error:
+            self.unplaced, self.place = str(error), None
+            return None
+        self.unplaced = None
+        if place is None:
+            self.place = None
+        return place
+
+    def at_goal(self) -> bool:
+        """Whether it reported the last node of its path."""
+        return bool(self.arcs) and self.node == len(self.arcs) - 1
 
     def state_record(self, state, j: int, t: float) -> dict:
         """The run log's record of ``state``, which says it reached node ``j``, at run time ``t``."""

@@ -40,6 +40,7 @@ __all__ = [
     "SolverCache",
     "Toppra",
     "make_schedule",
+    "method_for",
 ]
 
 _SOURCES = {
@@ -77,6 +78,27 @@ METHODS = MethodRegistry(
     ),
     default="optimal",
 )
+
+
+#: The method a track graph is timed by when none is asked for.
+GRAPH_DEFAULT = "exact"
+
+
+def method_for(method: TimingMethod | str | None, track) -> TimingMethod:
+    """The method object of ``method``, or for ``None`` the default for ``track``.
+
+    The one rule every command follows: ``exact`` on a track graph (:data:`GRAPH_DEFAULT`; its
+    optimal method can take minutes on a large layout), the registry's default (``optimal``) on a
+    junction.
+
+    Raises
+    ------
+    OptionError
+        Unknown method name.
+    """
+    from topology import TrackGraph
+
+    return METHODS.create(GRAPH_DEFAULT if method is None and isinstance(track, TrackGraph) else method)
 
 
 def make_schedule(route: Route, limits: Limits, *, method: TimingMethod | str | None = None) -> Schedule:

@@ -22,6 +22,7 @@ __all__ = [
     "acceleration_steps",
     "plot_period",
     "plot_speed",
+    "vehicle_colour",
 ]
 
 #: Sample period of the plotted curves, seconds (longer for long schedules: see :func:`plot_period`).
@@ -37,6 +38,13 @@ def plot_period(duration: float) -> float:
 
 #: Line colours of vehicle 1 and vehicle 2.
 VEHICLE_COLOURS = ("tab:blue", "tab:orange")
+
+
+def vehicle_colour(index: int) -> str:
+    """The colour of vehicle ``index`` (0-based): :data:`VEHICLE_COLOURS`, then matplotlib's cycle."""
+    return VEHICLE_COLOURS[index] if index < len(VEHICLE_COLOURS) else f"C{index % 10}"
+
+
 #: A change of acceleration below this share of the vehicle's limit is round-off, not a step.
 STEP_SHARE = 1e-6
 #: How far either side of a piece boundary its step is read, seconds per second of schedule (at least 1 s).

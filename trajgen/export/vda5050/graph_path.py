@@ -16,6 +16,7 @@ separation.
 
 from __future__ import annotations
 
+import functools
 import itertools
 import math
 from dataclasses import dataclass
@@ -34,6 +35,19 @@ __all__ = ["GraphOrderPath", "GraphPathEdge", "GraphPathNode", "graph_vehicle_pa
 
 #: A claim: stretches ``(edge, low, high)`` of track edges, metres from each edge's ``from`` node.
 Claim = tuple[tuple[int, float, float], ...]
+
+
+@functools.lru_cache(maxsize=16)
+def _scalar_metric(track: TrackGraph) -> tuple[list, list, list]:
+    """``track``'s edge ends, edge lengths and node-to-node distances as Python lists.
+
+    The release rule measures tens of thousands of gaps between single stretches: plain floats
+    do each in microseconds where a NumPy call per gap takes tens
+    (:meth:`~topology.TrackGraph.distances` computes the same ways).
+    """
+    ends = [track.ends(k) for k in range(track.edge_count)]
+    lengths = [track.length(k) for k in range(track.edge_count)]
+    return ends, lengths, track.node_distances.tolist()
 
 
 @dataclass(frozen=True, slots=True)
@@ -123,15 +137,24 @@ class GraphOrderPath:
         Each way between two points (along one edge, or through an end of each edge) is affine in
         each point's position, so its least value over two stretches is at a pair of their ends.
         """
+        ends, lengths, between = _scalar_metric(self.track)
         low = math.inf
         for (edge_a, low_a, high_a), (edge_b, low_b, high_b) in itertools.product(first, second):
             if edge_a == edge_b and low_a <= high_b and low_b <= high_a:
                 return 0.0
-            corners = np.array(list(itertools.product((low_a, high_a), (low_b, high_b))))
-            distances = self.track.distances(
-                np.full(4, edge_a), corners[:, 0], np.full(4, edge_b), corners[:, 1]
-            )
-            low = min(low, float(distances.min()))
+            (ua, va), (ub, vb) = ends[edge_a], ends[edge_b]
+            row_u, row_v = between[ua], between[va]
+            la, lb = lengths[edge_a], lengths[edge_b]
+            for sa in (low_a, high_a):
+                ra = la - sa
+                for sb in (low_b, high_b):
+                    rb = lb - sb
+                    way = min(
+                        row_u[ub] + sa + sb, row_u[vb] + sa + rb, row_v[ub] + ra + sb, row_v[vb] + ra + rb
+                    )
+                    if edge_a == edge_b:
+                        way = min(way, abs(sa - sb))
+                    low = min(low, way)
         return low
 
     def placed(self, index: int) -> bool:
