@@ -18,14 +18,12 @@ from __future__ import annotations
 import json
 import os
 import signal
-import subprocess
-import sys
 import time
 
 import pytest
 
 from tests.conftest import REPO
-from tests.support.live import States, closest_states, new_broker, place_reader
+from tests.support.live import States, closest_states, new_broker, place_reader, trajgen_process
 from trajgen.export.vda5050.graph_path import point_id
 from trajgen.live.broker import MosquittoBroker
 from trajgen.scenario import GraphScenario, load_scenario
@@ -35,15 +33,6 @@ H = str(REPO / "examples" / "graphs" / "h.toml")
 SCALE = 5.0
 #: Metres two states may lag each other by (a state per 0.1 s of the run, 2 m/s between them).
 STATE_SKEW_M = 0.25
-
-
-def _trajgen(*arguments: str) -> subprocess.Popen:
-    return subprocess.Popen(
-        [sys.executable, "-m", "trajgen", *arguments],
-        stdout=subprocess.PIPE,
-        stderr=subprocess.PIPE,
-        text=True,
-    )
 
 
 def _run_with_a_restart(path: str, method: str, log, *, last: bool = False):
@@ -60,8 +49,8 @@ def _run_with_a_restart(path: str, method: str, log, *, last: bool = False):
     states = States(broker.url, place_of)
     common = ["--broker", broker.url, "--time-scale", f"{SCALE:g}"]
     vehicle = ["--exit-at-goal", "--timeout", "600"]
-    processes = {name: _trajgen("vehicle", path, name, *common, *vehicle) for name in scenario.names}
-    serve = _trajgen(
+    processes = {name: trajgen_process("vehicle", path, name, *common, *vehicle) for name in scenario.names}
+    serve = trajgen_process(
         "serve", path, *common, "--method", method, "--json", "--log", str(log), "--timeout", "600"
     )
     try:
@@ -78,7 +67,7 @@ def _run_with_a_restart(path: str, method: str, log, *, last: bool = False):
         seen = len(states.seen)
         time.sleep(0.7)  # a second after the kill
         start = "last" if last else start_text(here)
-        processes["agv1"] = _trajgen("vehicle", path, "agv1", *common, "--start", start, *vehicle)
+        processes["agv1"] = trajgen_process("vehicle", path, "agv1", *common, "--start", start, *vehicle)
         while not any(serial == "agv1" for serial, _, _ in states.seen[seen:]):
             assert time.monotonic() < killed + 60.0, "agv1 never came back"
             time.sleep(0.01)

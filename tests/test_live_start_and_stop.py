@@ -14,13 +14,12 @@ import json
 import os
 import signal
 import subprocess
-import sys
 import time
 
 import pytest
 
 from tests.conftest import REPO
-from tests.support.live import States, Tap, closest_states, new_broker, place_reader
+from tests.support.live import States, Tap, closest_states, new_broker, place_reader, trajgen_process
 from topology import Position
 from trajgen.cli import main
 from trajgen.export.vda5050.graph_path import point_id
@@ -34,15 +33,6 @@ H = str(REPO / "examples" / "graphs" / "h.toml")
 SCALE = 10.0
 
 
-def _trajgen(*arguments: str) -> subprocess.Popen:
-    return subprocess.Popen(
-        [sys.executable, "-m", "trajgen", *arguments],
-        stdout=subprocess.PIPE,
-        stderr=subprocess.PIPE,
-        text=True,
-    )
-
-
 def _vehicles(path: str, url: str, starts: dict[str, str], *, timeout: float = 600.0) -> dict:
     """A ``trajgen vehicle`` process per vehicle of ``path``, each at its ``--start`` in ``starts``."""
     processes = {}
@@ -50,7 +40,7 @@ def _vehicles(path: str, url: str, starts: dict[str, str], *, timeout: float = 6
         start = ["--start", starts[name]] if name in starts else []
         common = ["--broker", url, "--time-scale", f"{SCALE:g}", "--exit-at-goal"]
         common += ["--timeout", f"{timeout:g}"]
-        processes[name] = _trajgen("vehicle", path, name, *common, *start)
+        processes[name] = trajgen_process("vehicle", path, name, *common, *start)
     return processes
 
 
@@ -201,7 +191,7 @@ def test_serve_says_planning_connection_first_orders_and_the_end_one_line_each(t
 def _serve_process(path: str, url: str, folder) -> subprocess.Popen:
     options = ["--broker", url, "--time-scale", f"{SCALE / 2:g}", "--timeout", "200"]
     files = ["--log", str(folder / "run.jsonl"), "--plot", str(folder / "run.png")]
-    return _trajgen("serve", path, *options, *files)
+    return trajgen_process("serve", path, *options, *files)
 
 
 @pytest.mark.parametrize(
@@ -218,7 +208,7 @@ def test_a_master_stopped_mid_run_keeps_its_log_and_its_vehicles_know(how, statu
         processes = {}
         for name in scenario.names:
             common = ["--broker", broker.url, "--time-scale", f"{SCALE / 2:g}", "--exit-at-goal"]
-            processes[name] = _trajgen("vehicle", H, name, *common, "--timeout", "120")
+            processes[name] = trajgen_process("vehicle", H, name, *common, "--timeout", "120")
         serve = _serve_process(H, broker.url, tmp_path)
         try:
             deadline = time.monotonic() + 60.0

@@ -24,6 +24,16 @@ FAST = {"time_scale": 25.0, "state_rate": 1.0, "period": 0.02, "spacing": 1.0}
 HOP_S = 0.02
 
 
+def trajgen_process(*arguments: str) -> subprocess.Popen:
+    """``python -m trajgen ARGUMENTS`` as a process of its own, its output captured as text."""
+    return subprocess.Popen(
+        [sys.executable, "-m", "trajgen", *arguments],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+
+
 def new_broker():
     """The broker of a test: mosquitto when it is installed, else amqtt in this process."""
     return MosquittoBroker() if mosquitto_available() else EmbeddedBroker()
