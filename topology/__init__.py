@@ -1,10 +1,12 @@
-"""Exact collision-free motion planner for two vehicles on a junction of 3 to 8 legs.
+"""Exact collision-free motion planners for two vehicles on track graphs: junctions, sidings, loops.
 
-Implements Baldi, *Collision-Free Motion Planning Algorithm in a Y-Graph*,
-with the conventions of docs/planner.md: on a Y the configuration space
-deforms onto a circle, so two continuous instructions suffice (topological
-complexity 2). With four to eight legs it deforms onto the graph ``G_k`` and
-the planner takes one of three instructions (docs/star.md).
+Any track is a :class:`TrackGraph` (named nodes, edges with lengths; a point :class:`EdgePoint`):
+:func:`plan_graph` gives the ℓ1-shortest one-at-a-time route on the roadmap of critical points
+(docs/graphs.md). A single junction of 3 to 8 legs (:class:`StarGraph`, :class:`YGraph`) has the exact
+algorithm of Baldi, *Collision-Free Motion Planning Algorithm in a Y-Graph* (:func:`plan`), with
+the conventions of docs/planner.md: on a Y the configuration space deforms onto a circle, so two
+continuous instructions suffice (topological complexity 2); with four to eight legs it deforms onto
+the graph ``G_k`` and the planner takes one of three instructions (docs/star.md).
 
 Examples
 --------

@@ -1,9 +1,10 @@
-"""trajgen: collision-free, time-optimal schedules for two AGVs on a track junction of 3 to 8 legs.
+"""trajgen: collision-free, time-optimal schedules for AGVs on track graphs and junctions of 3 to 8 legs.
 
-The package face: scenarios, the planner's types, the timing methods, the
-verifier and the pipeline. The planner lives in :mod:`topology`, the vehicle
-limits in :mod:`limits`. Heavy dependencies (CasADi, TOPPRA, matplotlib) are
-imported only when used.
+The package face: scenarios (:class:`Scenario` on a junction, :class:`GraphScenario` on a track
+graph), the planners' types (:class:`TrackGraph`, :class:`EdgePoint`, :class:`GraphRoute`,
+:func:`plan_graph`; :class:`StarGraph`, :class:`Route`, :func:`plan`), the timing methods, the
+verifier and the pipeline. The planners live in :mod:`topology`, the vehicle limits in
+:mod:`limits`. Heavy dependencies (CasADi, TOPPRA, matplotlib) are imported only when used.
 
 Examples
 --------
@@ -20,7 +21,19 @@ from trajgen.lazy import lazy_attributes
 
 if TYPE_CHECKING:  # the names as a type checker sees them; at run time each is imported when first used
     from limits import Limits, VehicleLimits
-    from topology import Configuration, Instruction, Position, Route, StarGraph, YGraph, plan
+    from topology import (
+        Configuration,
+        EdgePoint,
+        GraphRoute,
+        Instruction,
+        Position,
+        Route,
+        StarGraph,
+        TrackGraph,
+        YGraph,
+        plan,
+        plan_graph,
+    )
     from trajgen.errors import InputError, TrajgenError, VerificationError
     from trajgen.export import CsvOptions, Units, write_profiles
     from trajgen.methods import METHODS, Exact, HomotopyChoice, Optimal, SolverCache, Toppra, make_schedule
@@ -29,6 +42,7 @@ if TYPE_CHECKING:  # the names as a type checker sees them; at run time each is 
     from trajgen.pipeline import Outputs, RunResult, run
     from trajgen.scenario import (
         BuiltinScenario,
+        GraphScenario,
         Scenario,
         builtin_scenario,
         default_scenario,
@@ -42,8 +56,11 @@ _SOURCES = {
     "BuiltinScenario": "trajgen.scenario",
     "Configuration": "topology",
     "CsvOptions": "trajgen.export",
+    "EdgePoint": "topology",
     "Exact": "trajgen.methods",
     "FallbackReason": "trajgen.model.schedule",
+    "GraphRoute": "topology",
+    "GraphScenario": "trajgen.scenario",
     "HomotopyChoice": "trajgen.methods",
     "InputError": "trajgen.errors",
     "Instruction": "topology",
@@ -60,6 +77,7 @@ _SOURCES = {
     "StarGraph": "topology",
     "TimingMethod": "trajgen.model.schedule",
     "Toppra": "trajgen.methods",
+    "TrackGraph": "topology",
     "TrajgenError": "trajgen.errors",
     "Units": "trajgen.export",
     "VehicleLimits": "limits",
@@ -75,6 +93,7 @@ _SOURCES = {
     "make_schedule": "trajgen.methods",
     "parse_scenario": "trajgen.scenario",
     "plan": "topology",
+    "plan_graph": "topology",
     "run": "trajgen.pipeline",
     "verify": "trajgen.verification",
     "write_profiles": "trajgen.export",
@@ -85,8 +104,11 @@ __all__ = [
     "BuiltinScenario",
     "Configuration",
     "CsvOptions",
+    "EdgePoint",
     "Exact",
     "FallbackReason",
+    "GraphRoute",
+    "GraphScenario",
     "HomotopyChoice",
     "InputError",
     "Instruction",
@@ -102,6 +124,7 @@ __all__ = [
     "StarGraph",
     "TimingMethod",
     "Toppra",
+    "TrackGraph",
     "TrajgenError",
     "Units",
     "VehicleLimits",
@@ -117,6 +140,7 @@ __all__ = [
     "make_schedule",
     "parse_scenario",
     "plan",
+    "plan_graph",
     "run",
     "verify",
     "write_profiles",
