@@ -26,8 +26,8 @@ REPO = Path(__file__).resolve().parent.parent
 #: End-to-end tests, marked ``slow``: the docs build, the examples, installs, live runs over a broker,
 #: demos and simulations on the command line, runs under load, other processes, the optimal
 #: method's accuracy set, the online campaign, and the property tests over many random solves.
-#: ``pytest -m "not slow" -n auto`` is the fast set a developer runs after a change (about a minute
-#: on two cores); CI runs everything.
+#: ``pytest -m "not slow" -n auto`` is the fast set a developer runs after a change (about two
+#: minutes on two cores); CI runs everything. A test file may mark itself (``pytestmark``).
 SLOW_FILES = {
     "test_accuracy.py",
     "test_campaign.py",
