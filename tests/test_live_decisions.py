@@ -17,7 +17,7 @@ from topology import EdgePoint, Position
 from trajgen.cli.timeline import Timeline, timeline_line
 from trajgen.errors import InputError
 from trajgen.execution.tracks import GraphTrack, JunctionTrack
-from trajgen.live.memory import memory_path, remember, remembered_place
+from trajgen.live.memory import VehicleMemory, memory_path, remember, remembered_place
 from trajgen.live.mqtt import BrokerSettings, VehicleIdentity
 from trajgen.live.places import reported_place
 from trajgen.live.runlog import RunLog
@@ -162,6 +162,24 @@ def test_a_vehicle_remembers_where_it_stood_and_starts_there_again(tmp_path, mon
     assert json.loads(path.read_text())["lastNodeId"] == "e:3"
     assert H.track.distance(remembered_place(H.track, path), H.track.point("e:3.25")) == pytest.approx(0.0)
     assert not list(path.parent.glob(".*tmp"))  # replaced whole: no temporary left
+
+
+def test_the_memory_is_written_over_in_place_and_always_reads_back_whole(tmp_path):
+    """One ``pwrite`` per state, padded: a shorter place over a longer one leaves no tail of it."""
+    path = tmp_path / "agv1.json"
+    long_node = types.SimpleNamespace(node_id="e:" + "3" * 300)  # longer than the padding: it grows
+    places = [
+        _state(
+            serial_number="agv1", last_node_id="e:3.25", node_states=[long_node], distance_since_last_node=0.5
+        ),
+        _state(serial_number="agv1", last_node_id="D"),
+    ]
+    with VehicleMemory(path) as memory:
+        for state in places:
+            assert memory.keep(state)
+            assert json.loads(path.read_text())["lastNodeId"] == state.last_node_id
+    assert json.loads(path.read_text())["nextNodeId"] == ""  # nothing of the longer record survives
+    assert H.track.distance(remembered_place(H.track, path), H.track.point("D")) == 0.0
 
 
 @pytest.mark.parametrize(

@@ -106,6 +106,7 @@ class TrackGraph:
     _ends: np.ndarray = field(init=False, repr=False)
     _lengths: np.ndarray = field(init=False, repr=False)
     _node_points: tuple[EdgePoint, ...] = field(init=False, repr=False)
+    _hash: int = field(init=False, repr=False)
 
     def __post_init__(self) -> None:
         nodes = tuple(_name(n, "node") for n in self.nodes)
@@ -184,6 +185,8 @@ class TrackGraph:
             first.setdefault(start, EdgePoint(k, 0.0))
             first.setdefault(end, EdgePoint(k, float(lengths[k])))
         object.__setattr__(self, "_node_points", tuple(first[n] for n in range(len(nodes))))
+        # immutable: hashed once (caches keyed on the track look it up per call)
+        object.__setattr__(self, "_hash", hash((self.nodes, self.edges, self.coordinates)))
 
     @classmethod
     def from_edges(
@@ -377,7 +380,7 @@ class TrackGraph:
         return (self.nodes, self.edges, self.coordinates) == (other.nodes, other.edges, other.coordinates)
 
     def __hash__(self) -> int:
-        return hash((self.nodes, self.edges, self.coordinates))
+        return self._hash
 
 
 def _all_pairs(count: int, ends: np.ndarray, lengths: np.ndarray) -> np.ndarray:

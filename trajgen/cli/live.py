@@ -237,8 +237,6 @@ def _drive(master, goals, *, timeout: float | None, signals: _Signals) -> None:
     ``timeout``: seconds of the run's clock from the start; ``None``: 60 s plus four times the plan,
     from when the plan is made.
     """
-    from trajgen.errors import InputError as GoalRefused
-
     pending = list(goals)
     limit = timeout
     step = master.clock.time_scale * 0.05  # 50 ms of wall time, in seconds of the run
@@ -252,7 +250,7 @@ def _drive(master, goals, *, timeout: float | None, signals: _Signals) -> None:
             at, goal = pending.pop(0)
             try:
                 master.request_goal(goal)
-            except GoalRefused as error:
+            except InputError as error:
                 logger.warning("--goal-at %g: the goal is not taken: %s", at, error)
         master.wait(timeout=step)
 

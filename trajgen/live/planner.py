@@ -53,11 +53,6 @@ class PlanJob:
         self._thread.start()
         return self
 
-    def join(self, timeout: float | None = None) -> bool:
-        """Wait for the call to end (``timeout`` wall seconds at most); whether it has."""
-        self._thread.join(timeout)
-        return not self._thread.is_alive()
-
     def _run(self) -> None:
         began = time.perf_counter()
         try:

@@ -44,7 +44,7 @@ from trajgen.live.drive import AT_REST, Drive, VehicleSnapshot
 from trajgen.live.driven_path import NODE_TOLERANCE, DrivenPath
 from trajgen.live.faults import StopFault
 from trajgen.live.link import BrokerLink
-from trajgen.live.memory import remember
+from trajgen.live.memory import VehicleMemory
 from trajgen.live.mqtt import BrokerSettings, Topic, VehicleIdentity, make_client
 from trajgen.live.notices import CANCEL_ORDER, VDA5050_VERSION, connection_message
 
@@ -87,7 +87,7 @@ class SimulatedVehicle:
         The id of the node it stands at (its ``lastNodeId`` until its first order; ``""``: none).
     memory : path, optional
         A file where it keeps the place of every state it publishes (``lastNodeId``, the next node,
-        ``distanceSinceLastNode``, x/y), replaced whole each time: where it stood if it is killed
+        ``distanceSinceLastNode``, x/y), written over in place each time: where it stood if it is killed
         (:func:`~trajgen.live.memory.remembered_place`).
     """
 
@@ -135,6 +135,7 @@ class SimulatedVehicle:
         self._master_state = "ONLINE"  # the master's connection as last said (before any: online)
         self._master_left = False  # the master went (OFFLINE, its last will) while this vehicle ran
         self.memory = Path(memory) if memory is not None else None
+        self._memory: VehicleMemory | None = None  # the memory file, open while it runs
         self._headers = {Topic.STATE: 0, Topic.CONNECTION: 0}
         # (arrival, topic, payload)
         self._inbox: queue.SimpleQueue[tuple[float, str, bytes]] = queue.SimpleQueue()
@@ -210,6 +211,8 @@ class SimulatedVehicle:
         # its time is the clock's from here (a vehicle started late must not pull the clock back), on
         # the grid of its cycles, so that vehicles of one clock drive their cycles at the same times
         self._t = self._next_state = math.floor(self.clock.now() / self.period) * self.period
+        if self.memory is not None:
+            self._memory = VehicleMemory.opened(self.memory, who=self.identity.serial_number)
         self.link.start()
         self._thread = threading.Thread(
             target=self._run, name=f"trajgen-vehicle-{self.identity.serial_number}", daemon=True
@@ -233,6 +236,9 @@ class SimulatedVehicle:
             )
             info.wait_for_publish(1.0)
         self.link.close()
+        if self._memory is not None:  # after the last state: it holds the place said last
+            self._memory.close()
+            self._memory = None
 
     def drop_connection(self) -> None:
         """Lose the broker without a word (the broker sends the last will); it keeps driving its base."""
@@ -534,14 +540,9 @@ class SimulatedVehicle:
             safety_state={"e_stop": "NONE", "field_violation": False},
         )
         self._state = state
-        if self.memory is not None:
-            self._remember(state)
+        if self._memory is not None and not self._memory.keep(state):
+            self._memory = None  # said once: it drives on without its memory
         return state.to_json().encode()
-
-    def _remember(self, state) -> None:
-        """Where the state says it stands, kept in :attr:`memory`; none kept once the file fails."""
-        if not remember(self.memory, state):
-            self.memory = None
 
     def _publish_state(self) -> None:
         if not (self.link.connected and self._client.is_connected()):  # offline, or not yet ONLINE
