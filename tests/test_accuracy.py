@@ -19,7 +19,7 @@ from trajgen.methods.optimal import Outcome
 from trajgen.methods.optimal.solve import abandoned_solver_calls
 from trajgen.scenario.sampling import online_campaign, reference_sets
 
-pytestmark = pytest.mark.accuracy
+pytestmark = [pytest.mark.slow, pytest.mark.accuracy]
 
 REFERENCE = json.loads((REPO / "tests" / "data" / "optimal_makespans.json").read_text(encoding="utf-8"))
 CASES = [

@@ -230,6 +230,7 @@ def test_a_destination_under_proc_exits_2_before_solving_naming_it(capsys, optio
 
 
 @pytest.mark.usefixtures("nothing_scheduled")
+@pytest.mark.slow  # chattr, a process
 def test_an_immutable_folder_exits_2_before_solving_naming_the_file_asked_for(immutable_folder, capsys):
     argv = ["schedule", str(SWAP_FILE), "--csv", str(immutable_folder / "out"), "--method", "exact"]
     assert main(argv) == EXIT_BAD_INPUT
@@ -239,6 +240,7 @@ def test_an_immutable_folder_exits_2_before_solving_naming_the_file_asked_for(im
     assert list(immutable_folder.iterdir()) == []
 
 
+@pytest.mark.slow  # chattr, a process
 def test_a_folder_locked_during_the_commit_is_reported_by_the_path_asked_for(immutable_folder):
     """The last line of defence: the commit's own error names the file, not its hidden temporary."""
     import subprocess

@@ -14,6 +14,8 @@ import pytest
 from trajgen import Exact, Optimal, SolverCache, Toppra, certify, make_schedule
 from trajgen.scenario.sampling import campaign_scenarios
 
+pytestmark = pytest.mark.slow
+
 SCENARIOS = campaign_scenarios(300, seed=9)
 #: ``exact`` and ``toppra`` are timed on the scenarios whose index is a multiple of this, one test each
 #: (the longest schedules take seconds to verify) ...

@@ -67,6 +67,7 @@ def test_the_faster_class_wins_the_issue_swaps(legs, vehicles, baseline, before)
     assert all(c.lower_bound <= c.makespan * (1 + 1e-9) for c in classes)
 
 
+@pytest.mark.slow
 def test_optimal_fastest_on_a_crossing_takes_the_faster_of_two_classes(capsys):
     # the slow vehicle 1 would dodge into a side leg in the planner's class; in the other class the
     # fast vehicle 2 dodges, which is much faster
@@ -93,6 +94,7 @@ def test_optimal_fastest_on_a_crossing_takes_the_faster_of_two_classes(capsys):
     assert class_label(fastest.route) == "other (second-shortest route on G_4)"
 
 
+@pytest.mark.slow
 @pytest.mark.accuracy
 def test_the_four_times_faster_swap_reaches_its_closed_form_lower_bound():
     # the fast vehicle dodges into C while the slow one drives straight through: the slow vehicle's
@@ -104,6 +106,7 @@ def test_the_four_times_faster_swap_reaches_its_closed_form_lower_bound():
     assert bound <= Optimal().schedule(route, limits).duration <= bound * (1 + 2e-3)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("scenario", RANDOM, ids=[s.source for s in RANDOM])
 def test_the_class_lower_bound_holds_in_both_classes(scenario):
     paper = scenario.route()
@@ -127,6 +130,7 @@ CONVERGED = {
 }
 
 
+@pytest.mark.slow
 @pytest.mark.accuracy
 @pytest.mark.parametrize(
     ("legs", "start", "goal", "limits", "converged"),
@@ -165,6 +169,7 @@ def test_the_default_agrees_with_a_converged_solve(legs, start, goal, limits, co
         assert default.route.homotopy is its_class
 
 
+@pytest.mark.slow
 def test_the_converged_references_are_what_a_converged_solve_gives():
     # one of the stored converged solves, recomputed (the cheapest): the references are not stale
     route = route_of((12.0, 8.0, 15.0), ("A:3", "B:2"), ("C:4", "C:9"))
@@ -177,6 +182,7 @@ def test_the_converged_references_are_what_a_converged_solve_gives():
         assert value == pytest.approx(stored, rel=1e-6)
 
 
+@pytest.mark.slow
 @pytest.mark.accuracy
 def test_mesh_refinement_makes_a_long_track_accurate():
     # issue 10: on 200/120/80 m the fixed 32-node grid was 1.1 % over the converged 404.00 s

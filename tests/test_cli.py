@@ -12,7 +12,7 @@ import pytest
 
 import trajgen.cli
 from tests.conftest import REPO
-from tests.support.helpers import RUN_FILES, legs_id
+from tests.support.helpers import RUN_FILES, legs_cases, legs_id
 from tests.support.star_scenarios import CROSSING
 from trajgen import builtin_scenario
 from trajgen.cli import EXIT_BAD_INPUT, EXIT_FAILURE, EXIT_OK, main
@@ -35,7 +35,7 @@ PLAN_TEXT = {
 }
 
 
-@pytest.mark.parametrize("legs", sorted(PLAN_TEXT), ids=legs_id)
+@pytest.mark.parametrize("legs", legs_cases(sorted(PLAN_TEXT), slow={4}))
 def test_plan_prints_the_route(capsys, legs):
     assert main(["plan", SCENARIOS[legs]]) == EXIT_OK
     out = capsys.readouterr().out
@@ -65,7 +65,7 @@ PLAN_JSON = {
 }
 
 
-@pytest.mark.parametrize("legs", sorted(PLAN_JSON), ids=legs_id)
+@pytest.mark.parametrize("legs", legs_cases(sorted(PLAN_JSON), slow={4}))
 def test_plan_json_summary(capsys, legs):
     assert main(["plan", SCENARIOS[legs], "--json"]) == EXIT_OK
     summary = json.loads(capsys.readouterr().out)
@@ -78,6 +78,7 @@ def test_plan_json_summary(capsys, legs):
 ROUTE_CLASS = {4: "shortest route on G_4"}
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(
     ("legs", "method"),
     [(3, "exact"), (3, "toppra"), (3, "optimal"), (4, "exact"), (4, "toppra")],
@@ -157,6 +158,7 @@ DEMOS = {
 }
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("legs", sorted(DEMOS), ids=legs_id)
 def test_demo_runs_a_built_in_scenario_end_to_end(tmp_path, capsys, legs):
     options, name, first_line, class_line = DEMOS[legs]
@@ -175,6 +177,7 @@ def test_demo_runs_a_built_in_scenario_end_to_end(tmp_path, capsys, legs):
     assert verdict.check.report.min_separation >= 1.5 - 1e-9
 
 
+@pytest.mark.slow
 def test_demo_refuses_an_unknown_scenario(tmp_path, capsys):
     assert main(["demo", "--scenario", "roundabout", "--output", str(tmp_path / "out")]) == EXIT_BAD_INPUT
     assert "built-in scenario 'roundabout' is unknown: expected one of ['swap', 'crossing', 'h']" in (

@@ -12,6 +12,8 @@ import pytest
 from trajgen.export import atomic, commit_files
 from trajgen.export.atomic import JOURNAL_NAME, recover_folder
 
+pytestmark = pytest.mark.slow
+
 FORK = multiprocessing.get_context("fork")
 
 

@@ -166,6 +166,7 @@ def test_a_plan_without_clearance_runs_between_two_conflicts_that_touch_at_a_poi
 # -- the braking rule --------------------------------------------------------------------------
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("method", ["exact", "toppra", "optimal"])
 @pytest.mark.parametrize("name", ["swap", "crossing"])
 def test_every_methods_plan_for_execution_obeys_the_braking_rule(name, method):
@@ -180,6 +181,7 @@ def optimal_swap():
     return scenario, Optimal(braking_rule=True).schedule(scenario.route(), scenario.limits)
 
 
+@pytest.mark.slow
 def test_the_rule_binds_the_optimal_swap_two_centimetres_more_is_refused(optimal_swap):
     """The optimal swap brakes into its frontiers as late as the rule allows (within 1 cm)."""
     _, schedule = optimal_swap
@@ -191,6 +193,7 @@ def test_the_rule_binds_the_optimal_swap_two_centimetres_more_is_refused(optimal
     assert max(f.excess for f in failures) < 0.02  # it is 1 cm or less from the rule, not more
 
 
+@pytest.mark.slow
 def test_verify_refuses_a_plan_that_breaks_the_rule_naming_when_and_where(optimal_swap):
     from trajgen.errors import VerificationError
     from trajgen.model.schedule import Schedule

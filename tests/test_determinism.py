@@ -22,6 +22,8 @@ import pytest
 
 from tests.conftest import REPO
 
+pytestmark = pytest.mark.slow
+
 #: The issue's Y: legs of 6, 9.5 and 14 m, a 1.2 m/s and a 0.8 m/s vehicle swapping.
 Y_SCENARIO = """
 [track]

@@ -412,6 +412,7 @@ def test_every_column_of_a_generic_file_is_checked(exported, tmp_path, column, c
     assert any(re.search(match, f) for f in verdict.failures), verdict.failures
 
 
+@pytest.mark.slow
 def test_check_rejects_a_leg_the_crossing_lacks(tmp_path, capsys):
     out = tmp_path / "csv"
     assert main(["schedule", str(CROSSING), "--method", "exact", "--csv", str(out)]) == EXIT_OK
@@ -617,6 +618,7 @@ def test_an_api_error_names_the_apis_remedy_and_the_flag(swap, tmp_path, call, r
 # -- the table dialects on a 4-way crossing ----------------------------------------------------------------
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("dialect", [d.name.value for d in TABLE_DIALECTS])
 def test_table_dialects_on_a_crossing(tmp_path, capsys, dialect):
     out = tmp_path / dialect

@@ -21,6 +21,8 @@ import pytest
 
 from tests.conftest import REPO
 
+pytestmark = pytest.mark.slow
+
 DOCS = REPO / "docs"
 PAGES = sorted([*DOCS.glob("*.md"), *(DOCS / "formats").glob("*.md")])
 

@@ -26,10 +26,13 @@ import pytest
 from tests.conftest import REPO
 from trajgen.live.broker import MosquittoBroker, mosquitto_available
 
-pytestmark = pytest.mark.skipif(
-    not mosquitto_available() and os.environ.get("TRAJGEN_TEST_REQUIRE_MOSQUITTO") != "1",
-    reason="mosquitto is not installed",
-)
+pytestmark = [
+    pytest.mark.slow,
+    pytest.mark.skipif(
+        not mosquitto_available() and os.environ.get("TRAJGEN_TEST_REQUIRE_MOSQUITTO") != "1",
+        reason="mosquitto is not installed",
+    ),
+]
 
 PAGE = REPO / "docs" / "live.md"
 

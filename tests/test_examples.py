@@ -17,6 +17,8 @@ import pytest
 
 from tests.conftest import REPO
 
+pytestmark = pytest.mark.slow
+
 EXAMPLES = sorted((REPO / "examples").glob("[0-9][0-9]_*.py"))
 
 

@@ -199,6 +199,7 @@ def test_commit_files_takes_a_chunk_of_each_file_in_turn(tmp_path):
 # -- a junction of 8 legs: legs 1-based up to 8, x and y from the angles --------------------------------
 
 
+@pytest.mark.slow
 def test_csv_legs_are_one_based_up_to_k_and_xy_follow_the_angles(tmp_path, capsys):
     data = STAR_SCENARIOS[8]
     path = tmp_path / "eight.toml"

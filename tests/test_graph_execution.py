@@ -49,6 +49,7 @@ def test_an_undisturbed_run_on_a_graph_plays_its_plan_and_never_brakes(name, met
     assert result.certified_separation_m >= scenario.limits.min_separation + result.position_margin - 1e-6
 
 
+@pytest.mark.slow  # a stop at every moment: a campaign, as on a junction
 @pytest.mark.parametrize("method", ["exact", "toppra"])
 @pytest.mark.parametrize("name", ["h", "passing-loop"])
 def test_a_stop_at_any_moment_on_the_h_and_the_passing_loop_costs_at_most_its_bound(name, method):
@@ -273,6 +274,7 @@ def test_the_margin_on_a_graph_shrinks_to_what_the_start_and_goal_leave():
     assert result.violations == 0
 
 
+@pytest.mark.slow  # simulations of seeded random tracks with faults
 @pytest.mark.parametrize("method", ["exact", "toppra"])
 def test_seeded_random_track_graphs_with_faults_reach_their_goals_without_a_violation(method):
     """Trees and graphs with loops, random limits, one to three faults each (the bench's campaign)."""

@@ -86,6 +86,7 @@ def _check_moves(route, grid: GridTrack, edges) -> None:
     assert tuple(position) == route.goal
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("chunk", range(CHUNKS))
 @pytest.mark.parametrize("loops", [False, True], ids=["trees", "loops"])
 def test_the_planner_equals_a_grid_oracle_on_random_trees_and_graphs_with_loops(loops, chunk):

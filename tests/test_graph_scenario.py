@@ -164,6 +164,7 @@ def test_a_bad_graph_scenario_is_refused_naming_the_key(track, positions, match)
         parse_scenario(data, source="bad.toml")
 
 
+@pytest.mark.slow  # a demo on the command line, end to end
 def test_demo_runs_the_built_in_h_end_to_end(tmp_path, capsys):
     assert main(["demo", "--scenario", "h", "--method", "exact", "--output", str(tmp_path)]) == 0
     out = capsys.readouterr().out

@@ -94,14 +94,21 @@ def test_the_verifier_finds_a_schedule_that_passes_a_conflict_in_the_other_order
 def _together(route, limits) -> GraphSchedule:
     """Both vehicles driving at once from t = 0, each its whole path in one S-curve."""
     schedule = make_schedule(route, limits, method="exact")
-    profiles = []
+    moves = []
     for vehicle, path in enumerate(schedule.paths):
         v = limits.vehicles[vehicle]
         phases = [
             (d, math.nan, j)
             for d, j in scurve_phases(path.length, v.max_velocity, v.max_acceleration, v.max_jerk)
         ]
-        profiles.append(PiecewiseCubic.from_phases(0.0, phases, end=path.length))
+        moves.append(phases)
+    duration = max(sum(d for d, _, _ in phases) for phases in moves)
+    profiles = [  # the one that arrives first waits there: both motions end with the section
+        PiecewiseCubic.from_phases(
+            0.0, [*phases, (duration - sum(d for d, _, _ in phases), 0.0, 0.0)], end=path.length
+        )
+        for phases, path in zip(moves, schedule.paths, strict=True)
+    ]
     return dataclasses.replace(schedule, sections=(GraphSection(0.0, CubicKinematics(tuple(profiles))),))
 
 

@@ -20,6 +20,8 @@ import pytest
 
 from tests.conftest import REPO
 
+pytestmark = pytest.mark.slow
+
 LIVE_ONLY = {"amqtt", "paho-mqtt"}
 #: Modules of the standard library or of this repository (never a distribution to declare).
 OWN = {"trajgen", "topology", "limits"}

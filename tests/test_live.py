@@ -31,6 +31,8 @@ from trajgen.live.orders import horizon_length
 from trajgen.live.session import ClosestApproach, LiveDemo, identities, position_xy
 from trajgen.live.vehicle import SimulatedVehicle, StopFault, VehicleSnapshot
 
+pytestmark = pytest.mark.slow
+
 #: Time scale and state rate (Hz of the run) of the runs whose makespan is checked: states on every
 #: node reached carry the progress, so ~50 messages/s through amqtt (bench_live.py: +3.5 to +7.2 %).
 STRICT = {"time_scale": 4.0, "state_rate": 2.0, "period": 0.02}

@@ -33,6 +33,8 @@ from trajgen.live.broker import (
     mosquitto_available,
 )
 
+pytestmark = pytest.mark.slow
+
 KINDS = [
     pytest.param(EmbeddedBroker, id="amqtt"),
     pytest.param(

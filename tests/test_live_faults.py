@@ -11,11 +11,15 @@ import logging
 import time
 from datetime import datetime
 
+import pytest
+
 from tests.support.helpers import execution_plan
 from tests.support.live import Tap
 from trajgen.live.faults import StopFault
 from trajgen.live.outcome import LiveOutcome
 from trajgen.live.session import LiveDemo
+
+pytestmark = pytest.mark.slow
 
 SCALE = 25.0
 

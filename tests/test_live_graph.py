@@ -32,6 +32,8 @@ from trajgen.live.session import LiveDemo, live_plan
 from trajgen.live.vehicle import StopFault
 from trajgen.scenario import load_scenario
 
+pytestmark = pytest.mark.slow
+
 H = EXAMPLES / "h.toml"
 #: What a command says of a place on an edge the H does not have.
 NOT_ON_THE_H = "edge 'zz' is not on the track: expected one of ['a', 'b', 'm', 'c', 'e']"

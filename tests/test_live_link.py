@@ -21,6 +21,8 @@ from trajgen.live.mqtt import BrokerSettings, make_client
 from trajgen.live.outcome import LiveOutcome
 from trajgen.live.session import ClosestApproach, LiveDemo, identities
 
+pytestmark = pytest.mark.slow
+
 #: The issue's longest gap between two starts, wall seconds.
 GAP_S = 15.0
 #: The gap between starts in the six orders: each waiting part has retried (0.5 s, then 1 s apart);

@@ -28,6 +28,8 @@ from trajgen.export.vda5050.graph_path import point_id
 from trajgen.live.broker import MosquittoBroker
 from trajgen.scenario import GraphScenario, load_scenario
 
+pytestmark = pytest.mark.slow
+
 SWAP = str(REPO / "examples" / "swap.toml")
 H = str(REPO / "examples" / "graphs" / "h.toml")
 SCALE = 5.0

@@ -26,10 +26,13 @@ from trajgen.live.outcome import LiveOutcome
 from trajgen.live.vehicle import SimulatedVehicle
 from trajgen.scenario import load_scenario
 
-pytestmark = pytest.mark.skipif(
-    not mosquitto_available() and os.environ.get("TRAJGEN_TEST_REQUIRE_MOSQUITTO") != "1",
-    reason="mosquitto is not installed",
-)
+pytestmark = [
+    pytest.mark.slow,
+    pytest.mark.skipif(
+        not mosquitto_available() and os.environ.get("TRAJGEN_TEST_REQUIRE_MOSQUITTO") != "1",
+        reason="mosquitto is not installed",
+    ),
+]
 
 SWAP = str(REPO / "examples" / "swap.toml")
 #: The issue's bound: a plain message within 10 s.

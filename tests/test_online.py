@@ -346,6 +346,7 @@ def plans():
     }
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("method", ["exact", "toppra", "optimal"])
 @pytest.mark.parametrize("name", ["swap", "crossing"])
 def test_an_undisturbed_run_executes_its_plan_within_one_percent_and_never_brakes(plans, name, method):
@@ -365,6 +366,7 @@ def test_an_undisturbed_run_executes_its_plan_within_one_percent_and_never_brake
 # -- stops: the issue's table, and a stop at any moment -----------------------------------------
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(
     ("name", "method", "fault"),
     [
@@ -386,6 +388,7 @@ def test_a_stop_costs_about_its_own_length(plans, name, method, fault):
     assert result.makespan_s - result.planned_s <= stop_bound(scenario, faults[0].value), result.summary()
 
 
+@pytest.mark.slow
 @settings(max_examples=2, deadline=None)
 @given(moment=st.floats(0.0, 1.0), duration=st.floats(0.2, 8.0), vehicle=st.sampled_from([0, 1]))
 @pytest.mark.parametrize("method", ["exact", "toppra", "optimal"])
@@ -419,6 +422,7 @@ def random_plans(kind: str, count: int):
     return out
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("kind", ["y", "star"], ids=["random-y", "4-leg-star"])
 def test_single_stops_on_random_tracks_cost_at_most_their_bound(kind):
     rng = random.Random(7)
@@ -480,6 +484,7 @@ def test_a_waiting_follower_starts_the_moment_its_leader_moves_on(plans):
 # -- goals: the only thing that re-plans ---------------------------------------------------------
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("method", ["exact", "optimal"])
 def test_a_new_goal_mid_run_is_reached_with_no_violation(plans, method):
     scenario, verified = plans["swap", method]
@@ -504,6 +509,7 @@ def test_nothing_but_a_goal_re_plans(plans):
     assert result.replans == 0
 
 
+@pytest.mark.slow
 @settings(max_examples=6, derandomize=True, deadline=None)
 @given(
     name=st.sampled_from(["swap", "crossing"]),
@@ -566,6 +572,7 @@ CAMPAIGN_REGRESSIONS = [(k, None) for k in (121, 180, 191)]
 CAMPAIGN_REGRESSIONS += [(k, "exact") for k in (6, 113, 155, 187, 40, 132)]
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(
     ("k", "method"),
     CAMPAIGN_REGRESSIONS,
@@ -602,6 +609,7 @@ SEED_12_REGRESSIONS = {
 }
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("k", sorted(SEED_12_REGRESSIONS), ids=lambda k: f"scenario-{k}")
 def test_seed_12_campaign_scenarios_that_deadlocked_reach_their_goals_safely(k):
     scenario = online_campaign(k + 1, seed=12)[k]
@@ -617,6 +625,7 @@ def test_seed_12_campaign_scenarios_that_deadlocked_reach_their_goals_safely(k):
     assert result.emergency_brakes == 0, specs
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("k", [52, 583, 965, 280, 495], ids=lambda k: f"scenario-{k}")
 def test_seed_12_campaign_scenarios_that_braked_hard_keep_the_braking_invariant(k):
     """Followers closing on a leader still crossing the junction: holds, and no emergency brake.
@@ -715,6 +724,7 @@ def test_bad_input_to_the_executor(swap, call, match):
         call(executor)
 
 
+@pytest.mark.slow
 def test_the_executor_on_a_crossing_checks_legs_by_count():
     scenario = builtin_scenario("crossing")
     verified = certify(make_schedule(scenario.route(), scenario.limits, method="exact"))

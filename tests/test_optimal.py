@@ -52,6 +52,7 @@ def exact_schedule(route, limits):
     return Exact().schedule(route, limits)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(("legs", "start"), SWAPS)
 def test_swaps_are_at_most_half_of_exact_and_stay_in_the_class(legs, start):
     route = route_of(legs, start, start[::-1])
@@ -106,6 +107,7 @@ def test_slower_vehicle_sets_the_time_when_it_moves_alone():
     assert own <= schedule.duration <= own * (1 + 5e-3)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("scenario", RANDOM, ids=[s.source for s in RANDOM])
 def test_lower_bound_optimal_exact_order_and_verification(scenario):
     route = scenario.route()
@@ -193,6 +195,7 @@ def test_forced_solver_failure_falls_back_to_exact_and_logs(caplog):
     )
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(
     ("fatrop_iterations", "solved_by"),
     [
@@ -218,6 +221,7 @@ def test_backup_solvers_reach_fatrops_optimum(fatrop_iterations, solved_by):
     assert schedule.duration == pytest.approx(reference.duration, rel=1e-6)
 
 
+@pytest.mark.slow
 def test_fatrop_solves_the_five_phase_reordering_on_one_leg():
     # benchmark set c, random 2: both vehicles on B must swap their order, via A and C (5 phases),
     # and vehicle 1 ends at the end of B. With bounds tied to the rest and junction equalities
@@ -238,6 +242,7 @@ BENCHMARK_SAMPLE = [
 ]
 
 
+@pytest.mark.slow
 @pytest.mark.accuracy
 @pytest.mark.parametrize(("reference", "start", "goal"), BENCHMARK_SAMPLE)
 def test_benchmark_scenarios_are_verified_and_between_their_bounds(reference, start, goal):

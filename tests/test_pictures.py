@@ -20,7 +20,7 @@ from matplotlib.colors import to_rgb
 from PIL import Image
 
 from tests.conftest import REPO
-from tests.support.helpers import LIMITS, animation_gif, conf, legs_id, route_of
+from tests.support.helpers import LIMITS, animation_gif, conf, legs_cases, legs_id, route_of
 from topology import JUNCTION_INDEX, Instruction, StarGraph, YGraph, plan
 from topology.cycle import retract_indexed
 from topology.indexed import segment_region_key
@@ -266,7 +266,7 @@ def test_the_gif_decodes_with_its_frames_size_and_delays(swap, swap_gif):
     assert delays[-1] == END_HOLD_MS
 
 
-@pytest.mark.parametrize("legs", sorted(MAX_FRAMES), ids=legs_id)
+@pytest.mark.parametrize("legs", legs_cases(sorted(MAX_FRAMES), slow={4, 5, 8}))
 def test_the_first_frame_shows_the_start_and_the_last_the_goal(legs):
     verified = timed(legs)
     route = verified.schedule.route
@@ -300,7 +300,12 @@ MOMENTS = {
 @pytest.mark.parametrize(
     ("legs", "fraction"),
     [
-        pytest.param(legs, fraction, id=f"legs{legs}-{fraction:.0%}")
+        pytest.param(
+            legs,
+            fraction,
+            id=f"legs{legs}-{fraction:.0%}",
+            marks=pytest.mark.slow if legs in (4, 5, 8) else (),
+        )
         for legs, fractions in MOMENTS.items()
         for fraction in fractions
     ],
@@ -323,6 +328,7 @@ def test_frame_positions_are_the_schedules_positions(legs, fraction):
     assert geometry.distance[0] == pytest.approx(graph.separation(configuration), abs=1e-9)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("legs", [4, 5, 8], ids=legs_id)
 def test_every_leg_is_in_the_frame_to_scale(legs):
     verified = timed(legs)
@@ -596,7 +602,7 @@ def test_the_schedules_path_stays_in_its_class(swap):
             assert _in_region(layout.point(c), layout.region_polygon(region))
 
 
-@pytest.mark.parametrize("legs", [3, 4, 8], ids=legs_id)
+@pytest.mark.parametrize("legs", legs_cases([3, 4, 8], slow={4, 8}))
 def test_render_configuration_of_a_route_and_of_a_schedule(legs):
     """A Y's configuration space drawn flat; a star's as ``G_k``, as :func:`plot_retract_graph` draws it."""
     route = ROUTES["from-a-triangle"] if legs == 3 else _route(legs)
@@ -621,6 +627,7 @@ def test_render_configuration_of_a_route_and_of_a_schedule(legs):
 
 
 # -- the retract graph G_k of a star drawn as a table -------------------------------------------------
+@pytest.mark.slow
 @pytest.mark.parametrize("k", range(3, 9), ids=legs_id)
 def test_the_layout_draws_k_k_plus_1_vertices_and_2k_k_minus_1_edges(k):
     graph = StarGraph({f"L{j}": 8.0 + j for j in range(k)})
@@ -649,6 +656,7 @@ def test_the_layout_draws_k_k_plus_1_vertices_and_2k_k_minus_1_edges(k):
         assert 0.0 < bow <= BOW + 1e-12
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("k", [4, 8], ids=legs_id)
 def test_arcs_from_one_valley_never_cross(k):
     graph = StarGraph({f"L{j}": 10.0 for j in range(k)})
@@ -710,6 +718,7 @@ G_K_ROUTES = {
 }
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("make", G_K_ROUTES.values(), ids=G_K_ROUTES.keys())
 def test_the_drawn_route_passes_the_routes_vertices_of_g_k_in_order(make):
     route = make()
@@ -741,6 +750,7 @@ def test_the_drawn_route_passes_the_routes_vertices_of_g_k_in_order(make):
     assert np.hypot(*np.diff(line, axis=0).T).max() < 0.4
 
 
+@pytest.mark.slow
 def test_a_point_inside_an_edge_is_drawn_its_share_of_the_way_along():
     route = G_K_ROUTES["partial-5"]()
     layout = RetractGraphLayout.of(route.graph)
@@ -752,6 +762,7 @@ def test_a_point_inside_an_edge_is_drawn_its_share_of_the_way_along():
     assert drawn[0] == pytest.approx(0.5 * (peak[0] + valley[0]))  # half way along the row
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("k", [4, 8], ids=legs_id)
 def test_the_schedules_path_retracts_onto_the_routes_edges(k):
     verified = timed(k)
@@ -774,6 +785,7 @@ def test_the_schedules_path_retracts_onto_the_routes_edges(k):
             assert any(p.vertex in layout.edges[e] for e in used)
 
 
+@pytest.mark.slow
 def test_the_titles_name_the_class_and_the_rule_that_chose_the_route():
     y_route = plan(YGraph({"A": 10.0, "B": 10.0, "C": 10.0}), conf("A:10", "B:10"), conf("B:10", "A:10"))
     assert class_name(y_route) == y_route.way_round.value == "counterclockwise"  # the animation's, as before
@@ -793,7 +805,7 @@ def test_the_titles_name_the_class_and_the_rule_that_chose_the_route():
 
 
 # -- the pipeline and the command line -------------------------------------------------------------------
-@pytest.mark.parametrize("legs", [3, 4, 8], ids=legs_id)
+@pytest.mark.parametrize("legs", legs_cases([3, 4, 8], slow={4, 8}))
 def test_plot_writes_configuration_png(tmp_path, capsys, legs):
     assert "configuration.png" in PLOT_NAMES
     plots = tmp_path / "plots"
@@ -811,7 +823,7 @@ def test_plot_writes_configuration_png(tmp_path, capsys, legs):
 ANIMATE_FRAMES = {3: 40, 4: 10, 8: 10}
 
 
-@pytest.mark.parametrize("legs", sorted(ANIMATE_FRAMES), ids=legs_id)
+@pytest.mark.parametrize("legs", legs_cases(sorted(ANIMATE_FRAMES), slow={4, 8}))
 def test_animate_writes_the_gif(tmp_path, capsys, legs):
     out = tmp_path / "movie" / f"legs{legs}.gif"
     frames = ANIMATE_FRAMES[legs]

@@ -113,6 +113,7 @@ SHIMS = {
 }
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("name", list(SHIMS))
 def test_a_renderer_of_0_6_warns_and_returns_the_png_of_its_plot(name, subjects):
     old, new = SHIMS[name]

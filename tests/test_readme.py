@@ -13,6 +13,8 @@ import pytest
 from tests.conftest import REPO
 from tests.support.helpers import RUN_FILES
 
+pytestmark = pytest.mark.slow
+
 
 def _python_block() -> str:
     """The README's first ``python`` block."""

@@ -14,6 +14,8 @@ import pytest
 
 from tests.conftest import REPO
 
+pytestmark = pytest.mark.slow
+
 #: The largest tracked file allowed outside the folders of data, bytes.
 MAX_BYTES = 1_000_000
 #: Folders whose files may be larger: stored reference data, the documentation's pictures.

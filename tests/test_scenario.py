@@ -9,7 +9,7 @@ import pytest
 
 from limits import Limits
 from tests.conftest import REPO
-from tests.support.helpers import AGV, legs_id
+from tests.support.helpers import AGV, legs_cases, legs_id
 from tests.support.star_scenarios import STAR_SCENARIOS
 from topology import Position, StarGraph
 from trajgen import BuiltinScenario, builtin_scenario, make_schedule, parse_scenario, verify
@@ -24,7 +24,7 @@ GOOD = SWAP_FILE.read_text()
 BUILT_IN = {3: BuiltinScenario.SWAP, 4: BuiltinScenario.CROSSING}
 
 
-@pytest.mark.parametrize("legs", sorted(BUILT_IN), ids=legs_id)
+@pytest.mark.parametrize("legs", legs_cases(sorted(BUILT_IN), slow={4}))
 def test_example_file_is_the_built_in_scenario_and_ships_as_package_data(legs):
     name = BUILT_IN[legs]
     example = REPO / "examples" / f"{name.value}.toml"
@@ -58,6 +58,7 @@ def test_example_file_is_the_built_in_scenario_and_ships_as_package_data(legs):
     assert 'trajgen = ["data/*.toml"]' in pyproject  # setuptools package-data: every packaged scenario
 
 
+@pytest.mark.slow
 def test_builtin_scenario_refuses_an_unknown_name():
     with pytest.raises(
         InputError, match=r"built-in scenario 'ring' is unknown: expected one of \['swap', 'crossing', 'h'\]"
@@ -240,6 +241,7 @@ def test_missing_file_is_a_scenario_error(tmp_path):
 # -- junctions of 4 to 8 legs: the scenario refuses what a junction cannot be --------------------------------
 
 
+@pytest.mark.slow
 def test_the_scenario_refuses_nine_legs():
     data = STAR_SCENARIOS[8]
     legs = {**data["track"]["legs"], "I": 10.0}
@@ -250,6 +252,7 @@ def test_the_scenario_refuses_nine_legs():
         parse_scenario(bad, source="<nine>")
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(
     ("short", "named"),
     [({"W": 1.0}, r"\['W'\]"), ({"W": 1.0, "E": 1.2}, r"\['W', 'E'\]")],
@@ -268,6 +271,7 @@ def test_the_scenario_refuses_a_separation_longer_than_legs_naming_them(short, n
 # -- random scenarios of 3 to 8 legs -------------------------------------------------------------------------
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("k", [4, 6, 8], ids=legs_id)
 def test_random_scenarios_on_k_legs_plan_and_verify(k):
     scenarios = online_campaign(3, seed=13, leg_count=k)
@@ -279,6 +283,7 @@ def test_random_scenarios_on_k_legs_plan_and_verify(k):
         assert verify(schedule).passed
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("count", [2, 9, True], ids=["two", "nine", "bool"])
 def test_random_track_refuses_a_leg_count_out_of_range(count):
     with pytest.raises(
@@ -287,6 +292,7 @@ def test_random_track_refuses_a_leg_count_out_of_range(count):
         random_track(random.Random(0), leg_count=count)
 
 
+@pytest.mark.slow
 def test_random_three_leg_tracks_are_ygraphs_as_before():
     track = random_track(random.Random(3))
     assert track.names == ("A", "B", "C")

@@ -13,7 +13,7 @@ import pytest
 from hypothesis import assume, given, settings
 
 from limits import Limits, VehicleLimits
-from tests.support.helpers import AGV, LIMITS, MIXED, SLOW, legs_id, route_of, too_close
+from tests.support.helpers import AGV, LIMITS, MIXED, SLOW, legs_cases, legs_id, route_of, too_close
 from tests.support.sampled_verifier import sampled_verify
 from tests.support.star_scenarios import STAR_METHODS, STAR_SCENARIOS, leg_index, star_scenario, star_schedule
 from tests.support.strategies import star_queries
@@ -131,6 +131,7 @@ def test_method_lookup():
 # -- schedules on junctions of 4 to 8 legs verify ----------------------------------------------------
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("method", sorted(STAR_METHODS))
 @pytest.mark.parametrize("k", sorted(STAR_SCENARIOS), ids=legs_id)
 def test_every_method_verifies_on_k_legs(k, method):
@@ -174,11 +175,13 @@ def test_every_method_verifies_on_k_legs(k, method):
     assert np.all((state.leg >= JUNCTION_INDEX) & (state.leg < k))
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("k", sorted(STAR_SCENARIOS), ids=legs_id)
 def test_optimal_is_no_slower_than_exact_on_k_legs(k):
     assert star_schedule(k, "optimal").duration <= star_schedule(k, "exact").duration * (1 + 1e-9)
 
 
+@pytest.mark.slow
 @settings(max_examples=25, derandomize=True, deadline=None)
 @given(query=star_queries(4, 8))
 def test_exact_schedules_of_random_star_queries_verify(query):
@@ -244,7 +247,7 @@ OTHER_CLASS_FAILURES = {
 }
 
 
-@pytest.mark.parametrize("legs", sorted(OTHER_CLASS_FAILURES), ids=legs_id)
+@pytest.mark.parametrize("legs", legs_cases(sorted(OTHER_CLASS_FAILURES), slow={4}))
 def test_verifier_catches_the_other_homotopy_class(legs):
     if legs == 3:
         route, limits = route_of(*SWAP), LIMITS
@@ -288,6 +291,7 @@ def test_verifier_catches_a_broken_position_map():
     assert any("jumps" in f or "do not join" in f for f in report.failures), report.failures
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(
     ("k", "leg"),
     [(4, 4), (4, 7), (8, 8), (8, -2)],
@@ -318,6 +322,7 @@ def test_the_last_sample_is_the_goal_at_rest_with_no_jerk(method, period):
     assert np.all(np.abs(state.velocity[:, -1]) < 1e-9)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("method", ["exact", "toppra", "optimal"])
 @pytest.mark.parametrize("scenario", RANDOM[:6], ids=[s.source for s in RANDOM[:6]])
 def test_the_closed_form_verifier_agrees_with_the_sampled_second_opinion(scenario, method):

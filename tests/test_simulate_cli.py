@@ -27,6 +27,8 @@ from trajgen.plots import plot_simulation, png_bytes
 from trajgen.scenario import load_scenario
 from trajgen.simulation_pipeline import format_simulation, run_simulation
 
+pytestmark = pytest.mark.slow
+
 
 def simulation_png(*arguments, **options) -> bytes:
     """The PNG the pipeline writes of ``plot_simulation(...)``."""

@@ -15,6 +15,8 @@ import pytest
 import trajgen
 from tests.conftest import REPO
 
+pytestmark = pytest.mark.slow
+
 HEAVY = ("scipy", "casadi", "toppra", "matplotlib", "ruckig")
 
 

@@ -24,6 +24,8 @@ from trajgen.methods.optimal.solve import solve
 from trajgen.methods.optimal.store import StoredNlp, default_store
 from trajgen.methods.optimal.units import variable_dimensions
 
+pytestmark = pytest.mark.slow
+
 SWAP = ((12.0, 8.0, 15.0), ("A:12", "B:8"), ("B:8", "A:12"))
 #: The issue's long track: 1000/800/1200 m, a 1.0 and a 0.7 m/s vehicle, their S-curve bound 1502.583 s.
 LONG = ((1000.0, 800.0, 1200.0), ("A:900", "C:50"), ("A:100", "C:1100"))

@@ -1063,6 +1063,7 @@ def assert_each_vehicle_accepts_its_orders(scenario, folder) -> None:
         assert got == expected, name
 
 
+@pytest.mark.slow
 def test_export_vda5050_on_k_legs_validates_and_places_nodes_by_angle(tmp_path, capsys):
     data = STAR_SCENARIOS[5]
     path = tmp_path / "five.toml"
@@ -1099,6 +1100,7 @@ def test_export_vda5050_on_k_legs_validates_and_places_nodes_by_angle(tmp_path, 
     assert manifest  # written with the orders
 
 
+@pytest.mark.slow
 def test_export_vda5050_on_a_crossing_with_optimal(tmp_path, capsys):
     out = tmp_path / "vda"
     argv = ["export-vda5050", str(CROSSING), "--out", str(out), "--start-time", "2025-05-01T08:00:00Z"]

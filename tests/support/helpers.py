@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import functools
 
+import pytest
+
 from limits import Limits, VehicleLimits
 from tests.conftest import REPO
 from topology import Configuration, Position, YGraph, plan
@@ -22,6 +24,17 @@ MIXED = Limits(vehicles=(AGV, SLOW), min_separation=1.5)
 def legs_id(legs: int) -> str:
     """The id of a test case on a junction of ``legs`` legs: ``legs3`` (a Y), ``legs4`` ... ``legs8``."""
     return f"legs{legs}"
+
+
+def legs_cases(counts, slow=()) -> list:
+    """Cases of a test over junctions of ``counts`` legs; those in ``slow`` marked slow.
+
+    A property every junction has runs on the Y in the fast set, and on the stars end to end.
+    """
+    return [
+        pytest.param(legs, id=legs_id(legs), marks=pytest.mark.slow if legs in slow else ())
+        for legs in sorted(counts)
+    ]
 
 
 def conf(first: str, second: str) -> Configuration:

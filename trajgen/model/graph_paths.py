@@ -68,6 +68,11 @@ class GraphPath(ArrayValue):
         turns = np.nonzero(self.headings[1:] != self.headings[:-1])[0] + 1
         return readonly(self.starts[turns], float)
 
+    @property
+    def stops(self) -> tuple[float, ...]:
+        """Travel at each cusp (:attr:`cusps`), as the star's paths name them, metres."""
+        return tuple(float(p) for p in self.cusps)
+
     def segment(self, p) -> np.ndarray:
         """The segment each travel value lies in, shape (n,) (clipped to the path)."""
         p = np.atleast_1d(np.asarray(p, dtype=float))

@@ -31,10 +31,15 @@ import numpy as np
 from limits import VehicleLimits
 from trajgen.model.coordination import CoordinationDiagram, schedule_paths, stopping_distances
 from trajgen.model.pieces import Pieces
-from trajgen.model.schedule import Schedule
 from trajgen.model.values import sorted_unique
 
-__all__ = ["BRAKING_RULE_TOLERANCE", "BrakingRuleFailure", "braking_rule_failures", "stop_point_rate"]
+__all__ = [
+    "BRAKING_RULE_TOLERANCE",
+    "BrakingRuleFailure",
+    "braking_rule_failures",
+    "for_execution",
+    "stop_point_rate",
+]
 
 #: How far a follower's service stop point may pass its frontier, metres: the rule is certified to this
 #: (far inside the executor's position margin), which keeps the check's cost bounded where a plan brakes
@@ -88,7 +93,7 @@ class BrakingRuleFailure:
     Attributes
     ----------
     vehicle : int
-        0 or 1.
+        Its index in the schedule's vehicles.
     time : float
         The worst instant found, seconds.
     excess : float
@@ -100,15 +105,38 @@ class BrakingRuleFailure:
     time: float
     excess: float
 
+    def message(self, where: str) -> str:
+        """The finding in words, the vehicle being ``where`` (on the track) at :attr:`time`."""
+        what = (
+            f"its service stop point passes it by {self.excess:.3g} m"
+            if math.isfinite(self.excess)
+            else "its margin stays too thin to certify"
+        )
+        return (
+            f"vehicle {self.vehicle + 1} cannot stop short of its frontier at t={self.time:.6f} s ({where}): "
+            f"{what} (the braking rule; expected at most {BRAKING_RULE_TOLERANCE:g} m past it)"
+        )
+
+
+def for_execution(schedule) -> bool:
+    """Whether ``schedule`` is a plan for execution: its method plans for it, and it is no table read back.
+
+    Such a plan obeys the braking rule (a table read back follows a plan that was checked; its own
+    round-off is not an execution).
+    """
+    method = schedule.method
+    planned = method is None or bool(getattr(method, "plans_for_execution", True))
+    return planned and schedule.end_tolerance is None
+
 
 def braking_rule_failures(
-    schedule: Schedule, *, separation: float | None = None, pieces: Pieces | None = None
+    schedule, *, separation: float | None = None, pieces: Pieces | None = None
 ) -> list[BrakingRuleFailure]:
     """Where a follower of ``schedule`` could not stop short of its frontier: its worst instant, per vehicle.
 
     Parameters
     ----------
-    schedule : Schedule
+    schedule : Schedule or GraphSchedule
     separation : float, optional
         Track distance the conflicts keep, metres (default: the schedule's own separation).
     pieces : Pieces, optional

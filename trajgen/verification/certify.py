@@ -52,7 +52,7 @@ from trajgen.model import polynomials
 from trajgen.model.graph_schedule import GraphSchedule
 from trajgen.model.pieces import Pieces, UncheckableKinematicsError, schedule_pieces
 from trajgen.model.schedule import Schedule
-from trajgen.verification.braking_rule import BRAKING_RULE_TOLERANCE, braking_rule_failures
+from trajgen.verification.braking_rule import braking_rule_failures, for_execution
 from trajgen.verification.graph_schedule import verify_graph_schedule
 from trajgen.verification.integrity import array_failures
 from trajgen.verification.piecewise import (
@@ -250,12 +250,6 @@ def _check_tiling(schedule: Schedule, pieces: Pieces, failures: list[str]) -> No
         )
 
 
-def _for_execution(schedule: Schedule) -> bool:
-    """Whether the schedule's method plans for execution (its plans then obey the braking rule)."""
-    method = schedule.method
-    return method is None or bool(getattr(method, "plans_for_execution", True))
-
-
 def _verify(schedule: Schedule) -> VerificationReport:
     own = array_failures(schedule)
     if own:  # the motion is read from these numbers: broken ones make every other check meaningless
@@ -299,26 +293,14 @@ def _verify(schedule: Schedule) -> VerificationReport:
     if not pieces.count and start_gap < required - POSITION_TOLERANCE:
         failures.append(f"separation {start_gap:.9g} m at rest is below the minimum {required:g} m")
     check_piece_continuity(pieces, track, schedule, failures)
-    if not failures and schedule.end_tolerance is None and _for_execution(schedule):
-        # a plan for execution: each follower can always stop short of its frontier (a table read
-        # back follows a plan that was checked; its own round-off is not an execution)
+    if not failures and for_execution(schedule):
+        # a plan for execution: each follower can always stop short of its frontier
         for failure in braking_rule_failures(schedule, pieces=pieces):
             k = int(
                 np.clip(np.searchsorted(pieces.start, failure.time, side="right") - 1, 0, pieces.count - 1)
             )
-            what = (
-                f"its service stop point passes it by {failure.excess:.3g} m"
-                if math.isfinite(failure.excess)
-                else "its margin stays too thin to certify"
-            )
-            failures.append(
-                Finding(
-                    f"vehicle {failure.vehicle + 1} cannot stop short of its frontier at "
-                    f"t={failure.time:.6f} s ({place(schedule, pieces, failure.vehicle, k, failure.time)}): "
-                    f"{what} (the braking rule; expected at most {BRAKING_RULE_TOLERANCE:g} m past it)",
-                    piece_arrays(schedule, pieces, k),
-                )
-            )
+            where = place(schedule, pieces, failure.vehicle, k, failure.time)
+            failures.append(Finding(failure.message(where), piece_arrays(schedule, pieces, k)))
     expected = route.region_keys
     sequence = reduce_regions(regions)
     if sequence != expected:

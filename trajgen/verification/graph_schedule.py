@@ -12,10 +12,12 @@ and, on one edge, ``|s1 - s2|``. Their minima are taken in closed form
 Checked: the paths follow the route's moves from its start to its goal, travel starts at 0 and ends at
 each path's length at rest, never runs backwards, the vehicles are at rest where a path turns back,
 position, velocity (and acceleration when jerk-limited) are continuous, velocity, acceleration (and
-jerk) stay within the limits, the separation holds, every number is finite, and the schedule passes
-every conflict in the route's order (its class): each convex part of the region closer than the
-separation, in the plane of both vehicles' travel, lies on the same side of the schedule's curve as of
-the route's.
+jerk) stay within the limits, the separation holds, the schedule passes every conflict in the route's
+order (its class, :mod:`~trajgen.verification.graph_class`), and a plan for execution obeys the
+braking rule (:mod:`~trajgen.verification.braking_rule`). Before any of it, the schedule's own numbers
+(:mod:`~trajgen.verification.integrity`: finite, knots increasing, sections tiling time). A failure's
+details name the arrays it lies in (``sections[1].kinematics.vehicles[0].{times,initial,jerk}
+interval 3, paths[0].{edges,s_from,s_to,starts}[2]``), as on a junction.
 """
 
 from __future__ import annotations
@@ -27,21 +29,24 @@ import numpy as np
 
 from topology import EdgePoint
 from trajgen.model import polynomials
+from trajgen.model.blended import ToppraKinematics
 from trajgen.model.graph_schedule import GraphSchedule
 from trajgen.model.pieces import UncheckableKinematicsError, kinematics_polynomials, split_at_values
+from trajgen.verification.braking_rule import braking_rule_failures, for_execution
+from trajgen.verification.graph_class import check_class
 from trajgen.verification.graph_route import TrackDistances
+from trajgen.verification.integrity import array_failures
 from trajgen.verification.piecewise import allowance, continuity_allowance, time_resolution
 from trajgen.verification.report import (
     POSITION_TOLERANCE,
     REST_TOLERANCE,
     TRACK_END_TOLERANCE,
+    Finding,
     VerificationReport,
 )
 
 __all__ = ["verify_graph_schedule"]
 
-#: Area below which a convex part of the too-close region is a touching line, not an obstacle, m².
-_SLIVER_AREA = 1e-12
 #: Pieces whose separation is computed at once (the memory of a table read back stays bounded).
 _BLOCK = 1 << 15
 
@@ -51,21 +56,25 @@ class _Pieces:
 
     def __init__(self, schedule: GraphSchedule) -> None:
         parts = []
-        for section in schedule.sections:
-            times, travel, _ = kinematics_polynomials(section.kinematics)
-            parts.append((section.start_time + times[:-1], np.diff(times), travel))
+        for number, section in enumerate(schedule.sections):
+            times, travel, intervals = kinematics_polynomials(section.kinematics)
+            # rows: each vehicle's knot interval, and the section (for the findings' arrays)
+            origin = np.vstack([intervals, np.full((1, intervals.shape[1]), number)])
+            parts.append((section.start_time + times[:-1], np.diff(times), travel, origin))
         bounds = tuple(path.starts[1:-1] for path in schedule.paths)
         ends = np.concatenate([p[0] for p in parts] + [[parts[-1][0][-1] + parts[-1][1][-1]]])
         travel = np.concatenate([p[2] for p in parts], axis=1)
-        start, length, travel, _ = split_at_values(
-            ends, travel, np.zeros((2, ends.size - 1), dtype=int), bounds, margin=POSITION_TOLERANCE
+        origin = np.concatenate([p[3] for p in parts], axis=1)
+        start, length, travel, origin = split_at_values(
+            ends, travel, origin, bounds, margin=POSITION_TOLERANCE
         )
         keep = length > 0.0
         if not keep.any():  # nothing moves: one piece of no time at the start
-            start, length, travel = np.zeros(1), np.zeros(1), travel[:, :1]
+            start, length, travel, origin = np.zeros(1), np.zeros(1), travel[:, :1], origin[:, :1]
         else:
-            start, length, travel = start[keep], length[keep], travel[:, keep]
+            start, length, travel, origin = start[keep], length[keep], travel[:, keep], origin[:, keep]
         self.start, self.length, self.travel = start, length, travel
+        self.interval, self.section = origin[:2], origin[2]
         middle = np.stack([polynomials.evaluate(travel[v], 0.5 * length) for v in range(2)])
         self.segment = np.stack(
             [
@@ -84,18 +93,25 @@ class _Pieces:
     def count(self) -> int:
         return int(self.length.size)
 
-
-def _check_tiling(schedule: GraphSchedule, failures: list[str]) -> None:
-    """Sections follow each other without gap or overlap from t = 0."""
-    clock = 0.0
-    for number, section in enumerate(schedule.sections):
-        if not math.isfinite(section.duration) or abs(section.start_time - clock) > 1e-9 * max(1.0, clock):
-            failures.append(
-                f"section {number + 1} starts at t={section.start_time!r} s: expected the end of the one "
-                f"before, t={clock!r} s"
+    def arrays(self, schedule: GraphSchedule, k: int, vehicles: tuple[int, ...] = (0, 1)) -> str:
+        """The arrays that define piece ``k`` of the given vehicles, by their paths (for the findings)."""
+        section = int(self.section[k])
+        kinematics = schedule.sections[section].kinematics
+        named = []
+        for vehicle in vehicles:
+            if type(kinematics) is ToppraKinematics:
+                motion = f"sections[{section}].kinematics.{{grid,speed,times}}"
+            else:
+                motion = f"sections[{section}].kinematics.vehicles[{vehicle}].{{times,initial,jerk}}"
+            named.append(
+                f"{motion} interval {int(self.interval[vehicle, k])}, "
+                f"paths[{vehicle}].{{edges,s_from,s_to,starts}}[{int(self.segment[vehicle, k])}]"
             )
-            return
-        clock = section.start_time + section.duration
+        return "; ".join(named)
+
+    def at(self, t: float) -> int:
+        """The piece at time ``t`` (seconds)."""
+        return int(np.clip(np.searchsorted(self.start, t, side="right") - 1, 0, self.count - 1))
 
 
 def _track_polynomials(schedule: GraphSchedule, pieces: _Pieces) -> tuple[np.ndarray, np.ndarray]:
@@ -119,15 +135,28 @@ def _check_paths(schedule: GraphSchedule, distances: TrackDistances, failures: l
     """Each path follows its vehicle's moves of the route, from the route's start to its goal."""
     route, track = schedule.route, schedule.track
     for vehicle, path in enumerate(schedule.paths):
-        who = f"vehicle {vehicle + 1}"
-        arrays = [path.s_from, path.s_to, path.starts]
-        if not all(np.all(np.isfinite(a)) for a in arrays):
-            failures.append(f"{who}'s path holds a non-finite number: expected finite metres")
+        who, arrays = f"vehicle {vehicle + 1}", f"paths[{vehicle}]"
+        broken = [
+            (name, int(np.flatnonzero(~np.isfinite(values))[0]))
+            for name in ("s_from", "s_to", "starts")
+            if not np.all(np.isfinite(values := getattr(path, name)))
+        ]
+        if broken:
+            name, k = broken[0]
+            failures.append(
+                Finding(
+                    f"{who}'s path holds a non-finite number: expected finite metres",
+                    f"{arrays}.{name}[{k}] is {getattr(path, name)[k]!r}",
+                )
+            )
             continue
         m = path.edges.size
         if path.starts.size != m + 1 or path.headings.size != m or path.s_from.size != m:
             failures.append(
-                f"{who}'s path has {m} edges but {path.starts.size} travel marks: expected {m + 1}"
+                Finding(
+                    f"{who}'s path has {m} edges but {path.starts.size} travel marks: expected {m + 1}",
+                    f"{arrays}.{{edges,starts,headings,s_from}}",
+                )
             )
             continue
 
@@ -137,21 +166,37 @@ def _check_paths(schedule: GraphSchedule, distances: TrackDistances, failures: l
         for k in range(m):
             edge = int(path.edges[k])
             if not 0 <= edge < len(track.edges):
-                failures.append(f"{who}'s path runs on edge number {edge}: the track has {len(track.edges)}")
+                failures.append(
+                    Finding(
+                        f"{who}'s path runs on edge number {edge}: the track has {len(track.edges)}",
+                        f"{arrays}.edges[{k}]",
+                    )
+                )
                 return
             low, high = sorted((path.s_from[k], path.s_to[k]))
             if low < -TRACK_END_TOLERANCE or high > distances.lengths[edge] + TRACK_END_TOLERANCE:
                 failures.append(
-                    f"{who}'s path leaves edge {track.edges[edge].name!r} ({low:g} to {high:g} m of "
-                    f"{distances.lengths[edge]:g} m)"
+                    Finding(
+                        f"{who}'s path leaves edge {track.edges[edge].name!r} ({low:g} to {high:g} m of "
+                        f"{distances.lengths[edge]:g} m)",
+                        f"{arrays}.{{s_from,s_to}}[{k}]",
+                    )
                 )
             if abs((high - low) - (path.starts[k + 1] - path.starts[k])) > POSITION_TOLERANCE:
                 failures.append(
-                    f"{who}'s path segment {k + 1} is {high - low:g} m long but counts "
-                    f"{path.starts[k + 1] - path.starts[k]:g} m of travel"
+                    Finding(
+                        f"{who}'s path segment {k + 1} is {high - low:g} m long but counts "
+                        f"{path.starts[k + 1] - path.starts[k]:g} m of travel",
+                        f"{arrays}.{{s_from,s_to}}[{k}], {arrays}.starts[{k}:{k + 2}]",
+                    )
                 )
             if k and distances.between(point(k - 1, True), point(k, False)) > POSITION_TOLERANCE:
-                failures.append(f"{who}'s path jumps between its segments {k} and {k + 1}")
+                failures.append(
+                    Finding(
+                        f"{who}'s path jumps between its segments {k} and {k + 1}",
+                        f"{arrays}.{{edges,s_from,s_to}}[{k - 1}:{k + 1}]",
+                    )
+                )
             if k:
                 turns = (
                     edge == int(path.edges[k - 1])
@@ -159,21 +204,32 @@ def _check_paths(schedule: GraphSchedule, distances: TrackDistances, failures: l
                 )
                 if (path.headings[k] != path.headings[k - 1]) != turns:
                     failures.append(
-                        f"{who}'s path {'turns back' if turns else 'goes on'} after its segment {k} but its "
-                        f"heading {'does not flip' if turns else 'flips'} there"
+                        Finding(
+                            f"{who}'s path {'turns back' if turns else 'goes on'} after its segment {k} but "
+                            f"its heading {'does not flip' if turns else 'flips'} there",
+                            f"{arrays}.headings[{k - 1}:{k + 1}]",
+                        )
                     )
         start = point(0, False) if m else path.home
         goal = point(m - 1, True) if m else path.home
-        for what, here, expected in (
-            ("start", start, route.start[vehicle]),
-            ("goal", goal, route.goal[vehicle]),
+        for what, here, expected, k in (
+            ("start", start, route.start[vehicle], 0),
+            ("goal", goal, route.goal[vehicle], max(m - 1, 0)),
         ):
             off = distances.between(here, expected)
             if off > POSITION_TOLERANCE:
-                failures.append(f"{who}'s path {what} is {off:.3g} m off the route's {track.name(expected)}")
+                failures.append(
+                    Finding(
+                        f"{who}'s path {what} is {off:.3g} m off the route's {track.name(expected)}",
+                        f"{arrays}.{{edges,s_from,s_to}}[{k}]" if m else f"{arrays}.home",
+                    )
+                )
         if abs(path.length - route.travel[vehicle]) > POSITION_TOLERANCE * max(1.0, route.travel[vehicle]):
             failures.append(
-                f"{who}'s path is {path.length:g} m long: the route moves it {route.travel[vehicle]:g} m"
+                Finding(
+                    f"{who}'s path is {path.length:g} m long: the route moves it {route.travel[vehicle]:g} m",
+                    f"{arrays}.starts[{m}]",
+                )
             )
         travel = 0.0
         for number, move in enumerate(route.moves):
@@ -185,8 +241,11 @@ def _check_paths(schedule: GraphSchedule, distances: TrackDistances, failures: l
                 off = distances.between(EdgePoint(int(edge[0]), float(s[0])), b)
                 if off > 1e3 * POSITION_TOLERANCE:
                     failures.append(
-                        f"{who}'s path is {off:.3g} m off move {number + 1}'s point {track.name(b)} after "
-                        f"{reached:g} m of travel"
+                        Finding(
+                            f"{who}'s path is {off:.3g} m off move {number + 1}'s point {track.name(b)} "
+                            f"after {reached:g} m of travel",
+                            f"{arrays}.{{edges,s_from,s_to}}[{int(path.segment(reached)[0])}]",
+                        )
                     )
                     return
                 travel = reached
@@ -212,12 +271,23 @@ def _check_motion(schedule: GraphSchedule, pieces: _Pieces, failures: list[str])
         start_error = max(start_error, abs(first))
         goal_error = max(goal_error, abs(last - path.length))
         if abs(first) > end_tolerance or abs(last - path.length) > end_tolerance:
+            k = 0 if abs(first) > end_tolerance else pieces.count - 1
             failures.append(
-                f"{who}'s travel runs from {first:.9g} m to {last:.9g} m: expected 0 to its path's "
-                f"{path.length:.9g} m"
+                Finding(
+                    f"{who}'s travel runs from {first:.9g} m to {last:.9g} m: expected 0 to its path's "
+                    f"{path.length:.9g} m",
+                    pieces.arrays(schedule, k, (vehicle,)),
+                )
             )
-        if np.any(low < -past_end) or np.any(high > path.length + past_end):
-            failures.append(f"{who}'s travel leaves 0 to {path.length:g} m")
+        outside = np.nonzero((low < -past_end) | (high > path.length + past_end))[0]
+        if outside.size:
+            k = int(outside[0])
+            failures.append(
+                Finding(
+                    f"{who}'s travel leaves 0 to {path.length:g} m from t={pieces.start[k]:.6f} s",
+                    pieces.arrays(schedule, k, (vehicle,)),
+                )
+            )
         derivatives = [c]
         for _ in range(3):
             derivatives.append(polynomials.derivative(derivatives[-1]))
@@ -226,8 +296,12 @@ def _check_motion(schedule: GraphSchedule, pieces: _Pieces, failures: list[str])
         if backwards.size:
             k = int(backwards[0])
             failures.append(
-                f"{who} drives back along its path at {velocity_low[k]:.3g} m/s at t="
-                f"{pieces.start[k] + when[k]:.6f} s: expected to turn back only at rest where its path does"
+                Finding(
+                    f"{who} drives back along its path at {velocity_low[k]:.3g} m/s at t="
+                    f"{pieces.start[k] + when[k]:.6f} s: expected to turn back only at rest where its path "
+                    "does",
+                    pieces.arrays(schedule, k, (vehicle,)),
+                )
             )
         for order in (1, 2):
             begin = abs(float(derivatives[order][0, 0]))
@@ -236,8 +310,11 @@ def _check_motion(schedule: GraphSchedule, pieces: _Pieces, failures: list[str])
                 continue  # a linearly interpolated table has no velocity at its ends: the drive ramps
             if max(begin, end) > REST_TOLERANCE:
                 failures.append(
-                    f"{who} is not at rest at the {'start' if begin > end else 'goal'}: "
-                    f"{'velocity' if order == 1 else 'acceleration'} {max(begin, end):.3g}"
+                    Finding(
+                        f"{who} is not at rest at the {'start' if begin > end else 'goal'}: "
+                        f"{'velocity' if order == 1 else 'acceleration'} {max(begin, end):.3g}",
+                        pieces.arrays(schedule, 0 if begin > end else pieces.count - 1, (vehicle,)),
+                    )
                 )
         for order, (name, limit_name, unit) in enumerate(names, start=1):
             lo, t_lo, hi, t_hi = polynomials.extrema(derivatives[order], h)
@@ -248,8 +325,11 @@ def _check_motion(schedule: GraphSchedule, pieces: _Pieces, failures: list[str])
             if not peak[k] <= limit + allowance(schedule, vehicle, name):
                 at = pieces.start[k] + (t_hi[k] if abs(hi[k]) >= abs(lo[k]) else t_lo[k])
                 failures.append(
-                    f"{who} {name} reaches {peak[k]:.9g} {unit} at t={at:.6f} s: exceeds its {limit_name} "
-                    f"{limit:g} {unit}"
+                    Finding(
+                        f"{who} {name} reaches {peak[k]:.9g} {unit} at t={at:.6f} s: exceeds its "
+                        f"{limit_name} {limit:g} {unit}",
+                        pieces.arrays(schedule, k, (vehicle,)),
+                    )
                 )
         if pieces.count > 1:
             scale = max(1.0, path.length)
@@ -274,7 +354,12 @@ def _check_motion(schedule: GraphSchedule, pieces: _Pieces, failures: list[str])
                 jumps = np.nonzero(~(gap <= tolerance))[0]
                 if jumps.size:
                     k = int(jumps[0])
-                    failures.append(f"{who} {name} jumps by {gap[k]:.3g} at t={pieces.start[k + 1]:.6f} s")
+                    failures.append(
+                        Finding(
+                            f"{who} {name} jumps by {gap[k]:.3g} at t={pieces.start[k + 1]:.6f} s",
+                            pieces.arrays(schedule, k + 1, (vehicle,)),
+                        )
+                    )
         # at rest where the path turns back (the acceleration along its axis is continuous, above)
         if path.cusps.size and pieces.count > 1 and schedule.smoothness >= 1:
             boundary = pieces.travel[vehicle][1:, 0]
@@ -288,8 +373,12 @@ def _check_motion(schedule: GraphSchedule, pieces: _Pieces, failures: list[str])
                 speed = abs(float(derivatives[1][k + 1, 0]))
                 if speed > REST_TOLERANCE:
                     failures.append(
-                        f"{who} turns back at {boundary[k]:g} m of travel (t={pieces.start[k + 1]:.6f} s) at "
-                        f"{speed:.3g} m/s: expected at rest where its path turns back"
+                        Finding(
+                            f"{who} turns back at {boundary[k]:g} m of travel "
+                            f"(t={pieces.start[k + 1]:.6f} s) at {speed:.3g} m/s: expected at rest where its "
+                            "path turns back",
+                            pieces.arrays(schedule, k + 1, (vehicle,)),
+                        )
                     )
     return ratios, start_error, goal_error
 
@@ -388,157 +477,32 @@ def _check_separation(
     if crossing.any():
         j = int(np.argmax(crossing))
         failures.append(
-            f"the vehicles pass each other on edge {schedule.track.edges[edges[0, j]].name!r} between "
-            f"t={pieces.start[j]:.6f} s and t={pieces.start[j] + pieces.length[j]:.6f} s"
+            Finding(
+                f"the vehicles pass each other on edge {schedule.track.edges[edges[0, j]].name!r} between "
+                f"t={pieces.start[j]:.6f} s and t={pieces.start[j] + pieces.length[j]:.6f} s",
+                pieces.arrays(schedule, j),
+            )
         )
     elif closest[k] < required - _separation_slack(schedule):
         failures.append(
-            f"separation {closest[k]:.9g} m at t={pieces.start[k] + when[k]:.6f} s is below the minimum "
-            f"{required:g} m (vehicle 1 on {schedule.track.edges[edges[0, k]].name!r}, vehicle 2 on "
-            f"{schedule.track.edges[edges[1, k]].name!r})"
+            Finding(
+                f"separation {closest[k]:.9g} m at t={pieces.start[k] + when[k]:.6f} s is below the minimum "
+                f"{required:g} m (vehicle 1 on {schedule.track.edges[edges[0, k]].name!r}, vehicle 2 on "
+                f"{schedule.track.edges[edges[1, k]].name!r})",
+                pieces.arrays(schedule, k),
+            )
         )
     return float(closest[k])
 
 
-def _clip(polygon: list, a: float, b: float, c: float) -> list:
-    """The part of a convex polygon where ``a x + b y < c`` (Sutherland–Hodgman, one half-plane)."""
-    out = []
-    for (x0, y0), (x1, y1) in zip(polygon, polygon[1:] + polygon[:1], strict=True):
-        f0, f1 = a * x0 + b * y0 - c, a * x1 + b * y1 - c
-        if f0 < 0.0:
-            out.append((x0, y0))
-        if (f0 < 0.0) != (f1 < 0.0):
-            r = f0 / (f0 - f1)
-            out.append((x0 + r * (x1 - x0), y0 + r * (y1 - y0)))
-    return out
-
-
-def _centroid(polygon: list) -> tuple[float, float, float]:
-    """Area and centroid of a convex polygon."""
-    area = cx = cy = 0.0
-    for (x0, y0), (x1, y1) in zip(polygon, polygon[1:] + polygon[:1], strict=True):
-        cross = x0 * y1 - x1 * y0
-        area += cross
-        cx += (x0 + x1) * cross
-        cy += (y0 + y1) * cross
-    if abs(area) < 1e-300:
-        return 0.0, 0.0, 0.0
-    return 0.5 * abs(area), cx / (3.0 * area), cy / (3.0 * area)
-
-
-def _too_close_parts(schedule: GraphSchedule, distances: TrackDistances) -> list[tuple[float, float]]:
-    """A point inside each convex part of the region closer than the separation, in the travel plane."""
-    required = schedule.limits.min_separation
-    first, second = schedule.paths
-    points = []
-    for k1, k2 in itertools.product(range(first.edges.size), range(second.edges.size)):
-        e1, e2 = int(first.edges[k1]), int(second.edges[k2])
-        p_low, p_high = float(first.starts[k1]), float(first.starts[k1 + 1])
-        q_low, q_high = float(second.starts[k2]), float(second.starts[k2 + 1])
-        rectangle = [(p_low, q_low), (p_high, q_low), (p_high, q_high), (p_low, q_high)]
-        # s_i = offset_i + sign_i * travel_i on these segments
-        sign_1 = float(np.sign(first.s_to[k1] - first.s_from[k1]))
-        sign_2 = float(np.sign(second.s_to[k2] - second.s_from[k2]))
-        offset_1 = float(first.s_from[k1]) - sign_1 * p_low
-        offset_2 = float(second.s_from[k2]) - sign_2 * q_low
-        parts = []
-        for end_1, end_2 in itertools.product((0, 1), (0, 1)):
-            # distance through ends: (s1 or L1 - s1) + D + (s2 or L2 - s2) < d, as a x + b y < c
-            f1 = -1.0 if end_1 else 1.0
-            f2 = -1.0 if end_2 else 1.0
-            constant = distances.nodes[distances.ends[e1][end_1]][distances.ends[e2][end_2]]
-            constant += (distances.lengths[e1] if end_1 else 0.0) + (distances.lengths[e2] if end_2 else 0.0)
-            constant += f1 * offset_1 + f2 * offset_2
-            parts.append(_clip(rectangle, f1 * sign_1, f2 * sign_2, required - constant))
-        if e1 == e2:  # |s1 - s2| < d: a strip
-            strip = _clip(rectangle, sign_1, -sign_2, required - offset_1 + offset_2)
-            parts.append(_clip(strip, -sign_1, sign_2, required + offset_1 - offset_2))
-        for polygon in parts:
-            if len(polygon) >= 3:
-                area, cx, cy = _centroid(polygon)
-                if area > _SLIVER_AREA:
-                    points.append((cx, cy))
-    return points
-
-
-def _route_curve(schedule: GraphSchedule) -> np.ndarray:
-    """The route's moves as a monotone staircase in the travel plane, shape (m + 1, 2)."""
-    corners = [(0.0, 0.0)]
-    for move in schedule.route.moves:
-        here = list(corners[-1])
-        here[move.vehicle] += move.length
-        corners.append((here[0], here[1]))
-    return np.array(corners)
-
-
-def _side_of_polyline(curve: np.ndarray, point: tuple[float, float]) -> int:
-    """+1 if the point lies above the monotone polyline (vehicle 1 passes first), -1 below, 0 on it."""
-    x, y = point
-    lows, highs = [], []
-    for (x0, y0), (x1, y1) in itertools.pairwise(curve):
-        if min(x0, x1) <= x <= max(x0, x1):
-            if x1 == x0:
-                lows.append(min(y0, y1))
-                highs.append(max(y0, y1))
-            else:
-                y_at = y0 + (x - x0) / (x1 - x0) * (y1 - y0)
-                lows.append(y_at)
-                highs.append(y_at)
-    if not lows:
-        return 0
-    return 1 if y > max(highs) + POSITION_TOLERANCE else (-1 if y < min(lows) - POSITION_TOLERANCE else 0)
-
-
-def _side_of_schedule(pieces: _Pieces, point: tuple[float, float]) -> int:
-    """The same side test for the schedule's curve (travel of both vehicles, piece by piece)."""
-    x, y = point
-    first, second = pieces.travel
-    begin = first[:, 0]
-    end = polynomials.evaluate(first, pieces.length)
-    lo, hi = np.minimum(begin, end), np.maximum(begin, end)
-    hits = np.nonzero((lo <= x) & (x <= hi))[0]
-    if hits.size == 0:
-        return 0
-    values = []
-    for k in hits:
-        c = first[k : k + 1].copy()
-        c[0, 0] -= x
-        if begin[k] == end[k]:  # standing at x for the piece: the other's whole range
-            _, _, top, _ = polynomials.extrema(second[k : k + 1], pieces.length[k : k + 1])
-            values += [float(second[k, 0]), float(top[0])]
-            continue
-        root = polynomials.root_in(c, np.zeros(1), pieces.length[k : k + 1])
-        if np.isfinite(root[0]):
-            values.append(float(polynomials.evaluate(second[k : k + 1], root)[0]))
-    if not values:
-        return 0
-    return 1 if y > max(values) + POSITION_TOLERANCE else (-1 if y < min(values) - POSITION_TOLERANCE else 0)
-
-
-def _check_class(
-    schedule: GraphSchedule, pieces: _Pieces, distances: TrackDistances, failures: list[str]
-) -> bool:
-    """Whether every part of the too-close region lies on the same side of the schedule as of the route."""
-    route_curve = _route_curve(schedule)
-    for point in _too_close_parts(schedule, distances):
-        planned, timed = _side_of_polyline(route_curve, point), _side_of_schedule(pieces, point)
-        if planned and timed and planned != timed:
-            first = "vehicle 1" if planned > 0 else "vehicle 2"
-            failures.append(
-                "the schedule passes a conflict in another order than the route (at travel "
-                f"{point[0]:.3f} m, "
-                f"{point[1]:.3f} m the route lets {first} pass first): another class than the route's"
-            )
-            return False
-    return True
-
-
 def verify_graph_schedule(schedule: GraphSchedule) -> VerificationReport:
     """Check a schedule on a track graph independently of how it was computed (see the module)."""
+    own = array_failures(schedule)
+    if own:  # the motion is read from these numbers: broken ones make every other check meaningless
+        return VerificationReport.failed(tuple(own))
     failures: list[str] = []
     distances = TrackDistances(schedule.track)
     _check_paths(schedule, distances, failures)
-    _check_tiling(schedule, failures)
     if failures:
         return VerificationReport.failed(tuple(failures))
     try:
@@ -547,7 +511,15 @@ def verify_graph_schedule(schedule: GraphSchedule) -> VerificationReport:
         return VerificationReport.failed((str(error),))
     ratios, start_error, goal_error = _check_motion(schedule, pieces, failures)
     closest = _check_separation(schedule, pieces, distances, failures)
-    same_class = _check_class(schedule, pieces, distances, failures)
+    same_class = check_class(schedule, pieces, distances, failures)
+    if not failures and for_execution(schedule):
+        # a plan for execution: each follower can always stop short of its frontier
+        for failure in braking_rule_failures(schedule):
+            k = pieces.at(failure.time)
+            state = schedule.state([failure.time])
+            edge = schedule.track.edges[int(state.edge[failure.vehicle, 0])]
+            where = f"on edge {edge.name!r}, {float(state.s[failure.vehicle, 0]):.3f} m from {edge.start!r}"
+            failures.append(Finding(failure.message(where), pieces.arrays(schedule, k, (failure.vehicle,))))
     return VerificationReport(
         passed=not failures,
         failures=tuple(failures),

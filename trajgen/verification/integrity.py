@@ -24,7 +24,7 @@ import numpy as np
 
 from trajgen.model.blended import BlendedPath, ToppraKinematics
 from trajgen.model.profiles import PiecewiseCubic
-from trajgen.model.schedule import AxisMap, CubicKinematics, Schedule
+from trajgen.model.schedule import AxisMap, CubicKinematics
 from trajgen.verification.report import Finding
 
 __all__ = ["array_failures"]
@@ -305,12 +305,12 @@ def _kinematics(kinematics: object, where: _Array, section: str, failures: list[
     # any other kind is refused by the verifier as uncheckable
 
 
-def array_failures(schedule: Schedule) -> list[str]:
+def array_failures(schedule) -> list[str]:
     """Every failure of the schedule's own numbers, each naming its array in its details.
 
     Parameters
     ----------
-    schedule : Schedule
+    schedule : Schedule or GraphSchedule
 
     Returns
     -------
@@ -338,7 +338,7 @@ def array_failures(schedule: Schedule) -> list[str]:
                 f"{where}.start_time is {float(start)!r}: expected a finite number of seconds",
             )
         _kinematics(section_object.kinematics, _Array(f"{where}.kinematics", ""), section, failures)
-        for vehicle, axis_map in enumerate(section_object.maps):
+        for vehicle, axis_map in enumerate(getattr(section_object, "maps", ())):  # a star's sections
             words = f"vehicle {vehicle + 1}'s track map (where its axis lies on the track) in {section}"
             _axis_map(axis_map, _Array(f"{where}.maps[{vehicle}]", words), failures)
         if len(failures) > count:

@@ -1,0 +1,129 @@
+"""Each check of the verifier, tampered with once on every case of the table, is caught and placed.
+
+One verifier serves every track: the same tampering of a junction's plan and of a track graph's
+plan fails the same check, with a message in words and details that name the schedule's arrays.
+"""
+
+from __future__ import annotations
+
+import copy
+import dataclasses
+import math
+import re
+
+import numpy as np
+import pytest
+
+from limits import Limits
+from tests.support.cases import CASES
+from trajgen import verify
+from trajgen.model.schedule import CubicKinematics
+
+
+def _limits(schedule, **scale):
+    """The schedule's limits with each named limit scaled, and its separation."""
+    vehicles = tuple(
+        dataclasses.replace(v, **{name: getattr(v, name) * factor for name, factor in scale.items()})
+        for v in schedule.limits.vehicles
+    )
+    return Limits(vehicles, schedule.limits.min_separation)
+
+
+def _slower(name):
+    def tamper(schedule, report):
+        return dataclasses.replace(schedule, limits=_limits(schedule, **{name: 0.5}))
+
+    return tamper
+
+
+def _farther(schedule, report):
+    """A separation half a metre more than the closest approach the plan keeps."""
+    return dataclasses.replace(schedule, limits=Limits(schedule.limits.vehicles, report.min_separation + 0.5))
+
+
+def _moving_section(schedule) -> int:
+    """The first section whose kinematics are piecewise cubic with a vehicle that moves."""
+    for number, section in enumerate(schedule.sections):
+        if type(section.kinematics) is CubicKinematics:
+            return number
+    raise AssertionError("no piecewise cubic section")
+
+
+def _not_a_number(schedule, report):
+    """A NaN in a vehicle's knot jerks of a section."""
+    number = _moving_section(schedule)
+    section = schedule.sections[number]
+    profile = section.kinematics.vehicles[0]
+    jerk = np.array(profile.jerk, dtype=float)
+    jerk[0] = math.nan
+    broken = copy.copy(profile)  # past the constructor, which refuses it: as a corrupted object would be
+    object.__setattr__(broken, "jerk", jerk)
+    kinematics = CubicKinematics((broken, *section.kinematics.vehicles[1:]))
+    sections = list(schedule.sections)
+    sections[number] = dataclasses.replace(section, kinematics=kinematics)
+    return dataclasses.replace(schedule, sections=tuple(sections))
+
+
+def _late(schedule, report):
+    """The last section begins a second after the one before it ends."""
+    sections = list(schedule.sections)
+    sections[-1] = dataclasses.replace(sections[-1], start_time=sections[-1].start_time + 1.0)
+    return dataclasses.replace(schedule, sections=tuple(sections))
+
+
+#: check -> (tampering, the failure it must raise, what its details must name).
+CHECKS = {
+    "velocity": (_slower("max_velocity"), r"velocity reaches .* exceeds its max_velocity", "sections["),
+    "acceleration": (
+        _slower("max_acceleration"),
+        r"acceleration reaches .* exceeds its max_acceleration",
+        "sections[",
+    ),
+    "jerk": (_slower("max_jerk"), r"jerk reaches .* exceeds its max_jerk", "sections["),
+    "separation": (_farther, r"separation .* m at t=.* is below the minimum", "sections["),
+    "finite": (_not_a_number, r"hold nan: expected finite numbers", "].jerk["),
+    "tiling": (_late, r"starts at t=.* s: expected .* where the section before it ends", "].start_time"),
+}
+
+
+def test_every_case_of_the_table_passes_untouched():
+    for case in CASES:
+        assert case.verified().report.passed, case.name
+
+
+@pytest.mark.parametrize("check", sorted(CHECKS))
+@pytest.mark.parametrize("case", CASES, ids=[case.name for case in CASES])
+def test_each_check_catches_its_tampering_on_every_track(case, check):
+    tamper, failure, arrays = CHECKS[check]
+    verified = case.verified()
+    report = verify(tamper(verified.schedule, verified.report))
+    assert not report.passed
+    found = [(text, detail) for text, detail in zip(report.failures, report.details, strict=True)]
+    matching = [(text, detail) for text, detail in found if re.search(failure, text)]
+    assert matching, report.failures
+    text, detail = matching[0]
+    assert detail.startswith(text), detail
+    assert arrays in detail, detail
+
+
+#: Cases whose optimal plan, made without the braking rule, breaks it: relabelled as a plan for execution,
+#: the verifier must refuse it. On the passing loop and the ring the vehicles' optimal plans obey it
+#: untouched (checked too).
+BREAKS_THE_RULE = {"y": True, "4-leg": True, "8-leg": True, "h": True, "passing-loop": False, "ring": False}
+
+
+@pytest.mark.parametrize(
+    "case",
+    [
+        pytest.param(case, id=case.name, marks=pytest.mark.slow if case.name == "h" else ())
+        for case in CASES  # the H's optimal plan takes seconds
+    ],
+)
+def test_the_braking_rule_is_checked_on_every_track_for_a_plan_for_execution(case):
+    planned = case.verified("optimal").schedule
+    assert not planned.method.plans_for_execution
+    report = verify(dataclasses.replace(planned, method=planned.method.for_execution()))
+    assert report.passed != BREAKS_THE_RULE[case.name], report.failures
+    if not report.passed:
+        assert re.search(r"cannot stop short of its frontier at t=.* \(the braking rule", report.failures[0])
+        assert "sections[" in report.details[0]
