@@ -75,25 +75,29 @@ class VehicleLimits:
 
 @dataclass(frozen=True, slots=True)
 class Limits:
-    """Limits of both vehicles and the minimum separation between them.
+    """Limits of each vehicle and the minimum separation between every two of them.
+
+    The number of vehicles is data: the planners say how many they take (two, today).
 
     Parameters
     ----------
-    vehicles : tuple of 2 VehicleLimits
-        Vehicle 1's limits, then vehicle 2's; they may differ.
+    vehicles : sequence of VehicleLimits
+        Vehicle 1's limits, then vehicle 2's, and so on (at least one); they may differ.
     min_separation : float
-        Minimum track distance between the vehicles, metres, finite and >= 0.
+        Minimum track distance between any two vehicles, metres, finite and >= 0.
         Whether it fits the track (at most the shortest leg) is checked when
         planning.
     """
 
-    vehicles: tuple[VehicleLimits, VehicleLimits]
+    vehicles: tuple[VehicleLimits, ...]
     min_separation: float
 
     def __post_init__(self) -> None:
         vehicles = tuple(self.vehicles) if isinstance(self.vehicles, (tuple, list)) else None
-        if vehicles is None or len(vehicles) != 2:
-            raise LimitsError(f"vehicles must be a pair of VehicleLimits, got {self.vehicles!r}")
+        if not vehicles:
+            raise LimitsError(
+                f"vehicles must be a sequence of VehicleLimits, one per vehicle, got {self.vehicles!r}"
+            )
         for k, vehicle in enumerate(vehicles, start=1):
             if not isinstance(vehicle, VehicleLimits):
                 raise LimitsError(
@@ -104,6 +108,11 @@ class Limits:
             raise SeparationError(f"min_separation must be >= 0 m, got {separation!r}")
         object.__setattr__(self, "vehicles", vehicles)
         object.__setattr__(self, "min_separation", separation)
+
+    @property
+    def count(self) -> int:
+        """How many vehicles."""
+        return len(self.vehicles)
 
     @property
     def first(self) -> VehicleLimits:

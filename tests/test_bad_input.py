@@ -113,8 +113,10 @@ def test_the_api_refuses_names_that_leave_the_folder(tmp_path):
     )
     with pytest.raises(InputError, match=r"vehicle name '\.\./x' is not a portable file name"):
         write_profiles(verified, ("../x", "/abs/y"), tmp_path)
-    with pytest.raises(InputError, match="vehicle names must be a pair of names, got 5"):
+    with pytest.raises(InputError, match="vehicle names must be a sequence of names, one per vehicle, got 5"):
         write_profiles(verified, 5, tmp_path)  # type: ignore[arg-type]
+    with pytest.raises(InputError, match=r"vehicle names \('a', 'b', 'c'\): expected 2, one per vehicle"):
+        write_profiles(verified, ("a", "b", "c"), tmp_path)
     assert list(tmp_path.iterdir()) == []
 
 

@@ -12,7 +12,7 @@ from tests.support.grid_oracle import GridTrack, shortest_route
 from tests.support.helpers import RUN_FILES
 from topology import TrackGraph
 from trajgen.cli import main
-from trajgen.errors import ScenarioError
+from trajgen.errors import ScenarioError, VehicleCountError
 from trajgen.scenario import GraphScenario, load_scenario, parse_scenario
 
 EXAMPLES = REPO / "examples" / "graphs"
@@ -173,3 +173,49 @@ def test_demo_runs_the_built_in_h_end_to_end(tmp_path, capsys):
     assert "method: exact  duration: 51.500 s  verified: True" in out
     written = sorted(path.name for path in tmp_path.iterdir())
     assert written == RUN_FILES
+
+
+THREE = """
+[track.edges]
+a = { from = "J", to = "A", length = 10.0 }
+b = { from = "J", to = "B", length = 10.0 }
+c = { from = "J", to = "C", length = 10.0 }
+[safety]
+min_separation = 1.5
+""" + "".join(
+    f"""
+[[vehicle]]
+name = "agv{k}"
+max_velocity = 1.0
+max_acceleration = 0.5
+max_jerk = 1.0
+start = "{start}"
+goal = "{goal}"
+"""
+    for k, (start, goal) in enumerate([("A", "B"), ("B", "A"), ("C", "c:5")], start=1)
+)
+
+
+def test_three_vehicles_are_read_and_only_the_planner_refuses_them(tmp_path, capsys):
+    path = tmp_path / "three.toml"
+    path.write_text(THREE)
+    scenario = load_scenario(path)
+    assert scenario.names == ("agv1", "agv2", "agv3")
+    assert scenario.limits.count == 3
+    assert len(scenario.start) == len(scenario.goal) == 3
+    with pytest.raises(
+        VehicleCountError, match=r"three.toml: the track-graph planner plans exactly 2 vehicles, got 3"
+    ):
+        scenario.route()
+    for command in (["plan"], ["schedule"], ["simulate"]):
+        assert main([*command, str(path)]) == 2
+        assert "plans exactly 2 vehicles, got 3" in capsys.readouterr().err
+
+
+def test_every_pair_of_three_vehicles_keeps_the_separation_at_the_start(tmp_path):
+    path = tmp_path / "close.toml"
+    path.write_text(THREE.replace('start = "C"', 'start = "c:0.5"').replace('start = "B"', 'start = "b:0.5"'))
+    with pytest.raises(
+        ScenarioError, match=r"agv2's and agv3's start positions \(b:0.5, c:0.5\) are 1.0 m apart"
+    ):
+        load_scenario(path)

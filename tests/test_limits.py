@@ -45,8 +45,9 @@ def test_bad_vehicle_limits(kwargs, match):
 
 
 def test_bad_limits():
-    with pytest.raises(LimitsError, match="pair of VehicleLimits"):
-        Limits(vehicles=(ILLUSTRATIVE_VEHICLE,), min_separation=1.0)
+    with pytest.raises(LimitsError, match="a sequence of VehicleLimits, one per vehicle, got \\(\\)"):
+        Limits(vehicles=(), min_separation=1.0)
+    assert Limits(vehicles=(ILLUSTRATIVE_VEHICLE,) * 3, min_separation=1.0).count == 3  # the count is data
     with pytest.raises(LimitsError, match="limits of vehicle 2 must be VehicleLimits"):
         Limits(vehicles=(ILLUSTRATIVE_VEHICLE, 1.0), min_separation=1.0)
     with pytest.raises(SeparationError, match=r"min_separation must be >= 0 m, got -1\.0"):

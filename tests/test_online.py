@@ -714,7 +714,7 @@ def test_a_goal_too_close_to_the_other_goal_is_refused_with_the_reason(swap):
         (lambda e: e.step(VehicleState(0, 11.0), VehicleState(1, 10.0)), r"measured s 11.0 m is off leg 0"),
         (lambda e: e.step((0, 1.0), VehicleState(1, 10.0)), "must be a VehicleState"),
         (lambda e: e.request_speed_limit(0, 2.0), r"speed limit of vehicle 1 must be > 0 and <= 1.0"),
-        (lambda e: e.request_goal(2, Position("A", 1.0)), "vehicle must be 0 or 1"),
+        (lambda e: e.request_goal(2, Position("A", 1.0)), "vehicle must be an index from 0 to 1"),
     ],
     ids=["nan-s", "bad-leg", "off-leg", "not-a-state", "speed-above-limit", "bad-vehicle"],
 )

@@ -175,7 +175,7 @@ def _write(tmp_path, text):
             id="too-close-at-goal",
         ),
         pytest.param(
-            'name = "agv2"', 'name = "agv1"', "name 'agv1' is used by both vehicles", id="duplicate-name"
+            'name = "agv2"', 'name = "agv1"', "name 'agv1' is used by two vehicles", id="duplicate-name"
         ),
         pytest.param(
             'name = "agv2"',
@@ -190,7 +190,7 @@ def _write(tmp_path, text):
             'name = "agv2"', 'name = "NUL"', "'NUL' is a reserved device name on Windows", id="reserved"
         ),
         pytest.param(
-            'name = "agv2"', 'name = "AGV1"', r"'AGV1' is used by both vehicles \(case ignored\)", id="case"
+            'name = "agv2"', 'name = "AGV1"', r"'AGV1' is used by two vehicles \(case ignored\)", id="case"
         ),
         pytest.param('name = "agv2"', 'name = "x"', "", id="fine-name"),
         pytest.param(
@@ -224,12 +224,18 @@ def _replace_last(text: str, old: str, new: str) -> str:
     return head + new + tail
 
 
-def test_exactly_two_vehicles(tmp_path):
+def test_the_reader_takes_any_number_of_vehicles_and_the_junction_planner_two(tmp_path):
+    none = "vehicle = []\n" + GOOD[: GOOD.index("[[vehicle]]")]
+    with pytest.raises(ScenarioError, match=r"expected one or more \[\[vehicle\]\] tables, got 0"):
+        load_scenario(_write(tmp_path, none))
     one = GOOD[: GOOD.rindex("[[vehicle]]")]
-    with pytest.raises(ScenarioError, match=r"expected exactly two \[\[vehicle\]\] tables, got 1"):
+    with pytest.raises(
+        ScenarioError,
+        match=r"scenario.toml: the junction planner \(the paper's\) plans exactly 2 vehicles, got 1",
+    ):
         load_scenario(_write(tmp_path, one))
     three = GOOD + GOOD[GOOD.rindex("[[vehicle]]") :].replace("agv2", "agv3")
-    with pytest.raises(ScenarioError, match="got 3"):
+    with pytest.raises(ScenarioError, match="plans exactly 2 vehicles, got 3"):
         load_scenario(_write(tmp_path, three))
 
 

@@ -38,6 +38,7 @@ from topology.errors import (
     SeparationError,
     TrackError,
     TrajgenError,
+    VehicleCountError,
 )
 from topology.graph import MAX_LEGS, MIN_LEGS, StarGraph, YGraph
 from topology.graph_planner import GraphMove, GraphRoute, class_signature, plan_graph, plan_graph_classes
@@ -47,6 +48,7 @@ from topology.positions import JUNCTION, JUNCTION_NAME, Configuration, Position
 from topology.retract_graph import Geodesic, GraphPoint, RetractGraph
 from topology.route import Homotopy, Instruction, Region, Route, WayRound, plan, region_sequence
 from topology.track_graph import EdgePoint, TrackEdge, TrackGraph
+from topology.validation import PLANNED_VEHICLES, check_vehicle_count
 
 __all__ = [
     "ANTIPODAL_TOLERANCE",
@@ -55,6 +57,7 @@ __all__ = [
     "JUNCTION_NAME",
     "MAX_LEGS",
     "MIN_LEGS",
+    "PLANNED_VEHICLES",
     "BoundaryCycle",
     "Cell",
     "Configuration",
@@ -81,10 +84,12 @@ __all__ = [
     "TrackError",
     "TrackGraph",
     "TrajgenError",
+    "VehicleCountError",
     "WayRound",
     "YGraph",
     "as_indexed",
     "boundary_angle",
+    "check_vehicle_count",
     "class_signature",
     "classify",
     "is_antipodal",

@@ -17,6 +17,7 @@ __all__ = [
     "SeparationError",
     "TrackError",
     "TrajgenError",
+    "VehicleCountError",
 ]
 
 
@@ -50,3 +51,7 @@ class InfeasibleError(InputError):
     An answer about the scenario, not a failure of the planner: raised before any timing, it is
     bad input to the command line (exit 2).
     """
+
+
+class VehicleCountError(InputError):
+    """A planner was given a number of vehicles it does not plan for (the planners take two, today)."""

@@ -38,7 +38,7 @@ import numpy as np
 
 from topology.errors import InfeasibleError, SeparationError
 from topology.track_graph import EdgePoint, TrackGraph
-from topology.validation import finite_real, short_repr
+from topology.validation import check_vehicle_count, finite_real, short_repr
 
 __all__ = ["CLASS_WEIGHT", "GraphMove", "GraphRoute", "class_signature", "plan_graph", "plan_graph_classes"]
 
@@ -161,11 +161,12 @@ def plan_graph(
     separation = finite_real(min_separation, "minimum separation (m)", SeparationError)
     if separation <= 0.0:
         raise SeparationError(f"minimum separation is {separation!r} m: expected a positive distance")
-    if len(start) != 2 or len(goal) != 2 or len(names) != 2:
+    if not len(start) == len(goal) == len(names):
         raise SeparationError(
-            f"expected a start, a goal and a name for each of two vehicles, got {short_repr(start)}, "
+            f"expected a start, a goal and a name for each vehicle, got {short_repr(start)}, "
             f"{short_repr(goal)}, {short_repr(names)}"
         )
+    check_vehicle_count(len(start), "the track-graph planner")
     if len(weights) != 2 or not all(finite_real(w, "route weight", SeparationError) > 0.0 for w in weights):
         raise SeparationError(f"route weights {short_repr(weights)}: expected two positive numbers")
     starts = (track.point(start[0]), track.point(start[1]))

@@ -5,7 +5,13 @@ from __future__ import annotations
 import math
 from numbers import Real
 
-__all__ = ["finite_real", "short_repr"]
+from topology.errors import VehicleCountError
+
+__all__ = ["PLANNED_VEHICLES", "check_vehicle_count", "finite_real", "short_repr"]
+
+#: How many vehicles the planners take: the paper's on a junction and the roadmap's on a track graph
+#: plan two. Everything below the planners takes any number (the count is data).
+PLANNED_VEHICLES = 2
 
 
 def finite_real(value: object, quantity: str, error: type[Exception]) -> float:
@@ -49,3 +55,22 @@ def short_repr(value: object, limit: int = 60) -> str:
     """
     text = repr(value)
     return text if len(text) <= limit else text[: limit - 3] + "..."
+
+
+def check_vehicle_count(count: int, planner: str) -> None:
+    """Refuse a number of vehicles the planners do not plan for.
+
+    Raises
+    ------
+    VehicleCountError
+        ``count`` is not :data:`PLANNED_VEHICLES`; the message names ``planner``.
+
+    Examples
+    --------
+    >>> check_vehicle_count(2, "the junction planner")
+    """
+    if count != PLANNED_VEHICLES:
+        raise VehicleCountError(
+            f"{planner} plans exactly {PLANNED_VEHICLES} vehicles, got {count}: expected two [[vehicle]] "
+            "tables (planning more vehicles is to come)"
+        )

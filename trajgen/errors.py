@@ -24,6 +24,7 @@ from topology.errors import (
     SeparationError,
     TrackError,
     TrajgenError,
+    VehicleCountError,
 )
 
 __all__ = [
@@ -44,6 +45,7 @@ __all__ = [
     "TrackError",
     "TrajgenError",
     "UnverifiedScheduleError",
+    "VehicleCountError",
     "VerificationError",
 ]
 

@@ -53,6 +53,7 @@ from trajgen.execution.tracks import execution_track
 from trajgen.model.coordination import CoordinationDiagram, earliest_rest, stopping_distance
 from trajgen.model.graph_vehicle_path import GraphVehiclePath
 from trajgen.model.paths import VehiclePath
+from trajgen.scenario.naming import check_vehicle_index
 from trajgen.verification import VerifiedSchedule, require_verified
 from trajgen.verification.braking_rule import BRAKING_RULE_TOLERANCE
 
@@ -231,13 +232,12 @@ class Executor:
 
     # -- requests --------------------------------------------------------------------------------
     def request_goal(self, vehicle: int, position) -> GoalDecision:
-        """Ask for a new goal of ``vehicle`` (0 or 1): taken once both are at rest, or refused with why.
+        """A new goal for ``vehicle`` (its index, 0 for vehicle 1): taken once all rest, or refused with why.
 
         ``position``: a :class:`~topology.Position` on a junction; on a track graph an
         :class:`~topology.EdgePoint`, ``"EDGE:s"`` or a node's name.
         """
-        if vehicle not in (0, 1):
-            raise InputError(f"vehicle must be 0 or 1, got {vehicle!r}")
+        check_vehicle_index(vehicle, self.limits.count)
         try:
             candidate = self._track.goal_with(self._next_goal or self._goal, vehicle, position)
         except InputError as error:
@@ -257,8 +257,7 @@ class Executor:
 
     def request_speed_limit(self, vehicle: int, speed: float) -> None:
         """Limit ``vehicle``'s speed to ``speed`` m/s (at most its ``max_velocity``) from the next cycle."""
-        if vehicle not in (0, 1):
-            raise InputError(f"vehicle must be 0 or 1, got {vehicle!r}")
+        check_vehicle_index(vehicle, self.limits.count)
         top = self.limits.vehicles[vehicle].max_velocity
         if not (isinstance(speed, (int, float)) and math.isfinite(speed) and 0.0 < speed <= top):
             raise InputError(

@@ -11,6 +11,8 @@ where they stand, the timing method times it, the verifier certifies it
 
 from __future__ import annotations
 
+import itertools
+
 from limits import Limits
 from topology import Configuration, EdgePoint, InfeasibleError, StarGraph, TrackGraph, plan, plan_graph
 from trajgen.methods import make_schedule, method_for
@@ -38,7 +40,12 @@ def execution_margin(scenario, position_margin: float) -> float:
     track = scenario.track
     separation = scenario.limits.min_separation
     if isinstance(scenario, GraphScenario):
-        room = min(track.distance(*scenario.start), track.distance(*scenario.goal))
+        scenario.check_planned()
+        room = min(
+            track.distance(a, b)
+            for points in (scenario.start, scenario.goal)
+            for a, b in itertools.combinations(points, 2)
+        )
         margin = max(0.0, min(position_margin, 0.5 * (room - separation)))
         if margin > 0.0:  # on a graph the wider separation may close a siding or a loop
             try:

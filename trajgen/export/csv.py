@@ -29,7 +29,7 @@ from trajgen.export.limited import limited_columns
 from trajgen.export.numbers import format_number_rows
 from trajgen.model.graph_schedule import GraphSchedule
 from trajgen.model.schedule import Schedule, ScheduleState, check_period, sample_block, sample_rows
-from trajgen.scenario.naming import check_vehicle_names
+from trajgen.scenario.naming import check_vehicle_index, check_vehicle_names
 from trajgen.verification import VerifiedSchedule, require_verified
 
 __all__ = [
@@ -380,9 +380,7 @@ def profile_chunks(
     OutputLimitError
         The profile would have more than ``options.max_rows`` rows (raised at once, not when iterating).
     """
-    require_verified(verified, "profile_chunks")
-    if vehicle not in (0, 1):
-        raise InputError(f"vehicle must be 0 or 1, got {short_repr(vehicle)}")
+    check_vehicle_index(vehicle, require_verified(verified, "profile_chunks").schedule.limits.count)
     schedule, options = _checked(verified, options, "profile_chunks")
     rows = check_row_limit(schedule.duration, options)
     return _chunks(schedule, vehicle, options, rows, _SampledBlocks(schedule, options.sample_period))
@@ -390,13 +388,14 @@ def profile_chunks(
 
 def profile_chunk_pair(
     verified: VerifiedSchedule, options: CsvOptions | None = None
-) -> tuple[Iterator[bytes], Iterator[bytes]]:
-    """Both vehicles' CSV profiles as chunks (as :func:`profile_chunks`), sampling each block once.
+) -> tuple[Iterator[bytes], ...]:
+    """Each vehicle's CSV profile as chunks (as :func:`profile_chunks`), sampling each block once.
 
-    The two iterators share the sampled states of the block of rows they are at: taken in step, a
-    chunk of one then the same chunk of the other (as :func:`~trajgen.export.atomic.commit_files`
-    does), each block of :data:`ROWS_PER_CHUNK` rows is sampled once for both files. Taken otherwise,
-    the chunks are the same, only sampled twice. Memory stays bounded by one block.
+    One iterator per vehicle, in the schedule's order. They share the sampled states of the block of
+    rows they are at: taken in step, a chunk of each in turn (as
+    :func:`~trajgen.export.atomic.commit_files` does), each block of :data:`ROWS_PER_CHUNK` rows is
+    sampled once for every file. Taken otherwise, the chunks are the same, only sampled again.
+    Memory stays bounded by one block.
 
     Raises
     ------
@@ -406,7 +405,7 @@ def profile_chunk_pair(
     schedule, options = _checked(verified, options, "profile_chunk_pair")
     rows = check_row_limit(schedule.duration, options)
     blocks = _SampledBlocks(schedule, options.sample_period)
-    return _chunks(schedule, 0, options, rows, blocks), _chunks(schedule, 1, options, rows, blocks)
+    return tuple(_chunks(schedule, v, options, rows, blocks) for v in range(schedule.limits.count))
 
 
 def render_profile(verified: VerifiedSchedule, vehicle: int, options: CsvOptions | None = None) -> bytes:
@@ -427,19 +426,19 @@ def render_profile(verified: VerifiedSchedule, vehicle: int, options: CsvOptions
     return b"".join(profile_chunks(verified, vehicle, options))
 
 
-def profile_paths(names: Sequence[str], directory: str | Path) -> tuple[Path, Path]:
-    """``directory/<name>.csv`` for both vehicles.
+def profile_paths(names: Sequence[str], directory: str | Path) -> tuple[Path, ...]:
+    """``directory/<name>.csv`` for each vehicle, in the order of ``names``.
 
     Raises
     ------
     InputError
-        Not two portable, distinct file names (:func:`trajgen.scenario.naming.check_vehicle_names`).
+        Not portable, distinct file names (:func:`trajgen.scenario.naming.check_vehicle_names`).
     """
-    first, second = check_vehicle_names(names)
+    names = check_vehicle_names(names)
     if not isinstance(directory, (str, Path)) or str(directory) == "":
         raise InputError(f"CSV folder must name a folder, got {short_repr(directory)}")
     directory = Path(directory)
-    return (directory / f"{first}.csv", directory / f"{second}.csv")
+    return tuple(directory / f"{name}.csv" for name in names)
 
 
 def write_profiles(
@@ -449,22 +448,22 @@ def write_profiles(
     *,
     options: CsvOptions | None = None,
 ) -> tuple[Path, Path]:
-    """Write ``directory/<name>.csv`` for both vehicles, both or neither.
+    """Write ``directory/<name>.csv`` for each vehicle, all or none.
 
     Parameters
     ----------
     verified : VerifiedSchedule
         From :func:`trajgen.verification.certify`.
-    names : sequence of 2 str
-        Vehicle names, used as file names.
+    names : sequence of str
+        Vehicle names, one per vehicle of the schedule, used as file names.
     directory : path
         Created if missing.
     options : CsvOptions, optional
 
     Returns
     -------
-    (Path, Path)
-        The two files written.
+    tuple of Path
+        The files written, one per vehicle.
 
     Raises
     ------
@@ -473,7 +472,7 @@ def write_profiles(
     InputError
         Bad names, options or output folder; nothing was written.
     """
-    require_verified(verified, "write_profiles")
+    check_vehicle_names(names, count=require_verified(verified, "write_profiles").schedule.limits.count)
     paths = profile_paths(names, directory)
     commit_files(dict(zip(paths, profile_chunk_pair(verified, options), strict=True)))
     return paths

@@ -318,17 +318,15 @@ class _Scene:
         return self.paint()
 
 
-def _check_names(names: object) -> tuple[str, str]:
+def _check_names(names: object, count: int) -> tuple[str, ...]:
     if (
         not isinstance(names, Sequence)
         or isinstance(names, str)
-        or len(names) != 2
+        or len(names) != count
         or not all(isinstance(name, str) for name in names)
     ):
-        raise InputError(
-            f"animation names must be two strings (vehicle 1, vehicle 2), got {short_repr(names)}"
-        )
-    return (names[0], names[1])
+        raise InputError(f"animation names must be {count} strings, one per vehicle, got {short_repr(names)}")
+    return tuple(names)
 
 
 class Animation:
@@ -382,8 +380,8 @@ def animate(
     ----------
     verified : VerifiedSchedule
         From :func:`trajgen.certify`.
-    names : pair of str, optional
-        The vehicles' names, written beside them.
+    names : sequence of str, optional
+        The vehicles' names, one per vehicle, written beside them.
     fps : int, optional
         Frames per second of playback, 1 to :data:`~trajgen.plots.animation_layout.MAX_FPS` (default 10).
     max_frames : int, optional
@@ -404,10 +402,10 @@ def animate(
     OptionError
         ``fps`` or ``max_frames`` out of range.
     InputError
-        ``names`` is not two strings.
+        ``names`` is not one string per vehicle.
     """
     schedule = require_verified(verified, "animate").schedule
-    names = _check_names(names)
+    names = _check_names(names, schedule.limits.count)
     play = playback(schedule.duration, fps=fps, max_frames=max_frames)
     geometry = frame_geometry(verified, play.times())
     layout = frame_layout(

@@ -32,6 +32,7 @@ folder; see :mod:`trajgen.scenario.factsheet`); it still gives ``max_jerk``.
 
 from __future__ import annotations
 
+import itertools
 import tomllib
 import warnings
 from collections.abc import Callable
@@ -41,7 +42,7 @@ from pathlib import Path
 
 from limits import Limits, VehicleLimits
 from topology import Configuration, Option, Position, Route, StarGraph, TrackGraph, YGraph, plan
-from topology.validation import short_repr
+from topology.validation import check_vehicle_count, short_repr
 from trajgen.errors import InputError, OptionError, ScenarioError
 from trajgen.scenario.factsheet import read_factsheet
 from trajgen.scenario.graph import GraphScenario
@@ -181,7 +182,7 @@ class Scenario:
             raise InputError(f"scenario track must be a StarGraph or YGraph, got {type(self.track).__name__}")
         if not isinstance(self.limits, Limits):
             raise InputError(f"scenario limits must be Limits, got {type(self.limits).__name__}")
-        object.__setattr__(self, "names", check_vehicle_names(self.names))
+        object.__setattr__(self, "names", check_vehicle_names(self.names, count=self.limits.count))
         _check_plausible_track(self.track)
         for k, vehicle in enumerate(self.limits.vehicles, start=1):
             _check_plausible_vehicle(vehicle, f"vehicle {k}")
@@ -315,8 +316,7 @@ def _parse_vehicle(
         raise ScenarioError(f"{source}: {where} name: {error}") from None
     if any(name.casefold() == other.casefold() for other in taken):
         raise ScenarioError(
-            f"{source}: {where} name {name!r} is used by both vehicles (case ignored): "
-            "expected distinct names"
+            f"{source}: {where} name {name!r} is used by two vehicles (case ignored): expected distinct names"
         )
     numbers = {
         key: _number(vehicle[key], f"{where} {key}", source)
@@ -353,20 +353,20 @@ def _parse_vehicles(data: dict, position: Callable[[str], object], source: str, 
     _check_keys(safety, _SAFETY_KEYS, "[safety]", source)
     separation = _number(safety["min_separation"], "[safety] min_separation", source)
     vehicles = data["vehicle"]
-    if not isinstance(vehicles, list) or len(vehicles) != 2:
+    if not isinstance(vehicles, list) or not vehicles:
         count = len(vehicles) if isinstance(vehicles, list) else type(vehicles).__name__
-        raise ScenarioError(f"{source}: expected exactly two [[vehicle]] tables, got {count}")
+        raise ScenarioError(f"{source}: expected one or more [[vehicle]] tables, got {count}")
     names: list[str] = []
     parsed = []
     for k, vehicle in enumerate(vehicles, start=1):
         parsed.append(_parse_vehicle(vehicle, k, position, names, source, folder))
         names.append(parsed[-1][0])
     try:
-        limits = Limits(vehicles=(parsed[0][1], parsed[1][1]), min_separation=separation)
+        limits = Limits(vehicles=tuple(p[1] for p in parsed), min_separation=separation)
     except InputError as error:
         raise ScenarioError(f"{source}: [safety]: {error}") from None
-    ends = ((parsed[0][2], parsed[1][2]), (parsed[0][3], parsed[1][3]))
-    return separation, limits, (names[0], names[1]), ends
+    ends = (tuple(p[2] for p in parsed), tuple(p[3] for p in parsed))
+    return separation, limits, tuple(names), ends
 
 
 def parse_scenario(
@@ -393,6 +393,10 @@ def parse_scenario(
     separation, limits, names, ends = _parse_vehicles(
         data, _star_position(track), source, None if folder is None else Path(folder)
     )
+    try:  # a junction's start and goal are configurations of the paper's planner: two vehicles
+        check_vehicle_count(len(names), "the junction planner (the paper's)")
+    except InputError as error:
+        raise ScenarioError(f"{source}: {error}") from None
     start, goal = Configuration(*ends[0]), Configuration(*ends[1])
     shortest = track.shortest_leg
     if separation > shortest:
@@ -458,14 +462,17 @@ def _parse_graph_track(table: dict, source: str) -> TrackGraph:
 def _parse_graph_scenario(data: dict, source: str, folder: Path | None) -> GraphScenario:
     track = _parse_graph_track(_table(data["track"], "[track]", source), source)
     separation, limits, names, (start, goal) = _parse_vehicles(data, track.point, source, folder)
-    for label, pair in (("start", start), ("goal", goal)):
-        gap = track.distance(*pair)
-        if gap < separation or gap == 0.0:
-            raise ScenarioError(
-                f"{source}: the vehicles' {label} positions ({track.name(pair[0])}, {track.name(pair[1])}) "
-                f"are {gap!r} m apart along the track: expected at least [safety] min_separation "
-                f"{separation!r} m"
-            )
+    for label, points in (("start", start), ("goal", goal)):
+        for first, second in itertools.combinations(range(len(points)), 2):
+            pair = (points[first], points[second])
+            gap = track.distance(*pair)
+            if gap < separation or gap == 0.0:
+                between = "the vehicles'" if len(points) == 2 else f"{names[first]}'s and {names[second]}'s"
+                raise ScenarioError(
+                    f"{source}: {between} {label} positions ({track.name(pair[0])}, "
+                    f"{track.name(pair[1])}) are {gap!r} m apart along the track: expected at least "
+                    f"[safety] min_separation {separation!r} m"
+                )
     try:
         return GraphScenario(track, limits, names, start, goal, source)
     except InputError as error:

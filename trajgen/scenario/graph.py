@@ -10,7 +10,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from limits import Limits
-from topology import EdgePoint, GraphRoute, TrackGraph, plan_graph
+from topology import EdgePoint, GraphRoute, TrackGraph, VehicleCountError, check_vehicle_count, plan_graph
 from trajgen.errors import InputError
 from trajgen.scenario.naming import check_vehicle_names
 
@@ -19,15 +19,18 @@ __all__ = ["GraphScenario"]
 
 @dataclass(frozen=True, slots=True)
 class GraphScenario:
-    """Two vehicles on a track graph: where they start, where they go, their limits.
+    """Vehicles on a track graph: where they start, where they go, their limits.
+
+    Any number of vehicles is read and held; the planner (:meth:`route`) takes two today.
 
     Attributes
     ----------
     track : TrackGraph
     limits : Limits
-        Both vehicles' limits and the minimum separation (metres of track distance).
-    names : tuple of 2 str
-    start, goal : tuple of 2 EdgePoint
+        Each vehicle's limits and the minimum separation (metres of track distance).
+    names : tuple of str
+        One per vehicle.
+    start, goal : tuple of EdgePoint
         Each vehicle's start and goal.
     source : str, optional
         Where it came from (file path; default ``<python>``).
@@ -47,9 +50,9 @@ class GraphScenario:
 
     track: TrackGraph
     limits: Limits
-    names: tuple[str, str]
-    start: tuple[EdgePoint, EdgePoint]
-    goal: tuple[EdgePoint, EdgePoint]
+    names: tuple[str, ...]
+    start: tuple[EdgePoint, ...]
+    goal: tuple[EdgePoint, ...]
     source: str = "<python>"
 
     def __post_init__(self) -> None:
@@ -57,12 +60,27 @@ class GraphScenario:
             raise InputError(f"graph scenario track must be a TrackGraph, got {type(self.track).__name__}")
         if not isinstance(self.limits, Limits):
             raise InputError(f"scenario limits must be Limits, got {type(self.limits).__name__}")
-        object.__setattr__(self, "names", check_vehicle_names(self.names))
+        object.__setattr__(self, "names", check_vehicle_names(self.names, count=self.limits.count))
         for what in ("start", "goal"):
-            pair = tuple(self.track.point(p) for p in getattr(self, what))
-            if len(pair) != 2:
-                raise InputError(f"scenario {what} must be two positions, got {len(pair)}")
-            object.__setattr__(self, what, pair)
+            points = tuple(self.track.point(p) for p in getattr(self, what))
+            if len(points) != self.limits.count:
+                raise InputError(
+                    f"scenario {what} must be {self.limits.count} positions, one per vehicle, "
+                    f"got {len(points)}"
+                )
+            object.__setattr__(self, what, points)
+
+    def check_planned(self) -> None:
+        """Refuse, naming :attr:`source`, a number of vehicles the planner does not plan (two, today).
+
+        Raises
+        ------
+        VehicleCountError
+        """
+        try:
+            check_vehicle_count(self.limits.count, "the track-graph planner")
+        except VehicleCountError as error:
+            raise VehicleCountError(f"{self.source}: {error}") from None
 
     def route(self) -> GraphRoute:
         """The exact planner's route: the shortest collision-free one, one vehicle moving at a time.
@@ -71,7 +89,10 @@ class GraphScenario:
         ------
         InfeasibleError
             No collision-free route exists; the message names the vehicle and what blocks it.
+        VehicleCountError
+            Not two vehicles (the planner takes two today); the message names the scenario's source.
         """
+        self.check_planned()
         return plan_graph(
             self.track, self.start, self.goal, min_separation=self.limits.min_separation, names=self.names
         )

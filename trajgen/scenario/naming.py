@@ -8,7 +8,7 @@ from collections.abc import Sequence
 from topology.validation import short_repr
 from trajgen.errors import InputError
 
-__all__ = ["check_vehicle_name", "check_vehicle_names"]
+__all__ = ["check_vehicle_index", "check_vehicle_name", "check_vehicle_names"]
 
 _PORTABLE = re.compile(r"[A-Za-z0-9][A-Za-z0-9_.-]{0,63}")
 #: Names Windows reserves for devices, with any extension.
@@ -29,13 +29,20 @@ def check_vehicle_name(name: object) -> str:
     return name
 
 
-def check_vehicle_names(names: Sequence[str]) -> tuple[str, str]:
-    """Return the two vehicle names if both are portable file names and distinct, else raise.
+def check_vehicle_names(names: Sequence[str], *, count: int | None = None) -> tuple[str, ...]:
+    """Return the vehicle names if each is a portable file name and all are distinct, else raise.
 
     A portable name has 1 to 64 characters: letters, digits, ``_``, ``.``,
     ``-``, starting with a letter or digit and not ending with ``.``; it is no
-    Windows device name (``CON``, ``NUL``, ``COM1``, ...); the two names
-    differ also when case is ignored.
+    Windows device name (``CON``, ``NUL``, ``COM1``, ...); no two names
+    differ only in case (they name files, and some file systems ignore case).
+
+    Parameters
+    ----------
+    names : sequence of str
+        One per vehicle, at least one.
+    count : int, optional
+        How many vehicles the names are for (a schedule's): that many names are expected.
 
     Raises
     ------
@@ -47,13 +54,41 @@ def check_vehicle_names(names: Sequence[str]) -> tuple[str, str]:
     >>> check_vehicle_names(["agv1", "agv2"])
     ('agv1', 'agv2')
     """
-    if isinstance(names, (str, bytes)) or not isinstance(names, Sequence) or len(names) != 2:
-        raise InputError(f"vehicle names must be a pair of names, got {short_repr(names)}")
+    if isinstance(names, (str, bytes)) or not isinstance(names, Sequence) or not names:
+        raise InputError(
+            f"vehicle names must be a sequence of names, one per vehicle, got {short_repr(names)}"
+        )
+    if count is not None and len(names) != count:
+        raise InputError(f"vehicle names {short_repr(names)}: expected {count}, one per vehicle")
+    seen: dict[str, str] = {}
     for name in names:
         check_vehicle_name(name)
-    if names[0].casefold() == names[1].casefold():
+        key = name.casefold()
+        if key in seen:
+            raise InputError(
+                f"vehicle names {seen[key]!r} and {name!r} name the same file where case is ignored: "
+                "expected distinct names"
+            )
+        seen[key] = name
+    return tuple(names)
+
+
+def check_vehicle_index(vehicle: object, count: int) -> int:
+    """Return ``vehicle`` if it indexes one of ``count`` vehicles (0 for vehicle 1), else raise.
+
+    Raises
+    ------
+    InputError
+        Not an integer from 0 to ``count - 1``.
+
+    Examples
+    --------
+    >>> check_vehicle_index(1, 2)
+    1
+    """
+    if isinstance(vehicle, bool) or not isinstance(vehicle, int) or not 0 <= vehicle < count:
         raise InputError(
-            f"vehicle names {names[0]!r} and {names[1]!r} name the same file where case is ignored: "
-            "expected distinct names"
+            f"vehicle must be an index from 0 to {count - 1} (one of {count} vehicles), "
+            f"got {short_repr(vehicle)}"
         )
-    return names[0], names[1]
+    return vehicle

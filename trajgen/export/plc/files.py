@@ -100,11 +100,10 @@ def _written_above(dialect: TableDialect, contents: tuple[bytes, bytes], limits:
     return worst
 
 
-def table_paths(dialect: TableDialect, names: Sequence[str], directory: str | Path) -> tuple[Path, Path]:
-    """``directory/<name><suffix>`` for both vehicles."""
-    first, second = check_vehicle_names(names)
+def table_paths(dialect: TableDialect, names: Sequence[str], directory: str | Path) -> tuple[Path, ...]:
+    """``directory/<name><suffix>`` for each vehicle, in the order of ``names``."""
     directory = Path(directory)
-    return (directory / f"{first}{dialect.suffix}", directory / f"{second}{dialect.suffix}")
+    return tuple(directory / f"{name}{dialect.suffix}" for name in check_vehicle_names(names))
 
 
 def plc_tables(

@@ -516,8 +516,10 @@ def check_tables(
     -------
     TableCheck
     """
-    if len(tables) != 2 or not all(isinstance(table, ProfileTable) for table in tables):
-        raise InputError(f"check_tables expects two ProfileTables, got {short_repr(tables)}")
+    if len(tables) != limits.count or not all(isinstance(table, ProfileTable) for table in tables):
+        raise InputError(
+            f"check_tables expects {limits.count} ProfileTables, one per vehicle, got {short_repr(tables)}"
+        )
     failures: list[str] = []
     for vehicle, table in enumerate(tables):
         bad = table.decreasing_times()

@@ -22,16 +22,16 @@ from trajgen.verification import VerifiedSchedule, require_verified
 __all__ = ["order_files", "order_paths", "write_orders"]
 
 
-def order_paths(names: Sequence[str], directory: str | Path) -> tuple[Path, Path, Path]:
-    """The files every run writes: ``directory/manifest.json`` and each vehicle's first order.
+def order_paths(names: Sequence[str], directory: str | Path) -> tuple[Path, ...]:
+    """The files every run writes: ``directory/manifest.json``, then each vehicle's first order.
 
     Raises
     ------
     InputError
         Bad names (also a vehicle named like the manifest), or ``directory`` names no folder.
     """
-    first, second = check_vehicle_names(names)
-    for name in (first, second):
+    names = check_vehicle_names(names)
+    for name in names:
         if name.lower() == MANIFEST_NAME.lower():
             raise OptionError(
                 f"vehicle name {name!r} is the manifest's file name: expected another name (its orders "
@@ -40,11 +40,7 @@ def order_paths(names: Sequence[str], directory: str | Path) -> tuple[Path, Path
     if not isinstance(directory, (str, Path)) or str(directory) == "":
         raise OptionError(f"VDA 5050 output folder must name a folder, got {short_repr(directory)}")
     directory = Path(directory)
-    return (
-        directory / MANIFEST_NAME,
-        directory / first / "order-000.json",
-        directory / second / "order-000.json",
-    )
+    return (directory / MANIFEST_NAME, *(directory / name / "order-000.json" for name in names))
 
 
 def order_files(
