@@ -16,7 +16,7 @@ from __future__ import annotations
 import time
 from pathlib import Path
 
-from topology import TrackGraph, plan_graph
+from topology import plan_graph
 from trajgen import certify
 from trajgen.methods import make_schedule
 from trajgen.model.analysis import lower_bound
@@ -27,17 +27,15 @@ NAMES = ("h", "main-line-with-sidings", "passing-loop", "ring-with-spurs")
 
 
 def star_as_graph(scenario):
-    """The route of a junction scenario written as a track graph, and its limits."""
-    graph = scenario.track
-    track = TrackGraph.from_edges(
-        {name.lower(): ("O", name, length) for name, length in zip(graph.names, graph.lengths, strict=True)}
+    """The route of a junction scenario on its track as a track graph (``StarGraph.track_graph``)."""
+    star = scenario.track
+    return plan_graph(
+        star.track_graph(),
+        [star.edge_point(p) for p in scenario.start],
+        [star.edge_point(p) for p in scenario.goal],
+        min_separation=scenario.limits.min_separation,
+        names=scenario.names,
     )
-
-    def point(position) -> str:
-        return f"{position.leg.lower()}:{position.s}" if position.leg is not None and position.s > 0 else "O"
-
-    start, goal = [point(p) for p in scenario.start], [point(p) for p in scenario.goal]
-    return plan_graph(track, start, goal, min_separation=scenario.limits.min_separation, names=scenario.names)
 
 
 def main() -> None:

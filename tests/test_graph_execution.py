@@ -173,13 +173,13 @@ def test_a_measured_state_off_the_track_graph_is_refused_naming_the_edge():
     executor = Executor(verified, names=scenario.names)
     ok = VehicleState(0, 6.0)
     with pytest.raises(InputError, match=r"vehicle 1 measured edge must be an edge index 0 to 4 .* got 7"):
-        executor.step(VehicleState(7, 1.0), ok)
+        executor.step((VehicleState(7, 1.0), ok))
     with pytest.raises(
         InputError, match=r"vehicle 2 measured s 9\.0 m is off edge 'a': expected 0 to 6\.0 m"
     ):
-        executor.step(ok, VehicleState(0, 9.0))
+        executor.step((ok, VehicleState(0, 9.0)))
     with pytest.raises(InputError, match=r"vehicle 1 measured velocity must be a finite number, got nan"):
-        executor.step(VehicleState(0, 6.0, float("nan")), ok)
+        executor.step((VehicleState(0, 6.0, float("nan")), ok))
     track = GraphTrack(scenario.track)
     assert track.check_state(VehicleState(0, 6.0 + 5e-7), 1).s == 6.0  # round-off at the end is on it
 

@@ -103,9 +103,7 @@ def test_a_star_written_as_a_graph_plans_no_longer_than_the_star_planner(legs):
     for _ in range(25):
         lengths = {name: rng.randint(6, 30) * 0.5 for name in names}
         star = StarGraph(lengths)
-        graph = TrackGraph.from_edges(
-            {name: ("O", f"end-{name}", length) for name, length in lengths.items()}
-        )
+        graph = star.track_graph()
         first, second = rng.sample(names, 2)
         start = Configuration(Position(first, lengths[first]), Position(second, lengths[second]))
         goal = start.swapped()

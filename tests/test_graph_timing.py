@@ -10,7 +10,7 @@ import pytest
 from tests.conftest import REPO
 from tests.support.graph_cases import random_routes, verified_example
 from tests.support.graph_rows import ScenarioFile, check_profiles
-from topology import TrackGraph, class_signature, plan_graph, plan_graph_classes
+from topology import class_signature, plan_graph, plan_graph_classes
 from trajgen import certify
 from trajgen.cli import main
 from trajgen.export.csv import profile_chunk_pair
@@ -31,16 +31,13 @@ def _texts(verified) -> tuple[str, str]:
 
 
 def _star_as_graph(scenario):
-    """A junction scenario written as a track graph: each leg an edge from the junction ``O``."""
-    graph = scenario.track
-    track = TrackGraph.from_edges(
-        {name.lower(): ("O", name, length) for name, length in zip(graph.names, graph.lengths, strict=True)}
+    """A junction scenario's track as a track graph (the library's), its starts and goals on it."""
+    star = scenario.track
+    return (
+        star.track_graph(),
+        [star.edge_point(p) for p in scenario.start],
+        [star.edge_point(p) for p in scenario.goal],
     )
-
-    def point(position) -> str:
-        return f"{position.leg.lower()}:{position.s}" if position.leg is not None and position.s > 0 else "O"
-
-    return track, [point(p) for p in scenario.start], [point(p) for p in scenario.goal]
 
 
 @pytest.mark.parametrize("name", FEASIBLE)

@@ -119,7 +119,7 @@ def test_a_vehicle_on_a_graph_knows_its_node_and_is_placed_by_it_after_a_restart
 @pytest.mark.parametrize(
     ("goal", "match"),
     [
-        ("C", r"live goal must be two positions on the track, got 'C'"),
+        ("C", r"live goal must be 2 positions on the track, one per vehicle, got 'C'"),
         (("C", "zz:1"), r"zz"),
         (("C", "c:7"), r"c:7|7"),
     ],
@@ -127,7 +127,7 @@ def test_a_vehicle_on_a_graph_knows_its_node_and_is_placed_by_it_after_a_restart
 )
 def test_a_bad_live_goal_on_a_graph_is_refused_naming_it(goal, match):
     with pytest.raises(InputError, match=match):
-        live_goal(load_scenario(H).track, goal)
+        live_goal(load_scenario(H).track, goal, 2)
 
 
 # -- live runs on the H --------------------------------------------------------------------------------

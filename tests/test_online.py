@@ -552,7 +552,7 @@ def test_a_drive_still_short_of_its_reversal_is_read_before_it(swap):
     first = VehicleState(*executor.paths[0].locate(0.0))
     readings = []
     while executor.mode is not Mode.DONE and len(readings) < 20_000:
-        command = executor.step(first, setpoints[0])  # vehicle 2 measured where it was told 20 cycles ago
+        command = executor.step((first, setpoints[0]))  # vehicle 2 measured where it was told 20 cycles ago
         readings.append(executor.travel[1])
         first, second = (VehicleState(sp.leg, sp.s, sp.velocity, sp.acceleration) for sp in command.setpoints)
         setpoints.append(second)
@@ -667,7 +667,7 @@ def test_a_re_plan_continues_each_vehicles_axis_from_where_it_stands():
         states.append(VehicleState(leg, s, 0.0, 0.0))
     old = executor.paths
     assert executor.request_goal(0, scenario.goal.first).accepted
-    executor.step(*states)
+    executor.step(states)
     assert executor.replans == 1
     for v in (0, 1):
         assert executor.paths[v].axis(0.0) == pytest.approx(old[v].axis(short), abs=1e-12)
@@ -709,14 +709,28 @@ def test_a_goal_too_close_to_the_other_goal_is_refused_with_the_reason(swap):
 @pytest.mark.parametrize(
     ("call", "match"),
     [
-        (lambda e: e.step(VehicleState(0, math.nan), VehicleState(1, 10.0)), "measured s must be a finite"),
-        (lambda e: e.step(VehicleState(5, 1.0), VehicleState(1, 10.0)), "measured leg must be"),
-        (lambda e: e.step(VehicleState(0, 11.0), VehicleState(1, 10.0)), r"measured s 11.0 m is off leg 0"),
-        (lambda e: e.step((0, 1.0), VehicleState(1, 10.0)), "must be a VehicleState"),
+        (lambda e: e.step((VehicleState(0, math.nan), VehicleState(1, 10.0))), "measured s must be a finite"),
+        (lambda e: e.step((VehicleState(5, 1.0), VehicleState(1, 10.0))), "measured leg must be"),
+        (lambda e: e.step((VehicleState(0, 11.0), VehicleState(1, 10.0))), r"measured s 11.0 m is off leg 0"),
+        (lambda e: e.step((VehicleState(0, 1.0),)), r"states: expected 2, one per vehicle, got 1"),
+        (
+            lambda e: e.step(VehicleState(0, 1.0)),
+            "states must be a sequence of VehicleStates, one per vehicle",
+        ),
+        (lambda e: e.step(((0, 1.0), VehicleState(1, 10.0))), "must be a VehicleState"),
         (lambda e: e.request_speed_limit(0, 2.0), r"speed limit of vehicle 1 must be > 0 and <= 1.0"),
         (lambda e: e.request_goal(2, Position("A", 1.0)), "vehicle must be an index from 0 to 1"),
     ],
-    ids=["nan-s", "bad-leg", "off-leg", "not-a-state", "speed-above-limit", "bad-vehicle"],
+    ids=[
+        "nan-s",
+        "bad-leg",
+        "off-leg",
+        "one-state-for-two",
+        "not-a-sequence",
+        "not-a-state",
+        "speed-above-limit",
+        "bad-vehicle",
+    ],
 )
 def test_bad_input_to_the_executor(swap, call, match):
     executor = Executor(swap[1], min_separation=1.5)
@@ -733,8 +747,8 @@ def test_the_executor_on_a_crossing_checks_legs_by_count():
         InputError,
         match=r"measured leg must be a leg index 0 to 3 of the 4 legs or -1 \(the junction\), got 4",
     ):
-        executor.step(VehicleState(4, 1.0), VehicleState(2, 10.0))
-    command = executor.step(VehicleState(0, 10.0), VehicleState(2, 10.0))  # leg 3 (E) is known: no error
+        executor.step((VehicleState(4, 1.0), VehicleState(2, 10.0)))
+    command = executor.step((VehicleState(0, 10.0), VehicleState(2, 10.0)))  # leg 3 (E) is known: no error
     assert len(command.setpoints) == 2
 
 
@@ -808,3 +822,10 @@ def test_a_vehicle_that_stays_put_through_a_re_plan_drives_its_next_move_the_rig
     assert result.replans == 2
     assert result.violations == 0
     assert not any("off its setpoints" in e.detail for e in result.events), result.events
+
+
+def test_step_of_two_states_is_deprecated_and_steps_as_one_sequence(swap):
+    states = (VehicleState(0, 10.0), VehicleState(1, 10.0))
+    with pytest.warns(DeprecationWarning, match=r"step\(first, second\) is deprecated since trajgen 0.7"):
+        old = Executor(swap[1], min_separation=1.5).step(*states)
+    assert old == Executor(swap[1], min_separation=1.5).step(states)

@@ -663,7 +663,7 @@ def test_node_ids_are_stable_and_readable():
         ({"start_time": "2025-05-01T08:00:00Z"}, "time zone aware"),
         ({"start_time": START, "map_id": ""}, "map_id must be a non-empty"),
         ({"start_time": START, "order_id": "a\nb"}, "order_id must be a non-empty printable"),
-        ({"start_time": START, "manufacturers": "Acme"}, "manufacturers must be a pair"),
+        ({"start_time": START, "manufacturers": "Acme"}, "manufacturers must be a sequence of strings"),
         ({"start_time": START, "serial_numbers": ("SN1", 2)}, r"serial_numbers\[1\]"),
         ({"start_time": START, "first_header_id": -1}, "first_header_id must be an integer"),
         ({"start_time": START, "first_header_id": True}, "first_header_id must be an integer"),
@@ -672,7 +672,7 @@ def test_node_ids_are_stable_and_readable():
             {"start_time": datetime(1, 1, 1, tzinfo=timezone(timedelta(hours=14)))},
             "start_time .* is out of range: expected a time from the years 1970 to 9000",
         ),
-        ({"start_time": START, "serial_numbers": ("SN1", "SN1")}, "serial numbers are both 'SN1'"),
+        ({"start_time": START, "serial_numbers": ("SN1", "SN1")}, "vehicles 1 and 2 are both 'SN1'"),
         ({"start_time": START, "serial_numbers": ("a/b", "SN2")}, "serial number 'a/b' is not allowed"),
         ({"start_time": START, "manufacturers": ("x/y", "Acme")}, r"manufacturer 'x/y' has '/', '#' or '\+'"),
     ],
@@ -1125,3 +1125,15 @@ def test_schedules_of_every_method_can_be_certified_and_exported():
             document = json.loads(message.data)
             assert schema_errors(document) == []
             parse_order(document)
+
+
+def test_the_options_name_every_vehicle_or_the_export_refuses_them():
+    three = Vda5050Options(start_time=START, manufacturers=("A", "B", "C"))
+    assert [three.manufacturer(v) for v in range(3)] == ["A", "B", "C"]
+    one = Vda5050Options(start_time=START, manufacturers=("Acme",))
+    assert [one.manufacturer(v) for v in range(5)] == ["Acme"] * 5  # one manufacturer for every vehicle
+    with pytest.raises(OptionError, match=r"manufacturers: 3 given: expected one, or one per vehicle \(2\)"):
+        three.check_vehicles(2)
+    serials = Vda5050Options(start_time=START, serial_numbers=("S1",))
+    with pytest.raises(OptionError, match=r"serial_numbers: 1 given: expected one per vehicle \(2\)"):
+        serials.check_vehicles(2)

@@ -17,6 +17,7 @@ from topology.indexed import IndexedConfiguration
 from topology.legs import LegTable
 from topology.positions import JUNCTION, JUNCTION_NAME, Configuration, Position
 from topology.retract_graph import RetractGraph
+from topology.track_graph import EdgePoint, TrackGraph
 from topology.validation import finite_real, short_repr
 
 __all__ = ["MAX_LEGS", "MIN_LEGS", "StarGraph", "YGraph"]
@@ -134,6 +135,7 @@ class StarGraph:
     _index: Mapping[str, int] = field(repr=False, compare=False, hash=False)
     _legs: LegTable = field(repr=False, compare=False, hash=False)
     _retract_graph: list = field(repr=False, compare=False, hash=False)
+    _track_graph: list = field(repr=False, compare=False, hash=False)
 
     def __init__(self, legs, *, angles_deg: Mapping[str, float] | None = None) -> None:
         pairs = _leg_pairs(legs)
@@ -153,6 +155,7 @@ class StarGraph:
         object.__setattr__(self, "_legs", LegTable(names, lengths))
         object.__setattr__(self, "cycle", BoundaryCycle(names, lengths) if len(names) == 3 else None)
         object.__setattr__(self, "_retract_graph", [])  # filled on first use
+        object.__setattr__(self, "_track_graph", [])  # filled on first use
 
     # -- lookups ---------------------------------------------------------
     @property
@@ -241,6 +244,49 @@ class StarGraph:
             return (0.0, 0.0)
         angle = math.radians(self.angles_deg[self.index(position.leg)])
         return (position.s * math.cos(angle), position.s * math.sin(angle))
+
+    @property
+    def total_length(self) -> float:
+        """Every leg's length added up, metres."""
+        return float(sum(self.lengths))
+
+    def track_graph(self) -> TrackGraph:
+        """The junction as a track graph: the same track, the same points.
+
+        The junction is the node ``O``; each leg an edge named as the leg, from ``O`` to its end node
+        ``<leg>-end``, placed by the leg's angle. ``A:s`` names the same point on both (``O`` too).
+
+        Examples
+        --------
+        >>> track = StarGraph({"A": 10.0, "B": 8.0, "C": 6.0}).track_graph()
+        >>> [(e.name, e.start, e.end, e.length) for e in track.edges]
+        [('A', 'O', 'A-end', 10.0), ('B', 'O', 'B-end', 8.0), ('C', 'O', 'C-end', 6.0)]
+        >>> track.name(track.point("B:3"))
+        'B:3'
+        """
+        built = self._track_graph
+        if not built:
+            coordinates = {JUNCTION_NAME: (0.0, 0.0)}
+            edges = {}
+            for name, length, angle in zip(self.names, self.lengths, self.angles_deg, strict=True):
+                radians = math.radians(angle)
+                coordinates[f"{name}-end"] = (length * math.cos(radians), length * math.sin(radians))
+                edges[name] = (JUNCTION_NAME, f"{name}-end", length)
+            built.append(TrackGraph.from_edges(edges, coordinates=coordinates))
+        return built[0]
+
+    def edge_point(self, position: Position) -> EdgePoint:
+        """``position`` as the point of :meth:`track_graph` (the junction: the start of the first edge).
+
+        Examples
+        --------
+        >>> StarGraph({"A": 10.0, "B": 8.0, "C": 6.0}).edge_point(Position("B", 3.0))
+        EdgePoint(edge=1, s=3.0)
+        """
+        self.check(position)
+        if position.leg is None:
+            return EdgePoint(0, 0.0)
+        return EdgePoint(self.index(position.leg), position.s)
 
     def configuration(self, c: IndexedConfiguration) -> Configuration:
         """The configuration of an indexed configuration ``(leg1, s1, leg2, s2)``, unchecked (hot paths)."""

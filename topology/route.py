@@ -206,6 +206,11 @@ class Route:
             )
 
     @property
+    def track(self) -> StarGraph:
+        """The track the route is on (its :attr:`graph`; a track graph's route names it so too)."""
+        return self.graph
+
+    @property
     def way_round(self) -> WayRound:
         """The direction the route goes round the boundary circle (from the sign of ``arc_length``).
 

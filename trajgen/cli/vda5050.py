@@ -41,18 +41,18 @@ def parse_start_time(text: str | None) -> datetime:
     return moment
 
 
-def _per_vehicle(values: list[str], names: tuple[str, str], option: str, default: tuple[str, str]):
-    """``VALUE`` (both vehicles) or ``NAME=VALUE`` (one), repeatable, onto ``default``."""
+def _per_vehicle(values: list[str], names: tuple[str, ...], option: str, default: tuple[str, ...]):
+    """``VALUE`` (every vehicle) or ``NAME=VALUE`` (one), repeatable, onto ``default``."""
     result = list(default)
     for value in values:
         name, equals, text = value.partition("=")
         if not equals:
             if option == "--serial-number":
                 raise OptionError(
-                    f"{option} {short_repr(value)} names no vehicle: expected NAME=SERIAL (two vehicles "
+                    f"{option} {short_repr(value)} names no vehicle: expected NAME=SERIAL (vehicles "
                     "cannot share a serial number)"
                 )
-            result = [value, value]
+            result = [value] * len(names)
             continue
         if name not in names:
             raise OptionError(
@@ -100,7 +100,7 @@ def _command_export(args: argparse.Namespace) -> int:
         start_time=parse_start_time(args.start_time),
         map_id=args.map_id,
         order_id=args.order_id,
-        manufacturers=_per_vehicle(args.manufacturer, names, "--manufacturer", ("unspecified",) * 2),
+        manufacturers=_per_vehicle(args.manufacturer, names, "--manufacturer", ("unspecified",) * len(names)),
         serial_numbers=_per_vehicle(args.serial_number, names, "--serial-number", names),
         first_header_id=args.first_header_id,
     )

@@ -25,16 +25,18 @@ The argument (separation, no deadlock, what a stop costs) is in docs/online.md.
 
 from __future__ import annotations
 
-import bisect
 import collections
 import dataclasses
 import logging
 import math
+import warnings
+from collections.abc import Sequence
 
 from limits import Limits
 from topology import Configuration
 from trajgen.errors import InputError, ScheduleError, TrajgenError
 from trajgen.execution.braking_check import PathState
+from trajgen.execution.locate import locate_on_path
 from trajgen.execution.messages import (
     PERIOD_RANGE,
     Command,
@@ -85,8 +87,8 @@ class Executor:
     latency : float, optional
         How late a drive may follow its setpoints, seconds: a vehicle within the tolerances of any
         setpoint of that window is on them.
-    names : pair of str, optional
-        The vehicles' names, as the events call them (default "vehicle 1", "vehicle 2").
+    names : tuple of str, optional
+        The vehicles' names, one per vehicle, as the events call them (default "vehicle 1", ...).
     """
 
     def __init__(
@@ -99,11 +101,11 @@ class Executor:
         velocity_tolerance: float = 0.05,
         position_margin: float = 0.05,
         latency: float = 0.2,
-        names: tuple[str, str] = ("vehicle 1", "vehicle 2"),
+        names: tuple[str, ...] | None = None,
     ) -> None:
         verified = require_verified(verified, "Executor")
-        self.names = checked_names(names)
         schedule = verified.schedule
+        self.names = checked_names(names, schedule.limits.count)
         period = checked_period(period)
         self.position_tolerance = checked_number(position_tolerance, "position_tolerance (m)")
         self.velocity_tolerance = checked_number(velocity_tolerance, "velocity_tolerance (m/s)")
@@ -268,19 +270,31 @@ class Executor:
         self._log("speed-limit", f"{self.names[vehicle]} held to {speed:g} m/s")
 
     # -- the cycle -------------------------------------------------------------------------------
-    def step(self, first: VehicleState, second: VehicleState) -> Command:
-        """One control cycle: the measured states now, the setpoints for one period later.
+    def step(self, states: Sequence[VehicleState], *more: VehicleState) -> Command:
+        """One control cycle: the measured states now (one per vehicle), the setpoints one period later.
 
-        Parameters
-        ----------
-        first, second : VehicleState
-            Measured states of vehicle 1 and vehicle 2.
+        ``step(first, second)``, the form before 0.7, is deprecated: pass one sequence.
 
-        Returns
-        -------
-        Command
+        Raises
+        ------
+        InputError
+            Not one VehicleState per vehicle, or a state off the track (naming the vehicle).
         """
-        measured = (self._track.check_state(first, 1), self._track.check_state(second, 2))
+        if more:
+            warnings.warn(
+                "Executor.step(first, second) is deprecated since trajgen 0.7: pass the states as one "
+                "sequence, step((first, second))",
+                DeprecationWarning,
+                stacklevel=2,
+            )
+            states = (states, *more)
+        if isinstance(states, VehicleState | str) or not isinstance(states, Sequence):
+            raise InputError(
+                f"states must be a sequence of VehicleStates, one per vehicle, got {states!r:.80}"
+            )
+        if len(states) != self.limits.count:
+            raise InputError(f"states: expected {self.limits.count}, one per vehicle, got {len(states)}")
+        measured = tuple(self._track.check_state(state, k) for k, state in enumerate(states, start=1))
         along = self._locate(measured)
         if along is None:
             return self._emergency_stop(measured, "a vehicle is off its path beyond the margins")
@@ -516,46 +530,19 @@ class Executor:
         return self._issue(measured, along, proposals)
 
     # -- measurements ----------------------------------------------------------------------------
-    def _locate(self, measured) -> tuple[PathState, PathState] | None:
-        """Both measured states in travel coordinates, or ``None`` if one is off its path."""
+    def _locate(self, measured) -> tuple[PathState, ...] | None:
+        """Every measured state in travel coordinates, or ``None`` if one is off its path."""
+        slack = self.position_tolerance + self.position_margin
         out = []
-        for v in (0, 1):
-            path = self._paths[v]
-            slack = self.position_tolerance + self.position_margin
-            near = self._command[v].p
-            # next to a reversal one place is on the path twice: travel never runs back, so the later
-            p = self._track.project(path, measured[v].leg, measured[v].s, near + slack, slack)
-            if p is None or abs(p - near) > slack:
-                p = self._track.project(path, measured[v].leg, measured[v].s, near, slack)
-            if p is None:
+        for v, state in enumerate(measured):
+            here = locate_on_path(
+                self._track, self._paths[v], state, self._command[v].p, self._travel[v], slack
+            )
+            if here is None:
                 return None
-            p = min(max(p, 0.0), path.length)
-            heading = path.heading(p)
-            if heading * measured[v].velocity <= 0.0:
-                p = self._not_yet_reversed(v, p, slack)
-                heading = path.heading(p)
-            out.append(PathState(p, heading * measured[v].velocity, heading * measured[v].acceleration))
-            self._travel[v] = p
-        return out[0], out[1]
-
-    def _not_yet_reversed(self, v: int, p: float, slack: float) -> float:
-        """``p``, or the same place before the reversal just behind it if ``v`` has not turned there yet.
-
-        Either side of a reversal, travel ``c - x`` and ``c + x`` are one place. A vehicle that was
-        before ``c`` in the last cycle and is not moving away from the tip now (a lagging drive still
-        approaching it, or resting short of it) is still before it: reading it as past the tip would
-        move its earliest rest point, and its follower's frontier, back.
-        """
-        path = self._paths[v]
-        k = bisect.bisect_right(path.stops, p) - 1
-        if k < 0:
-            return p
-        tip = path.stops[k]
-        mirrored = 2.0 * tip - p
-        before = path.stops[k - 1] if k else 0.0
-        if self._travel[v] < tip < p <= tip + slack and mirrored >= before:
-            return mirrored
-        return p
+            out.append(here)
+            self._travel[v] = here.p
+        return tuple(out)
 
     def _departed(self, v: int, state: PathState) -> bool:
         """Whether ``v`` is off every setpoint of the last ``latency`` seconds (a drive may follow late)."""

@@ -176,16 +176,19 @@ def checked_number(value: object, name: str, *, zero: bool = False) -> float:
     return float(value)
 
 
-def checked_names(names: object) -> tuple[str, str]:
-    """The two vehicles' names as events call them: two non-empty strings.
+def checked_names(names: object, count: int) -> tuple[str, ...]:
+    """The vehicles' names as events call them: one non-empty string per vehicle (``None``: ``vehicle k``).
 
     Raises
     ------
     InputError
-        Naming the value given.
+        Naming the value given and the number of vehicles.
     """
-    if not (isinstance(names, tuple) and len(names) == 2 and all(isinstance(n, str) and n for n in names)):
-        raise InputError(f"names must be two non-empty strings, got {names!r}")
+    if names is None:
+        return tuple(f"vehicle {k}" for k in range(1, count + 1))
+    named = isinstance(names, tuple) and all(isinstance(name, str) and name for name in names)
+    if not (named and len(names) == count):
+        raise InputError(f"names must be {count} non-empty strings, one per vehicle, got {names!r}")
     return names
 
 

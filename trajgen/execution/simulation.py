@@ -338,7 +338,7 @@ def _time_limit(
     for fault in faults:
         if fault.kind is FaultKind.SLOW:
             slowest = min(slowest, fault.value)
-    total = graph.total_length if isinstance(graph, TrackGraph) else sum(graph.lengths)
+    total = graph.total_length
     crawl = 2.0 * total * 2.0 / slowest  # both vehicles round the whole track twice
     latest = max((f.time + (f.value if f.kind is FaultKind.STOP else 0.0) for f in faults), default=0.0)
     return latest + 3.0 * planned + crawl + 60.0
@@ -455,7 +455,7 @@ def simulate(
                     decision = executor.request_goal(fault.vehicle, fault.goal)
                     logger.info("goal request %s: %s", fault.spec, decision)
             measured = plant.measure()
-            command = executor.step(*measured)
+            command = executor.step(measured)
             if observer is not None:
                 observer(executor, measured, command)
             if executor.replans > len(plans):  # left for a new goal where both stood at rest

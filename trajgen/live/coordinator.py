@@ -485,7 +485,7 @@ class LiveCoordinator:
         InputError
             ``goal`` is not on the track, or leaves the vehicles closer than the separation.
         """
-        goal = live_goal(self.graph, goal)
+        goal = live_goal(self.graph, goal, len(self.names))
         refusal = self.track.goal_refusal(goal, self.limits.min_separation)
         if refusal is not None:
             raise InputError(f"{refusal} (the separation the plan keeps)")

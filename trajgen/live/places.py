@@ -24,18 +24,20 @@ __all__ = [
 ]
 
 
-def live_goal(graph: StarGraph | TrackGraph, goal) -> Configuration | tuple[EdgePoint, EdgePoint]:
-    """``goal`` checked on the track: a Configuration on a junction, a pair of EdgePoints on a graph.
+def live_goal(graph: StarGraph | TrackGraph, goal, count: int) -> Configuration | tuple[EdgePoint, ...]:
+    """``goal`` checked on the track: a Configuration on a junction, an EdgePoint per vehicle on a graph.
 
     Raises
     ------
     InputError
-        Not a goal for both vehicles, or a position not on the track.
+        Not a goal for each of the ``count`` vehicles, or a position not on the track.
     """
     if isinstance(graph, TrackGraph):
-        if not isinstance(goal, tuple | list) or len(goal) != 2:
-            raise InputError(f"live goal must be two positions on the track, got {goal!r:.80}")
-        return (graph.point(goal[0]), graph.point(goal[1]))
+        if not isinstance(goal, tuple | list) or len(goal) != count:
+            raise InputError(
+                f"live goal must be {count} positions on the track, one per vehicle, got {goal!r:.80}"
+            )
+        return tuple(graph.point(point) for point in goal)
     if not isinstance(goal, Configuration):
         raise InputError(f"live goal must be a Configuration, got {type(goal).__name__}")
     return Configuration(graph.check(goal.first), graph.check(goal.second))

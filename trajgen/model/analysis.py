@@ -7,7 +7,7 @@ import itertools
 import numpy as np
 
 from limits import Limits
-from topology import GraphRoute, Route
+from topology import Route
 from topology.indexed import JUNCTION_INDEX, track_distance
 from trajgen.model.graph_schedule import GraphSchedule
 from trajgen.model.profiles import rest_to_rest_time
@@ -22,7 +22,7 @@ def lower_bound(route: Route, limits: Limits) -> float:
     Ignores the other vehicle entirely, so no schedule from the route's start
     to its goal can be faster.
     """
-    graph = route.track if isinstance(route, GraphRoute) else route.graph
+    graph = route.track
     times = []
     for vehicle, (start, goal) in enumerate(zip(route.start, route.goal, strict=True)):
         vehicle_limits = limits.vehicles[vehicle]

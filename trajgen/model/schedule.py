@@ -438,6 +438,11 @@ class Schedule:
         )
 
     @property
+    def track(self) -> StarGraph:
+        """The track the schedule is on (its route's; a track graph's schedule names it so too)."""
+        return self.route.graph
+
+    @property
     def duration(self) -> float:
         """Makespan: time until both vehicles are at rest at the goal, seconds."""
         last = self.sections[-1]

@@ -408,9 +408,7 @@ def animate(
     names = _check_names(names, schedule.limits.count)
     play = playback(schedule.duration, fps=fps, max_frames=max_frames)
     geometry = frame_geometry(verified, play.times())
-    layout = frame_layout(
-        schedule.track if isinstance(schedule, GraphSchedule) else schedule.route.graph, geometry
-    )
+    layout = frame_layout(schedule.track, geometry)
     scene = _Scene(verified, geometry, layout, names, play)
     count = play.frame_count
     samples = [scene.pixels(k) for k in sorted({0, int(np.argmin(geometry.distance)), count - 1})]

@@ -192,7 +192,7 @@ def path_node_id(graph: StarGraph | TrackGraph, path: OrderPath | GraphOrderPath
 
 def _layout(schedule: Schedule | GraphSchedule) -> StarGraph | TrackGraph:
     """The track a schedule's node ids and positions are on."""
-    return schedule.track if isinstance(schedule, GraphSchedule) else schedule.route.graph
+    return schedule.track
 
 
 def order_elements(
@@ -334,9 +334,10 @@ def _dumps(document: dict) -> bytes:
 
 def _checked(verified: object, names: Sequence[str], options: object, what: str):
     schedule = require_verified(verified, what).schedule
-    names = check_vehicle_names(names)
+    names = check_vehicle_names(names, count=schedule.limits.count)
     if not isinstance(options, Vda5050Options):
         raise OptionError(f"VDA 5050 options must be Vda5050Options, got {type(options).__name__}")
+    options.check_vehicles(schedule.limits.count)
     return schedule, names
 
 
@@ -404,7 +405,7 @@ def render_orders(
             header_id=header_id,
             timestamp=timestamp,
             version=VDA5050_VERSION,
-            manufacturer=options.manufacturers[vehicle],
+            manufacturer=options.manufacturer(vehicle),
             serial_number=options.serial_number(vehicle, names),
             order_id=f"{options.order_id}-{names[vehicle]}",
             order_update_id=release.update,
@@ -459,7 +460,7 @@ def _manifest(
     for vehicle, name in enumerate(names):
         path = plan.paths[vehicle]
         vehicles[name] = {
-            "manufacturer": options.manufacturers[vehicle],
+            "manufacturer": options.manufacturer(vehicle),
             "serial_number": options.serial_number(vehicle, names),
             "order_id": f"{options.order_id}-{name}",
             "nodes": [path_node_id(graph, path, index) for index in range(len(path.nodes))],

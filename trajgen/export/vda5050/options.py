@@ -8,6 +8,7 @@ and the MQTT topics accept.
 from __future__ import annotations
 
 import re
+from collections.abc import Sequence
 from dataclasses import dataclass
 from datetime import UTC, datetime
 
@@ -48,9 +49,9 @@ class Vda5050Options:
         ``nodePosition.mapId`` (default ``"trajgen"``).
     order_id : str
         Prefix of the ``orderId``: ``<order_id>-<vehicle name>`` (default ``"trajgen"``).
-    manufacturers : tuple of 2 str
-        ``manufacturer`` of vehicle 1 and vehicle 2 (default ``"unspecified"``).
-    serial_numbers : tuple of 2 str or None
+    manufacturers : tuple of str
+        ``manufacturer`` of each vehicle, or one for every vehicle (default ``"unspecified"``).
+    serial_numbers : tuple of str or None
         ``serialNumber`` of each vehicle; ``None`` (default): the vehicle names.
     first_header_id : int
         ``headerId`` of each vehicle's first message (default 0); it grows by 1 with each message.
@@ -59,8 +60,8 @@ class Vda5050Options:
     start_time: datetime
     map_id: str = "trajgen"
     order_id: str = "trajgen"
-    manufacturers: tuple[str, str] = ("unspecified", "unspecified")
-    serial_numbers: tuple[str, str] | None = None
+    manufacturers: tuple[str, ...] = ("unspecified",)
+    serial_numbers: tuple[str, ...] | None = None
     first_header_id: int = 0
 
     def __post_init__(self) -> None:
@@ -80,7 +81,7 @@ class Vda5050Options:
         object.__setattr__(self, "start_time", start)
         for name in ("map_id", "order_id"):
             _check_text(getattr(self, name), f"VDA 5050 {name}")
-        manufacturers = _text_pair(self.manufacturers, "manufacturers")
+        manufacturers = _texts(self.manufacturers, "manufacturers")
         for value in manufacturers:
             if any(character in value for character in "/#+"):
                 raise OptionError(
@@ -89,19 +90,22 @@ class Vda5050Options:
                 )
         object.__setattr__(self, "manufacturers", manufacturers)
         if self.serial_numbers is not None:
-            serials = _text_pair(self.serial_numbers, "serial_numbers")
+            serials = _texts(self.serial_numbers, "serial_numbers")
             for value in serials:
                 if not SERIAL_NUMBER.fullmatch(value):
                     raise OptionError(
                         f"VDA 5050 serial number {short_repr(value)} is not allowed: expected the characters "
                         "A-Z a-z 0-9 _ . : - only"
                     )
-            if serials[0] == serials[1] and manufacturers[0] == manufacturers[1]:
-                raise OptionError(
-                    f"VDA 5050 serial numbers are both {serials[0]!r} with one manufacturer: expected "
-                    "two vehicles (one MQTT topic each)"
-                )
             object.__setattr__(self, "serial_numbers", serials)
+            topics = {}
+            for vehicle, serial in enumerate(serials):
+                other = topics.setdefault((self.manufacturer(vehicle), serial), vehicle)
+                if other != vehicle:
+                    raise OptionError(
+                        f"VDA 5050 serial numbers of vehicles {other + 1} and {vehicle + 1} are both "
+                        f"{serial!r} with one manufacturer: expected one MQTT topic per vehicle"
+                    )
         value = self.first_header_id
         if isinstance(value, bool) or not isinstance(value, int) or not 0 <= value <= MAX_FIRST_HEADER_ID:
             raise OptionError(
@@ -109,9 +113,32 @@ class Vda5050Options:
                 f"got {short_repr(value)}"
             )
 
-    def serial_number(self, vehicle: int, names: tuple[str, str]) -> str:
-        """``serialNumber`` of ``vehicle`` (0 or 1) named ``names[vehicle]``."""
+    def manufacturer(self, vehicle: int) -> str:
+        """``manufacturer`` of ``vehicle`` (its index, 0 for vehicle 1)."""
+        return self.manufacturers[0] if len(self.manufacturers) == 1 else self.manufacturers[vehicle]
+
+    def serial_number(self, vehicle: int, names: Sequence[str]) -> str:
+        """``serialNumber`` of ``vehicle`` (its index) named ``names[vehicle]``."""
         return names[vehicle] if self.serial_numbers is None else self.serial_numbers[vehicle]
+
+    def check_vehicles(self, count: int) -> None:
+        """Refuse options that do not name ``count`` vehicles (one manufacturer may serve them all).
+
+        Raises
+        ------
+        OptionError
+            Naming the option, its number of values and the vehicles'.
+        """
+        if len(self.manufacturers) not in (1, count):
+            raise OptionError(
+                f"VDA 5050 manufacturers: {len(self.manufacturers)} given: expected one, or one per vehicle "
+                f"({count})"
+            )
+        if self.serial_numbers is not None and len(self.serial_numbers) != count:
+            raise OptionError(
+                f"VDA 5050 serial_numbers: {len(self.serial_numbers)} given: expected one per vehicle "
+                f"({count})"
+            )
 
 
 def _check_text(value: object, what: str) -> str:
@@ -120,7 +147,7 @@ def _check_text(value: object, what: str) -> str:
     return value
 
 
-def _text_pair(value: object, what: str) -> tuple[str, str]:
-    if isinstance(value, str) or not isinstance(value, (tuple, list)) or len(value) != 2:
-        raise OptionError(f"VDA 5050 {what} must be a pair of strings (vehicle 1, vehicle 2), got {value!r}")
-    return (_check_text(value[0], f"VDA 5050 {what}[0]"), _check_text(value[1], f"VDA 5050 {what}[1]"))
+def _texts(value: object, what: str) -> tuple[str, ...]:
+    if isinstance(value, str) or not isinstance(value, (tuple, list)) or not value:
+        raise OptionError(f"VDA 5050 {what} must be a sequence of strings, one per vehicle, got {value!r}")
+    return tuple(_check_text(text, f"VDA 5050 {what}[{k}]") for k, text in enumerate(value))
