@@ -20,6 +20,7 @@ from matplotlib.colors import to_rgb
 from PIL import Image
 
 from tests.conftest import REPO
+from tests.support.cases import case
 from tests.support.helpers import LIMITS, animation_gif, conf, legs_cases, legs_id, route_of
 from topology import JUNCTION_INDEX, Instruction, StarGraph, YGraph, plan
 from topology.cycle import retract_indexed
@@ -135,8 +136,7 @@ def scenario_file(tmp_path, legs: int) -> str:
 def timed(legs: int):
     """The verified exact schedule of the query of ``legs`` legs: the demo swap, or the k-leg query."""
     if legs == 3:
-        scenario = default_scenario()
-        return certify(make_schedule(scenario.route(), scenario.limits, method=Exact()))
+        return case("y").verified("exact")
     return certify(make_schedule(_route(legs), LIMITS, method=Exact()))
 
 
@@ -200,7 +200,7 @@ def _in_region(point: np.ndarray, polygon: np.ndarray) -> bool:
 # -- the swap of examples/swap.toml, timed by exact (fast), rendered once -------------------------
 @pytest.fixture(scope="module")
 def swap():
-    return default_scenario(), timed(3)
+    return case("y").scenario(), case("y").verified("exact")
 
 
 @pytest.fixture(scope="module")

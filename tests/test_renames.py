@@ -14,8 +14,8 @@ from datetime import UTC, datetime
 import pytest
 
 from tests.conftest import REPO
+from tests.support.cases import case
 from topology import Homotopy, WayRound, plan
-from trajgen import Exact, certify, default_scenario, make_schedule
 from trajgen.export.plc.dialects import DIALECTS
 from trajgen.export.vda5050 import Vda5050Options, order_releases, render_manifest, render_orders
 from trajgen.methods import METHODS
@@ -26,8 +26,7 @@ RENAMED = pytest.mark.filterwarnings("error::DeprecationWarning")
 
 @pytest.fixture(scope="module")
 def swap():
-    scenario = default_scenario()
-    return scenario, certify(make_schedule(scenario.route(), scenario.limits, method=Exact()))
+    return case("y").scenario(), case("y").verified("exact")
 
 
 @RENAMED

@@ -16,7 +16,7 @@ from trajgen import certify
 from trajgen.methods import make_schedule
 from trajgen.scenario import BuiltinScenario, builtin_scenario, load_scenario
 
-__all__ = ["CASES", "Case"]
+__all__ = ["CASES", "Case", "case"]
 
 
 @dataclass(frozen=True, slots=True)
@@ -61,3 +61,8 @@ CASES = (
     Case("passing-loop", "passing-loop"),
     Case("ring", "ring-with-spurs"),
 )
+
+
+def case(name: str) -> Case:
+    """The case of the table named ``name`` (``"y"`` is the demo swap)."""
+    return next(c for c in CASES if c.name == name)
