@@ -304,7 +304,7 @@ def test_cli_bad_homotopy_exits_2_and_writes_nothing(tmp_path, capsys, options, 
 
 
 def test_a_class_that_fails_is_reported_and_the_other_class_is_returned(monkeypatch):
-    import trajgen.methods.optimal.method as optimal_method
+    import trajgen.methods.optimal.class_solve as optimal_method
 
     real = optimal_method.initial_guess
 
@@ -327,7 +327,7 @@ def test_a_class_that_fails_is_reported_and_the_other_class_is_returned(monkeypa
 
 
 def test_a_refinement_that_raises_keeps_the_passes_solved_before(monkeypatch, caplog):
-    import trajgen.methods.optimal.method as optimal_method
+    import trajgen.methods.optimal.class_solve as optimal_method
 
     def broken(*args):
         raise FloatingPointError("injected refinement fault")

@@ -142,7 +142,7 @@ def _failing_solve(*_arguments, **_options):
 def test_a_forced_fallback_is_reported_in_the_json_and_the_text(command, monkeypatch, capsys, caplog):
     from trajgen.cli import main
     from trajgen.cli.entry import LogFormatter
-    from trajgen.methods.optimal import method as optimal_method
+    from trajgen.methods.optimal import class_solve as optimal_method
 
     monkeypatch.setattr(optimal_method, "solve", _failing_solve)
     scenario = str(REPO / "examples" / "swap.toml")

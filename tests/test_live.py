@@ -566,7 +566,7 @@ def test_demo_live_runs_broker_vehicles_and_master_in_one_command(tmp_path, caps
 
 
 def test_a_fallback_plan_of_demo_live_is_reported_in_its_json_and_its_log(tmp_path, capsys, monkeypatch):
-    from trajgen.methods.optimal import method as optimal_method
+    from trajgen.methods.optimal import class_solve as optimal_method
 
     monkeypatch.setattr(optimal_method, "solve", _failing_solve)
     fast = ["--time-scale", "25", "--state-rate", "1"]

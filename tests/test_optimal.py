@@ -422,7 +422,7 @@ def test_the_cache_builds_an_abandoned_nlp_afresh():
 
 
 def test_a_time_limit_reached_after_the_first_pass_keeps_that_pass_and_says_so(monkeypatch):
-    from trajgen.methods.optimal import method as optimal_method
+    from trajgen.methods.optimal import class_solve as optimal_method
     from trajgen.model.summary import provenance
 
     route = route_of(UNEQUAL, ("A:12", "B:8"), ("B:8", "A:12"))
