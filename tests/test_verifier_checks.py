@@ -64,6 +64,21 @@ def _not_a_number(schedule, report):
     return dataclasses.replace(schedule, sections=tuple(sections))
 
 
+def _jump(schedule, report):
+    """Vehicle 1's motion in the last piecewise cubic section after the first starts a centimetre on."""
+    sections = list(schedule.sections)
+    number = max(k for k, s in enumerate(sections) if k and type(s.kinematics) is CubicKinematics)
+    section = sections[number]
+    profile = section.kinematics.vehicles[0]
+    initial = np.array(profile.initial, dtype=float)
+    initial[:, 0] += 0.01
+    broken = copy.copy(profile)
+    object.__setattr__(broken, "initial", initial)
+    kinematics = CubicKinematics((broken, *section.kinematics.vehicles[1:]))
+    sections[number] = dataclasses.replace(section, kinematics=kinematics)
+    return dataclasses.replace(schedule, sections=tuple(sections))
+
+
 def _late(schedule, report):
     """The last section begins a second after the one before it ends."""
     sections = list(schedule.sections)
@@ -73,7 +88,11 @@ def _late(schedule, report):
 
 #: check -> (tampering, the failure it must raise, what its details must name).
 CHECKS = {
-    "velocity": (_slower("max_velocity"), r"velocity reaches .* exceeds its max_velocity", "sections["),
+    "velocity": (
+        _slower("max_velocity"),
+        r"velocity reaches .* at t=.* s \(on (leg|edge) '.*\) exceeds its max_velocity",
+        "sections[",
+    ),
     "acceleration": (
         _slower("max_acceleration"),
         r"acceleration reaches .* exceeds its max_acceleration",
@@ -83,6 +102,11 @@ CHECKS = {
     "separation": (_farther, r"separation .* m at t=.* is below the minimum", "sections["),
     "finite": (_not_a_number, r"hold nan: expected finite numbers", "].jerk["),
     "tiling": (_late, r"starts at t=.* s: expected .* where the section before it ends", "].start_time"),
+    "continuity": (
+        _jump,
+        r"vehicle 1 (position|axis) jumps by 0.01 .*at t=.* s \(on (leg|edge) '",
+        "sections[",
+    ),
 }
 
 

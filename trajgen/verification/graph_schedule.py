@@ -45,7 +45,7 @@ from trajgen.verification.report import (
     VerificationReport,
 )
 
-__all__ = ["verify_graph_schedule"]
+__all__ = ["place", "verify_graph_schedule"]
 
 #: Pieces whose separation is computed at once (the memory of a table read back stays bounded).
 _BLOCK = 1 << 15
@@ -129,6 +129,13 @@ def _track_polynomials(schedule: GraphSchedule, pieces: _Pieces) -> tuple[np.nda
         s[vehicle] = direction[:, None] * pieces.travel[vehicle]
         s[vehicle, :, 0] += path.s_from[k] - direction * path.starts[k]
     return edges, s
+
+
+def place(schedule: GraphSchedule, vehicle: int, time: float) -> str:
+    """Where ``vehicle`` is at ``time`` (seconds), in words: ``on edge 'c', 1.530 m from 'J2'``."""
+    state = schedule.state([time])
+    edge = schedule.track.edges[int(state.edge[vehicle, 0])]
+    return f"on edge {edge.name!r}, {float(state.s[vehicle, 0]):.3f} m from {edge.start!r}"
 
 
 def _check_paths(schedule: GraphSchedule, distances: TrackDistances, failures: list[str]) -> None:
@@ -295,10 +302,11 @@ def _check_motion(schedule: GraphSchedule, pieces: _Pieces, failures: list[str])
         backwards = np.nonzero(_backwards(schedule, vehicle, c, h, velocity_low))[0]
         if backwards.size:
             k = int(backwards[0])
+            at = pieces.start[k] + when[k]
             failures.append(
                 Finding(
-                    f"{who} drives back along its path at {velocity_low[k]:.3g} m/s at t="
-                    f"{pieces.start[k] + when[k]:.6f} s: expected to turn back only at rest where its path "
+                    f"{who} drives back along its path at {velocity_low[k]:.3g} m/s at t={at:.6f} s "
+                    f"({place(schedule, vehicle, at)}): expected to turn back only at rest where its path "
                     "does",
                     pieces.arrays(schedule, k, (vehicle,)),
                 )
@@ -326,8 +334,8 @@ def _check_motion(schedule: GraphSchedule, pieces: _Pieces, failures: list[str])
                 at = pieces.start[k] + (t_hi[k] if abs(hi[k]) >= abs(lo[k]) else t_lo[k])
                 failures.append(
                     Finding(
-                        f"{who} {name} reaches {peak[k]:.9g} {unit} at t={at:.6f} s: exceeds its "
-                        f"{limit_name} {limit:g} {unit}",
+                        f"{who} {name} reaches {peak[k]:.9g} {unit} at t={at:.6f} s "
+                        f"({place(schedule, vehicle, at)}) exceeds its {limit_name} {limit:g} {unit}",
                         pieces.arrays(schedule, k, (vehicle,)),
                     )
                 )
@@ -356,7 +364,8 @@ def _check_motion(schedule: GraphSchedule, pieces: _Pieces, failures: list[str])
                     k = int(jumps[0])
                     failures.append(
                         Finding(
-                            f"{who} {name} jumps by {gap[k]:.3g} at t={pieces.start[k + 1]:.6f} s",
+                            f"{who} {name} jumps by {gap[k]:.3g} at t={pieces.start[k + 1]:.6f} s "
+                            f"({place(schedule, vehicle, pieces.start[k + 1])})",
                             pieces.arrays(schedule, k + 1, (vehicle,)),
                         )
                     )
@@ -516,9 +525,7 @@ def verify_graph_schedule(schedule: GraphSchedule) -> VerificationReport:
         # a plan for execution: each follower can always stop short of its frontier
         for failure in braking_rule_failures(schedule):
             k = pieces.at(failure.time)
-            state = schedule.state([failure.time])
-            edge = schedule.track.edges[int(state.edge[failure.vehicle, 0])]
-            where = f"on edge {edge.name!r}, {float(state.s[failure.vehicle, 0]):.3f} m from {edge.start!r}"
+            where = place(schedule, failure.vehicle, failure.time)
             failures.append(Finding(failure.message(where), pieces.arrays(schedule, k, (failure.vehicle,))))
     return VerificationReport(
         passed=not failures,
