@@ -16,7 +16,9 @@ import pytest
 
 from limits import Limits
 from tests.support.cases import CASES
+from topology import plan
 from trajgen import verify
+from trajgen.methods import make_schedule
 from trajgen.model.schedule import CubicKinematics
 
 
@@ -151,3 +153,35 @@ def test_the_braking_rule_is_checked_on_every_track_for_a_plan_for_execution(cas
     if not report.passed:
         assert re.search(r"cannot stop short of its frontier at t=.* \(the braking rule", report.failures[0])
         assert "sections[" in report.details[0]
+
+
+def _in_another_class(case):
+    """The case's plan relabelled with a route of the other class (the order of passing reversed).
+
+    On a junction, the planner's route of the other class; on a track graph, the route's moves with
+    each vehicle's own in order, the vehicle that moved first now moving after the other.
+    """
+    scenario, schedule = case.scenario(), case.verified().schedule
+    route = schedule.route
+    if hasattr(route, "moves"):
+        moves = tuple(sorted(route.moves, key=lambda move: move.vehicle == route.moves[0].vehicle))
+        timed = make_schedule(dataclasses.replace(route, moves=moves), scenario.limits, method="exact")
+        return dataclasses.replace(timed, route=route)
+    other = plan(
+        scenario.track, scenario.start, scenario.goal, min_separation=route.min_separation, homotopy="other"
+    )
+    return dataclasses.replace(schedule, route=other)
+
+
+@pytest.mark.parametrize("case", CASES, ids=[case.name for case in CASES])
+def test_the_class_check_catches_a_plan_of_another_class_on_every_track(case):
+    report = verify(_in_another_class(case))
+    assert not report.passed
+    assert not report.regions_match
+    found = [
+        (text, detail)
+        for text, detail in zip(report.failures, report.details, strict=True)
+        if re.search(r"another class than (the|their) route's", text)
+    ]
+    assert found, report.failures
+    assert "sections[" in found[0][1]
