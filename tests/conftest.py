@@ -45,6 +45,9 @@ def pytest_configure(config) -> None:
     every process the tests start inherit: nothing of the user's cache is read, and each shape is
     built once for the whole run. It is deleted when the run ends.
     """
+    # matplotlib builds its font cache with fc-list when it is cold: before any test is watched
+    import matplotlib.font_manager  # noqa: F401
+
     if hasattr(config, "workerinput"):
         return
     import tempfile

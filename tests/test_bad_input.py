@@ -12,6 +12,7 @@ from tests.support.helpers import LIMITS, route_of
 from trajgen import Exact, certify, make_schedule, write_profiles
 from trajgen.cli import EXIT_BAD_INPUT, EXIT_OK, main
 from trajgen.errors import InputError
+from trajgen.export import write_tables
 
 SWAP_FILE = REPO / "examples" / "swap.toml"
 GOOD = SWAP_FILE.read_text(encoding="utf-8")
@@ -277,3 +278,12 @@ def test_an_unknown_option_value_is_named_in_words(capsys, argv, message):
     assert message in err
     assert "dialectname" not in err
     assert "homotopychoice" not in err
+
+
+def test_table_files_are_one_per_vehicle_of_the_schedule(tmp_path):
+    verified = certify(
+        Exact().schedule(route_of((10.0, 10.0, 10.0), ("A:10", "B:10"), ("B:10", "A:10")), LIMITS)
+    )
+    with pytest.raises(InputError, match=r"vehicle names \('a', 'b', 'c'\): expected 2, one per vehicle"):
+        write_tables(verified, ("a", "b", "c"), tmp_path, dialect="codesys-xy")
+    assert list(tmp_path.iterdir()) == []

@@ -25,6 +25,7 @@ def _paths(name: str):
     return track, GraphMetric(track), paths
 
 
+@pytest.mark.slow  # a sampled campaign over every example's plan
 @pytest.mark.parametrize("name", ["h", "ring-with-spurs", "main-line-with-sidings"])
 def test_what_the_braking_check_certifies_keeps_the_distance_at_every_sampled_instant(name):
     """Random states along both paths: a certified pair never comes closer than required when sampled."""

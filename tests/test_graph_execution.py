@@ -95,7 +95,10 @@ def test_the_runs_that_overshot_a_frontier_and_deadlocked_now_reach_the_goal(nam
         assert result.makespan_s - result.planned_s <= stop_bound(scenario, faults[0].value)
 
 
-@pytest.mark.parametrize("name", ["h", "main-line-with-sidings"])
+@pytest.mark.parametrize(
+    "name",
+    ["h", pytest.param("main-line-with-sidings", marks=pytest.mark.slow)],  # the H in the fast set
+)
 def test_slowdowns_lags_and_jumps_on_a_graph_keep_the_separation_and_reach_the_goal(name):
     scenario, verified = plan(name, "exact")
     margin = execution_margin(scenario, 0.05)

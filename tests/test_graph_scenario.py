@@ -2,17 +2,21 @@
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import tomllib
 
 import pytest
 
+from limits import Limits
 from tests.conftest import REPO
 from tests.support.grid_oracle import GridTrack, shortest_route
 from tests.support.helpers import RUN_FILES
 from topology import TrackGraph
+from trajgen import verify
 from trajgen.cli import main
-from trajgen.errors import ScenarioError, VehicleCountError
+from trajgen.errors import InputError, ScenarioError, VehicleCountError
+from trajgen.methods import make_schedule
 from trajgen.scenario import GraphScenario, load_scenario, parse_scenario
 
 EXAMPLES = REPO / "examples" / "graphs"
@@ -207,9 +211,41 @@ def test_three_vehicles_are_read_and_only_the_planner_refuses_them(tmp_path, cap
         VehicleCountError, match=r"three.toml: the track-graph planner plans exactly 2 vehicles, got 3"
     ):
         scenario.route()
-    for command in (["plan"], ["schedule"], ["simulate"]):
-        assert main([*command, str(path)]) == 2
-        assert "plans exactly 2 vehicles, got 3" in capsys.readouterr().err
+    out = tmp_path / "out"
+    commands = (
+        ["plan"],
+        ["schedule"],
+        ["simulate"],
+        ["check", "--csv", str(tmp_path)],
+        ["export-vda5050", "--out", str(out)],
+        ["animate", "--out", str(out / "a.gif")],
+    )
+    for count, vehicles in (
+        (3, THREE),
+        (1, THREE[: THREE.index("[[vehicle]]", THREE.index("[[vehicle]]") + 1)]),
+    ):
+        path.write_text(vehicles)
+        for command in commands:
+            assert main([*command, str(path)]) == 2, command
+            error = capsys.readouterr().err
+            assert f"three.toml: the track-graph planner plans exactly 2 vehicles, got {count}" in error, (
+                command
+            )
+            assert "internal failure" not in error
+    assert not out.exists()
+
+
+def test_the_api_refuses_limits_of_another_number_of_vehicles_than_the_route_moves():
+    scenario = load_scenario(REPO / "examples" / "graphs" / "h.toml")
+    route, (agv, _) = scenario.route(), scenario.limits.vehicles
+    for count in (1, 3):
+        limits = Limits((agv,) * count, scenario.limits.min_separation)
+        with pytest.raises(InputError, match=rf"limits of {count} vehicle\(s\) for a route of 2"):
+            make_schedule(route, limits, method="exact")
+    schedule = make_schedule(route, scenario.limits, method="exact")
+    report = verify(dataclasses.replace(schedule, limits=Limits((agv,) * 3, 1.5)))
+    assert not report.passed
+    assert report.failures == ("the limits are of 3 vehicle(s), the route moves 2: expected one per vehicle",)
 
 
 def test_every_pair_of_three_vehicles_keeps_the_separation_at_the_start(tmp_path):

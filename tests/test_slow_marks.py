@@ -61,3 +61,25 @@ def test_slow_marks_sit_on_the_tests_not_in_lists():
     for name in ("SLOW_FILES", "SLOW_TESTS", "SLOW_LEGS", "add_marker"):
         assert name not in conftest
     assert set(EVENTS) >= {"subprocess.Popen", "socket.bind", "os.posix_spawn", "os.fork"}
+
+
+def test_a_thread_older_than_the_test_is_not_held_against_it():
+    import threading
+
+    guard = SlowGuard()
+    started, release = threading.Event(), threading.Event()
+
+    def left_over():  # a thread an earlier test left running
+        started.set()
+        release.wait(5)
+        guard.audit("subprocess.Popen", ("x", ["x"], None, None))
+
+    thread = threading.Thread(target=left_over)
+    thread.start()
+    started.wait(5)
+    guard.watch(True)  # this test begins after the thread
+    release.set()
+    thread.join(5)
+    assert guard.take() is None
+    guard.audit("subprocess.Popen", ("y", ["y"], None, None))  # the test's own thread is watched
+    assert guard.take() == "starts a process (subprocess.Popen ['y'])"

@@ -1137,3 +1137,8 @@ def test_the_options_name_every_vehicle_or_the_export_refuses_them():
     serials = Vda5050Options(start_time=START, serial_numbers=("S1",))
     with pytest.raises(OptionError, match=r"serial_numbers: 1 given: expected one per vehicle \(2\)"):
         serials.check_vehicles(2)
+
+
+def test_manufacturers_and_serial_numbers_of_unlike_counts_are_refused():
+    with pytest.raises(OptionError, match=r"manufacturers: 2 given for 3 serial numbers: expected one"):
+        Vda5050Options(start_time=START, manufacturers=("a", "b"), serial_numbers=("x", "y", "z"))

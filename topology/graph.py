@@ -254,7 +254,8 @@ class StarGraph:
         """The junction as a track graph: the same track, the same points.
 
         The junction is the node ``O``; each leg an edge named as the leg, from ``O`` to its end node
-        ``<leg>-end``, placed by the leg's angle. ``A:s`` names the same point on both (``O`` too).
+        ``<leg>-end`` (``-end`` once more where a leg has that name), placed by the leg's angle.
+        ``A:s`` names the same point on both (``O`` too).
 
         Examples
         --------
@@ -268,10 +269,15 @@ class StarGraph:
         if not built:
             coordinates = {JUNCTION_NAME: (0.0, 0.0)}
             edges = {}
+            taken = {JUNCTION_NAME, *self.names}
             for name, length, angle in zip(self.names, self.lengths, self.angles_deg, strict=True):
+                end = f"{name}-end"
+                while end in taken:  # a leg named like another's end node ('A' and 'A-end')
+                    end += "-end"
+                taken.add(end)
                 radians = math.radians(angle)
-                coordinates[f"{name}-end"] = (length * math.cos(radians), length * math.sin(radians))
-                edges[name] = (JUNCTION_NAME, f"{name}-end", length)
+                coordinates[end] = (length * math.cos(radians), length * math.sin(radians))
+                edges[name] = (JUNCTION_NAME, end, length)
             built.append(TrackGraph.from_edges(edges, coordinates=coordinates))
         return built[0]
 

@@ -6,6 +6,11 @@ through Python's audit events (:func:`sys.addaudithook`), whichever code starts 
 a fixture's, the library's. ``tests/conftest.py`` installs one :class:`SlowGuard` per process,
 watches each test not marked ``slow`` from its setup to its teardown, and fails it naming what it
 started.
+
+What it cannot see: a process started without an audit event (``multiprocessing`` with the
+``spawn`` context, ``system()`` called from C); no test does that. What it does not hold against a
+test: events of threads already running when the test began. matplotlib's font cache, built with
+``fc-list`` on a cold cache, is warmed before any test runs (``pytest_configure``).
 """
 
 from __future__ import annotations
@@ -34,12 +39,19 @@ class SlowGuard:
         self._lock = threading.Lock()
         self._watching = False
         self._found: str | None = None
+        self._older: frozenset[int] = frozenset()
 
     def watch(self, fast: bool) -> None:
-        """Begin watching a test that is not marked slow (``fast``), or stop watching."""
+        """Begin watching a test that is not marked slow (``fast``), or stop watching.
+
+        Threads other than the main one that run already when a test begins are not the test's
+        (a thread left by an earlier test): their events are not held against it.
+        """
         with self._lock:
             self._watching = fast
             self._found = None
+            main = threading.main_thread().ident
+            self._older = frozenset(t.ident for t in threading.enumerate() if t.ident != main)
 
     def take(self) -> str | None:
         """What the test did that a fast test may not (``None``: nothing), forgotten once taken."""
@@ -50,7 +62,7 @@ class SlowGuard:
     def audit(self, event: str, args: tuple) -> None:
         """The audit hook: note ``event`` if it is one of :data:`EVENTS` and a fast test runs."""
         what = EVENTS.get(event)
-        if what is None or not self._watching:
+        if what is None or not self._watching or threading.get_ident() in self._older:
             return
         with self._lock:
             if self._watching and self._found is None:

@@ -31,8 +31,14 @@ __all__ = [
 
 
 def scenario_from(path: str | None) -> Scenario | GraphScenario:
-    """The scenario of a file (a junction's or a track graph's), or the built-in one for ``None``."""
-    return default_scenario() if path is None else load_scenario(path)
+    """The scenario of a file (a junction's or a track graph's), or the built-in one for ``None``.
+
+    Every command plans it: a number of vehicles the planners do not take is refused here, at the
+    door, naming the file (:class:`~trajgen.errors.VehicleCountError`, exit 2).
+    """
+    scenario = default_scenario() if path is None else load_scenario(path)
+    scenario.check_planned()
+    return scenario
 
 
 #: The generic CSV's options and their defaults (``None`` in the parser, so a given one is known).

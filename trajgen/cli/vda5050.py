@@ -60,7 +60,7 @@ def _per_vehicle(values: list[str], names: tuple[str, ...], option: str, default
                 f"with NAME one of {list(names)!r}"
             )
         result[names.index(name)] = text
-    return result[0], result[1]
+    return tuple(result)
 
 
 def _format(summary: dict) -> str:

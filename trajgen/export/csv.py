@@ -447,7 +447,7 @@ def write_profiles(
     directory: str | Path,
     *,
     options: CsvOptions | None = None,
-) -> tuple[Path, Path]:
+) -> tuple[Path, ...]:
     """Write ``directory/<name>.csv`` for each vehicle, all or none.
 
     Parameters

@@ -8,7 +8,7 @@ from dataclasses import dataclass
 
 from limits import Limits
 from topology import GraphRoute, Route
-from trajgen.errors import OptionError
+from trajgen.errors import InputError, OptionError
 from trajgen.model.graph_schedule import GraphSchedule
 from trajgen.model.schedule import Schedule, TimingMethod
 
@@ -154,10 +154,15 @@ class MethodRegistry:
         OptionError
             Unknown method name.
         InputError
-            ``route`` or ``limits`` of the wrong type, or a route planned for a
-            smaller separation than ``limits`` asks.
+            ``route`` or ``limits`` of the wrong type, a route planned for a smaller separation than
+            ``limits`` asks, or limits of another number of vehicles than the route moves.
         """
         chosen = self.create(method)
+        count = len(tuple(getattr(route, "start", ())))
+        if isinstance(limits, Limits) and count and limits.count != count:
+            raise InputError(
+                f"limits of {limits.count} vehicle(s) for a route of {count}: expected one per vehicle"
+            )
         if isinstance(route, GraphRoute):
             return chosen.schedule_graph(route, limits)
         return chosen.schedule(route, limits)

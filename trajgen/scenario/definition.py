@@ -42,6 +42,7 @@ from pathlib import Path
 
 from limits import Limits, VehicleLimits
 from topology import Configuration, Option, Position, Route, StarGraph, TrackGraph, YGraph, plan
+from topology.errors import VehicleCountError
 from topology.validation import check_vehicle_count, short_repr
 from trajgen.errors import InputError, OptionError, ScenarioError
 from trajgen.scenario.factsheet import read_factsheet
@@ -183,9 +184,22 @@ class Scenario:
         if not isinstance(self.limits, Limits):
             raise InputError(f"scenario limits must be Limits, got {type(self.limits).__name__}")
         object.__setattr__(self, "names", check_vehicle_names(self.names, count=self.limits.count))
+        self.check_planned()
         _check_plausible_track(self.track)
         for k, vehicle in enumerate(self.limits.vehicles, start=1):
             _check_plausible_vehicle(vehicle, f"vehicle {k}")
+
+    def check_planned(self) -> None:
+        """Refuse, naming :attr:`source`, a number of vehicles the junction planner does not plan (two).
+
+        Raises
+        ------
+        VehicleCountError
+        """
+        try:
+            check_vehicle_count(self.limits.count, "the junction planner (the paper's)")
+        except VehicleCountError as error:
+            raise VehicleCountError(f"{self.source}: {error}") from None
 
     def route(self) -> Route:
         """The planner's route from start to goal, keeping the scenario's minimum separation."""

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import re
 from collections.abc import Sequence
+from numbers import Integral
 
 from topology.validation import short_repr
 from trajgen.errors import InputError
@@ -86,9 +87,9 @@ def check_vehicle_index(vehicle: object, count: int) -> int:
     >>> check_vehicle_index(1, 2)
     1
     """
-    if isinstance(vehicle, bool) or not isinstance(vehicle, int) or not 0 <= vehicle < count:
+    if isinstance(vehicle, bool) or not isinstance(vehicle, Integral) or not 0 <= vehicle < count:
         raise InputError(
             f"vehicle must be an index from 0 to {count - 1} (one of {count} vehicles), "
             f"got {short_repr(vehicle)}"
         )
-    return vehicle
+    return int(vehicle)

@@ -129,6 +129,14 @@ def verify(schedule: Schedule) -> VerificationReport:
     if not isinstance(schedule, Schedule | GraphSchedule):
         raise InputError(f"verify expects a Schedule or a GraphSchedule, got {type(schedule).__name__}")
     began = time.perf_counter()
+    moved = len(tuple(schedule.route.start))
+    if schedule.limits.count != moved:  # the motion's vehicles are the route's: limits for each
+        return VerificationReport.failed(
+            (
+                f"the limits are of {schedule.limits.count} vehicle(s), the route moves {moved}: "
+                "expected one per vehicle",
+            )
+        )
     report = verify_graph_schedule(schedule) if isinstance(schedule, GraphSchedule) else _verify(schedule)
     logger.debug(
         "verified a %s schedule (%d pieces) in %.1f ms: %s",

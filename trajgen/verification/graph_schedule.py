@@ -32,6 +32,7 @@ from trajgen.model import polynomials
 from trajgen.model.blended import ToppraKinematics
 from trajgen.model.graph_schedule import GraphSchedule
 from trajgen.model.pieces import UncheckableKinematicsError, kinematics_polynomials, split_at_values
+from trajgen.model.schedule import CubicKinematics
 from trajgen.verification.braking_rule import braking_rule_failures, for_execution
 from trajgen.verification.graph_class import check_class
 from trajgen.verification.graph_route import TrackDistances
@@ -479,7 +480,13 @@ def _check_separation(
             schedule, distances, edges[:, block], s[:, block], pieces.length[block]
         )
     if not np.all(np.isfinite(closest)):
-        failures.append("the track distance is not finite on some piece: expected finite numbers")
+        k = int(np.argmax(~np.isfinite(closest)))
+        failures.append(
+            Finding(
+                f"the track distance is not finite from t={pieces.start[k]:.6f} s: expected finite numbers",
+                pieces.arrays(schedule, k),
+            )
+        )
         return math.nan
     k = int(np.argmin(closest))
     required = schedule.limits.min_separation
@@ -517,7 +524,9 @@ def verify_graph_schedule(schedule: GraphSchedule) -> VerificationReport:
     try:
         pieces = _Pieces(schedule)
     except UncheckableKinematicsError as error:
-        return VerificationReport.failed((str(error),))
+        known = (CubicKinematics, ToppraKinematics)
+        k = next((k for k, s in enumerate(schedule.sections) if type(s.kinematics) not in known), 0)
+        return VerificationReport.failed((Finding(str(error), f"sections[{k}].kinematics"),))
     ratios, start_error, goal_error = _check_motion(schedule, pieces, failures)
     closest = _check_separation(schedule, pieces, distances, failures)
     same_class = check_class(schedule, pieces, distances, failures)

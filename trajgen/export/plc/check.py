@@ -333,13 +333,13 @@ def check_profiles(
     jerk: bool = True,
     max_points: int | None = None,
 ) -> ProfileCheck:
-    """Read both vehicles' files of ``dialect`` in ``directory`` and verify them against ``scenario``.
+    """Read each vehicle's file of ``dialect`` in ``directory`` and verify them against ``scenario``.
 
     Parameters
     ----------
     scenario : Scenario or GraphScenario
     directory : path
-        Holds ``<vehicle name><suffix>`` of both vehicles.
+        Holds ``<vehicle name><suffix>`` of each vehicle.
     dialect : Dialect or str, optional
         Default ``generic``.
     jerk : bool, optional
@@ -356,7 +356,11 @@ def check_profiles(
     ------
     ProfileFileError
         A file is missing, too large, or not readable as the dialect.
+    VehicleCountError
+        The scenario has a number of vehicles the planners do not plan (its files cannot be checked
+        against a plan).
     """
+    scenario.check_planned()
     dialect = DIALECTS.lookup(dialect)
     limit = dialect.check_points(max_points) if isinstance(dialect, TableDialect) else None
     files = profile_files(scenario, directory, dialect)

@@ -182,7 +182,7 @@ def write_tables(
     *,
     dialect: TableDialect | str,
     max_points: int | None = None,
-) -> tuple[Path, Path]:
+) -> tuple[Path, ...]:
     """Write both vehicles' tables in a PLC ``dialect`` into ``directory``, both or neither.
 
     The tables are those of :func:`plc_tables` (verified as their controllers interpolate them);
@@ -192,8 +192,9 @@ def write_tables(
     ----------
     verified : VerifiedSchedule
         From :func:`trajgen.verification.certify`.
-    names : sequence of 2 str
-        Vehicle names, used as file names (``<name><suffix>``: ``.txt`` for ``codesys-xy``).
+    names : sequence of str
+        Vehicle names, one per vehicle of the schedule, used as file names (``<name><suffix>``:
+        ``.txt`` for ``codesys-xy``).
     directory : path
         Created if missing.
     dialect : TableDialect or str
@@ -204,8 +205,8 @@ def write_tables(
 
     Returns
     -------
-    tuple of 2 Path
-        Vehicle 1's and vehicle 2's table, as committed.
+    tuple of Path
+        Each vehicle's table, as committed, in the order of ``names``.
 
     Raises
     ------
@@ -229,7 +230,7 @@ def write_tables(
         raise OptionError(
             f"dialect {chosen.name.value!r} is sampled, not resampled: write it with write_profiles"
         )
+    check_vehicle_names(names, count=require_verified(verified, "write_tables").schedule.limits.count)
     paths = check_output_paths(table_paths(chosen, names, directory))
     tables = plc_tables(verified, chosen, max_points=max_points)
-    first, second = commit_files(dict(zip(paths, tables.contents, strict=True)))
-    return first, second
+    return tuple(commit_files(dict(zip(paths, tables.contents, strict=True))))

@@ -98,6 +98,11 @@ class Vda5050Options:
                         "A-Z a-z 0-9 _ . : - only"
                     )
             object.__setattr__(self, "serial_numbers", serials)
+            if len(manufacturers) not in (1, len(serials)):
+                raise OptionError(
+                    f"VDA 5050 manufacturers: {len(manufacturers)} given for {len(serials)} serial numbers: "
+                    "expected one, or one per vehicle"
+                )
             topics = {}
             for vehicle, serial in enumerate(serials):
                 other = topics.setdefault((self.manufacturer(vehicle), serial), vehicle)
