@@ -193,6 +193,10 @@ class GraphSchedule:
             t, travel, axis, heading * values[:, 1], heading * values[:, 2], heading * values[:, 3], edge, s
         )
 
+    def distances(self, state: GraphState) -> np.ndarray:
+        """Track distance between the vehicles in ``state`` (this schedule's, at some times), metres, (n,)."""
+        return self.track.distances(state.edge[0], state.s[0], state.edge[1], state.s[1])
+
     def sample(self, period: float) -> GraphState:
         """States every ``period`` seconds from t = 0, plus a last sample exactly at the goal."""
         period = check_period(period)

@@ -20,6 +20,7 @@ import numpy as np
 
 from limits import Limits
 from topology import JUNCTION_INDEX, JUNCTION_NAME, Configuration, Position, Route, StarGraph
+from topology.indexed import track_distance
 from topology.validation import finite_real
 from trajgen.errors import InputError
 from trajgen.lazy import RenamedAttribute
@@ -481,6 +482,10 @@ class Schedule:
         """States every ``period`` seconds from t = 0, plus a last sample exactly at the goal."""
         period = check_period(period)
         return self.state(sample_block(self.duration, period, 0, sample_rows(self.duration, period)))
+
+    def distances(self, state: ScheduleState) -> np.ndarray:
+        """Track distance between the vehicles in ``state`` (this schedule's, at some times), metres, (n,)."""
+        return track_distance(state.leg[0], state.s[0], state.leg[1], state.s[1])
 
     def configuration_at(self, t: float) -> Configuration:
         """The two vehicles' positions at time ``t`` (seconds) as a Configuration."""

@@ -4,8 +4,6 @@ from __future__ import annotations
 
 import numpy as np
 
-from topology.indexed import track_distance
-from trajgen.model.graph_schedule import GraphSchedule
 from trajgen.model.summary import class_label, closest_text
 from trajgen.plots.figure import drawing_axis, finished
 from trajgen.plots.speed import plot_period
@@ -19,9 +17,7 @@ _ROUNDS = 4
 
 def _distance(schedule, state) -> np.ndarray:
     """Track distance between the vehicles in ``state`` (the schedule's, at some times), metres."""
-    if isinstance(schedule, GraphSchedule):
-        return schedule.track.distances(state.edge[0], state.s[0], state.edge[1], state.s[1])
-    return track_distance(state.leg[0], state.s[0], state.leg[1], state.s[1])
+    return schedule.distances(state)
 
 
 def _closest(schedule, sample: float, period: float) -> tuple[float, float]:

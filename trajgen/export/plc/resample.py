@@ -19,7 +19,6 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from topology.indexed import track_distance
 from trajgen.errors import InputError, OutputLimitError
 from trajgen.export.plc.tables import Interpolation, ProfileTable, divided_differences, limit_ratios, slowdown
 from trajgen.model.graph_schedule import GraphSchedule
@@ -206,10 +205,7 @@ def _errors(table: ProfileTable, grid: np.ndarray, axis: np.ndarray, velocity: n
 def _closest_approaches(schedule: Schedule | GraphSchedule, grid: np.ndarray, state) -> np.ndarray:
     """Times of the grid where the vehicles' track distance has a local minimum near the separation."""
     separation = schedule.limits.min_separation
-    if isinstance(schedule, GraphSchedule):
-        distance = schedule.track.distances(state.edge[0], state.s[0], state.edge[1], state.s[1])
-    else:
-        distance = track_distance(state.leg[0], state.s[0], state.leg[1], state.s[1])
+    distance = schedule.distances(state)
     if distance.size < 3:
         return np.zeros(0)
     inner = (distance[1:-1] < distance[:-2]) & (distance[1:-1] <= distance[2:])
