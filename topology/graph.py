@@ -281,6 +281,25 @@ class StarGraph:
             built.append(TrackGraph.from_edges(edges, coordinates=coordinates))
         return built[0]
 
+    def point(self, text: str | Position) -> Position:
+        """The position written ``"LEG:s"`` or ``"O"``, checked on this track (as a track graph's ``point``).
+
+        Raises
+        ------
+        PositionError
+            Not of that form, an unknown leg, or ``s`` off the leg.
+
+        Examples
+        --------
+        >>> StarGraph({"A": 10.0, "B": 8.0, "C": 6.0}).point("B:3")
+        Position(leg='B', s=3.0)
+        """
+        if isinstance(text, Position):
+            return self.check(text)
+        if not isinstance(text, str):
+            raise PositionError(f"position {short_repr(text)} is not 'LEG:s' or 'O'")
+        return self.check(Position.parse(text))
+
     def edge_point(self, position: Position) -> EdgePoint:
         """``position`` as the point of :meth:`track_graph` (the junction: the start of the first edge).
 

@@ -166,8 +166,7 @@ def parse_fault(
         raise FaultError(f"fault {short_repr(spec)}: {kind.value} takes {expected}")
     if kind is FaultKind.GOAL:
         try:
-            on_graph = isinstance(graph, TrackGraph)
-            goal = graph.point(text) if on_graph else graph.check(Position.parse(text))
+            goal = graph.point(text)
         except InputError as error:
             raise FaultError(f"fault {short_repr(spec)}: goal: {error}") from None
         return Fault(kind, vehicle, time, 0.0, goal, spec)
