@@ -212,6 +212,7 @@ def test_a_method_that_does_not_time_graphs_says_so_naming_itself():
         make_schedule(route, limits, method=Junctions())
 
 
+@pytest.mark.slow  # seeded random graphs, each timed, verified and written: a campaign
 def test_seeded_random_graphs_are_timed_and_verified_with_the_rows_safe(tmp_path):
     checked = 0
     for seed in range(400):
