@@ -91,11 +91,11 @@ def timed_cycles(
 
     original = Executor.step
 
-    def step(self, first, second):
+    def step(self, states, *more):
         before = self.replans + self.rejected_goals
         runs = collections[0]
         start = time.perf_counter_ns()
-        command = original(self, first, second)
+        command = original(self, states, *more)
         elapsed = time.perf_counter_ns() - start
         if self.replans + self.rejected_goals > before:
             steps.append(("plan", elapsed / 1e6))
