@@ -64,9 +64,15 @@ def test_each_change_of_the_connection_is_said_once_and_retries_are_not(caplog):
         )
         broker.start()
         assert _until(lambda: link.connected, RETRY_MAX_S + 2.0)
-        connected = [
-            r for r in caplog.records if r.getMessage() == f"vehicle probe: connected to {broker.url}"
-        ]
+
+        said = f"vehicle probe: connected to {broker.url}"
+
+        def said_connected() -> list:
+            return [r for r in caplog.records if r.getMessage() == said]
+
+        # the link says it just after its state changes, in its own thread
+        assert _until(lambda: bool(said_connected()), 2.0)
+        connected = said_connected()
         assert len(connected) == 1
         assert connected[0].levelno == logging.WARNING  # said loudly: it follows a problem
         broker.restart(down_for=1.0)
