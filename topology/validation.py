@@ -57,20 +57,22 @@ def short_repr(value: object, limit: int = 60) -> str:
     return text if len(text) <= limit else text[: limit - 3] + "..."
 
 
-def check_vehicle_count(count: int, planner: str) -> None:
+def check_vehicle_count(count: int, planner: str, *, source: str | None = None) -> None:
     """Refuse a number of vehicles the planners do not plan for.
 
     Raises
     ------
     VehicleCountError
-        ``count`` is not :data:`PLANNED_VEHICLES`; the message names ``planner``.
+        ``count`` is not :data:`PLANNED_VEHICLES`; the message names ``planner`` (and ``source``,
+        the file the vehicles come from, first).
 
     Examples
     --------
     >>> check_vehicle_count(2, "the junction planner")
     """
     if count != PLANNED_VEHICLES:
+        where = "" if source is None else f"{source}: "
         raise VehicleCountError(
-            f"{planner} plans exactly {PLANNED_VEHICLES} vehicles, got {count}: expected two [[vehicle]] "
-            "tables (planning more vehicles is to come)"
+            f"{where}{planner} plans exactly {PLANNED_VEHICLES} vehicles, got {count}: expected two "
+            "[[vehicle]] tables (planning more vehicles is to come)"
         )

@@ -19,18 +19,22 @@ VDA5050_VERSION = "2.1.0"
 CANCEL_ORDER = "cancelOrder"
 
 
+def _header(identity: VehicleIdentity, header: int, timestamp: str) -> dict:
+    """The header fields every message of ``identity`` carries."""
+    return {
+        "header_id": header,
+        "timestamp": timestamp,
+        "version": VDA5050_VERSION,
+        "manufacturer": identity.manufacturer,
+        "serial_number": identity.serial_number,
+    }
+
+
 def connection_message(identity: VehicleIdentity, state: str, *, header: int, timestamp: str) -> bytes:
     """A ``connection`` message of ``identity`` (``ONLINE``, ``OFFLINE`` or ``CONNECTIONBROKEN``)."""
     from vda5050.model.connection import Connection
 
-    message = Connection(
-        header_id=header,
-        timestamp=timestamp,
-        version=VDA5050_VERSION,
-        manufacturer=identity.manufacturer,
-        serial_number=identity.serial_number,
-        connection_state=state,
-    )
+    message = Connection(**_header(identity, header, timestamp), connection_state=state)
     return message.to_json().encode()
 
 
@@ -39,11 +43,7 @@ def cancel_order_message(identity: VehicleIdentity, *, action_id: str, header: i
     from vda5050.model.instant_actions import InstantActions
 
     message = InstantActions(
-        header_id=header,
-        timestamp=timestamp,
-        version=VDA5050_VERSION,
-        manufacturer=identity.manufacturer,
-        serial_number=identity.serial_number,
+        **_header(identity, header, timestamp),
         actions=[{"action_type": CANCEL_ORDER, "action_id": action_id, "blocking_type": "HARD"}],
     )
     return message.to_json().encode()

@@ -42,7 +42,6 @@ from pathlib import Path
 
 from limits import Limits, VehicleLimits
 from topology import Configuration, Option, Position, Route, StarGraph, TrackGraph, YGraph, plan
-from topology.errors import VehicleCountError
 from topology.validation import check_vehicle_count, short_repr
 from trajgen.errors import InputError, OptionError, ScenarioError
 from trajgen.scenario.factsheet import read_factsheet
@@ -196,10 +195,7 @@ class Scenario:
         ------
         VehicleCountError
         """
-        try:
-            check_vehicle_count(self.limits.count, "the junction planner (the paper's)")
-        except VehicleCountError as error:
-            raise VehicleCountError(f"{self.source}: {error}") from None
+        check_vehicle_count(self.limits.count, "the junction planner (the paper's)", source=self.source)
 
     def route(self) -> Route:
         """The planner's route from start to goal, keeping the scenario's minimum separation."""

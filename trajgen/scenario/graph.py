@@ -10,7 +10,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from limits import Limits
-from topology import EdgePoint, GraphRoute, TrackGraph, VehicleCountError, check_vehicle_count, plan_graph
+from topology import EdgePoint, GraphRoute, TrackGraph, check_vehicle_count, plan_graph
 from trajgen.errors import InputError
 from trajgen.scenario.naming import check_vehicle_names
 
@@ -77,10 +77,7 @@ class GraphScenario:
         ------
         VehicleCountError
         """
-        try:
-            check_vehicle_count(self.limits.count, "the track-graph planner")
-        except VehicleCountError as error:
-            raise VehicleCountError(f"{self.source}: {error}") from None
+        check_vehicle_count(self.limits.count, "the track-graph planner", source=self.source)
 
     def route(self) -> GraphRoute:
         """The exact planner's route: the shortest collision-free one, one vehicle moving at a time.
