@@ -174,8 +174,8 @@ def test_format_rows_are_the_lines_of_format_block(swap_exact):
     schedule = swap_exact.schedule
     state = schedule.sample(0.5)
     options = CsvOptions(delimiter="\t", decimal=",", units=Units.MILLIMETRES)
-    block = format_block(schedule.route.graph, state, 1, options)
-    rows = format_rows(schedule.route.graph, state, 1, options)
+    block = format_block(schedule.track, state, 1, options)
+    rows = format_rows(schedule.track, state, 1, options)
     assert len(rows) == state.t.size
     assert "".join(row + "\r\n" for row in rows).encode("ascii") == block
     assert rows[0].split("\t")[:2] == ["0,000000", "0,000000"]

@@ -154,19 +154,19 @@ def test_a_velocity_table_still_above_its_limit_after_every_resampling_is_never_
 
 
 def test_a_graph_csv_holds_a_velocity_a_hair_above_its_limit_to_the_limit():
-    from trajgen.export.graph_rows import format_graph_block
+    from trajgen.export.rows import format_rows_block
 
     scenario, verified = bench("h", "exact")
     state = verified.schedule.state(np.linspace(0.0, verified.schedule.duration, 400))
     above = dataclasses.replace(state, velocity=state.velocity * (1.0 + 5e-9))
     options = {"delimiter": ";", "decimal": ",", "scale": 1000.0, "decimals": 6}
     limits = scenario.limits.vehicles[0]
-    held = numbers(format_graph_block(scenario.track, above, 0, **options, limits=limits), ";", ",")
-    as_is = numbers(format_graph_block(scenario.track, above, 0, **options), ";", ",")
+    held = numbers(format_rows_block(scenario.track, above, 0, **options, limits=limits), ";", ",")
+    as_is = numbers(format_rows_block(scenario.track, above, 0, **options), ";", ",")
     assert np.abs(as_is[:, 2]).max() > 1000.0  # the case is real: unheld, it is written above the limit
     assert np.abs(held[:, 2]).max() == 1000.0
     far = dataclasses.replace(state, velocity=state.velocity * 1.01)  # no round-off: left for a check to see
-    beyond = numbers(format_graph_block(scenario.track, far, 0, **options, limits=limits), ";", ",")
+    beyond = numbers(format_rows_block(scenario.track, far, 0, **options, limits=limits), ";", ",")
     assert np.abs(beyond[:, 2]).max() == pytest.approx(1010.0, abs=1e-3)
 
 

@@ -13,6 +13,7 @@ import math
 import random
 import re
 
+import numpy as np
 import pytest
 
 from tests.support.grid_oracle import GRID, GridTrack, random_case, shortest_route
@@ -214,6 +215,72 @@ def test_lengths_default_to_the_straight_distance_of_the_nodes_coordinates():
 def test_a_bad_track_is_refused_naming_the_culprit(edges, coordinates, match):
     with pytest.raises(TrackError, match=match):
         TrackGraph.from_edges(edges, coordinates=coordinates)
+
+
+_LINE = {"a": ("J", "A", 5.0), "b": ("J", "B", 5.0)}
+_LINE_XY = {"J": (0.0, 0.0), "A": (3.0, 4.0), "B": (-5.0, 0.0)}
+
+
+@pytest.mark.parametrize(
+    ("coordinates", "directions", "numbered", "match"),
+    [
+        pytest.param(
+            None, {"a": (0.6, 0.8), "b": (-1.0, 0.0)}, False, r"directions but the nodes no x/y", id="no-xy"
+        ),
+        pytest.param(_LINE_XY, {"a": (0.6, 0.8)}, False, r"edges \['b'\] have no direction", id="some"),
+        pytest.param(
+            _LINE_XY,
+            {"a": (0.8, 0.6), "b": (-1.0, 0.0)},
+            False,
+            r"edge 'a''s direction \(0.8, 0.6\) leads 1.41 m from its node 'A': expected it to lead from 'J'",
+            id="off-its-end",
+        ),
+        pytest.param(
+            _LINE_XY,
+            {"a": (math.nan, 0.8), "b": (-1.0, 0.0)},
+            False,
+            r"direction x of edge 'a' \(per metre\) must be finite",
+            id="nan",
+        ),
+        pytest.param(None, None, "yes", r"numbered_legs 'yes' is not a bool", id="numbered-not-bool"),
+    ],
+)
+def test_bad_directions_or_numbering_are_refused_naming_the_edge(coordinates, directions, numbered, match):
+    with pytest.raises(TrackError, match=match):
+        TrackGraph.from_edges(_LINE, coordinates=coordinates, directions=directions, numbered_legs=numbered)
+
+
+def test_numbered_legs_must_all_leave_one_node():
+    with pytest.raises(
+        TrackError, match=r"numbered legs leave nodes \['J', 'K'\]: expected every edge to leave one"
+    ):
+        TrackGraph.from_edges({"a": ("J", "K", 3.0), "b": ("K", "B", 3.0)}, numbered_legs=True)
+
+
+def test_a_point_is_drawn_at_start_plus_s_times_its_edges_direction():
+    track = TrackGraph.from_edges(_LINE, coordinates=_LINE_XY)
+    assert track.directions == ((0.6, 0.8), (-1.0, 0.0))
+    assert track.xy(track.point("a:2.5")) == pytest.approx((1.5, 2.0))
+    x, y = track.xy_along([0, 1, 1], [5.0, 0.0, 5.0])
+    np.testing.assert_allclose(np.stack([x, y]), [[3.0, 0.0, -5.0], [4.0, 0.0, 0.0]])
+    assert TrackGraph.from_edges(_LINE).xy_along([0], [1.0]) is None
+
+
+def test_a_stars_track_graph_draws_its_legs_by_their_angles_to_the_bit():
+    star = StarGraph({"A": 10.0, "B": 8.0, "C": 6.0}, angles_deg={"A": 90.0, "B": 210.0, "C": 330.0})
+    track = star.track_graph()
+    assert track.numbered_legs
+    s = np.linspace(0.0, 10.0, 101)
+    radians = np.radians(np.array(star.angles_deg))
+    for leg in range(3):
+        x, y = track.xy_along(np.full(s.size, leg), s)
+        # the star's rows always wrote s cos(angle), s sin(angle): the same floats
+        np.testing.assert_array_equal(x, s * np.cos(radians[leg]))
+        np.testing.assert_array_equal(y, s * np.sin(radians[leg]))
+    assert track != TrackGraph.from_edges(
+        {e.name: (e.start, e.end, e.length) for e in track.edges},
+        coordinates=dict(zip(track.nodes, track.coordinates, strict=True)),
+    )
 
 
 def test_an_unknown_node_of_an_edge_is_named():

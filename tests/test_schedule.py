@@ -411,7 +411,7 @@ def test_the_csv_leg_column_is_the_states_leg_plus_one_and_leg_names_read_both(t
     column = np.array([int(row[5]) for row in rows])
     state = verified.schedule.state(t)
     np.testing.assert_array_equal(column, state.leg[0] + 1)
-    names = state.leg_names(scenario.track)
+    names = state.leg_names(verified.schedule.track)
     assert set(names[0]) == {"A", "B", JUNCTION_NAME}  # agv1 drives A -> O -> (C) -> O -> B
     assert all(
         names[0][k] == (JUNCTION_NAME if c == 0 else scenario.track.names[c - 1])

@@ -11,6 +11,8 @@ from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field
 from types import MappingProxyType
 
+import numpy as np
+
 from topology.boundary import BoundaryCycle
 from topology.errors import PositionError, TrackError
 from topology.indexed import IndexedConfiguration
@@ -254,8 +256,9 @@ class StarGraph:
         """The junction as a track graph: the same track, the same points.
 
         The junction is the node ``O``; each leg an edge named as the leg, from ``O`` to its end node
-        ``<leg>-end`` (``-end`` once more where a leg has that name), placed by the leg's angle.
-        ``A:s`` names the same point on both (``O`` too).
+        ``<leg>-end`` (``-end`` once more where a leg has that name), placed by the leg's angle (its
+        direction the angle's cosine and sine). ``A:s`` names the same point on both (``O`` too). Its
+        legs are numbered (``numbered_legs``): rows name them 1, 2, ... and the junction 0.
 
         Examples
         --------
@@ -278,7 +281,20 @@ class StarGraph:
                 radians = math.radians(angle)
                 coordinates[end] = (length * math.cos(radians), length * math.sin(radians))
                 edges[name] = (JUNCTION_NAME, end, length)
-            built.append(TrackGraph.from_edges(edges, coordinates=coordinates))
+            # as the star's rows always placed a leg's points: s times its angle's cosine and sine
+            radians = np.radians(np.array(self.angles_deg, dtype=float))
+            directions = dict(
+                zip(
+                    self.names,
+                    zip(np.cos(radians).tolist(), np.sin(radians).tolist(), strict=True),
+                    strict=True,
+                )
+            )
+            built.append(
+                TrackGraph.from_edges(
+                    edges, coordinates=coordinates, directions=directions, numbered_legs=True
+                )
+            )
         return built[0]
 
     def point(self, text: str | Position) -> Position:

@@ -88,18 +88,30 @@ class TrackGraph:
     edges : tuple of TrackEdge
     coordinates : tuple of (float, float), optional
         Each node's x/y in metres, in the order of ``nodes`` (``None``: no coordinates).
+    directions : tuple of (float, float), optional
+        Each edge's change of x/y per metre along it from its ``from`` node, in the order of ``edges``
+        (needs ``coordinates``; ``None``: the straight line of its nodes, ``(end - start) / length``).
+        A point ``s`` metres along an edge is drawn at ``start + s * direction``. A star's legs give
+        their angle's cosine and sine (:meth:`~topology.StarGraph.track_graph`).
+    numbered_legs : bool, optional
+        Every edge leaves one node, the junction of a star: rows and tables name where a vehicle is
+        by the number of its edge (1 for the first, 0 at the junction), in a column ``leg``, as a
+        star's always have. Default False: by the edge's name, in a column ``edge``.
 
     Raises
     ------
     TrackError
         A self-loop, an unknown or duplicate name, a disconnected track, a length that is not a
         positive number or is shorter than the straight distance of its nodes, coordinates of some
-        nodes only.
+        nodes only, directions that do not lead from an edge's ``from`` node to its ``to`` node,
+        numbered legs that do not all leave one node.
     """
 
     nodes: tuple[str, ...]
     edges: tuple[TrackEdge, ...]
     coordinates: tuple[tuple[float, float], ...] | None = None
+    directions: tuple[tuple[float, float], ...] | None = None
+    numbered_legs: bool = False
     _node_index: dict[str, int] = field(init=False, repr=False)
     _edge_index: dict[str, int] = field(init=False, repr=False)
     _node_distance: np.ndarray = field(init=False, repr=False)
@@ -161,6 +173,16 @@ class TrackGraph:
                     )
         ends = np.array([[index[e.start], index[e.end]] for e in edges], dtype=np.intp)
         lengths = np.array([float(e.length) for e in edges])
+        directions = _directions(edges, coordinates, ends, lengths, self.directions)
+        if self.numbered_legs is not False and self.numbered_legs is not True:
+            raise TrackError(
+                f"numbered_legs {short_repr(self.numbered_legs)} is not a bool: expected True or False"
+            )
+        if self.numbered_legs and len({e.start for e in edges}) != 1:
+            raise TrackError(
+                f"numbered legs leave nodes {sorted({e.start for e in edges})!r}: expected every edge to "
+                "leave one node (a star's junction)"
+            )
         distance = _all_pairs(len(nodes), ends, lengths)
         if not np.isfinite(distance).all():
             reached = np.isfinite(distance[0])
@@ -175,6 +197,7 @@ class TrackGraph:
         object.__setattr__(self, "nodes", nodes)
         object.__setattr__(self, "edges", edges)
         object.__setattr__(self, "coordinates", coordinates)
+        object.__setattr__(self, "directions", directions)
         object.__setattr__(self, "_node_index", index)
         object.__setattr__(self, "_edge_index", {e.name: i for i, e in enumerate(edges)})
         object.__setattr__(self, "_node_distance", distance)
@@ -186,7 +209,7 @@ class TrackGraph:
             first.setdefault(end, EdgePoint(k, float(lengths[k])))
         object.__setattr__(self, "_node_points", tuple(first[n] for n in range(len(nodes))))
         # immutable: hashed once (caches keyed on the track look it up per call)
-        object.__setattr__(self, "_hash", hash((self.nodes, self.edges, self.coordinates)))
+        object.__setattr__(self, "_hash", hash(self._key()))
 
     @classmethod
     def from_edges(
@@ -194,10 +217,14 @@ class TrackGraph:
         edges: Mapping[str, tuple[str, str, float | None]],
         *,
         coordinates: Mapping[str, tuple[float, float]] | None = None,
+        directions: Mapping[str, tuple[float, float]] | None = None,
+        numbered_legs: bool = False,
     ) -> TrackGraph:
         """A track from ``{edge name: (from node, to node, length)}``; nodes in order of appearance.
 
         A length of ``None`` is the straight distance of the nodes (``coordinates`` needed).
+        ``directions`` (``{edge name: (dx, dy)}``, every edge) and ``numbered_legs`` are as the
+        class's.
         """
         nodes: list[str] = list(coordinates or ())
         built = []
@@ -223,7 +250,16 @@ class TrackGraph:
                     "or of none"
                 )
             xy = tuple(tuple(coordinates[n]) for n in nodes)
-        return cls(tuple(nodes), tuple(built), xy)
+        steps = None
+        if directions is not None:
+            missing = [name for name in edges if name not in directions]
+            if missing:
+                raise TrackError(
+                    f"edges {missing[:5]!r} have no direction while others do: expected a direction of "
+                    "every edge, or of none"
+                )
+            steps = tuple(tuple(directions[name]) for name in edges)
+        return cls(tuple(nodes), tuple(built), xy, steps, numbered_legs)
 
     # -- points ---------------------------------------------------------------------------------
 
@@ -341,10 +377,21 @@ class TrackGraph:
         """The point's x/y in metres, on the straight line of its edge's nodes (``None`` without x/y)."""
         if self.coordinates is None:
             return None
-        start, end = self._ends[point.edge]
-        (x0, y0), (x1, y1) = self.coordinates[start], self.coordinates[end]
-        f = point.s / float(self._lengths[point.edge])
-        return (x0 + f * (x1 - x0), y0 + f * (y1 - y0))
+        x, y = self.xy_along([point.edge], [point.s])
+        return (float(x[0]), float(y[0]))
+
+    def xy_along(self, edge, s) -> tuple[np.ndarray, np.ndarray] | None:
+        """The x and y, metres, of the points ``s`` metres along edges ``edge``, shape (n,) each.
+
+        ``start + s * direction`` (:attr:`directions`); ``None`` without x/y.
+        """
+        if self.coordinates is None:
+            return None
+        edge = np.asarray(edge, dtype=np.intp)
+        s = np.asarray(s, dtype=float)
+        start = np.asarray(self.coordinates, dtype=float)[self._ends[edge, 0]]
+        step = np.asarray(self.directions, dtype=float)[edge]
+        return start[..., 0] + s * step[..., 0], start[..., 1] + s * step[..., 1]
 
     # -- distances ------------------------------------------------------------------------------
 
@@ -377,10 +424,48 @@ class TrackGraph:
     def __eq__(self, other: object) -> bool:
         if not isinstance(other, TrackGraph):
             return NotImplemented
-        return (self.nodes, self.edges, self.coordinates) == (other.nodes, other.edges, other.coordinates)
+        return self._key() == other._key()
 
     def __hash__(self) -> int:
         return self._hash
+
+    def _key(self) -> tuple:
+        return (self.nodes, self.edges, self.coordinates, self.directions, self.numbered_legs)
+
+
+def _directions(
+    edges: tuple[TrackEdge, ...],
+    coordinates: tuple[tuple[float, float], ...] | None,
+    ends: np.ndarray,
+    lengths: np.ndarray,
+    given: object,
+) -> tuple[tuple[float, float], ...] | None:
+    """Each edge's x/y per metre: the given ones (checked to lead to its end), else the straight line."""
+    if coordinates is None:
+        if given is not None:
+            raise TrackError("the edges have directions but the nodes no x/y: expected coordinates too")
+        return None
+    xy = np.asarray(coordinates, dtype=float)
+    if given is None:
+        return tuple(
+            ((xy[v, 0] - xy[u, 0]) / length, (xy[v, 1] - xy[u, 1]) / length)
+            for (u, v), length in zip(ends.tolist(), lengths.tolist(), strict=True)
+        )
+    given = tuple(given)
+    if len(given) != len(edges):
+        raise TrackError(f"{len(given)} directions for {len(edges)} edges: expected one per edge")
+    steps = []
+    for edge, (u, v), length, step in zip(edges, ends.tolist(), lengths.tolist(), given, strict=True):
+        dx = finite_real(step[0], f"direction x of edge {edge.name!r} (per metre)", TrackError)
+        dy = finite_real(step[1], f"direction y of edge {edge.name!r} (per metre)", TrackError)
+        miss = math.hypot(xy[u, 0] + length * dx - xy[v, 0], xy[u, 1] + length * dy - xy[v, 1])
+        if miss > POINT_TOLERANCE * max(1.0, length):
+            raise TrackError(
+                f"edge {edge.name!r}'s direction ({dx:g}, {dy:g}) leads {miss:.3g} m from its node "
+                f"{edge.end!r}: expected it to lead from {edge.start!r} to {edge.end!r} over its length"
+            )
+        steps.append((dx, dy))
+    return tuple(steps)
 
 
 def _all_pairs(count: int, ends: np.ndarray, lengths: np.ndarray) -> np.ndarray:

@@ -12,11 +12,10 @@ from collections.abc import Iterator
 
 import numpy as np
 
-from topology import JUNCTION_INDEX, StarGraph, TrackGraph
-from trajgen.export.csv import HEADER_NAMES, CsvOptions, format_rows
-from trajgen.export.graph_rows import check_edge_names, format_graph_block, graph_header
-from trajgen.model.graph_schedule import GraphState
-from trajgen.model.schedule import ScheduleState
+from topology import TrackGraph
+from trajgen.export.csv import CsvOptions, format_block
+from trajgen.export.rows import check_edge_names, header
+from trajgen.model.state import TrackState
 
 __all__ = ["PLOT_SAMPLES", "Decimated", "Trace"]
 
@@ -27,14 +26,17 @@ _ROWS_PER_BLOCK = 5_000
 
 
 class Trace:
-    """The executed motion (true positions) of both vehicles, spooled to temporary files as CSV rows.
+    """The executed motion (true positions) of the vehicles, spooled to temporary files as CSV rows.
 
     Parameters
     ----------
-    graph : StarGraph or TrackGraph
-        The track (on a track graph the rows are a graph's generic CSV: edge and metres on it).
+    track : TrackGraph
+        The schedule's track (:attr:`~trajgen.model.schedule.Schedule.track`): the rows are its
+        generic CSV's (:func:`~trajgen.export.rows.header`).
     options : CsvOptions
         Dialect of the rows (the sample period is the simulation's control period).
+    count : int, optional
+        Number of vehicles (default 2).
 
     Raises
     ------
@@ -42,28 +44,23 @@ class Trace:
         An edge name the CSV could not hold as one field.
     """
 
-    def __init__(self, graph: StarGraph | TrackGraph, options: CsvOptions) -> None:
-        self.graph = graph
+    def __init__(self, track: TrackGraph, options: CsvOptions, count: int = 2) -> None:
+        self.track = track
         self.options = options
-        if isinstance(graph, TrackGraph):
-            check_edge_names(graph, options.delimiter)
-            names = graph_header(graph, options.units.value)
-        else:
-            names = HEADER_NAMES[options.units]
-        self._files = [tempfile.TemporaryFile(), tempfile.TemporaryFile()]  # noqa: SIM115 - closed by close()
-        header = (options.delimiter.join(names) + "\r\n").encode("ascii")
+        check_edge_names(track, options.delimiter)
+        names = header(track, options.units.value)
+        self._files = [tempfile.TemporaryFile() for _ in range(count)]  # noqa: SIM115 - closed by close()
+        line = (options.delimiter.join(names) + "\r\n").encode("ascii")
         for handle in self._files:
-            handle.write(header)
+            handle.write(line)
         self._rows: list[list[float]] = []
         self.rows = 0
 
     def add(self, t: float, bodies) -> None:
-        """Record both vehicles' true state at time ``t``."""
+        """Record the vehicles' true states at time ``t``."""
         row = [t]
-        graph = isinstance(self.graph, TrackGraph)
-        for body in bodies:
-            leg = body.leg if graph or body.s > 0.0 else JUNCTION_INDEX
-            row.extend((body.axis, body.v, body.a, body.j, leg, body.s))
+        for body in bodies:  # a star's body at its junction is on no leg: s = 0 on the first
+            row.extend((body.axis, body.v, body.a, body.j, max(body.leg, 0), body.s))
         self._rows.append(row)
         self.rows += 1
         if len(self._rows) >= _ROWS_PER_BLOCK:
@@ -74,55 +71,18 @@ class Trace:
             return
         data = np.array(self._rows)
         self._rows = []
-        t = data[:, 0]
+        count = len(self._files)
         columns = {
-            name: np.stack([data[:, 1 + 6 * v + k] for v in (0, 1)])
-            for k, name in enumerate(("axis", "velocity", "acceleration", "jerk", "leg", "s"))
+            name: np.stack([data[:, 1 + 6 * v + k] for v in range(count)])
+            for k, name in enumerate(("axis", "velocity", "acceleration", "jerk", "edge", "s"))
         }
-        if isinstance(self.graph, TrackGraph):
-            self._flush_graph(t, columns)
-            return
-        state = ScheduleState(
-            t,
-            columns["axis"],
-            columns["velocity"],
-            columns["acceleration"],
-            columns["jerk"],
-            columns["leg"].astype(int),
-            columns["s"],
-        )
+        columns["edge"] = columns["edge"].astype(int)
+        state = TrackState(data[:, 0], **columns)
         for v, handle in enumerate(self._files):
-            lines = format_rows(self.graph, state, v, self.options)
-            handle.write(("\r\n".join(lines) + "\r\n").encode("ascii"))
-
-    def _flush_graph(self, t: np.ndarray, columns: dict) -> None:
-        """Spool a block of rows on a track graph (the travel is not a column of the rows)."""
-        state = GraphState(
-            t,
-            np.zeros_like(columns["axis"]),
-            columns["axis"],
-            columns["velocity"],
-            columns["acceleration"],
-            columns["jerk"],
-            columns["leg"].astype(int),
-            columns["s"],
-        )
-        units = self.options.units
-        for v, handle in enumerate(self._files):
-            handle.write(
-                format_graph_block(
-                    self.graph,
-                    state,
-                    v,
-                    delimiter=self.options.delimiter,
-                    decimal=self.options.decimal,
-                    scale=units.scale,
-                    decimals=units.decimals,
-                )
-            )
+            handle.write(format_block(self.track, state, v, self.options))
 
     def chunks(self, vehicle: int) -> Iterator[bytes]:
-        """The CSV of ``vehicle`` (0 or 1), a block at a time."""
+        """The CSV of vehicle number ``vehicle``, a block at a time."""
         self._flush()
         handle = self._files[vehicle]
         handle.seek(0)

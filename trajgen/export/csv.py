@@ -17,18 +17,15 @@ from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
-import numpy as np
-
 from limits import VehicleLimits
-from topology import JUNCTION_INDEX, Option, StarGraph
+from topology import Option, TrackGraph
 from topology.validation import short_repr
 from trajgen.errors import InputError, OptionError, OutputLimitError
 from trajgen.export.atomic import commit_files
-from trajgen.export.graph_rows import check_edge_names, format_graph_block, graph_header
-from trajgen.export.limited import limited_columns
-from trajgen.export.numbers import format_number_rows
+from trajgen.export.rows import LEG_HEADER_NAMES, check_edge_names, format_rows_block, header
 from trajgen.model.graph_schedule import GraphSchedule
-from trajgen.model.schedule import Schedule, ScheduleState, check_period, sample_block, sample_rows
+from trajgen.model.schedule import Schedule, check_period, sample_block, sample_rows
+from trajgen.model.state import TrackState
 from trajgen.scenario.naming import check_vehicle_index, check_vehicle_names
 from trajgen.verification import VerifiedSchedule, require_verified
 
@@ -78,11 +75,9 @@ class Units(Option):
         return 6 if self is Units.MILLIMETRES else 9
 
 
-#: Column names per unit.
-HEADER_NAMES = {
-    Units.METRES: ("t_s", "axis_m", "v_mps", "a_mps2", "j_mps3", "leg", "s_m", "x_m", "y_m"),
-    Units.MILLIMETRES: ("t_s", "axis_mm", "v_mmps", "a_mmps2", "j_mmps3", "leg", "s_mm", "x_mm", "y_mm"),
-}
+#: Column names per unit on a star's track (its legs numbered); :func:`~trajgen.export.rows.header`
+#: gives any track's.
+HEADER_NAMES = {unit: LEG_HEADER_NAMES[unit.value] for unit in Units}
 
 
 #: The record line of a generic CSV: ``# schedule timed by METHOD: jerk not limited ...`` (or ``limited``).
@@ -188,65 +183,32 @@ def _usable_delimiter(value: object) -> bool:
     )
 
 
-def _xy(graph: StarGraph, state: ScheduleState, vehicle: int) -> tuple[np.ndarray, np.ndarray]:
-    angles = np.radians(np.array(graph.angles_deg))
-    leg = state.leg[vehicle]
-    s = state.s[vehicle]
-    angle = angles[np.where(leg == JUNCTION_INDEX, 0, leg)]
-    return s * np.cos(angle), s * np.sin(angle)
-
-
-def _columns(
-    graph: StarGraph,
-    state: ScheduleState,
-    vehicle: int,
-    options: CsvOptions,
-    limits: VehicleLimits | None,
-    jerk_limited: bool,
-) -> list[tuple[np.ndarray, int | None]]:
-    """The nine columns of a vehicle's rows and their decimal places (``None``: the integer leg)."""
-    scale = options.units.scale
-    decimals = options.units.decimals
-    x, y = _xy(graph, state, vehicle)
-    velocity, acceleration, jerk = limited_columns(state, vehicle, scale, decimals, limits, jerk_limited)
-    return [
-        (state.t, 6),
-        (state.axis[vehicle] * scale, decimals),
-        (velocity, decimals),
-        (acceleration, decimals),
-        (jerk, decimals),
-        (state.leg[vehicle] + 1, None),  # 1-based, 0 at the junction
-        (state.s[vehicle] * scale, decimals),
-        (x * scale, decimals),
-        (y * scale, decimals),
-    ]
-
-
 def format_block(
-    graph: StarGraph,
-    state: ScheduleState,
+    track: TrackGraph,
+    state: TrackState,
     vehicle: int,
     options: CsvOptions,
     *,
     limits: VehicleLimits | None = None,
     jerk_limited: bool = True,
 ) -> bytes:
-    """Rows of one vehicle's CSV profile for the sampled ``state`` on ``graph``: ASCII, CRLF after each row.
+    """Rows of one vehicle's CSV profile for the sampled ``state`` on ``track``: ASCII, CRLF after each row.
 
     Numbers as :func:`~trajgen.export.numbers.fixed_point_text` writes them (time with 6 decimals,
     lengths with ``options.units.decimals``), the decimal mark and delimiter of ``options``; formatted
     with numpy (:func:`~trajgen.export.numbers.format_number_rows`). With ``limits`` the velocity,
     acceleration and (if ``jerk_limited``) jerk are held to them as written
-    (:func:`~trajgen.export.limited.limited_columns`).
+    (:func:`~trajgen.export.limited.limited_columns`). The columns are
+    :func:`~trajgen.export.rows.header`'s.
 
     Parameters
     ----------
-    graph : StarGraph
-        The track (its leg angles give x and y).
-    state : ScheduleState
-        Both vehicles at n sample times.
+    track : TrackGraph
+        The schedule's track (:attr:`~trajgen.model.schedule.Schedule.track`; a star's, its track graph).
+    state : TrackState
+        The vehicles at n sample times.
     vehicle : int
-        0 or 1.
+        Index of the vehicle.
     options : CsvOptions
     limits : VehicleLimits, optional
         The vehicle's limits (a schedule's export); ``None``: the values as they are (executed motion).
@@ -258,18 +220,26 @@ def format_block(
     bytes
         n rows.
     """
-    separators = (options.delimiter,) * (len(HEADER_NAMES[options.units]) - 1) + ("\r\n",)
-    columns = _columns(graph, state, vehicle, options, limits, jerk_limited)
-    return format_number_rows(columns, separators, decimal=options.decimal)
+    return format_rows_block(
+        track,
+        state,
+        vehicle,
+        delimiter=options.delimiter,
+        decimal=options.decimal,
+        scale=options.units.scale,
+        decimals=options.units.decimals,
+        limits=limits,
+        jerk_limited=jerk_limited,
+    )
 
 
-def format_rows(graph: StarGraph, state: ScheduleState, vehicle: int, options: CsvOptions) -> list[str]:
-    """Rows of one vehicle's CSV profile for the sampled ``state`` on ``graph``, without line ends.
+def format_rows(track: TrackGraph, state: TrackState, vehicle: int, options: CsvOptions) -> list[str]:
+    """Rows of one vehicle's CSV profile for the sampled ``state`` on ``track``, without line ends.
 
     Also the format of executed motion (``trajgen simulate --trace``); :func:`format_block` gives the
     same rows as bytes.
     """
-    return format_block(graph, state, vehicle, options).decode("ascii").split("\r\n")[:-1]
+    return format_block(track, state, vehicle, options).decode("ascii").split("\r\n")[:-1]
 
 
 def profile_rows(duration: float, options: CsvOptions) -> int:
@@ -313,9 +283,9 @@ class _SampledBlocks:
         self.schedule = schedule
         self.period = period
         self.first: int | None = None
-        self.state: ScheduleState | None = None
+        self.state: TrackState | None = None
 
-    def block(self, first: int) -> ScheduleState:
+    def block(self, first: int) -> TrackState:
         """The states of rows ``first`` to ``first + ROWS_PER_CHUNK - 1``."""
         if first != self.first:
             times = sample_block(self.schedule.duration, self.period, first, first + ROWS_PER_CHUNK)
@@ -330,8 +300,7 @@ def _checked(
     options = CsvOptions() if options is None else options
     if not isinstance(options, CsvOptions):
         raise OptionError(f"CSV options must be CsvOptions, got {type(options).__name__}")
-    if isinstance(schedule, GraphSchedule):
-        check_edge_names(schedule.track, options.delimiter)
+    check_edge_names(schedule.track, options.delimiter)
     return schedule, options
 
 
@@ -341,27 +310,11 @@ def _chunks(
     limits, jerk_limited = schedule.limits.vehicles[vehicle], schedule.jerk_limited
     if not jerk_limited:  # said in the file, so that a check of it knows (a jerk-limited one: as before 0.7)
         yield (ScheduleRecord.of(schedule).line() + "\r\n").encode("ascii")
-    if isinstance(schedule, GraphSchedule):  # the edge by name, x/y only with node coordinates
-        header = graph_header(schedule.track, options.units.value)
-        yield (options.delimiter.join(header) + "\r\n").encode("ascii")
-        for first in range(0, rows, ROWS_PER_CHUNK):
-            yield format_graph_block(
-                schedule.track,
-                blocks.block(first),  # type: ignore[arg-type]
-                vehicle,
-                delimiter=options.delimiter,
-                decimal=options.decimal,
-                scale=options.units.scale,
-                decimals=options.units.decimals,
-                limits=limits,
-                jerk_limited=jerk_limited,
-            )
-        return
-    yield (options.delimiter.join(HEADER_NAMES[options.units]) + "\r\n").encode("ascii")
+    track = schedule.track
+    yield (options.delimiter.join(header(track, options.units.value)) + "\r\n").encode("ascii")
     for first in range(0, rows, ROWS_PER_CHUNK):
-        block = blocks.block(first)
         yield format_block(
-            schedule.route.graph, block, vehicle, options, limits=limits, jerk_limited=jerk_limited
+            track, blocks.block(first), vehicle, options, limits=limits, jerk_limited=jerk_limited
         )
 
 

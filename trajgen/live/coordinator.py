@@ -171,7 +171,7 @@ class LiveCoordinator:
         )
 
     def _ready(self, verified, offsets) -> ReadyPlan:
-        return ready_plan(verified, offsets, graph=self.graph, spacing=self.spacing, map_id=self.map_id)
+        return ready_plan(verified, offsets, spacing=self.spacing, map_id=self.map_id)
 
     def _plan(self, plan, *, what: str, context, offsets) -> None:
         """Make a plan and ready it to send, beside the network (the outbox); :meth:`planned` takes it up.
@@ -389,7 +389,7 @@ class LiveCoordinator:
             return
         view.resend_after = RESEND_INTERVAL_S
         view.lacking_since = None
-        j = view.base_node(self.graph, state, self.rule.released[v])
+        j = view.base_node(state, self.rule.released[v])
         if j is None:
             self._off_plan(
                 v,

@@ -27,7 +27,7 @@ def horizon_length(limits: VehicleLimits) -> float:
     return stopping_distance(limits.max_velocity, 0.0, limits)
 
 
-def path_elements(graph, path, *, offset: int, map_id: str) -> list:
+def path_elements(path, *, offset: int, map_id: str) -> list:
     """Each node and edge of ``path`` (an order path) as a vda5050-sdk model, as horizon and as base.
 
     Returns
@@ -39,7 +39,6 @@ def path_elements(graph, path, *, offset: int, map_id: str) -> list:
     last = len(path.nodes) - 1
     return [
         order_elements(
-            graph,
             path,
             first=0,
             decision_point=last if released else -1,

@@ -47,7 +47,7 @@ class ReadyPlan:
     offsets: tuple[int, ...]
 
 
-def ready_plan(verified: VerifiedSchedule, offsets, *, graph, spacing: float, map_id: str) -> ReadyPlan:
+def ready_plan(verified: VerifiedSchedule, offsets, *, spacing: float, map_id: str) -> ReadyPlan:
     """``verified`` ready to send: its order paths, release rule and order elements.
 
     Nodes at most ``spacing`` metres apart, ``nodePosition.mapId`` ``map_id``, each path numbered from
@@ -56,7 +56,7 @@ def ready_plan(verified: VerifiedSchedule, offsets, *, graph, spacing: float, ma
     releases = order_releases(verified, spacing=spacing)
     rule = BaseRelease(releases.paths, verified.schedule.limits.min_separation)
     elements = tuple(
-        path_elements(graph, path, offset=offset, map_id=map_id)
+        path_elements(path, offset=offset, map_id=map_id)
         for path, offset in zip(releases.paths, offsets, strict=True)
     )
     return ReadyPlan(verified, releases, rule, elements, tuple(offsets))

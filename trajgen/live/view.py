@@ -4,7 +4,6 @@ from __future__ import annotations
 
 from topology import EdgePoint, Position
 from trajgen.errors import InputError
-from trajgen.export.vda5050.messages import path_node_id
 from trajgen.live.mqtt import Topic, VehicleIdentity
 from trajgen.live.outcome import LiveOutcome
 from trajgen.live.places import path_place, reported_place
@@ -137,14 +136,14 @@ class VehicleView:
         self.plan_update = self.update + 1
         self.elements = elements
 
-    def base_node(self, graph, state, released: int) -> int | None:
-        """The index on its path (on ``graph``) of the node its ``state`` says it reached, if on its base.
+    def base_node(self, state, released: int) -> int | None:
+        """The index on its path of the node its ``state`` says it reached, if on its base.
 
         ``None``: the state's last node (``lastNodeId``, ``lastNodeSequenceId``) is not a node of its
         path up to node ``released`` (it stands off its plan).
         """
         j, odd = divmod(state.last_node_sequence_id - self.offset, 2)
-        on = 0 <= j <= released and not odd and state.last_node_id == path_node_id(graph, self.path, j)
+        on = 0 <= j <= released and not odd and state.last_node_id == self.path.node_id(j)
         return j if on else None
 
     def connection(self, online: bool, *, running: bool) -> bool:

@@ -28,7 +28,7 @@ from trajgen.model.schedule import (
     sample_block,
     sample_rows,
 )
-from trajgen.model.values import ArrayValue, frozen
+from trajgen.model.state import TrackState
 
 __all__ = ["GraphSchedule", "GraphSection", "GraphState"]
 
@@ -38,53 +38,9 @@ __all__ = ["GraphSchedule", "GraphSection", "GraphState"]
 GraphSection = TimedSection
 
 
-@dataclass(frozen=True, slots=True, eq=False)
-class GraphState(ArrayValue):
-    """States of both vehicles on a track graph at sample times (read-only arrays).
-
-    Attributes
-    ----------
-    t : ndarray, shape (n,)
-        Times, seconds.
-    travel : ndarray, shape (2, n)
-        Metres each vehicle has driven along its path (never decreasing).
-    axis, velocity, acceleration, jerk : ndarray, shape (2, n)
-        Per vehicle: signed axis (m), its velocity (m/s), acceleration (m/s²), jerk (m/s³).
-    edge : ndarray of int, shape (2, n)
-        Edge number in the track's order (:meth:`edge_names` gives the names).
-    s : ndarray, shape (2, n)
-        Metres from the edge's ``from`` node.
-    """
-
-    t: np.ndarray
-    travel: np.ndarray
-    axis: np.ndarray
-    velocity: np.ndarray
-    acceleration: np.ndarray
-    jerk: np.ndarray
-    edge: np.ndarray
-    s: np.ndarray
-
-    def __post_init__(self) -> None:
-        for name in ("t", "travel", "axis", "velocity", "acceleration", "jerk", "edge", "s"):
-            object.__setattr__(self, name, frozen(np.asarray(getattr(self, name))))
-
-    def edge_names(self, track: TrackGraph) -> np.ndarray:
-        """Each vehicle's edge by its name in ``track``, shape (2, n), read-only."""
-        names = np.array([edge.name for edge in track.edges], dtype=object)
-        return frozen(names[self.edge])
-
-    def xy(self, track: TrackGraph) -> np.ndarray | None:
-        """Each vehicle's x/y on the line of its edge's nodes, metres, shape (2, 2, n) (``None``: no x/y)."""
-        if track.coordinates is None:
-            return None
-        coordinates = np.asarray(track.coordinates, dtype=float)
-        ends = np.array([track.ends(k) for k in range(len(track.edges))], dtype=int)
-        lengths = np.array([edge.length for edge in track.edges])
-        fraction = self.s / lengths[self.edge]
-        start, end = coordinates[ends[self.edge, 0]], coordinates[ends[self.edge, 1]]  # (2, n, 2)
-        points = start + fraction[..., None] * (end - start)
-        return frozen(np.moveaxis(points, -1, 1))
+#: The states a track graph's schedule gives: the one :class:`~trajgen.model.state.TrackState`, with
+#: each vehicle's ``travel``.
+GraphState = TrackState
 
 
 @dataclass(frozen=True, slots=True)
@@ -177,7 +133,7 @@ class GraphSchedule:
                 values[:, :, mask] = section.kinematics.evaluate(local)
         return values
 
-    def state(self, t) -> GraphState:
+    def state(self, t) -> TrackState:
         """States of both vehicles at times ``t`` (seconds, clipped to [0, duration])."""
         t = np.clip(np.atleast_1d(np.asarray(t, dtype=float)), 0.0, self.duration)
         values = self.travel(t)
@@ -189,15 +145,22 @@ class GraphSchedule:
             axis[vehicle] = path.axis(travel[vehicle])
             heading[vehicle] = path.heading(travel[vehicle])
             edge[vehicle], s[vehicle] = path.locate(travel[vehicle])
-        return GraphState(
-            t, travel, axis, heading * values[:, 1], heading * values[:, 2], heading * values[:, 3], edge, s
+        return TrackState(
+            t,
+            axis,
+            heading * values[:, 1],
+            heading * values[:, 2],
+            heading * values[:, 3],
+            edge,
+            s,
+            travel=travel,
         )
 
-    def distances(self, state: GraphState) -> np.ndarray:
+    def distances(self, state: TrackState) -> np.ndarray:
         """Track distance between the vehicles in ``state`` (this schedule's, at some times), metres, (n,)."""
         return self.track.distances(state.edge[0], state.s[0], state.edge[1], state.s[1])
 
-    def sample(self, period: float) -> GraphState:
+    def sample(self, period: float) -> TrackState:
         """States every ``period`` seconds from t = 0, plus a last sample exactly at the goal."""
         period = check_period(period)
         return self.state(sample_block(self.duration, period, 0, sample_rows(self.duration, period)))

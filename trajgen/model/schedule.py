@@ -19,13 +19,14 @@ from typing import ClassVar
 import numpy as np
 
 from limits import Limits
-from topology import JUNCTION_INDEX, JUNCTION_NAME, Configuration, Position, Route, StarGraph
+from topology import JUNCTION_INDEX, Configuration, Position, Route, TrackGraph
 from topology.indexed import track_distance
 from topology.validation import finite_real
 from trajgen.errors import InputError
 from trajgen.lazy import RenamedAttribute
 from trajgen.model.profiles import PiecewiseCubic
-from trajgen.model.values import ArrayValue, frozen, readonly
+from trajgen.model.state import TrackState
+from trajgen.model.values import ArrayValue, readonly
 
 __all__ = [
     "AxisMap",
@@ -314,51 +315,9 @@ class Section(TimedSection):
     maps: tuple[AxisMap, AxisMap]
 
 
-@dataclass(frozen=True, slots=True, eq=False)
-class ScheduleState(ArrayValue):
-    """States of both vehicles at sample times (read-only arrays).
-
-    Attributes
-    ----------
-    t : ndarray, shape (n,)
-        Times, seconds.
-    axis, velocity, acceleration, jerk : ndarray, shape (2, n)
-        Per vehicle: signed axis (m), its velocity (m/s), acceleration (m/s²), jerk (m/s³).
-    leg : ndarray of int, shape (2, n)
-        Leg index counted from 0 in the track's order (``graph.names[leg]``), or
-        ``JUNCTION_INDEX`` (-1) at the junction. The generic CSV's ``leg`` column is this plus
-        one (1 for the first leg, 0 at the junction); :meth:`leg_names` gives the names, which
-        need no convention.
-    s : ndarray, shape (2, n)
-        Distance from the junction, metres.
-    """
-
-    t: np.ndarray
-    axis: np.ndarray
-    velocity: np.ndarray
-    acceleration: np.ndarray
-    jerk: np.ndarray
-    leg: np.ndarray
-    s: np.ndarray
-
-    def __post_init__(self) -> None:
-        for name in ("t", "axis", "velocity", "acceleration", "jerk", "leg", "s"):
-            object.__setattr__(self, name, frozen(np.asarray(getattr(self, name))))
-
-    def leg_names(self, graph: StarGraph) -> np.ndarray:
-        """Each vehicle's leg by its name in ``graph`` (``"O"`` at the junction), shape (2, n), read-only.
-
-        Examples
-        --------
-        >>> from trajgen import default_scenario, make_schedule
-        >>> scenario = default_scenario()
-        >>> schedule = make_schedule(scenario.route(), scenario.limits, method="exact")
-        >>> state = schedule.state([0.0, schedule.duration])
-        >>> state.leg_names(scenario.track).tolist(), state.leg.tolist()
-        ([['A', 'B'], ['B', 'A']], [[0, 1], [1, 0]])
-        """
-        names = np.array([*graph.names, JUNCTION_NAME], dtype=object)
-        return frozen(names[np.where(self.leg == JUNCTION_INDEX, len(graph.names), self.leg)])
+#: The states a junction's schedule gives: the one :class:`~trajgen.model.state.TrackState` of every
+#: track (its legs the edges of its track graph; before issue 49 a type of its own, with ``leg``).
+ScheduleState = TrackState
 
 
 @dataclass(frozen=True, slots=True)
@@ -439,9 +398,13 @@ class Schedule:
         )
 
     @property
-    def track(self) -> StarGraph:
-        """The track the schedule is on (its route's; a track graph's schedule names it so too)."""
-        return self.route.graph
+    def track(self) -> TrackGraph:
+        """The track the schedule is on, as a track graph (its route's junction at the door).
+
+        The junction is its node ``O``, each leg an edge from it (:meth:`~topology.StarGraph.track_graph`);
+        :meth:`state` places the vehicles on it. ``route.graph`` is the junction itself.
+        """
+        return self.route.graph.track_graph()
 
     @property
     def duration(self) -> float:
@@ -449,7 +412,7 @@ class Schedule:
         last = self.sections[-1]
         return last.start_time + last.duration
 
-    def state(self, t) -> ScheduleState:
+    def state(self, t) -> TrackState:
         """States of both vehicles at times ``t`` (seconds, clipped to [0, duration]).
 
         Parameters
@@ -476,14 +439,15 @@ class Schedule:
                 leg[vehicle, mask], s[vehicle, mask] = section.maps[vehicle].locate(values[vehicle, 0])
         for array in (t, kin, leg, s):  # freeze the buffers, so the state's views are safe as they are
             array.flags.writeable = False
-        return ScheduleState(t, kin[:, 0], kin[:, 1], kin[:, 2], kin[:, 3], leg, s)
+        edge = np.where(leg == JUNCTION_INDEX, 0, leg)  # the junction: s = 0 on the first leg
+        return TrackState(t, kin[:, 0], kin[:, 1], kin[:, 2], kin[:, 3], edge, s)
 
-    def sample(self, period: float) -> ScheduleState:
+    def sample(self, period: float) -> TrackState:
         """States every ``period`` seconds from t = 0, plus a last sample exactly at the goal."""
         period = check_period(period)
         return self.state(sample_block(self.duration, period, 0, sample_rows(self.duration, period)))
 
-    def distances(self, state: ScheduleState) -> np.ndarray:
+    def distances(self, state: TrackState) -> np.ndarray:
         """Track distance between the vehicles in ``state`` (this schedule's, at some times), metres, (n,)."""
         return track_distance(state.leg[0], state.s[0], state.leg[1], state.s[1])
 

@@ -29,9 +29,9 @@ from topology import Option
 from topology.validation import short_repr
 from trajgen.errors import OptionError, ProfileFileError
 from trajgen.export.csv import HEADER_NAMES, ScheduleRecord, Units
-from trajgen.export.graph_rows import GRAPH_HEADER_NAMES
 from trajgen.export.numbers import format_number_rows
 from trajgen.export.plc.tables import Interpolation, ProfileTable
+from trajgen.export.rows import GRAPH_HEADER_NAMES
 from trajgen.lazy import RenamedAttribute
 
 __all__ = [

@@ -173,6 +173,20 @@ class GraphOrderPath:
         (x0, y0), (x1, y1) = self.track.coordinates[start], self.track.coordinates[end]
         return self.track.length(point.edge) <= math.hypot(x1 - x0, y1 - y0) + 1e-9
 
+    def node_xy(self, index: int) -> tuple[float, float] | None:
+        """Node ``index``'s x/y, metres (``None`` where it is not known: :meth:`placed`)."""
+        return self.track.xy(self.nodes[index].point) if self.placed(index) else None
+
+    def node_description(self, index: int) -> str:
+        """Why node ``index`` is on the path, in words (``nodeDescription``)."""
+        return self.nodes[index].description
+
+    def edge_direction(self, index: int) -> str | None:
+        """The track edge edge ``index`` takes where it leaves a junction (``None`` elsewhere)."""
+        edge = self.edges[index]
+        leaving = self.junction_at(index) and edge.length > 0.0
+        return self.track.edges[edge.stretches[0][0]].name if leaving else None
+
     def junction_at(self, index: int) -> bool:
         """Whether node ``index`` is a junction of the track (a node where three or more edges meet)."""
         node = self.track.node_at(self.nodes[index].point)

@@ -16,11 +16,10 @@ from dataclasses import dataclass
 from datetime import datetime, timedelta
 from pathlib import PurePosixPath
 
-from topology import JUNCTION_INDEX, JUNCTION_NAME, StarGraph, TrackGraph
 from trajgen.errors import OptionError
-from trajgen.export.vda5050.graph_path import GraphOrderPath, GraphPathEdge
+from trajgen.export.vda5050.graph_path import GraphOrderPath
 from trajgen.export.vda5050.options import Vda5050Options
-from trajgen.export.vda5050.path import NodeKind, OrderPath, PathEdge, PathNode
+from trajgen.export.vda5050.path import OrderPath, node_id
 from trajgen.export.vda5050.release import OrderReleases, Release, order_releases
 from trajgen.model.graph_schedule import GraphSchedule
 from trajgen.model.schedule import Schedule
@@ -43,26 +42,6 @@ __all__ = [
 VDA5050_VERSION = "2.1.0"
 
 
-def _number(value: float) -> str:
-    text = f"{value:.6f}".rstrip("0").rstrip(".")
-    return "0" if text in ("", "-0") else text
-
-
-def node_id(graph: StarGraph, leg: int, s: float) -> str:
-    """The id of the node at ``s`` metres on leg ``leg``: ``"O"`` or ``"<leg name>:<metres>"`` (µm).
-
-    Examples
-    --------
-    >>> node_id(StarGraph({"A": 10.0, "B": 10.0, "C": 10.0}), 0, 1.5)
-    'A:1.5'
-    >>> node_id(StarGraph({"N": 10.0, "W": 10.0, "S": 10.0, "E": 10.0}), 3, 10.0)
-    'E:10'
-    """
-    if leg == JUNCTION_INDEX or s == 0.0:
-        return JUNCTION_NAME
-    return f"{graph.names[leg]}:{_number(s)}"
-
-
 def edge_id(start: str, end: str) -> str:
     """The id of the edge from node ``start`` to node ``end``: ``"<start>-><end>"``."""
     return f"{start}->{end}"
@@ -78,79 +57,11 @@ def _coordinate(value: float) -> float:
     return round(value, 9) + 0.0  # nanometres, no "-0.0"
 
 
-def _node_description(node: PathNode) -> str:
-    parts = []
-    for kind in node.kinds:
-        if kind is NodeKind.HOLD:
-            parts.append(f"hold: {_number(node.s)} m from the junction (the minimum separation)")
-        else:
-            parts.append(kind.value)
-    return ", ".join(parts)
-
-
-def _node(graph: StarGraph, node: PathNode, sequence: int, released: bool, map_id: str, deviation):
+def _order_node(path, index: int, sequence: int, released: bool, map_id: str, deviation):
+    """Node ``index`` of ``path`` (either kind of order path: they answer the same questions)."""
     from vda5050.model.order import Node
 
-    angle = math.radians(graph.angles_deg[node.leg]) if node.leg != JUNCTION_INDEX else 0.0
-    return Node(
-        node_id=node_id(graph, node.leg, node.s),
-        sequence_id=sequence,
-        node_description=_node_description(node),
-        released=released,
-        node_position={
-            "x": _coordinate(node.s * math.cos(angle)),
-            "y": _coordinate(node.s * math.sin(angle)),
-            "allowed_deviation_xy": deviation,
-            "map_id": map_id,
-        },
-        actions=[],
-    )
-
-
-def _edge(graph: StarGraph, path: OrderPath, edge: PathEdge, sequence: int, released: bool):
-    start, end = path.nodes[edge.index], path.nodes[edge.index + 1]
-    # the leg taken at the junction
-    leaving = start.leg == JUNCTION_INDEX and end.leg != JUNCTION_INDEX
-    return _order_edge(
-        (node_id(graph, start.leg, start.s), node_id(graph, end.leg, end.s)),
-        edge,
-        graph.names[end.leg] if leaving else None,
-        sequence,
-        released,
-    )
-
-
-def _order_edge(
-    ends: tuple[str, str],
-    edge: PathEdge | GraphPathEdge,
-    direction: str | None,
-    sequence: int,
-    released: bool,
-):
-    """The order's edge between node ids ``ends``, taking ``direction`` (a leg or track edge) or none."""
-    from vda5050.model.order import Edge
-
-    first, second = ends
-    return Edge(
-        edge_id=edge_id(first, second),
-        sequence_id=sequence,
-        released=released,
-        start_node_id=first,
-        end_node_id=second,
-        max_speed=edge.max_speed,
-        length=_coordinate(edge.length),
-        orientation=math.pi if edge.backward else 0.0,
-        orientation_type="TANGENTIAL",
-        direction=direction,
-        actions=[],
-    )
-
-
-def _graph_node(path: GraphOrderPath, index: int, sequence: int, released: bool, map_id: str, deviation):
-    from vda5050.model.order import Node
-
-    node = path.nodes[index]
-    xy = path.track.xy(node.point) if path.placed(index) else None
+    xy = path.node_xy(index)
     position = None
     if xy is not None:  # a track without coordinates, or a point inside a curved edge, has none to give
         position = {
@@ -162,41 +73,40 @@ def _graph_node(path: GraphOrderPath, index: int, sequence: int, released: bool,
     return Node(
         node_id=path.node_id(index),
         sequence_id=sequence,
-        node_description=node.description,
+        node_description=path.node_description(index),
         released=released,
         node_position=position,
         actions=[],
     )
 
 
-def _graph_edge(path: GraphOrderPath, index: int, sequence: int, released: bool):
+def _order_edge(path, index: int, sequence: int, released: bool):
+    """Edge ``index`` of ``path``, between its nodes' ids (the leg or track edge it leaves a junction by)."""
+    from vda5050.model.order import Edge
+
     edge = path.edges[index]
-    # the track edge taken where the vehicle leaves a junction
-    leaving = path.junction_at(index) and edge.length > 0.0
-    return _order_edge(
-        (path.node_id(index), path.node_id(index + 1)),
-        edge,
-        path.track.edges[edge.stretches[0][0]].name if leaving else None,
-        sequence,
-        released,
+    first, second = path.node_id(index), path.node_id(index + 1)
+    return Edge(
+        edge_id=edge_id(first, second),
+        sequence_id=sequence,
+        released=released,
+        start_node_id=first,
+        end_node_id=second,
+        max_speed=edge.max_speed,
+        length=_coordinate(edge.length),
+        orientation=math.pi if edge.backward else 0.0,
+        orientation_type="TANGENTIAL",
+        direction=path.edge_direction(index),
+        actions=[],
     )
 
 
-def path_node_id(graph: StarGraph | TrackGraph, path: OrderPath | GraphOrderPath, index: int) -> str:
-    """The id of node ``index`` of ``path`` (a junction's ``graph``; a graph path knows its track)."""
-    if isinstance(path, GraphOrderPath):
-        return path.node_id(index)
-    node = path.nodes[index]
-    return node_id(graph, node.leg, node.s)
-
-
-def _layout(schedule: Schedule | GraphSchedule) -> StarGraph | TrackGraph:
-    """The track a schedule's node ids and positions are on."""
-    return schedule.track
+def path_node_id(path: OrderPath | GraphOrderPath, index: int) -> str:
+    """The id of node ``index`` of ``path`` (each kind of path knows its track)."""
+    return path.node_id(index)
 
 
 def order_elements(
-    graph: StarGraph | TrackGraph,
     path: OrderPath | GraphOrderPath,
     *,
     first: int,
@@ -213,9 +123,8 @@ def order_elements(
 
     Parameters
     ----------
-    graph : StarGraph or TrackGraph
-        The junction of an ``OrderPath``; a ``GraphOrderPath`` uses its own track.
     path : OrderPath or GraphOrderPath
+        A vehicle's path on a junction or on a track graph (each knows its track).
     first : int
         Index of the first node sent: 0 for an order, the previous decision point for an update.
     decision_point : int
@@ -237,22 +146,12 @@ def order_elements(
         Edge ``k`` has ``sequenceId`` ``2 k + 1`` (plus the offset).
     """
     last = len(path.nodes) - 1 if last is None else last
-    if isinstance(path, GraphOrderPath):  # on a track graph: the path knows its track
-        nodes = [
-            _graph_node(path, j, sequence_offset + 2 * j, j <= decision_point, map_id, node_deviation)
-            for j in range(first, last + 1)
-        ]
-        edges = [
-            _graph_edge(path, k, sequence_offset + 2 * k + 1, k < decision_point) for k in range(first, last)
-        ]
-        return nodes, edges
     nodes = [
-        _node(graph, path.nodes[j], sequence_offset + 2 * j, j <= decision_point, map_id, node_deviation)
+        _order_node(path, j, sequence_offset + 2 * j, j <= decision_point, map_id, node_deviation)
         for j in range(first, last + 1)
     ]
     edges = [
-        _edge(graph, path, path.edges[k], sequence_offset + 2 * k + 1, k < decision_point)
-        for k in range(first, last)
+        _order_edge(path, k, sequence_offset + 2 * k + 1, k < decision_point) for k in range(first, last)
     ]
     return nodes, edges
 
@@ -389,15 +288,14 @@ def render_orders(
     """
     from vda5050.model.order import Order
 
-    schedule, names = _checked(verified, names, options, "render_orders")
+    _, names = _checked(verified, names, options, "render_orders")
     plan = _releases(verified, releases, plan, "render_orders")
-    graph = _layout(schedule)
     messages = []
     for release in plan.releases:
         vehicle = release.vehicle
         path = plan.paths[vehicle]
         nodes, edges = order_elements(
-            graph, path, first=release.first, decision_point=release.decision_point, map_id=options.map_id
+            path, first=release.first, decision_point=release.decision_point, map_id=options.map_id
         )
         header_id = options.first_header_id + release.update
         timestamp = _timestamp(options.start_time, release.send_at)
@@ -429,10 +327,8 @@ def render_orders(
 def _manifest(
     schedule: Schedule | GraphSchedule, plan: OrderReleases, messages, names, options: Vda5050Options
 ) -> dict:
-    graph = _layout(schedule)
-
     def node_ref(vehicle: int, index: int) -> dict:
-        return {"node_id": path_node_id(graph, plan.paths[vehicle], index), "sequence_id": 2 * index}
+        return {"node_id": plan.paths[vehicle].node_id(index), "sequence_id": 2 * index}
 
     entries = []
     for message in messages:
@@ -463,7 +359,7 @@ def _manifest(
             "manufacturer": options.manufacturer(vehicle),
             "serial_number": options.serial_number(vehicle, names),
             "order_id": f"{options.order_id}-{name}",
-            "nodes": [path_node_id(graph, path, index) for index in range(len(path.nodes))],
+            "nodes": [path.node_id(index) for index in range(len(path.nodes))],
             "messages": sum(1 for m in messages if m.vehicle == vehicle),
         }
     return {

@@ -19,7 +19,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from topology import JUNCTION_INDEX, Option
+from topology import JUNCTION_INDEX, JUNCTION_NAME, Option, StarGraph
 from trajgen.model.pieces import Pieces, shift
 from trajgen.model.polynomials import derivative, evaluate, extrema, root_in
 from trajgen.model.schedule import Schedule
@@ -31,8 +31,30 @@ __all__ = [
     "OrderPath",
     "PathEdge",
     "PathNode",
+    "node_id",
     "vehicle_path",
 ]
+
+
+def _number(value: float) -> str:
+    text = f"{value:.6f}".rstrip("0").rstrip(".")
+    return "0" if text in ("", "-0") else text
+
+
+def node_id(graph: StarGraph, leg: int, s: float) -> str:
+    """The id of the node at ``s`` metres on leg ``leg``: ``"O"`` or ``"<leg name>:<metres>"`` (µm).
+
+    Examples
+    --------
+    >>> node_id(StarGraph({"A": 10.0, "B": 10.0, "C": 10.0}), 0, 1.5)
+    'A:1.5'
+    >>> node_id(StarGraph({"N": 10.0, "W": 10.0, "S": 10.0, "E": 10.0}), 3, 10.0)
+    'E:10'
+    """
+    if leg == JUNCTION_INDEX or s == 0.0:
+        return JUNCTION_NAME
+    return f"{graph.names[leg]}:{_number(s)}"
+
 
 #: Reversals shorter than this are round-off; nodes this close to each other, to a route waypoint,
 #: a leg's end or the junction are one, metres.
@@ -122,10 +144,45 @@ class PathEdge:
 
 @dataclass(frozen=True, slots=True)
 class OrderPath:
-    """One vehicle's nodes and edges (``len(edges) == len(nodes) - 1``)."""
+    """One vehicle's nodes and edges on a junction (``len(edges) == len(nodes) - 1``).
 
+    Its order elements are read through the methods a track graph's
+    :class:`~trajgen.export.vda5050.graph_path.GraphOrderPath` has too: :meth:`node_id`,
+    :meth:`node_xy`, :meth:`node_description`, :meth:`edge_direction`.
+    """
+
+    track: StarGraph
     nodes: tuple[PathNode, ...]
     edges: tuple[PathEdge, ...]
+
+    def node_id(self, index: int) -> str:
+        """Node ``index``'s id: ``"O"`` or ``"<leg name>:<metres>"`` (:func:`node_id`)."""
+        node = self.nodes[index]
+        return node_id(self.track, node.leg, node.s)
+
+    def node_xy(self, index: int) -> tuple[float, float]:
+        """Node ``index``'s x/y, metres: on its leg's line at the leg's angle, the junction at the origin."""
+        node = self.nodes[index]
+        angle = math.radians(self.track.angles_deg[node.leg]) if node.leg != JUNCTION_INDEX else 0.0
+        return (node.s * math.cos(angle), node.s * math.sin(angle))
+
+    def node_description(self, index: int) -> str:
+        """Why node ``index`` is on the path, in words (``nodeDescription``)."""
+        parts = []
+        for kind in self.nodes[index].kinds:
+            if kind is NodeKind.HOLD:
+                parts.append(
+                    f"hold: {_number(self.nodes[index].s)} m from the junction (the minimum separation)"
+                )
+            else:
+                parts.append(kind.value)
+        return ", ".join(parts)
+
+    def edge_direction(self, index: int) -> str | None:
+        """The leg edge ``index`` takes where it leaves the junction (``None`` elsewhere)."""
+        start, end = self.nodes[index], self.nodes[index + 1]
+        leaving = start.leg == JUNCTION_INDEX and end.leg != JUNCTION_INDEX
+        return self.track.names[end.leg] if leaving else None
 
     @staticmethod
     def gap(first: tuple[int, float, float], second: tuple[int, float, float]) -> float:
@@ -432,4 +489,4 @@ def vehicle_path(
                 backward=b.axis < a.axis,
             )
         )
-    return OrderPath(nodes, tuple(edges))
+    return OrderPath(schedule.route.graph, nodes, tuple(edges))
