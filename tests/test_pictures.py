@@ -277,7 +277,7 @@ def test_the_first_frame_shows_the_start_and_the_last_the_goal(legs):
     assert image.format == "GIF"
     assert image.size == (FRAME_WIDTH_PX, FRAME_HEIGHT_PX)
     assert image.n_frames == play.frame_count <= MAX_FRAMES[legs]
-    layout = frame_layout(graph, frame_geometry(verified, play.times()))
+    layout = frame_layout(verified.schedule.track, frame_geometry(verified, play.times()))
     frames = _frames(gif)
     swap = route.goal == route.start.swapped()
     for frame, here, there in ((frames[0], route.start, route.goal), (frames[-1], route.goal, route.start)):
@@ -334,7 +334,7 @@ def test_every_leg_is_in_the_frame_to_scale(legs):
     verified = timed(legs)
     graph = verified.schedule.route.graph
     geometry = frame_geometry(verified, [0.0])
-    layout = frame_layout(graph, geometry)
+    layout = frame_layout(verified.schedule.track, geometry)
     left, bottom, width, height = layout.track_box
     across = (layout.track_xlim[1] - layout.track_xlim[0]) / width
     up = (layout.track_ylim[1] - layout.track_ylim[0]) / height
@@ -349,7 +349,7 @@ def test_the_separation_bar_is_the_track_distance_long(swap, swap_gif):
     scenario, verified = swap
     play = playback(verified.schedule.duration, max_frames=80)
     geometry = frame_geometry(verified, play.times())
-    layout = frame_layout(scenario.track, geometry)
+    layout = frame_layout(verified.schedule.track, geometry)
     frames = _frames(swap_gif)
     for k in (0, len(frames) // 3, len(frames) // 2, len(frames) - 1):
         end = layout.bar_pixel(geometry.distance[k])
@@ -369,7 +369,7 @@ def test_the_separation_bar_is_red_near_the_minimum():
     gif = animation_gif(verified, max_frames=6)
     play = playback(verified.schedule.duration, max_frames=6)
     geometry = frame_geometry(verified, play.times())
-    layout = frame_layout(route.graph, geometry)
+    layout = frame_layout(verified.schedule.track, geometry)
     first = _frames(gif)[0]
     end = layout.bar_pixel(geometry.distance[0])
     assert geometry.distance[0] == pytest.approx(1.6)

@@ -23,11 +23,9 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from topology import StarGraph, TrackGraph
+from topology import TrackGraph
 from topology.validation import short_repr
 from trajgen.errors import InputError
-from trajgen.model.graph_schedule import GraphSchedule
-from trajgen.model.summary import class_name
 from trajgen.plots.animation_layout import (
     DEFAULT_FPS,
     DEFAULT_MAX_FRAMES,
@@ -60,10 +58,9 @@ def _round_length(target: float) -> float:
     return max(digit * decade for digit in (1, 2, 5) if digit * decade <= target)
 
 
-def _free_corners(graph: StarGraph, layout: FrameLayout) -> list[str]:
-    """The track area's corners, farthest from the legs first, as legend locations."""
-    angles = np.radians(np.array(graph.angles_deg))
-    ends = np.stack([np.array(graph.lengths) * np.cos(angles), np.array(graph.lengths) * np.sin(angles)], 1)
+def _free_corners(drawn: TrackLayout, labels: list, layout: FrameLayout) -> list[str]:
+    """The track area's corners, farthest from the drawn track and its labels first (legend, scale bar)."""
+    every = np.vstack([drawn.nodes, *drawn.edges, *(np.reshape(label, (1, 2)) for label in labels)])
     corners = {
         "upper left": (layout.track_xlim[0], layout.track_ylim[1]),
         "upper right": (layout.track_xlim[1], layout.track_ylim[1]),
@@ -72,20 +69,18 @@ def _free_corners(graph: StarGraph, layout: FrameLayout) -> list[str]:
     }
 
     def clearance(corner) -> float:
-        point = np.array(corner)
-        along = np.clip((ends @ point) / np.einsum("ij,ij->i", ends, ends), 0.0, 1.0)
-        return float(np.min(np.linalg.norm(point - along[:, None] * ends, axis=1)))
+        return float(np.min(np.linalg.norm(every - np.array(corner), axis=1)))
 
     return sorted(corners, key=lambda name: -clearance(corners[name]))
 
 
-def _widest_gap(angles_deg: Sequence[float]) -> float:
-    """The direction halfway across the widest angle between two neighbouring legs, radians."""
-    angles = sorted(a % 360.0 for a in angles_deg)
-    count = len(angles)
-    gaps = [((angles[(k + 1) % count] - angles[k]) % 360.0, k) for k in range(count)]
-    width, k = max(gaps)
-    return math.radians(angles[k] + 0.5 * width)
+def _dead_ends(track: TrackGraph) -> set[int]:
+    """The nodes one edge ends at."""
+    degree = np.zeros(len(track.nodes), dtype=int)
+    for k in range(track.edge_count):
+        for node in track.ends(k):
+            degree[node] += 1
+    return {int(n) for n in np.nonzero(degree == 1)[0]}
 
 
 def _disc(x: float, y: float, radius: float) -> np.ndarray:
@@ -114,8 +109,7 @@ class _Scene:
         figure.text(
             0.5,
             0.965,
-            f"{names[0]} and {names[1]}: {schedule.method.name} schedule, {schedule.duration:.2f} s, "
-            + ("on a track graph" if isinstance(schedule, GraphSchedule) else class_name(schedule.route)),
+            f"{' and '.join(names)}: {schedule.method.name} schedule, {schedule.duration:.2f} s",
             ha="center",
             va="center",
             fontsize=11,
@@ -128,11 +122,7 @@ class _Scene:
             )
             for v, (x, ha) in enumerate(((0.03, "left"), (0.97, "right")))
         ]
-        self.graph = isinstance(schedule, GraphSchedule)
-        if self.graph:
-            self.vehicles = self._draw_graph_track(schedule.track, layout)
-        else:
-            self.vehicles = self._draw_track(schedule.route.graph, layout)
+        self.vehicles = self._draw_track(schedule.track, layout)
         self.bar, self.minimum, self.bar_value = self._draw_bar(layout)
         moving = [self.clock, *self.speeds]
         for disc, dot, name in self.vehicles:
@@ -144,10 +134,13 @@ class _Scene:
         sizes = (FRAME_WIDTH_PX, FRAME_HEIGHT_PX, FRAME_WIDTH_PX, FRAME_HEIGHT_PX)
         return self.figure.add_axes([value / size for value, size in zip(box, sizes, strict=True)])
 
-    def _draw_graph_track(self, track: TrackGraph, layout: FrameLayout) -> list:
-        """The track graph as :class:`~trajgen.plots.track_layout.TrackLayout` draws it.
+    def _draw_track(self, track: TrackGraph, layout: FrameLayout) -> list:
+        """The track as :class:`~trajgen.plots.track_layout.TrackLayout` draws it; the vehicles' artists.
 
-        Its nodes named, both vehicles' starts and goals marked; returns the vehicles' moving artists.
+        Each edge that ends at a dead end is named with its length beyond that end (a star's legs,
+        a graph's spurs), each other edge beside its middle; each node is named, but for a dead end
+        named after its edge (``<edge>-end``, a star's leg ends: the edge's name says it). Both
+        vehicles' starts and goals are marked, the legend sits in the corner farthest from the track.
         """
         axis = self._axes(layout.track_box)
         axis.set_xlim(*layout.track_xlim)
@@ -155,19 +148,48 @@ class _Scene:
         axis.set_aspect("auto")  # the limits already give a metre the same pixels both ways
         axis.set_axis_off()
         drawn = TrackLayout.of(track)
-        for line in drawn.edges:
+        span = layout.track_xlim[1] - layout.track_xlim[0]
+        dead_ends = _dead_ends(track)
+        labels: list = []
+        for number, line in enumerate(drawn.edges):
             axis.plot(line[:, 0], line[:, 1], color="0.75", linewidth=7, solid_capstyle="round", zorder=1)
-        for name, (x, y) in zip(track.nodes, drawn.nodes, strict=True):
+            edge = track.edges[number]
+            text = f"{edge.name}\n{edge.length:g} m"
+            start, end = track.ends(number)
+            if end in dead_ends or start in dead_ends:
+                tip, before = (line[-1], line[-2]) if end in dead_ends else (line[0], line[1])
+                outward = (tip - before) / max(float(np.hypot(*(tip - before))), 1e-12)
+                label = tip + 0.075 * span * outward
+                labels.append(label)
+                axis.text(*label, text, ha="center", va="center", fontsize=9, color="0.3")
+            else:
+                middle = line[len(line) // 2]
+                labels.append(middle)
+                axis.annotate(
+                    text,
+                    middle,
+                    xytext=(0, -14),
+                    textcoords="offset points",
+                    ha="center",
+                    va="top",
+                    fontsize=8,
+                    color="0.3",
+                )
+        for node, (name, (x, y)) in enumerate(zip(track.nodes, drawn.nodes, strict=True)):
             axis.plot([x], [y], "o", color="white", markeredgecolor="0.3", markersize=6, zorder=2)
+            mine = [track.edges[k].name for k in range(track.edge_count) if node in track.ends(k)]
+            if node in dead_ends and name in (f"{m}-end" for m in mine):
+                continue
             axis.annotate(name, (x, y), xytext=(7, 7), textcoords="offset points", fontsize=9, color="0.3")
         self._mark_ends(axis)
-        axis.legend(loc="upper right", fontsize=8, framealpha=0.9, ncols=2)
-        self._scale_bar(axis, layout, ("lower left",))
+        corners = _free_corners(drawn, labels, layout)
+        axis.legend(loc=corners[0], fontsize=8, framealpha=0.9, ncols=2)
+        self._scale_bar(axis, layout, corners[1])
         return self._vehicle_artists(axis)
 
     def _mark_ends(self, axis) -> None:
         geometry = self.geometry
-        for v in range(2):
+        for v in range(len(self.names)):
             for k, marker, what in ((0, "o", "start"), (-1, "s", "goal")):
                 axis.plot(
                     geometry.x[v, k],
@@ -181,13 +203,13 @@ class _Scene:
                     label=f"{self.names[v]} {what}",
                 )
 
-    def _scale_bar(self, axis, layout: FrameLayout, corners) -> None:
+    def _scale_bar(self, axis, layout: FrameLayout, corner: str) -> None:
         span = layout.track_xlim[1] - layout.track_xlim[0]
         height = layout.track_ylim[1] - layout.track_ylim[0]
         length = _round_length(0.2 * span)
-        left = "left" in corners[-1]
+        left = "left" in corner
         x0 = layout.track_xlim[0] + 0.04 * span if left else layout.track_xlim[1] - 0.04 * span - length
-        lower = "lower" in corners[-1]
+        lower = "lower" in corner
         y0 = layout.track_ylim[0] + 0.05 * height if lower else layout.track_ylim[1] - 0.08 * height
         axis.plot([x0, x0 + length], [y0, y0], color="black", linewidth=2, solid_capstyle="butt")
         axis.text(
@@ -202,7 +224,7 @@ class _Scene:
     def _vehicle_artists(self, axis) -> list:
         radius = 0.5 * self.geometry.min_separation
         vehicles = []
-        for v in range(2):
+        for v in range(len(self.names)):
             colour = VEHICLE_COLOURS[v]
             disc = axis.fill(*_disc(0.0, 0.0, radius).T, color=colour, alpha=0.3, linewidth=0, zorder=4)[0]
             dot = axis.plot(
@@ -220,43 +242,6 @@ class _Scene:
             vehicles.append((disc, dot, name))
         self.radius = radius
         return vehicles
-
-    def _draw_track(self, graph: StarGraph, layout: FrameLayout) -> list:
-        axis = self._axes(layout.track_box)
-        axis.set_xlim(*layout.track_xlim)
-        axis.set_ylim(*layout.track_ylim)
-        axis.set_aspect("auto")  # the limits already give a metre the same pixels both ways
-        axis.set_axis_off()
-        span = layout.track_xlim[1] - layout.track_xlim[0]
-        for name, length, angle in zip(graph.names, graph.lengths, np.radians(graph.angles_deg), strict=True):
-            direction = np.array([math.cos(angle), math.sin(angle)])
-            axis.plot(
-                [0.0, length * direction[0]],
-                [0.0, length * direction[1]],
-                color="0.75",
-                linewidth=7,
-                solid_capstyle="round",
-                zorder=1,
-            )
-            label = length * direction + 0.075 * span * direction
-            axis.text(*label, f"{name}\n{length:g} m", ha="center", va="center", fontsize=9, color="0.3")
-        axis.plot([0.0], [0.0], "o", color="white", markeredgecolor="0.3", markersize=7, zorder=2)
-        free = _widest_gap(graph.angles_deg)
-        axis.annotate(
-            "O",
-            (0.0, 0.0),
-            xytext=(10 * math.cos(free), 10 * math.sin(free)),
-            textcoords="offset points",
-            ha="center",
-            va="center",
-            fontsize=9,
-            color="0.3",
-        )
-        self._mark_ends(axis)
-        corners = _free_corners(graph, layout)
-        axis.legend(loc=corners[0], fontsize=8, framealpha=0.9, ncols=2)
-        self._scale_bar(axis, layout, corners)
-        return self._vehicle_artists(axis)
 
     def _draw_bar(self, layout: FrameLayout):
         figure, geometry = self.figure, self.geometry
@@ -298,13 +283,15 @@ class _Scene:
             disc.set_xy(_disc(x, y, self.radius))
             dot.set_data([x], [y])
             name.xy = (x, y)
-            # the name beside the leg (clear of the leg's label), on the side away from the other vehicle
-            away = np.array([x - geometry.x[1 - v, k], y - geometry.y[1 - v, k]])
+            # the name beside its edge (clear of the edge's label), on the side away from the others
+            others = [u for u in range(len(self.vehicles)) if u != v]
+            nearest = min(
+                others, key=lambda u: math.hypot(x - geometry.x[u, k], y - geometry.y[u, k]), default=v
+            )
+            away = np.array([x - geometry.x[nearest, k], y - geometry.y[nearest, k]])
             away = away / np.hypot(*away) if np.hypot(*away) > 0.0 else np.array([0.0, 1.0])
-            radius = 0.0 if self.graph else math.hypot(x, y)  # beside a star's leg; on a graph: away
-            if radius > 0.0:
-                across = np.array([-y, x]) / radius
-                away = across if across @ away >= 0.0 else -across
+            across = geometry.across[v, :, k]
+            away = across if across @ away >= 0.0 else -across
             name.xyann = tuple(11.0 * away)
             name.set_horizontalalignment("left" if away[0] > 0.3 else "right" if away[0] < -0.3 else "center")
             name.set_verticalalignment("bottom" if away[1] > 0.3 else "top" if away[1] < -0.3 else "center")

@@ -1,7 +1,7 @@
 """The animation's frames computed apart from the pixels: which instants are played and where everything is.
 
-The animation (drawn and encoded by :mod:`trajgen.plots.animation`) plays a
-schedule on a track of 3 to 8 legs seen from above. What each frame shows is computed
+The animation (drawn and encoded by :mod:`trajgen.plots.animation`) plays a schedule on its
+track seen from above (a junction's legs, or any track graph). What each frame shows is computed
 here, so it can be checked without looking at pixels:
 
 - the instants played (:func:`playback`): at most ``max_frames`` frames, whatever the
@@ -19,11 +19,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from topology import JUNCTION_INDEX, StarGraph, TrackGraph
-from topology.indexed import track_distance
+from topology import TrackGraph
 from topology.validation import short_repr
 from trajgen.errors import OptionError
-from trajgen.model.graph_schedule import GraphSchedule
 from trajgen.model.values import ArrayValue, frozen
 from trajgen.plots.gif import GIF_DELAY_UNIT_MS
 from trajgen.plots.track_layout import TrackLayout
@@ -181,10 +179,14 @@ class FrameGeometry(ArrayValue):
     ----------
     t : ndarray, shape (n,)
         Schedule time of each frame, seconds.
-    x, y : ndarray, shape (2, n)
-        Each vehicle's position from above, metres, junction at the origin
-        (the legs' directions ``StarGraph.angles_deg``, as in the CSV export).
-    velocity : ndarray, shape (2, n)
+    x, y : ndarray, shape (m, n)
+        Each vehicle's position from above, metres, where the track's layout draws it
+        (:class:`~trajgen.plots.track_layout.TrackLayout`; a star's junction at the origin, its legs
+        at their angles).
+    across : ndarray, shape (m, 2, n)
+        The unit vector across the vehicle's edge as drawn there (its direction turned a quarter
+        counterclockwise): the vehicle's name is written beside its edge, not on it.
+    velocity : ndarray, shape (m, n)
         Each vehicle's velocity along its signed axis, m/s.
     distance : ndarray, shape (n,)
         Track distance between the vehicles, metres: the length of the separation bar.
@@ -195,12 +197,13 @@ class FrameGeometry(ArrayValue):
     t: np.ndarray
     x: np.ndarray
     y: np.ndarray
+    across: np.ndarray
     velocity: np.ndarray
     distance: np.ndarray
     min_separation: float
 
     def __post_init__(self) -> None:
-        for name in ("t", "x", "y", "velocity", "distance"):
+        for name in ("t", "x", "y", "across", "velocity", "distance"):
             object.__setattr__(self, name, frozen(np.asarray(getattr(self, name), dtype=float)))
 
     @property
@@ -225,26 +228,23 @@ def frame_geometry(verified: VerifiedSchedule, times) -> FrameGeometry:
     """
     schedule = require_verified(verified, "frame_geometry").schedule
     state = schedule.state(times)
-    required = max(schedule.limits.min_separation, schedule.route.min_separation)
-    if isinstance(schedule, GraphSchedule):  # where the track's layout draws each position
-        layout = TrackLayout.of(schedule.track)
-        xy = np.stack([layout.points(state.edge[v], state.s[v]) for v in range(2)])  # (2, n, 2)
-        return FrameGeometry(
-            t=state.t,
-            x=xy[:, :, 0],
-            y=xy[:, :, 1],
-            velocity=state.velocity,
-            distance=schedule.track.distances(state.edge[0], state.s[0], state.edge[1], state.s[1]),
-            min_separation=required,
-        )
-    angles = np.radians(np.array(schedule.route.graph.angles_deg))
-    direction = angles[np.where(state.leg == JUNCTION_INDEX, 0, state.leg)]
+    track = schedule.track
+    layout = TrackLayout.of(track)
+    count = state.edge.shape[0]
+    xy = np.stack([layout.points(state.edge[v], state.s[v]) for v in range(count)])  # (m, n, 2)
+    tangent = np.stack([layout.tangents(state.edge[v], state.s[v]) for v in range(count)])
+    across = np.stack([-tangent[..., 1], tangent[..., 0]], axis=1)  # (m, 2, n)
+    pairs = [(a, b) for a in range(count) for b in range(a + 1, count)]
+    distance = np.full(state.t.shape, np.inf)  # the closest pair's track distance
+    for a, b in pairs:
+        distance = np.minimum(distance, track.distances(state.edge[a], state.s[a], state.edge[b], state.s[b]))
     return FrameGeometry(
         t=state.t,
-        x=state.s * np.cos(direction),
-        y=state.s * np.sin(direction),
+        x=xy[:, :, 0],
+        y=xy[:, :, 1],
+        across=across,
         velocity=state.velocity,
-        distance=track_distance(state.leg[0], state.s[0], state.leg[1], state.s[1]),
+        distance=distance,
         min_separation=max(schedule.limits.min_separation, schedule.route.min_separation),
     )
 
@@ -309,23 +309,18 @@ def _box(fraction: tuple[float, float, float, float]) -> tuple[float, float, flo
     return (left * FRAME_WIDTH_PX, bottom * FRAME_HEIGHT_PX, width * FRAME_WIDTH_PX, height * FRAME_HEIGHT_PX)
 
 
-def frame_layout(graph: StarGraph | TrackGraph, geometry: FrameGeometry) -> FrameLayout:
-    """The layout of the frames of ``geometry`` on ``graph``: the whole track to scale, and the bar's range.
+def frame_layout(track: TrackGraph, geometry: FrameGeometry) -> FrameLayout:
+    """The layout of the frames of ``geometry`` on ``track``: the whole track to scale, and the bar's range.
 
-    The track area shows every leg (every edge of a track graph, as
-    :class:`~trajgen.plots.track_layout.TrackLayout` draws it) with a margin for the labels and
-    the vehicles' discs, widened in one direction so that a metre is as many pixels across as up.
+    The track area shows every edge as :class:`~trajgen.plots.track_layout.TrackLayout` draws it
+    (a star's legs at their angles from the junction) with a margin for the labels and the
+    vehicles' discs, widened in one direction so that a metre is as many pixels across as up.
     The bar's range is the largest track distance of the frames (at least :data:`NEAR_FACTOR`
     times the minimum), with 5 % to spare.
     """
-    if isinstance(graph, TrackGraph):
-        drawn = TrackLayout.of(graph)
-        every = np.vstack([drawn.nodes, *drawn.edges])
-        ends_x, ends_y = every[:, 0], every[:, 1]
-    else:
-        angles = np.radians(np.array(graph.angles_deg))
-        ends_x = np.append(np.array(graph.lengths) * np.cos(angles), 0.0)
-        ends_y = np.append(np.array(graph.lengths) * np.sin(angles), 0.0)
+    drawn = TrackLayout.of(track)
+    every = np.vstack([drawn.nodes, *drawn.edges])
+    ends_x, ends_y = every[:, 0], every[:, 1]
     span = max(float(np.ptp(ends_x)), float(np.ptp(ends_y)), 1e-9)
     margin = 0.14 * span + 0.5 * geometry.min_separation
     xlim = [float(ends_x.min()) - margin, float(ends_x.max()) + margin]

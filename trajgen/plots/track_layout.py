@@ -85,6 +85,24 @@ class TrackLayout:
         piece = np.vstack([ends[0], line[inside], ends[1]])
         return piece if s_from <= s_to else piece[::-1]
 
+    def tangents(self, edges, s) -> np.ndarray:
+        """The unit direction of each edge as drawn at ``s`` metres, toward its ``to`` node, shape (n, 2)."""
+        out = np.zeros((len(edges), 2))
+        for k, (edge, at) in enumerate(zip(edges, s, strict=True)):
+            line = self.edges[int(edge)]
+            steps = np.diff(line, axis=0)
+            lengths = np.linalg.norm(steps, axis=1)
+            drawn = np.concatenate([[0.0], np.cumsum(lengths)]) / max(float(lengths.sum()), 1e-12)
+            piece = int(
+                np.clip(
+                    np.searchsorted(drawn, float(at) / self.track.length(int(edge))) - 1, 0, len(steps) - 1
+                )
+            )
+            step = steps[piece] if lengths[piece] > 0.0 else line[-1] - line[0]
+            norm = float(np.hypot(*step))
+            out[k] = step / norm if norm > 0.0 else (1.0, 0.0)
+        return out
+
     def move(self, route: GraphRoute, number: int) -> np.ndarray:
         """The drawn path of move ``number`` of ``route``, shape (m, 2)."""
         move = route.moves[number]
