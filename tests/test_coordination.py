@@ -1,12 +1,15 @@
 """The coordination diagram, the frontier, the stopping distance and the braking rule plans obey.
 
-Closed-form cases on the swap of ``examples/swap.toml``; agreement of the closed-form stopping
-distance with Ruckig's braking; seeded property tests of the frontier.
+Closed-form cases on the swap of ``examples/swap.toml`` and on the H; agreement of the closed-form
+stopping distance with Ruckig's braking, and of a track graph's conflicts with the tests' own track
+distance; every plan of the table of cases (:mod:`tests.support.cases`) behind its frontiers;
+seeded property tests of the frontier.
 """
 
 from __future__ import annotations
 
 import dataclasses
+import functools
 import itertools
 import math
 
@@ -18,6 +21,9 @@ from ruckig import ControlInterface, InputParameter, Ruckig, Trajectory
 
 from limits import Limits, VehicleLimits
 from tests.conftest import REPO
+from tests.support.cases import CASES, case
+from tests.support.graph_cases import EXAMPLES
+from tests.support.graph_rows import ScenarioFile
 from tests.support.helpers import conf, execution_plan
 from topology import YGraph, plan
 from trajgen import Exact, Optimal, certify, load_scenario, verify
@@ -25,6 +31,7 @@ from trajgen.model.coordination import (
     CoordinationDiagram,
     earliest_rest,
     schedule_paths,
+    schedule_times,
     stopping_distance,
     stopping_distances,
 )
@@ -132,6 +139,114 @@ def test_the_frontier_in_closed_form_on_the_swap(swap_plan):
     assert diagram.frontier(1, 5.0) == pytest.approx(28.5)
     assert diagram.frontier(1, 11.0) == pytest.approx(29.5)
     assert diagram.frontier(1, 12.0) == math.inf
+
+
+# -- the diagram of every plan of the table of cases ---------------------------------------------
+
+
+@functools.cache
+def _diagram(name: str, method: str):
+    """A case's plan, its diagram, and each vehicle's travel on a fine grid of its time."""
+    verified = case(name).verified(method)
+    schedule = verified.schedule
+    paths, times, _ = schedule_paths(schedule)
+    diagram = CoordinationDiagram(paths, schedule.limits.min_separation, schedule, times)
+    # between two of the schedule's times no vehicle turns: travel is the sum of the axis' moves
+    grid = np.union1d(times, np.linspace(0.0, schedule.duration, 2001))
+    axis = schedule.state(grid).axis
+    travel = np.concatenate([np.zeros((2, 1)), np.cumsum(np.abs(np.diff(axis, axis=1)), axis=1)], axis=1)
+    return schedule, diagram, grid, travel
+
+
+@pytest.mark.parametrize("method", ["exact", "toppra"])
+@pytest.mark.parametrize("name", [c.name for c in CASES])
+def test_the_plan_stays_behind_each_followers_frontier_and_passes_each_conflict_on_its_leaders_side(
+    name, method
+):
+    _, diagram, grid, travel = _diagram(name, method)
+    assert diagram.conflicts  # each case has vehicles that must pass one another
+    for conflict in diagram.conflicts:
+        leader, follower = conflict.leader, conflict.follower
+        # the leader at rest where it is now: the follower may rest anywhere up to its frontier
+        bounds = np.array([conflict.bound(p) for p in travel[leader]])
+        worst = int(np.argmax(travel[follower] - bounds))
+        assert travel[follower, worst] <= bounds[worst] + 1e-6, (leader, grid[worst])
+    for follower in (0, 1):
+        frontiers = diagram.frontiers(follower, travel[1 - follower])
+        assert np.all(travel[follower] <= frontiers + 1e-6)
+
+
+GRAPH_EXAMPLES = ["h", "main-line-with-sidings", "passing-loop", "ring-with-spurs"]
+
+
+@functools.cache
+def _graph_diagram(name: str):
+    from tests.support.graph_cases import verified_example
+
+    scenario, verified = verified_example(name, "exact")
+    schedule = verified.schedule
+    diagram = CoordinationDiagram(
+        schedule.paths, scenario.limits.min_separation, schedule, schedule_times(schedule)
+    )
+    return scenario, schedule, diagram
+
+
+def _inside(polygon, x: np.ndarray, y: np.ndarray, margin: float) -> np.ndarray:
+    """Points inside a convex polygon or within ``margin`` (metres) of it."""
+    inside = np.ones(x.shape, dtype=bool)
+    count = len(polygon)
+    area = sum(
+        polygon[k][0] * polygon[(k + 1) % count][1] - polygon[(k + 1) % count][0] * polygon[k][1]
+        for k in range(count)
+    )
+    orientation = 1.0 if area > 0 else -1.0
+    for k in range(count):
+        (x0, y0), (x1, y1) = polygon[k], polygon[(k + 1) % count]
+        length = np.hypot(x1 - x0, y1 - y0)
+        if length == 0.0:
+            continue
+        cross = orientation * ((x1 - x0) * (y - y0) - (y1 - y0) * (x - x0)) / length
+        inside &= cross >= -margin
+    return inside
+
+
+@pytest.mark.parametrize("name", GRAPH_EXAMPLES)
+def test_a_graphs_conflicts_are_exactly_where_the_vehicles_would_be_too_close(name):
+    """Agreement on a grid of the travel plane with the tests' own track distance (scenario file alone)."""
+    scenario, schedule, diagram = _graph_diagram(name)
+    own = ScenarioFile(EXAMPLES / f"{name}.toml")
+    names = [edge.name for edge in scenario.track.edges]
+    p1 = np.linspace(0.0, schedule.paths[0].length, 121)
+    p2 = np.linspace(0.0, schedule.paths[1].length, 121)
+    x, y = (a.ravel() for a in np.meshgrid(p1, p2))
+    places = [schedule.paths[v].locate(p) for v, p in enumerate((x, y))]
+    distance = np.array(
+        [
+            own.distance((names[places[0][0][k]], places[0][1][k]), (names[places[1][0][k]], places[1][1][k]))
+            for k in range(x.size)
+        ]
+    )
+    separation = scenario.limits.min_separation
+    inside = np.zeros(x.size, dtype=bool)
+    for conflict in diagram.conflicts:
+        for polygon in conflict.polygons:
+            inside |= _inside(polygon, x, y, 1e-9)
+    clear = np.abs(distance - separation) > 2e-3  # off the boundary, where sampling decides nothing
+    assert np.all(inside[clear] == (distance[clear] < separation))
+    assert inside.any()
+
+
+def test_the_hs_conflicts_are_led_in_the_routes_order():
+    """agv1 goes up c (15.5 m), agv2 passes from D to A, agv1 comes back down to D."""
+    _, schedule, diagram = _graph_diagram("h")
+    first_move = schedule.paths[0].cusps[0]
+    assert first_move == pytest.approx(15.5)
+    assert len(diagram.conflicts) == 2
+    up, down = sorted(diagram.conflicts, key=lambda c: c.low[0])
+    assert up.leader == 0  # agv1's way up against agv2's pass: agv1 first
+    assert up.high[0] <= first_move + 1e-9
+    assert down.leader == 1  # agv1's way down against agv2's pass: agv2 first
+    assert down.low[0] >= first_move - 1e-9
 
 
 @settings(max_examples=100)
