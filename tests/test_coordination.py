@@ -176,6 +176,47 @@ def test_the_plan_stays_behind_each_followers_frontier_and_passes_each_conflict_
         assert np.all(travel[follower] <= frontiers + 1e-6)
 
 
+def _frontiers_by_every_edge(diagram, follower: int, earliest: np.ndarray) -> np.ndarray:
+    """The frontiers from every polygon edge at once: its vertices right of ``e``, its crossings of ``e``."""
+    best = np.full(earliest.shape, math.inf)
+    for conflict in diagram.conflicts:
+        if conflict.follower != follower:
+            continue
+        leader = conflict.leader
+        for polygon in conflict.polygons:
+            reach = max(a[leader] for a in polygon)
+            for k, a in enumerate(polygon):
+                b = polygon[(k + 1) % len(polygon)]
+                alive = reach > earliest + 1e-9
+                vertex = np.where(alive & (a[leader] >= earliest), a[1 - leader], math.inf)
+                crossing = alive & ((a[leader] - earliest) * (b[leader] - earliest) < 0.0)
+                with np.errstate(divide="ignore", invalid="ignore"):
+                    w = (earliest - a[leader]) / (b[leader] - a[leader])
+                    edge = np.where(crossing, a[1 - leader] + w * (b[1 - leader] - a[1 - leader]), math.inf)
+                best = np.minimum(best, np.minimum(vertex, edge))
+    return best
+
+
+@pytest.mark.parametrize("name", [c.name for c in CASES])
+def test_the_frontiers_read_off_each_polygons_lower_chain_agree_with_every_edge_of_it(name):
+    """Agreement of two computations, at random earliest rests and at every vertex of every polygon."""
+    _, diagram, _, travel = _diagram(name, "exact")
+    rng = np.random.default_rng(3)
+    for follower in (0, 1):
+        leader = 1 - follower
+        vertices = [
+            a[c.leader] for c in diagram.conflicts if c.follower == follower for p in c.polygons for a in p
+        ]
+        earliest = np.concatenate(
+            [rng.uniform(-1.0, travel[leader, -1] + 1.0, 400), np.array(vertices), np.array(vertices) + 1e-7]
+        )
+        chain = diagram.frontiers(follower, earliest)
+        every = _frontiers_by_every_edge(diagram, follower, earliest)
+        assert np.array_equal(np.isinf(chain), np.isinf(every))
+        finite = np.isfinite(every)
+        np.testing.assert_allclose(chain[finite], every[finite], rtol=0.0, atol=1e-9)
+
+
 GRAPH_EXAMPLES = ["h", "main-line-with-sidings", "passing-loop", "ring-with-spurs"]
 
 

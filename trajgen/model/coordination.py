@@ -149,6 +149,11 @@ def _clip(polygon: list[tuple[float, float]], a: float, b: float, c: float) -> l
     return out
 
 
+def _cross(o: tuple[float, float], a: tuple[float, float], b: tuple[float, float]) -> float:
+    """The z of ``(a - o) x (b - o)``: positive when ``o, a, b`` turn counterclockwise."""
+    return (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0])
+
+
 def _area(polygon: list[tuple[float, float]]) -> float:
     return 0.5 * abs(
         sum(
@@ -263,7 +268,7 @@ class CoordinationDiagram:
         plan's piece ends and velocity roots: :func:`schedule_times`).
     """
 
-    __slots__ = ("_by_follower", "_edges", "_last", "conflicts", "paths", "separation")
+    __slots__ = ("_by_follower", "_chain_table", "_last", "conflicts", "paths", "separation")
 
     def __init__(self, paths: tuple[VehiclePath, VehiclePath], separation: float, schedule, times) -> None:
         self.paths = paths
@@ -312,25 +317,33 @@ class CoordinationDiagram:
         conflicts.sort(key=lambda c: (c.low[c.leader], c.low[c.follower]))
         self.conflicts = tuple(conflicts)
         self._by_follower = tuple(tuple(c for c in conflicts if c.follower == v) for v in (0, 1))
-        self._edges = tuple(self._edge_table(v) for v in (0, 1))
+        self._chain_table = tuple(self._chains(v) for v in (0, 1))
         self._last = [(math.nan, math.inf), (math.nan, math.inf)]  # (earliest, frontier) per follower
 
-    def _edge_table(self, follower: int) -> tuple[np.ndarray, ...] | None:
-        """Every polygon edge of the conflicts ``follower`` follows, as columns (for :meth:`frontiers`).
+    def _chains(self, follower: int) -> tuple[tuple[np.ndarray, np.ndarray, float], ...]:
+        """The rising lower chain of each polygon of the conflicts ``follower`` follows (:meth:`frontiers`).
 
-        Its ends' leader and follower travel, and how far its polygon reaches in the leader's travel.
+        In the plane of (leader's travel, follower's travel) the least follower travel of a convex
+        polygon right of a leader travel ``e`` is its lower chain at ``max(e, x*)``, ``x*`` where the
+        chain is lowest: from there on the chain only rises. Each entry: the rising part's leader
+        and follower travels (increasing leader travel, at least one point) and the polygon's reach.
         """
-        rows = []
+        chains = []
         for conflict in self._by_follower[follower]:
             leader = conflict.leader
             for polygon, reach in zip(conflict.polygons, conflict._reaches, strict=True):
-                for k, a in enumerate(polygon):
-                    b = polygon[(k + 1) % len(polygon)]
-                    rows.append((a[leader], a[1 - leader], b[leader], b[1 - leader], reach))
-        if not rows:
-            return None
-        table = np.array(rows)
-        return tuple(table[:, k] for k in range(5))
+                points = sorted({(a[leader], a[1 - leader]) for a in polygon})
+                lower: list[tuple[float, float]] = []
+                for point in points:
+                    while len(lower) >= 2 and _cross(lower[-2], lower[-1], point) <= 0.0:
+                        lower.pop()
+                    if lower and lower[-1][0] == point[0]:
+                        continue  # above a point of the same leader travel: not on the lower chain
+                    lower.append(point)
+                lowest = min(range(len(lower)), key=lambda k: lower[k][1])
+                rising = np.array(lower[lowest:])
+                chains.append((rising[:, 0].copy(), rising[:, 1].copy(), float(reach)))
+        return tuple(chains)
 
     def frontier(self, follower: int, earliest: float) -> float:
         """The farthest travel ``follower`` may come to rest at, metres (``inf``: nothing binds it).
@@ -354,21 +367,19 @@ class CoordinationDiagram:
         return best
 
     def frontiers(self, follower: int, earliest: np.ndarray) -> np.ndarray:
-        """:meth:`frontier` for many earliest rest points at once, shape of ``earliest`` (metres)."""
+        """:meth:`frontier` for many earliest rest points at once, shape of ``earliest`` (metres).
+
+        Each polygon's least follower travel right of the leader's earliest rest, read off its rising
+        lower chain (:meth:`_chains`): time and memory grow with the polygons times the points, one
+        array of the points at a time.
+        """
         earliest = np.asarray(earliest, dtype=float)
         best = np.full(earliest.shape, math.inf)
-        edges = self._edges[follower]
-        if edges is None:
-            return best
-        a_lead, a_follow, b_lead, b_follow, reach = edges  # (m,) each: every edge of every polygon
-        e = earliest[..., None]
-        alive = reach > e + _TOUCH  # polygons reaching past the earliest rest by more than a boundary
-        vertex = np.where(alive & (a_lead >= e), a_follow, math.inf)
-        crossing = alive & ((a_lead - e) * (b_lead - e) < 0.0)
-        with np.errstate(divide="ignore", invalid="ignore"):
-            w = (e - a_lead) / (b_lead - a_lead)
-            edge = np.where(crossing, a_follow + w * (b_follow - a_follow), math.inf)
-        return np.minimum(vertex.min(axis=-1), edge.min(axis=-1))
+        for leader_travel, follower_travel, reach in self._chain_table[follower]:
+            value = np.interp(earliest, leader_travel, follower_travel)  # flat left of the lowest point
+            # polygons reaching past the earliest rest by more than a boundary
+            np.minimum(best, np.where(reach > earliest + _TOUCH, value, math.inf), out=best)
+        return best
 
     def leading(self, vehicle: int, travel: float) -> tuple[Conflict, ...]:
         """The conflicts ``vehicle`` leads that it has not yet passed at ``travel``."""
