@@ -170,7 +170,7 @@ def test_demo_runs_a_built_in_scenario_end_to_end(tmp_path, capsys, legs):
     if class_line is not None:
         assert class_line in out
     assert sorted(p.name for p in output.iterdir()) == RUN_FILES
-    for picture in ("configuration.png", "speed.png"):
+    for picture in ("configuration.png", "layout.png", "speed.png"):
         assert (output / picture).read_bytes().startswith(b"\x89PNG\r\n\x1a\n")
     verdict = check_profiles(builtin_scenario(name), output)
     assert verdict.passed, verdict.failures

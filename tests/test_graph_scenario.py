@@ -11,7 +11,7 @@ import pytest
 from limits import Limits
 from tests.conftest import REPO
 from tests.support.grid_oracle import GridTrack, shortest_route
-from tests.support.helpers import RUN_FILES
+from tests.support.helpers import GRAPH_RUN_FILES
 from topology import TrackGraph
 from trajgen import verify
 from trajgen.cli import main
@@ -176,7 +176,7 @@ def test_demo_runs_the_built_in_h_end_to_end(tmp_path, capsys):
     assert "   2  agv2: D -> A along e, m, a, 20.5 m (the other at c:1.5)" in out  # the route's moves
     assert "method: exact  duration: 51.500 s  verified: True" in out
     written = sorted(path.name for path in tmp_path.iterdir())
-    assert written == RUN_FILES
+    assert written == GRAPH_RUN_FILES
 
 
 THREE = """

@@ -1,9 +1,11 @@
-"""The pictures people look at: the animation (GIF) and the configuration space drawn (PNG).
+"""The pictures people look at: the animation (GIF), the layout and the configuration space drawn (PNG).
 
 On junctions of 3 to 8 legs: the configuration space of a Y is drawn flat (its regions and
 boundary circle), that of a star of 4 to 8 legs as its retract graph ``G_k`` in a table. A test
 of a picture every junction has is parametrized over the number of legs (``legs3`` the demo swap,
-``legs4`` ... ``legs8`` a query on a star of that many legs).
+``legs4`` ... ``legs8`` a query on a star of that many legs). The layout (``layout.png``) runs over
+the table of cases (:mod:`tests.support.cases`); track graphs add the too-close region against the
+track's own distances, the layout's geometry and the route plot (``trajgen plan --plot``).
 """
 
 from __future__ import annotations
@@ -17,20 +19,24 @@ import re
 import numpy as np
 import pytest
 from matplotlib.colors import to_rgb
+from matplotlib.figure import Figure
+from matplotlib.path import Path as PolygonPath
 from PIL import Image
 
 from tests.conftest import REPO
 from tests.support.cases import case
+from tests.support.graph_cases import EXAMPLES
 from tests.support.helpers import LIMITS, animation_gif, conf, legs_cases, legs_id, route_of
-from topology import JUNCTION_INDEX, Instruction, StarGraph, YGraph, plan
+from topology import JUNCTION_INDEX, EdgePoint, Instruction, StarGraph, TrackGraph, YGraph, plan, plan_graph
 from topology.cycle import retract_indexed
 from topology.indexed import segment_region_key
 from trajgen import Exact, certify, default_scenario, load_scenario, make_schedule
 from trajgen.cli import EXIT_BAD_INPUT, EXIT_OK, main
 from trajgen.errors import InputError, OptionError, UnverifiedScheduleError
+from trajgen.model.graph_cells import too_close_polygons
 from trajgen.model.summary import class_label, class_name
-from trajgen.pipeline import PLOT_NAMES
-from trajgen.plots import plot_configuration, png_bytes
+from trajgen.pipeline import JUNCTION_PLOT_NAMES, PLOT_NAMES, Outputs, run
+from trajgen.plots import animate, plot_configuration, plot_coordination, plot_separation, png_bytes
 from trajgen.plots.animation_layout import (
     DEFAULT_MAX_FRAMES,
     END_HOLD_MS,
@@ -45,6 +51,7 @@ from trajgen.plots.animation_layout import (
 )
 from trajgen.plots.configuration_layout import ConfigurationLayout, route_samples, schedule_samples
 from trajgen.plots.gif import gif_bytes
+from trajgen.plots.graph_route import plot_graph_route
 from trajgen.plots.speed import VEHICLE_COLOURS
 from trajgen.plots.star_configuration import (
     BOW,
@@ -55,6 +62,7 @@ from trajgen.plots.star_configuration import (
     route_points,
     schedule_points,
 )
+from trajgen.plots.track_layout import TrackLayout
 
 
 def configuration_png(*arguments, **options) -> bytes:
@@ -807,15 +815,15 @@ def test_the_titles_name_the_class_and_the_rule_that_chose_the_route():
 # -- the pipeline and the command line -------------------------------------------------------------------
 @pytest.mark.parametrize("legs", legs_cases([3, 4, 8], slow={4, 8}))
 def test_plot_writes_configuration_png(tmp_path, capsys, legs):
-    assert "configuration.png" in PLOT_NAMES
+    assert JUNCTION_PLOT_NAMES == ("configuration.png",)
     plots = tmp_path / "plots"
     argv = ["schedule", scenario_file(tmp_path, legs), "--method", "exact", "--plot", str(plots)]
     assert main(argv) == EXIT_OK
     capsys.readouterr()
     data = (plots / "configuration.png").read_bytes()
     assert data.startswith(b"\x89PNG\r\n\x1a\n")
-    assert sorted(p.name for p in plots.iterdir()) == sorted(PLOT_NAMES)
-    for name in PLOT_NAMES:
+    assert sorted(p.name for p in plots.iterdir()) == sorted([*PLOT_NAMES, *JUNCTION_PLOT_NAMES])
+    for name in (*PLOT_NAMES, *JUNCTION_PLOT_NAMES):
         Image.open(plots / name).verify()
 
 
@@ -939,3 +947,229 @@ def test_the_speed_plot_says_what_a_negative_velocity_means(swap_by_method):
 
     title = plot_speed(swap_by_method["optimal"], names=("agv1", "agv2")).axes[0].get_title()
     assert "v < 0 is backing out of a side leg" in title
+
+
+# -- layout.png: every track from above, each vehicle's moves ---------------------------------------------
+
+
+@pytest.mark.parametrize("name", ["h", "passing-loop", "ring"])
+def test_the_moves_of_a_graphs_exact_schedule_are_its_routes_moves(name):
+    """Agreement of two computations: the moves read off the states and the planner's moves."""
+    from trajgen.plots.layout import schedule_moves
+
+    verified = case(name).verified("exact")
+    route = verified.schedule.route
+    moves = schedule_moves(verified.schedule)
+    assert [m.vehicle for m in moves] == [m.vehicle for m in route.moves]
+    assert [m.length for m in moves] == pytest.approx([m.length for m in route.moves], abs=1e-6)
+    track = verified.schedule.track
+    for drawn, planned in zip(moves, route.moves, strict=True):
+        first = EdgePoint(int(drawn.edges[0]), float(drawn.s[0]))
+        last = EdgePoint(int(drawn.edges[-1]), float(drawn.s[-1]))
+        assert track.distance(first, planned.points[0]) <= 1e-6
+        assert track.distance(last, planned.points[-1]) <= 1e-6
+        assert drawn.start < drawn.end
+
+
+def test_the_swaps_moves_in_closed_form():
+    """agv2 backs from B through O to the end of C (20 m), agv1 drives A to B (20 m), agv2 C to A (20 m)."""
+    from trajgen.plots.layout import schedule_moves
+
+    moves = schedule_moves(case("y").verified("exact").schedule)
+    assert [(m.vehicle, round(m.length, 6)) for m in moves] == [(1, 20.0), (0, 20.0), (1, 20.0)]
+    assert moves[0].end <= moves[1].start + 1e-9  # one at a time
+    assert moves[1].end <= moves[2].start + 1e-9
+
+
+@pytest.mark.parametrize("method", ["exact", "toppra"])
+@pytest.mark.parametrize("name", ["y", "4-leg", "8-leg", "h", "passing-loop", "ring"])
+def test_the_layout_of_every_track_draws_each_move_in_its_vehicles_colour(name, method):
+    from trajgen.plots import plot_layout
+    from trajgen.plots.layout import schedule_moves
+
+    verified = case(name).verified(method)
+    figure = plot_layout(verified, names=("agv1", "agv2"))
+    axis = figure.axes[0]
+    coloured = [line for line in axis.get_lines() if line.get_linewidth() == pytest.approx(2.2)]
+    moves = schedule_moves(verified.schedule)
+    assert len(coloured) == len(moves) >= 2
+    for line, move in zip(coloured, moves, strict=True):
+        assert to_rgb(line.get_color()) == to_rgb(VEHICLE_COLOURS[move.vehicle])
+    numbers = sorted(int(t.get_text()) for t in axis.texts if t.get_text().isdigit())
+    assert numbers == list(range(1, len(moves) + 1))
+    assert f"{len(moves)} moves" in axis.get_title()
+    legend = [t.get_text() for t in axis.get_legend().get_texts()]
+    assert legend == ["agv1 start", "agv1 goal", "agv2 start", "agv2 goal"]
+
+
+def test_the_layout_refuses_names_that_are_not_one_per_vehicle():
+    from trajgen.plots import plot_layout
+
+    with pytest.raises(
+        InputError, match=r"plot_layout names must be 2 strings, one per vehicle, got \('a',\)"
+    ):
+        plot_layout(case("y").verified("exact"), names=("a",))
+    with pytest.raises(UnverifiedScheduleError, match="plot_layout"):
+        plot_layout(case("y").verified("exact").schedule)
+
+
+# -- track graphs: the too-close region, the pictures of a run, the layout's geometry, the route plot ------
+
+
+@pytest.mark.parametrize("name", ["h", "passing-loop", "ring-with-spurs", "main-line-with-sidings"])
+def test_the_too_close_polygons_are_exactly_where_the_track_distance_is_below_the_separation(name):
+    """Agreement of two computations: the clipped polygons against the track's own distances."""
+    scenario = load_scenario(EXAMPLES / f"{name}.toml")
+    schedule = make_schedule(scenario.route(), scenario.limits, method="exact")
+    paths, track, d = schedule.paths, scenario.track, scenario.limits.min_separation
+    polygons = [PolygonPath(np.array(part.polygon)) for part in too_close_polygons(track, paths, d)]
+    assert polygons
+    rng = np.random.default_rng(7)
+    points = rng.uniform([0.0, 0.0], [paths[0].length, paths[1].length], size=(4000, 2))
+    inside = np.zeros(len(points), dtype=bool)
+    for polygon in polygons:
+        inside |= polygon.contains_points(points)
+    edge_1, s_1 = paths[0].locate(points[:, 0])
+    edge_2, s_2 = paths[1].locate(points[:, 1])
+    distance = track.distances(edge_1, s_1, edge_2, s_2)
+    clear = np.abs(distance - d) > 1e-6  # on the boundary either answer is right
+    assert np.array_equal(inside[clear], (distance < d)[clear])
+
+
+def test_every_graph_schedules_curve_stays_out_of_the_shaded_region_and_the_figure_compares_them():
+    scenario = load_scenario(EXAMPLES / "h.toml")
+    route = scenario.route()
+    verified = {m: certify(make_schedule(route, scenario.limits, method=m)) for m in ("exact", "toppra")}
+    figure = plot_coordination(verified)
+    axis = figure.axes[0]
+    assert len(axis.patches) == len(too_close_polygons(scenario.track, verified["exact"].schedule.paths, 1.5))
+    for name, v in verified.items():
+        travel = v.schedule.travel(np.linspace(0.0, v.schedule.duration, 2000))[:, 0]
+        for patch in axis.patches:
+            polygon = patch.get_path().transformed(patch.get_patch_transform())
+            assert not polygon.contains_points(travel.T, radius=-1e-6).any(), name
+    labels = [line.get_label() for line in axis.get_lines()]
+    assert any(label.startswith("exact (51.5 s)") for label in labels)
+    separation = plot_separation(verified["toppra"]).axes[0]
+    closest = min(float(np.min(line.get_ydata())) for line in separation.get_lines()[:1])
+    assert closest == pytest.approx(verified["toppra"].report.min_separation, abs=0.02)
+
+
+def test_a_graph_run_with_plots_writes_the_four_pictures_and_its_layout(tmp_path):
+    scenario = load_scenario(EXAMPLES / "passing-loop.toml")
+    result = run(scenario, method="toppra", outputs=Outputs(plot_dir=tmp_path, compare=("exact",)))
+    assert sorted(p.name for p in result.files) == sorted(PLOT_NAMES)
+    for name in PLOT_NAMES:
+        assert (tmp_path / name).read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_the_animation_of_a_graph_schedule_puts_the_vehicles_where_the_layout_draws_their_positions(tmp_path):
+    scenario = load_scenario(EXAMPLES / "h.toml")
+    verified = certify(make_schedule(scenario.route(), scenario.limits, method="exact"))
+    layout = TrackLayout.of(scenario.track)
+    geometry = frame_geometry(verified, [0.0, verified.schedule.duration])
+    for vehicle in range(2):
+        start = layout.point(scenario.start[vehicle])
+        goal = layout.point(scenario.goal[vehicle])
+        assert np.allclose([geometry.x[vehicle, 0], geometry.y[vehicle, 0]], start, atol=1e-9)
+        assert np.allclose([geometry.x[vehicle, -1], geometry.y[vehicle, -1]], goal, atol=1e-9)
+    animation = animate(verified, names=scenario.names, max_frames=20)
+    frames = list(animation.frames())
+    assert len(frames) == animation.frame_count
+    assert frames[0].shape == (600, 640, 3)
+    assert (
+        main(["animate", str(EXAMPLES / "h.toml"), "--out", str(tmp_path / "h.gif"), "--max-frames", "20"])
+        == 0
+    )
+    assert (tmp_path / "h.gif").read_bytes()[:6] == b"GIF89a"
+
+
+def _drawn_length(line: np.ndarray) -> float:
+    return float(np.linalg.norm(np.diff(line, axis=0), axis=1).sum())
+
+
+def test_nodes_are_drawn_where_the_scenario_puts_them_and_edges_as_long_as_they_are():
+    scenario = load_scenario(EXAMPLES / "h.toml")
+    layout = TrackLayout.of(scenario.track)
+    assert layout.given
+    np.testing.assert_allclose(layout.nodes, np.array(scenario.track.coordinates))
+    for number, edge in enumerate(scenario.track.edges):
+        assert _drawn_length(layout.edges[number]) == pytest.approx(edge.length, rel=0.02), edge.name
+        start, end = scenario.track.ends(number)
+        np.testing.assert_allclose(layout.edges[number][[0, -1]], layout.nodes[[start, end]], atol=1e-9)
+
+
+def test_a_passing_loop_is_drawn_apart_from_the_main_and_a_point_lies_at_its_fraction_of_the_edge():
+    scenario = load_scenario(EXAMPLES / "passing-loop.toml")
+    track, layout = scenario.track, TrackLayout.of(scenario.track)
+    main_line, loop = layout.edges[track.edge("main")], layout.edges[track.edge("loop")]
+    assert np.max(np.linalg.norm(main_line - loop, axis=1)) > 2.0  # told apart at a glance
+    half = layout.point(track.point("loop:5.75"))
+    walked = layout.along(track.edge("loop"), 0.0, 5.75)
+    assert _drawn_length(walked) == pytest.approx(_drawn_length(loop) / 2, rel=1e-6)
+    np.testing.assert_allclose(walked[-1], half)
+
+
+def test_without_coordinates_a_line_is_laid_out_straight_at_its_track_distances():
+    track = TrackGraph.from_edges({"p": ("A", "B", 3.0), "q": ("B", "C", 4.0), "r": ("C", "D", 5.0)})
+    layout = TrackLayout.of(track)
+    assert not layout.given
+    gaps = np.linalg.norm(layout.nodes[:, None] - layout.nodes[None], axis=2)
+    np.testing.assert_allclose(gaps, track.node_distances, atol=1e-9)
+
+
+@pytest.mark.parametrize("name", ["h", "main-line-with-sidings", "passing-loop", "ring-with-spurs"])
+def test_each_move_is_drawn_from_where_its_vehicle_is_to_where_it_goes(name):
+    scenario = load_scenario(EXAMPLES / f"{name}.toml")
+    route = scenario.route()
+    layout = TrackLayout.of(scenario.track)
+    where = [layout.point(p) for p in route.start]
+    for number, move in enumerate(route.moves):
+        line = layout.move(route, number)
+        np.testing.assert_allclose(line[0], where[move.vehicle], atol=1e-9)
+        assert _drawn_length(line) >= move.length * 0.98  # drawn edges are at least as long as straight
+        where[move.vehicle] = line[-1]
+    for vehicle in (0, 1):
+        np.testing.assert_allclose(where[vehicle], layout.point(route.goal[vehicle]), atol=1e-9)
+
+
+def test_the_plot_draws_into_the_axis_given_and_returns_its_figure():
+    route = load_scenario(EXAMPLES / "h.toml").route()
+    figure = Figure()
+    ax = figure.subplots(1, 2)[1]
+    assert plot_graph_route(route, names=("agv1", "agv2"), ax=ax) is figure
+    labels = [text.get_text() for text in ax.get_legend().get_texts()]
+    assert labels == ["agv1: start A", "agv1: goal D", "agv2: start D", "agv2: goal A"]
+    assert "agv1 23.5 m, agv2 20.5 m, 3 moves" in ax.get_title()
+    assert isinstance(plot_graph_route(route), Figure)
+    with pytest.raises(InputError, match="plot_graph_route takes a GraphRoute, got str"):
+        plot_graph_route("route")
+
+
+def test_plan_plot_writes_the_picture_of_a_graph_and_of_a_junction(tmp_path, capsys):
+    for scenario, target in (
+        (EXAMPLES / "ring-with-spurs.toml", "ring.png"),
+        (REPO / "examples" / "swap.toml", "y.png"),
+    ):
+        assert main(["plan", str(scenario), "--plot", str(tmp_path / target)]) == 0
+        image = Image.open(io.BytesIO((tmp_path / target).read_bytes()))
+        assert image.format == "PNG"
+        assert min(image.size) > 300
+    capsys.readouterr()
+    assert main(["plan", str(EXAMPLES / "h.toml"), "--plot", str(tmp_path / "h.gif")]) == 2
+    assert "--plot" in capsys.readouterr().err
+    assert not (tmp_path / "h.gif").exists()
+
+
+def test_the_docs_show_a_picture_of_each_example():
+    page = (REPO / "docs" / "graphs.md").read_text(encoding="utf-8")
+    for name in ["h", "main-line-with-sidings", "passing-loop", "ring-with-spurs"]:
+        assert f"images/graph-{name}.png" in page
+        assert (REPO / "docs" / "images" / f"graph-{name}.png").stat().st_size > 10_000
+    route = plan_graph(
+        TrackGraph.from_edges({"a": ("J", "A", 6.0), "b": ("J", "B", 6.0), "c": ("J", "C", 6.0)}),
+        ("A", "B"),
+        ("B", "A"),
+        min_separation=1.5,
+    )
+    assert plot_graph_route(route) is not None

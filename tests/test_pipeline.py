@@ -137,6 +137,7 @@ def test_a_run_certifies_each_schedule_and_commits_every_file(tmp_path, caplog):
         "speed.png",
         "separation.png",
         "coordination.png",
+        "layout.png",
         "configuration.png",
     ]
     assert all(p.is_file() for p in result.files)

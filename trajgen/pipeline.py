@@ -25,7 +25,7 @@ from trajgen.model.summary import graph_route_summary, provenance, route_summary
 from trajgen.scenario import GraphScenario, Scenario
 from trajgen.verification import VerifiedSchedule, certify
 
-__all__ = ["LONG_SCHEDULE_S", "PLOT_NAMES", "Outputs", "RunResult", "run"]
+__all__ = ["JUNCTION_PLOT_NAMES", "LONG_SCHEDULE_S", "PLOT_NAMES", "Outputs", "RunResult", "run"]
 
 logger = logging.getLogger(__name__)
 
@@ -33,7 +33,9 @@ logger = logging.getLogger(__name__)
 LONG_SCHEDULE_S = 86_400.0
 
 #: The files written into the plot folder.
-PLOT_NAMES = ("speed.png", "separation.png", "coordination.png", "configuration.png")
+PLOT_NAMES = ("speed.png", "separation.png", "coordination.png", "layout.png")
+#: The picture a junction's run adds: its configuration space (``G_k`` on four to eight legs).
+JUNCTION_PLOT_NAMES = ("configuration.png",)
 
 
 def _folder(value: object, option: str) -> Path | None:
@@ -93,15 +95,16 @@ class Outputs:
                 "sampled every sample period (its limit is max_rows)"
             )
 
-    def paths(self, names: tuple[str, str]) -> tuple[Path, ...]:
-        """Every file this request writes for vehicles named ``names``."""
+    def paths(self, names: tuple[str, ...], *, junction: bool = False) -> tuple[Path, ...]:
+        """Every file this request writes for vehicles named ``names`` (``junction``: a junction's run)."""
         paths: list[Path] = []
         if self.csv_dir is not None and isinstance(self.dialect, TableDialect):
             paths += table_paths(self.dialect, names, self.csv_dir)
         elif self.csv_dir is not None:
             paths += profile_paths(names, self.csv_dir)
         if self.plot_dir is not None:
-            paths += [self.plot_dir / name for name in PLOT_NAMES]
+            extra = JUNCTION_PLOT_NAMES if junction else ()
+            paths += [self.plot_dir / name for name in (*PLOT_NAMES, *extra)]
         return tuple(paths)
 
 
@@ -223,7 +226,8 @@ def run(
     if not isinstance(scenario, Scenario | GraphScenario):
         raise InputError(f"run expects a Scenario or a GraphScenario, got {type(scenario).__name__}")
     chosen = method_for(method, scenario.track)
-    check_output_paths(outputs.paths(scenario.names))
+    junction = isinstance(scenario, Scenario)  # the configuration space is a junction's picture
+    check_output_paths(outputs.paths(scenario.names, junction=junction))
     tabled = outputs.csv_dir is not None and isinstance(outputs.dialect, TableDialect)
     if tabled:
         check_dialect_method(outputs.dialect, chosen.jerk_limited)
@@ -255,6 +259,7 @@ def run(
         from trajgen.plots import (
             plot_configuration,
             plot_coordination,
+            plot_layout,
             plot_separation,
             plot_speed,
             png_bytes,
@@ -262,15 +267,13 @@ def run(
 
         compared, plot_notes = _comparison(route, scenario, chosen, verified, outputs.compare)
         notes += plot_notes
-        speed, separation, coordination, configuration = (outputs.plot_dir / name for name in PLOT_NAMES)
+        speed, separation, coordination, layout = (outputs.plot_dir / name for name in PLOT_NAMES)
         files[speed] = png_bytes(plot_speed(verified, names=scenario.names))
         files[separation] = png_bytes(plot_separation(verified))
         files[coordination] = png_bytes(plot_coordination(compared))
-        if isinstance(scenario, GraphScenario):  # the track from above with both paths, move by move
-            from trajgen.plots import plot_graph_route
-
-            files[configuration] = png_bytes(plot_graph_route(verified.schedule.route, names=scenario.names))
-        else:
+        files[layout] = png_bytes(plot_layout(verified, names=scenario.names))
+        if junction:
+            configuration = outputs.plot_dir / JUNCTION_PLOT_NAMES[0]
             files[configuration] = png_bytes(plot_configuration(verified, names=scenario.names))
     written = commit_files(files) if files else ()
     # the schedule's route: optimal may have taken another class than the planner's route

@@ -13,7 +13,9 @@ from trajgen import Optimal, Schedule, load_scenario
 from trajgen.execution.goals import schedule_for_execution
 
 #: The files a run with CSV and plots into one folder writes (sorted): the demo's, the README's.
-RUN_FILES = ["agv1.csv", "agv2.csv", "configuration.png", "coordination.png", "separation.png", "speed.png"]
+#: The files of a run with CSV profiles and plots on a track graph; a junction's adds ``configuration.png``.
+GRAPH_RUN_FILES = ["agv1.csv", "agv2.csv", "coordination.png", "layout.png", "separation.png", "speed.png"]
+RUN_FILES = sorted([*GRAPH_RUN_FILES, "configuration.png"])
 
 SLOW = VehicleLimits(max_velocity=0.7, max_acceleration=0.35, max_jerk=0.6)
 AGV = VehicleLimits(max_velocity=1.0, max_acceleration=0.5, max_jerk=1.0)

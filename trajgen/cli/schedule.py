@@ -178,7 +178,8 @@ def register(commands) -> None:
     schedule.add_argument(
         "--plot",
         metavar="DIR",
-        help="write DIR/speed.png, DIR/separation.png, DIR/coordination.png,\n"
+        help="write DIR/speed.png, DIR/separation.png, DIR/coordination.png, DIR/layout.png\n"
+        "(the track from above with each vehicle's moves, numbered); on a junction also\n"
         "DIR/configuration.png (the configuration space drawn flat: route and retraction;\n"
         "4 to 8 legs: the retract graph G_k with the route)",
     )

@@ -27,6 +27,7 @@ if TYPE_CHECKING:
     from trajgen.plots.figure import png_bytes
     from trajgen.plots.gif import encode_gif, gif_bytes
     from trajgen.plots.graph_route import plot_graph_route
+    from trajgen.plots.layout import plot_layout
     from trajgen.plots.live_run import plot_live_run
     from trajgen.plots.separation import plot_separation
     from trajgen.plots.simulation import plot_simulation
@@ -41,6 +42,7 @@ __all__ = [
     "plot_configuration",
     "plot_coordination",
     "plot_graph_route",
+    "plot_layout",
     "plot_live_run",
     "plot_separation",
     "plot_simulation",
@@ -64,6 +66,7 @@ _SOURCES = {
     "plot_configuration": "trajgen.plots.configuration",
     "plot_coordination": "trajgen.plots.coordination",
     "plot_graph_route": "trajgen.plots.graph_route",
+    "plot_layout": "trajgen.plots.layout",
     "plot_live_run": "trajgen.plots.live_run",
     "plot_separation": "trajgen.plots.separation",
     "plot_simulation": "trajgen.plots.simulation",

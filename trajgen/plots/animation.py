@@ -45,6 +45,7 @@ from trajgen.plots.animation_layout import (
 )
 from trajgen.plots.figure import frame_painter, new_figure
 from trajgen.plots.speed import VEHICLE_COLOURS
+from trajgen.plots.track_drawing import draw_track
 from trajgen.plots.track_layout import TrackLayout
 from trajgen.progress import progress
 from trajgen.verification import VerifiedSchedule, require_verified
@@ -72,15 +73,6 @@ def _free_corners(drawn: TrackLayout, labels: list, layout: FrameLayout) -> list
         return float(np.min(np.linalg.norm(every - np.array(corner), axis=1)))
 
     return sorted(corners, key=lambda name: -clearance(corners[name]))
-
-
-def _dead_ends(track: TrackGraph) -> set[int]:
-    """The nodes one edge ends at."""
-    degree = np.zeros(len(track.nodes), dtype=int)
-    for k in range(track.edge_count):
-        for node in track.ends(k):
-            degree[node] += 1
-    return {int(n) for n in np.nonzero(degree == 1)[0]}
 
 
 def _disc(x: float, y: float, radius: float) -> np.ndarray:
@@ -135,12 +127,10 @@ class _Scene:
         return self.figure.add_axes([value / size for value, size in zip(box, sizes, strict=True)])
 
     def _draw_track(self, track: TrackGraph, layout: FrameLayout) -> list:
-        """The track as :class:`~trajgen.plots.track_layout.TrackLayout` draws it; the vehicles' artists.
+        """The track (:func:`~trajgen.plots.track_drawing.draw_track`); returns the vehicles' artists.
 
-        Each edge that ends at a dead end is named with its length beyond that end (a star's legs,
-        a graph's spurs), each other edge beside its middle; each node is named, but for a dead end
-        named after its edge (``<edge>-end``, a star's leg ends: the edge's name says it). Both
-        vehicles' starts and goals are marked, the legend sits in the corner farthest from the track.
+        Both vehicles' starts and goals are marked; the legend and the scale bar sit in the two
+        corners farthest from the track and its labels.
         """
         axis = self._axes(layout.track_box)
         axis.set_xlim(*layout.track_xlim)
@@ -148,39 +138,7 @@ class _Scene:
         axis.set_aspect("auto")  # the limits already give a metre the same pixels both ways
         axis.set_axis_off()
         drawn = TrackLayout.of(track)
-        span = layout.track_xlim[1] - layout.track_xlim[0]
-        dead_ends = _dead_ends(track)
-        labels: list = []
-        for number, line in enumerate(drawn.edges):
-            axis.plot(line[:, 0], line[:, 1], color="0.75", linewidth=7, solid_capstyle="round", zorder=1)
-            edge = track.edges[number]
-            text = f"{edge.name}\n{edge.length:g} m"
-            start, end = track.ends(number)
-            if end in dead_ends or start in dead_ends:
-                tip, before = (line[-1], line[-2]) if end in dead_ends else (line[0], line[1])
-                outward = (tip - before) / max(float(np.hypot(*(tip - before))), 1e-12)
-                label = tip + 0.075 * span * outward
-                labels.append(label)
-                axis.text(*label, text, ha="center", va="center", fontsize=9, color="0.3")
-            else:
-                middle = line[len(line) // 2]
-                labels.append(middle)
-                axis.annotate(
-                    text,
-                    middle,
-                    xytext=(0, -14),
-                    textcoords="offset points",
-                    ha="center",
-                    va="top",
-                    fontsize=8,
-                    color="0.3",
-                )
-        for node, (name, (x, y)) in enumerate(zip(track.nodes, drawn.nodes, strict=True)):
-            axis.plot([x], [y], "o", color="white", markeredgecolor="0.3", markersize=6, zorder=2)
-            mine = [track.edges[k].name for k in range(track.edge_count) if node in track.ends(k)]
-            if node in dead_ends and name in (f"{m}-end" for m in mine):
-                continue
-            axis.annotate(name, (x, y), xytext=(7, 7), textcoords="offset points", fontsize=9, color="0.3")
+        labels = draw_track(axis, drawn)
         self._mark_ends(axis)
         corners = _free_corners(drawn, labels, layout)
         axis.legend(loc=corners[0], fontsize=8, framealpha=0.9, ncols=2)
