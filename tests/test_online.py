@@ -1,5 +1,8 @@
 """The online executor: paths, the braking check, the plan's order kept under faults, goals, bad input.
 
+On junctions, then on track graphs (the braking check and the safety guard against dense sampling,
+the execution form of a path and the graph metric, the executor and closed-loop runs).
+
 The frontier and the coordination diagram are in ``test_coordination.py``; the full 200-scenario
 campaign is ``benchmarks/bench_online.py``; the CLI is in ``test_simulate_cli.py``.
 """
@@ -7,6 +10,8 @@ campaign is ``benchmarks/bench_online.py``; the CLI is in ``test_simulate_cli.py
 from __future__ import annotations
 
 import collections
+import functools
+import json
 import logging
 import math
 import random
@@ -19,19 +24,34 @@ from ruckig import ControlInterface, InputParameter, Ruckig, Trajectory
 
 from limits import ILLUSTRATIVE_LIMITS, Limits, VehicleLimits
 from tests.conftest import REPO
+from tests.support.graph_cases import CONVOY, EXAMPLES, random_routes, verified_example
 from tests.support.helpers import execution_plan, stop_bound
-from topology import JUNCTION_INDEX, Configuration, Position, StarGraph, YGraph
+from topology import JUNCTION_INDEX, Configuration, EdgePoint, Position, StarGraph, TrackGraph, YGraph
 from topology.indexed import separation as indexed_separation
 from trajgen import builtin_scenario, certify, default_scenario, load_scenario, make_schedule
+from trajgen.cli import main
 from trajgen.errors import InputError, UnverifiedScheduleError
-from trajgen.execution import BrakingCheck, Executor, Mode, PathState, VehicleState
-from trajgen.execution.braking_check import emergency_position
-from trajgen.execution.goals import execution_margin, schedule_for_execution
+from trajgen.execution import (
+    BrakingCheck,
+    Executor,
+    Mode,
+    PathState,
+    VehicleState,
+    execution_margin,
+    schedule_for_execution,
+)
+from trajgen.execution.braking_check import ServiceBraking, emergency_position
+from trajgen.execution.faults import FaultError
 from trajgen.execution.messages import Command, Setpoint, checked_state
-from trajgen.execution.plant import Plant
+from trajgen.execution.plant import GraphBody, GraphShape, Plant
+from trajgen.execution.safety_guard import SafetyGuard
 from trajgen.execution.simulation import parse_faults, simulate
+from trajgen.execution.tracks import GraphTrack
+from trajgen.model.graph_paths import graph_paths
+from trajgen.model.graph_vehicle_path import GraphMetric, GraphVehiclePath
 from trajgen.model.paths import VehiclePath
-from trajgen.scenario import Scenario
+from trajgen.scenario import GraphScenario, Scenario
+from trajgen.scenario.graph_sampling import graph_campaign_faults, graph_online_campaign
 from trajgen.scenario.sampling import campaign_faults, online_campaign, random_scenarios
 
 AGV = VehicleLimits(max_velocity=1.0, max_acceleration=0.5, max_jerk=1.0)
@@ -829,3 +849,732 @@ def test_step_of_two_states_is_deprecated_and_steps_as_one_sequence(swap):
     with pytest.warns(DeprecationWarning, match=r"step\(first, second\) is deprecated since trajgen 0.7"):
         old = Executor(swap[1], min_separation=1.5).step(*states)
     assert old == Executor(swap[1], min_separation=1.5).step(states)
+
+
+# -- track graphs: the execution form of a path and the graph metric -------------------------------------
+
+
+FEASIBLE = ["h", "main-line-with-sidings", "passing-loop", "ring-with-spurs"]
+
+
+def _cases():
+    """Every example's route and 12 seeded random ones (trees and loops), with both paths."""
+    for name in FEASIBLE:
+        scenario, verified = verified_example(name, "exact")
+        yield name, scenario.track, verified.schedule.route
+    for seed, route, _ in random_routes(12, 5000):
+        yield f"seed {seed}", route.track, route
+
+
+CASES = list(_cases())
+
+
+@pytest.mark.parametrize(("name", "track", "route"), CASES, ids=[c[0] for c in CASES])
+def test_place_axis_and_heading_agree_with_the_schedules_path(name, track, route):
+    for path in graph_paths(route):
+        fast = GraphVehiclePath.from_path(path, track)
+        p = np.linspace(0.0, path.length, 401)
+        edges, s = path.locate(p)
+        for k, q in enumerate(p):
+            edge, along, heading, axis, _ = fast.place(float(q))
+            assert fast.locate(float(q)) == (edge, along)
+            assert track.distances([edge], [along], [edges[k]], [s[k]])[0] <= 1e-9, (name, q)
+            assert axis == pytest.approx(float(path.axis(q)[0]), abs=1e-9)
+            assert fast.heading(float(q)) == heading
+        assert fast.stops == tuple(path.cusps)
+        assert fast.length == path.length
+
+
+@pytest.mark.parametrize(("name", "track", "route"), CASES, ids=[c[0] for c in CASES])
+def test_a_place_projects_back_to_its_travel_and_an_axis_value_to_its_travel(name, track, route):
+    metric = GraphMetric(track)
+    for path in graph_paths(route):
+        fast = GraphVehiclePath.from_path(path, track, axis_start=3.0)
+        for q in np.linspace(0.0, path.length, 97):
+            q = float(q)
+            edge, s = fast.locate(q)
+            assert fast.project(edge, s, q, metric) == pytest.approx(q, abs=1e-9), (name, q)
+            if fast.edges:
+                velocity = fast.heading(q)  # moving on along its path
+                assert fast.travel_at_axis(fast.axis(q), max(q - 1e-3, 0.0), velocity) == pytest.approx(
+                    q, abs=1e-9
+                )
+
+
+def test_a_position_off_the_path_does_not_project_and_one_past_its_end_runs_on():
+    """Off the path: None. Past the goal along the last edge: travel beyond the length.
+
+    The same for the edge's end node given on another of its edges (the same node).
+    """
+    ran_on, nodes_elsewhere = 0, 0
+    for _, track, route in CASES:
+        metric = GraphMetric(track)
+        fast = GraphVehiclePath.from_path(graph_paths(route)[0], track)
+        if not fast.edges:
+            continue
+        used = set(fast.edges) | set(graph_paths(route)[1].edges.tolist())
+        for other in (k for k in range(track.edge_count) if k not in used):
+            midway = 0.5 * track.length(other)
+            if metric.distance(other, midway, *fast.locate(0.0)) > midway + 1e-6:  # not a neighbour
+                assert fast.project(other, midway, 0.0, metric) is None
+        k = len(fast.edges) - 1
+        edge, ahead = fast.edges[k], (1.0 if fast.s_to[k] > fast.s_from[k] else -1.0)
+        top = track.length(edge)
+        room = top - fast.s_to[k] if ahead > 0 else fast.s_to[k]
+        if room > 0.25:
+            ran_on += 1
+            end = fast.s_to[k] + ahead * 0.25
+            assert fast.project(edge, end, fast.length, metric) == pytest.approx(fast.length + 0.25)
+        node = track.ends(edge)[1 if ahead > 0 else 0]
+        at_node = fast.length + room
+        assert fast.project(edge, top if ahead > 0 else 0.0, at_node, metric) == pytest.approx(at_node)
+        for neighbour in range(track.edge_count):
+            u, v = track.ends(neighbour)
+            if neighbour == edge or node not in (u, v) or neighbour in fast.edges:
+                continue
+            nodes_elsewhere += 1
+            given = 0.0 if u == node else track.length(neighbour)
+            assert fast.project(neighbour, given, at_node, metric) == pytest.approx(at_node), (
+                edge,
+                neighbour,
+            )
+    assert ran_on >= 3, ran_on
+    assert nodes_elsewhere >= 3, nodes_elsewhere
+
+
+def test_the_metric_agrees_with_the_tracks_vectorised_distances():
+    rng = np.random.default_rng(7)
+    for _, track, _ in CASES:
+        metric = GraphMetric(track)
+        lengths = np.array([track.length(k) for k in range(track.edge_count)])
+        ea, eb = rng.integers(0, track.edge_count, 200), rng.integers(0, track.edge_count, 200)
+        sa, sb = rng.random(200) * lengths[ea], rng.random(200) * lengths[eb]
+        expected = track.distances(ea, sa, eb, sb)
+        got = [
+            metric.distance(int(a), float(x), int(b), float(y))
+            for a, x, b, y in zip(ea, sa, eb, sb, strict=True)
+        ]
+        np.testing.assert_allclose(got, expected, rtol=0, atol=1e-12)
+
+
+def test_the_stretch_distance_is_the_least_over_dense_samples_of_both_stretches():
+    rng = np.random.default_rng(11)
+    for _, track, _ in CASES[:8]:
+        metric = GraphMetric(track)
+        for _ in range(30):
+            stretches = []
+            for _ in range(2):
+                edge = int(rng.integers(0, track.edge_count))
+                low, high = sorted(rng.random(2) * track.length(edge))
+                stretches.append((edge, float(low), float(high)))
+            a, b = stretches
+            u, w = np.linspace(a[1], a[2], 60), np.linspace(b[1], b[2], 60)
+            uu, ww = (x.ravel() for x in np.meshgrid(u, w))
+            sampled = track.distances(np.full(uu.size, a[0]), uu, np.full(ww.size, b[0]), ww).min()
+            exact = metric.stretch_distance(a, b)
+            # a lower bound, and within the sampling step of the samples' least
+            step = max(a[2] - a[1], b[2] - b[1]) / 59.0
+            assert exact <= sampled + 1e-12
+            assert exact >= sampled - step - 1e-12
+
+
+@pytest.mark.parametrize(("name", "track", "route"), CASES, ids=[c[0] for c in CASES])
+def test_a_sweep_holds_every_place_of_its_travel_range_and_no_more(name, track, route):
+    metric = GraphMetric(track)
+    rng = np.random.default_rng(3)
+    for path in graph_paths(route):
+        fast = GraphVehiclePath.from_path(path, track)
+        for _ in range(20):
+            low, high = sorted(rng.uniform(-0.5, path.length + 0.5, 2))
+            swept = fast.sweep(float(low), float(high))
+            samples = np.linspace(low, high, 200)
+            places = [_run_on(fast, float(q)) for q in samples]
+            for edge, s in places:
+                assert metric.set_distance(swept, ((edge, s, s),)) <= 1e-9, (name, low, high)
+            # every end of a stretch is within a sample step of a place driven
+            step = (high - low) / 199.0 + 1e-9
+            for edge, lo, hi in swept:
+                for end in (lo, hi):
+                    assert min(metric.distance(edge, end, e, s) for e, s in places) <= step + 1e-9
+
+
+def _run_on(fast: GraphVehiclePath, q: float) -> tuple[int, float]:
+    """Where travel ``q`` puts the vehicle, running on along the end segments' edges (clipped)."""
+    if not fast.edges:
+        return fast.home
+    k = 0 if q < 0.0 else (len(fast.edges) - 1 if q > fast.length else fast.segment(q))
+    sign = 1.0 if fast.s_to[k] > fast.s_from[k] else -1.0
+    s = fast.s_from[k] + sign * (q - fast.starts[k])
+    if 0.0 <= q <= fast.length:
+        return fast.locate(q)
+    return fast.edges[k], min(max(s, 0.0), fast.edge_lengths[fast.edges[k]])
+
+
+def test_an_axis_given_the_other_way_round_flips_every_heading():
+    _, track, route = CASES[0]
+    path = graph_paths(route)[1]
+    along = GraphVehiclePath.from_path(path, track)
+    direction = 1 if path.s_to[0] > path.s_from[0] else -1
+    against = GraphVehiclePath.from_path(path, track, axis_start=2.0, orientation=-direction)
+    assert against.headings == tuple(-h for h in along.headings)
+    for q in np.linspace(0.0, path.length, 21):
+        assert against.axis(float(q)) == pytest.approx(2.0 - along.axis(float(q)))
+
+
+def test_a_vehicle_that_stays_put_sweeps_its_home_and_any_travel_off_it_is_overrun():
+    """Its path does not say which way it would go: travel off 0 is all overrun, in any direction."""
+    still = 0
+    for _, track, route in CASES:
+        for path in graph_paths(route):
+            if path.edges.size:
+                continue
+            still += 1
+            fast = GraphVehiclePath.from_path(path, track)
+            assert fast.sweep(-1.0, 0.5) == ((path.home.edge, path.home.s, path.home.s),)
+            assert fast.overrun(-1.0, 0.5) == 1.0
+            assert fast.overrun(0.0, 0.0) == 0.0
+            assert all(fast.locate(q) == fast.home for q in (-1.0, 0.0, 1.0))
+    assert still >= 1
+
+
+def test_the_overrun_is_what_runs_past_the_end_segments_edge_ends_only():
+    """Within the end segments' edges the sweep holds the run-on: no overrun; past them, the rest."""
+    for _, track, route in CASES:
+        fast = GraphVehiclePath.from_path(graph_paths(route)[0], track)
+        if not fast.edges:
+            continue
+        assert fast.overrun(0.0, fast.length) == 0.0
+        k = len(fast.edges) - 1
+        room = track.length(fast.edges[k]) - fast.s_to[k] if fast.s_to[k] > fast.s_from[k] else fast.s_to[k]
+        assert fast.overrun(0.0, fast.length + room) == pytest.approx(0.0, abs=1e-12)
+        assert fast.overrun(0.0, fast.length + room + 0.3) == pytest.approx(0.3)
+        top = track.length(fast.edges[0])
+        back = fast.s_from[0] if fast.s_to[0] > fast.s_from[0] else top - fast.s_from[0]
+        assert fast.overrun(-back - 0.2, fast.length) == pytest.approx(0.2)
+
+
+@pytest.mark.parametrize(("name", "track", "route"), CASES, ids=[c[0] for c in CASES])
+def test_the_branch_is_the_edge_the_vehicle_is_on_once_it_leaves_its_segment(name, track, route):
+    for path in graph_paths(route):
+        fast = GraphVehiclePath.from_path(path, track)
+        for k in range(len(fast.edges)):
+            end = fast.starts[k + 1] if k + 1 < len(fast.edges) else fast.length
+            middle = 0.5 * (fast.starts[k] + end)
+            after = fast.place(min(end + 1e-6, fast.length))[0] if k + 1 < len(fast.edges) else fast.edges[k]
+            assert fast.place(middle)[4] == after, (name, k)
+
+
+# -- track graphs: the braking check and the safety guard ------------------------------------------------
+
+
+EMERGENCY = (1.0, 1.0)
+
+
+def _paths(name: str):
+    scenario, verified = verified_example(name, "exact")
+    track = scenario.track
+    paths = tuple(GraphVehiclePath.from_path(p, track) for p in graph_paths(verified.schedule.route))
+    return track, GraphMetric(track), paths
+
+
+@pytest.mark.slow  # a sampled campaign over every example's plan
+@pytest.mark.parametrize("name", ["h", "ring-with-spurs", "main-line-with-sidings"])
+def test_what_the_braking_check_certifies_keeps_the_distance_at_every_sampled_instant(name):
+    """Random states along both paths: a certified pair never comes closer than required when sampled."""
+    track, metric, paths = _paths(name)
+    graph_path_pair = graph_paths(verified_example(name, "exact")[1].schedule.route)
+    check = BrakingCheck((AGV, AGV), EMERGENCY, metric)
+    rng = np.random.default_rng(5)
+    outcomes = []
+    for _ in range(60):
+        states = []
+        for path in paths:
+            p = float(rng.uniform(0.0, path.length)) if path.edges else 0.0
+            v = float(rng.uniform(0.0, AGV.max_velocity)) if path.edges else 0.0
+            states.append(PathState(p, v, 0.0))
+        required = 1.5
+        certified = check.clearance(paths, tuple(states), tuple(states), required)
+        least = _least_distance_of_places(track, graph_path_pair, states, states, steps=300, samples=3)
+        if certified:
+            assert least >= required - 1e-9, (name, states, least)
+        outcomes.append((certified, least >= required))
+    # neither always yes nor always no, and rarely pessimistic where the sample has room
+    assert any(c for c, _ in outcomes)
+    assert not all(c for c, _ in outcomes)
+    roomy = [c for c, room in outcomes if room]
+    assert sum(roomy) >= 0.8 * len(roomy)
+
+
+def test_the_guard_takes_a_track_graph_and_measures_its_track_distance():
+    track, metric, paths = _paths("h")
+    limits = Limits((AGV, AGV), 1.5)
+    guard = SafetyGuard(limits, track)
+
+    class Measured:
+        def __init__(self, place):
+            self.leg, self.s = place
+
+    # the vehicles at their starts: the guard's required distance is the separation, or what they have
+    first, second = paths[0].locate(0.0), paths[1].locate(0.0)
+    apart = metric.distance(*first, *second)
+    assert guard.required((Measured(first), Measured(second))) == pytest.approx(
+        min(1.5 - 1e-6, apart - 1e-12)
+    )
+    at_rest = (PathState(0.0, 0.0, 0.0), PathState(0.0, 0.0, 0.0))
+    assert guard.certifies(paths, at_rest, at_rest, guard.required((Measured(first), Measured(second))))
+
+
+def _beyond(track, edge: int, s: float) -> list[tuple[int, float]]:
+    """Every place ``s`` metres along ``edge`` can be, ``s`` possibly beyond the edge's ends.
+
+    Past an end node the vehicle is on one of the node's edges (any: the track does not say which),
+    as far from the node as it ran past it. Written from the track alone, not from the sweep.
+    """
+    length = track.length(edge)
+    if 0.0 <= s <= length:
+        return [(edge, s)]
+    node, past = (track.ends(edge)[0], -s) if s < 0.0 else (track.ends(edge)[1], s - length)
+    places = []
+    for other in range(track.edge_count):
+        u, v = track.ends(other)
+        reach = min(past, track.length(other))
+        if u == node:
+            places.append((other, reach))
+        if v == node:
+            places.append((other, track.length(other) - reach))
+    return places
+
+
+def _places(track, path, p: float) -> list[tuple[int, float]]:
+    """Where a vehicle whose path is ``path`` (a GraphPath) can be at travel ``p``."""
+    if path.edges.size == 0:
+        edge, s = path.home.edge, path.home.s
+        return _beyond(track, edge, s - abs(p)) + _beyond(track, edge, s + abs(p))
+    if 0.0 <= p <= path.length:
+        edges, s = path.locate(p)
+        return [(int(edges[0]), float(s[0]))]
+    if p < 0.0:
+        return _beyond(track, int(path.edges[0]), float(path.s_from[0] + path.directions[0] * p))
+    return _beyond(track, int(path.edges[-1]), float(path.s_to[-1] + path.directions[-1] * (p - path.length)))
+
+
+def _least_distance_of_places(track, graph_path_pair, commanded, measured, steps: int, samples: int) -> float:
+    """The least track distance between the places the two braking vehicles can be (a dense sample).
+
+    At ``steps`` instants and ``samples`` travel values across each vehicle's range there.
+    """
+    trajectories = [ServiceBraking(AGV).trajectory(state) for state in commanded]
+    horizon = max(
+        *(t.duration for t in trajectories), *(abs(m.v) / e for m, e in zip(measured, EMERGENCY, strict=True))
+    )
+    least = np.inf
+    for t in np.linspace(0.0, horizon, steps):
+        places = []
+        for v in (0, 1):
+            trajectory = trajectories[v]
+            upper = trajectory.at_time(min(t, trajectory.duration))[0][0]
+            lower = emergency_position(measured[v], EMERGENCY[v], t)
+            places.append(
+                [q for p in np.linspace(lower, upper, samples) for q in _places(track, graph_path_pair[v], p)]
+            )
+        first = np.array([(e, s) for e, s in places[0] for _ in places[1]])
+        second = np.array([(e, s) for _ in places[0] for e, s in places[1]])
+        apart = track.distances(first[:, 0].astype(int), first[:, 1], second[:, 0].astype(int), second[:, 1])
+        least = min(least, float(apart.min()))
+    return least
+
+
+def test_a_stop_that_runs_past_a_goal_at_a_track_node_is_not_certified(tmp_path):
+    """A vehicle 1 cm before its goal at a track node at 0.5 m/s runs past it: not certified.
+
+    agv1 parks at node J exactly the separation behind agv2 (at e:1.5); its emergency stop runs
+    11.5 cm past J onto e, 1.385 m from agv2. The sweep stops at J (the end of agv1's edge w);
+    what runs past J is the path's overrun, taken off the distance. Arriving at rest, the same
+    plan is certified.
+    """
+    text = CONVOY.replace('goal = "e:5.5"', 'goal = "J"').replace('goal = "e:7"', 'goal = "e:1.5"')
+    scenario_file = tmp_path / "convoy_at_node.toml"
+    scenario_file.write_text(text)
+    route = load_scenario(scenario_file).route()
+    track = route.track
+    graph_path_pair = graph_paths(route)
+    paths = tuple(GraphVehiclePath.from_path(p, track) for p in graph_path_pair)
+    check = BrakingCheck((AGV, AGV), EMERGENCY, GraphMetric(track))
+    ends = (PathState(paths[0].length, 0.0, 0.0), PathState(paths[1].length, 0.0, 0.0))
+    required = 1.5 - 1e-6
+    assert paths[0].overrun(paths[0].length, paths[0].length + 0.115) == pytest.approx(0.115)
+    running_on = (PathState(paths[0].length - 0.01, 0.5, 0.0), ends[1])
+    truth = _least_distance_of_places(track, graph_path_pair, ends, running_on, steps=400, samples=5)
+    assert truth == pytest.approx(1.385, abs=1e-3)
+    assert not check.clearance(paths, ends, running_on, required)
+    assert check.clearance(paths, ends, ends, required)
+
+
+def test_a_vehicle_that_should_stay_put_and_moves_is_not_certified_by_its_home_point():
+    """A path with no segments sweeps its home point; travel away from it is overrun, any way."""
+    _, metric, _ = _paths("h")
+    still = GraphVehiclePath((), (), (), (), (), (0.0,), 0.0, (), (0, 3.0), metric.lengths)
+    assert still.sweep(-0.5, 0.25) == ((0, 3.0, 3.0),)
+    assert still.overrun(-0.5, 0.25) == 0.5
+    assert still.overrun(0.0, 0.0) == 0.0
+
+
+# -- track graphs: the executor and closed-loop runs -----------------------------------------------------
+
+
+NAMES = ["h", "passing-loop", "main-line-with-sidings", "ring-with-spurs"]
+
+
+@functools.cache
+def plan(name: str, method: str):
+    """The example ``name``'s scenario and its verified plan for execution by ``method``, once."""
+    scenario = load_scenario(EXAMPLES / f"{name}.toml")
+    return scenario, schedule_for_execution(scenario, method=method)
+
+
+@pytest.mark.parametrize("method", ["exact", "toppra"])
+@pytest.mark.parametrize("name", NAMES)
+def test_an_undisturbed_run_on_a_graph_plays_its_plan_and_never_brakes(name, method):
+    scenario, verified = plan(name, method)
+    result, _ = simulate(scenario, verified=verified)
+    assert result.reached_goal
+    assert abs(result.makespan_s - result.planned_s) <= 0.01 * result.planned_s + 0.02, result.summary()
+    assert result.violations == 0
+    assert result.holds == 0
+    assert result.emergency_brakes == 0
+    assert [e.kind for e in result.events] == ["done"], result.events
+    # the conflicts keep the separation and the margin; the plan keeps a second margin of clearance
+    assert result.certified_separation_m >= scenario.limits.min_separation + result.position_margin - 1e-6
+
+
+@pytest.mark.slow  # a stop at every moment: a campaign, as on a junction
+@pytest.mark.parametrize("method", ["exact", "toppra"])
+@pytest.mark.parametrize("name", ["h", "passing-loop"])
+def test_a_stop_at_any_moment_on_the_h_and_the_passing_loop_costs_at_most_its_bound(name, method):
+    """Seeded stops of either vehicle, anywhere in the run, 0.5 to 10 s: the issue's bound, 0 violations."""
+    scenario, verified = plan(name, method)
+    rng = random.Random(f"{name}-{method}")
+    for _ in range(6):
+        vehicle = rng.choice(scenario.names)
+        spec = (
+            f"stop:{vehicle}@{rng.uniform(0.0, verified.schedule.duration):.2f}+{rng.uniform(0.5, 10.0):.2f}"
+        )
+        faults = parse_faults(scenario, [spec])
+        result, _ = simulate(scenario, faults, verified=verified)
+        assert result.reached_goal, spec
+        assert result.violations == 0, spec
+        assert result.emergency_brakes == 0, spec
+        assert result.makespan_s - result.planned_s <= stop_bound(scenario, faults[0].value), (
+            spec,
+            result.summary(),
+        )
+
+
+@pytest.mark.parametrize(
+    ("name", "method", "spec"),
+    [
+        # agv1 waits at its frontier for agv2 to clear J2; a jump back sets its drive closing the gap
+        ("passing-loop", "exact", "jump:agv1@22.4=-0.04"),
+        ("ring-with-spurs", "exact", "jump:agv1@32.07=-0.04"),
+        # agv1 stops while agv2, on the plan's clock, drives a toppra plan at its frontier
+        ("h", "toppra", "stop:agv1@10+5"),
+    ],
+    ids=["jump-while-waiting-loop", "jump-while-waiting-ring", "toppra-follower-at-its-frontier"],
+)
+def test_the_runs_that_overshot_a_frontier_and_deadlocked_now_reach_the_goal(name, method, spec):
+    """Each ran past its frontier into the conflict and both waited for ever (holds, no goal)."""
+    scenario, verified = plan(name, method)
+    faults = parse_faults(scenario, [spec])
+    result, _ = simulate(scenario, faults, verified=verified)
+    assert result.reached_goal, result.summary()
+    assert result.violations == 0
+    assert result.emergency_brakes == 0
+    if faults[0].kind.value == "stop":
+        assert result.makespan_s - result.planned_s <= stop_bound(scenario, faults[0].value)
+
+
+@pytest.mark.parametrize(
+    "name",
+    ["h", pytest.param("main-line-with-sidings", marks=pytest.mark.slow)],  # the H in the fast set
+)
+def test_slowdowns_lags_and_jumps_on_a_graph_keep_the_separation_and_reach_the_goal(name):
+    scenario, verified = plan(name, "exact")
+    margin = execution_margin(scenario, 0.05)
+    rng = random.Random(name)
+    for _ in range(6):
+        vehicle = rng.choice(scenario.names)
+        at = rng.uniform(0.0, verified.schedule.duration)
+        spec = rng.choice(
+            [
+                f"slow:{vehicle}@{at:.2f}+{rng.uniform(1.0, 8.0):.2f}=0.3",
+                f"lag:{vehicle}@{at:.2f}=150",
+                f"jump:{vehicle}@{at:.2f}={rng.choice([-1, 1]) * margin * 0.8:.4f}",
+            ]
+        )
+        result, _ = simulate(scenario, parse_faults(scenario, [spec]), verified=verified)
+        assert result.reached_goal, spec
+        assert result.violations == 0, spec
+        assert result.emergency_brakes == 0, spec
+
+
+@pytest.mark.parametrize(
+    "spec",
+    ["goal:agv1@10=C", "goal:agv2@5=b:3", "goal:agv1@15=J2", "goal:agv1@12=e:6"],
+)
+def test_a_new_goal_on_a_graph_stops_both_replans_and_reaches_it(spec):
+    """The vehicles stop, the exact planner plans from where they stand, and the new goal is reached.
+
+    The re-planned paths continue each vehicle's own axis, also where it stands at a node and leaves
+    on another edge: after the re-plan no vehicle is off its setpoints.
+    """
+    scenario, verified = plan("h", "toppra")
+    faults = parse_faults(scenario, [spec])
+    final = []
+
+    def observe(executor, measured, command):
+        final[:] = [measured, executor.goal]
+
+    result, _ = simulate(scenario, faults, verified=verified, observer=observe)
+    assert result.reached_goal, result.summary()
+    assert result.replans == 1
+    assert result.violations == 0
+    assert result.emergency_brakes == 0
+    kinds = [e.kind for e in result.events]
+    assert "replan" in kinds
+    after = result.events[kinds.index("replan") :]
+    assert not any("off its setpoints" in e.detail for e in after), result.events
+    measured, goal = final
+    track = scenario.track
+    wanted = track.point(faults[0].goal)
+    assert goal[faults[0].vehicle] == wanted
+    for state, point in zip(measured, goal, strict=True):
+        assert track.distance(EdgePoint(state.leg, state.s), point) <= 0.05
+
+
+def test_a_goal_too_close_to_the_other_vehicles_is_refused_and_the_run_goes_on():
+    scenario, verified = plan("h", "exact")
+    result, _ = simulate(scenario, parse_faults(scenario, ["goal:agv1@8=A"]), verified=verified)
+    assert result.reached_goal
+    assert result.replans == 0
+    assert result.rejected_goals == 1
+    refused = [e.detail for e in result.events if e.kind == "goal-refused"]
+    assert refused
+    assert "goal (A, A) leaves the vehicles 0.000 m apart: expected at least 1.600 m" in refused[0]
+    assert "(separation + twice the position margin" in refused[0]  # 1.5 + 2 x 0.05
+
+
+def test_a_goal_fault_off_the_graph_names_the_spec():
+    scenario, _ = plan("h", "exact")
+    with pytest.raises(FaultError, match=r"fault 'goal:agv1@3=zz:1': goal: .*zz"):
+        parse_faults(scenario, ["goal:agv1@3=zz:1"])
+
+
+def test_a_measured_state_off_the_track_graph_is_refused_naming_the_edge():
+    scenario, verified = plan("h", "exact")
+    executor = Executor(verified, names=scenario.names)
+    ok = VehicleState(0, 6.0)
+    with pytest.raises(InputError, match=r"vehicle 1 measured edge must be an edge index 0 to 4 .* got 7"):
+        executor.step((VehicleState(7, 1.0), ok))
+    with pytest.raises(
+        InputError, match=r"vehicle 2 measured s 9\.0 m is off edge 'a': expected 0 to 6\.0 m"
+    ):
+        executor.step((ok, VehicleState(0, 9.0)))
+    with pytest.raises(InputError, match=r"vehicle 1 measured velocity must be a finite number, got nan"):
+        executor.step((VehicleState(0, 6.0, float("nan")), ok))
+    track = GraphTrack(scenario.track)
+    assert track.check_state(VehicleState(0, 6.0 + 5e-7), 1).s == 6.0  # round-off at the end is on it
+
+
+def test_a_body_passes_a_node_onto_the_edge_it_is_steered_to():
+    """Closed form: through J2 from m onto e and onto c and back onto m; a dead end stops it."""
+    track = TrackGraph.from_edges(
+        {"m": ("J1", "J2", 8.0), "e": ("J2", "D", 6.5), "c": ("C", "J2", 6.0), "a": ("J1", "A", 6.0)}
+    )
+    shape = GraphShape(track)
+    m, e, c, a = (track.edge(name) for name in "meca")
+
+    class Steer:
+        def __init__(self, leg, branch):
+            self.leg, self.branch = leg, branch
+
+    body = GraphBody(m, 7.9, 1, 0.0)
+    body.steer(Steer(m, e))
+    body.move(0.3, shape)
+    assert (body.leg, body.s, body.orientation, body.axis) == (e, pytest.approx(0.2), 1, pytest.approx(0.3))
+    body = GraphBody(m, 7.9, 1, 0.0)  # onto c, whose "to" node is J2: s counts down from its length
+    body.steer(Steer(c, c))
+    body.move(0.3, shape)
+    assert (body.leg, body.s, body.orientation) == (c, pytest.approx(5.8), -1)
+    body.steer(Steer(m, m))  # and back through J2 onto m, driving the axis the other way
+    body.move(-0.5, shape)
+    assert (body.leg, body.s, body.orientation) == (m, pytest.approx(7.7), 1)
+    body = GraphBody(a, 5.9, 1, 0.0)  # A is a dead end: the vehicle stops there, at rest
+    body.v = 0.5
+    body.steer(Steer(a, a))
+    body.move(0.3, shape)
+    assert (body.leg, body.s, body.axis, body.v) == (a, 6.0, pytest.approx(0.1), 0.0)
+
+
+def test_simulate_on_the_h_writes_a_trace_whose_rows_keep_the_separation(tmp_path):
+    """``trajgen simulate`` on a graph: the trace's rows, read back and measured by the track alone."""
+    code = main(
+        [
+            "simulate",
+            str(EXAMPLES / "h.toml"),
+            "--method",
+            "exact",
+            "--fault",
+            "stop:agv1@10+5",
+            "--trace",
+            str(tmp_path / "trace"),
+            "--json",
+        ]
+    )
+    assert code == 0
+    scenario = load_scenario(EXAMPLES / "h.toml")
+    track = scenario.track
+    rows = []
+    for name in scenario.names:
+        lines = (tmp_path / "trace" / f"{name}.csv").read_text().splitlines()
+        assert lines[0] == "t_s;axis_m;v_mps;a_mps2;j_mps3;edge;s_m;x_m;y_m"
+        fields = [line.split(";") for line in lines[1:]]
+        edges = np.array([track.edge(f[5]) for f in fields])
+        s = np.array([float(f[6]) for f in fields])
+        rows.append((edges, s))
+    assert rows[0][0].size == rows[1][0].size > 1000
+    apart = track.distances(rows[0][0], rows[0][1], rows[1][0], rows[1][1])
+    assert apart.min() >= scenario.limits.min_separation - 1e-6
+    start = [
+        track.distance(EdgePoint(int(r[0][0]), r[1][0]), p) for r, p in zip(rows, scenario.start, strict=True)
+    ]
+    goal = [
+        track.distance(EdgePoint(int(r[0][-1]), r[1][-1]), p)
+        for r, p in zip(rows, scenario.goal, strict=True)
+    ]
+    assert max(start) <= 1e-9
+    assert max(goal) <= 0.01
+
+
+def test_simulate_json_on_a_graph_reports_the_run(capsys):
+    code = main(["simulate", str(EXAMPLES / "passing-loop.toml"), "--method", "exact", "--json"])
+    assert code == 0
+    summary = json.loads(capsys.readouterr().out)
+    assert summary["reached_goal"] is True
+    assert summary["separation_violations"] == 0
+    assert summary["emergency_brakes"] == 0
+
+
+def test_the_margin_on_a_graph_shrinks_to_what_the_start_and_goal_leave():
+    track = TrackGraph.from_edges({"a": ("J", "A", 6.0), "b": ("J", "B", 6.0), "c": ("J", "C", 6.0)})
+    agv = VehicleLimits(max_velocity=1.0, max_acceleration=0.5, max_jerk=1.0)
+    scenario = GraphScenario(track, Limits((agv, agv), 1.5), ("agv1", "agv2"), ("a:1.56", "b:0"), ("A", "B"))
+    # the start leaves 1.56 m: 0.03 m each side of the separation
+    assert execution_margin(scenario, 0.05) == pytest.approx(0.03)
+    result, _ = simulate(scenario, method="exact")
+    assert result.reached_goal
+    assert result.violations == 0
+
+
+@pytest.mark.slow  # simulations of seeded random tracks with faults
+@pytest.mark.parametrize("method", ["exact", "toppra"])
+def test_seeded_random_track_graphs_with_faults_reach_their_goals_without_a_violation(method):
+    """Trees and graphs with loops, random limits, one to three faults each (the bench's campaign)."""
+    for k, scenario in enumerate(graph_online_campaign(8, seed=23)):
+        verified = schedule_for_execution(scenario, method=method)
+        margin = execution_margin(scenario, 0.05)
+        specs = graph_campaign_faults(scenario, verified.schedule.duration, seed=k, margin=margin)
+        result, _ = simulate(scenario, parse_faults(scenario, specs), verified=verified)
+        assert result.reached_goal, (k, specs)
+        assert result.violations == 0, (k, specs, result.summary())
+        assert result.emergency_brakes == 0, (k, specs)
+
+
+def test_the_campaign_draws_trees_and_loops_whose_start_and_goal_keep_the_separation():
+    scenarios = graph_online_campaign(6, seed=5)
+    assert scenarios == graph_online_campaign(6, seed=5)  # seeded: the same draw
+    for k, scenario in enumerate(scenarios):
+        track = scenario.track
+        cycle = track.edge_count - len(track.nodes) + 1  # independent loops of a connected graph
+        assert (cycle > 0) == (k % 2 == 1), k
+        for pair in (scenario.start, scenario.goal):
+            assert track.distance(*pair) >= scenario.limits.min_separation
+        scenario.route()  # a route exists
+
+
+def test_a_throttled_drive_brakes_down_to_its_cap_no_harder_than_its_max_acceleration():
+    """A slow fault caps agv1 at 0.2 m/s while it drives at 1 m/s: it slows at most at 0.5 m/s².
+
+    A drive dropping to its cap within one cycle (80 m/s² here) made the braking check assume the
+    worst of it and brake both hard (a campaign run on a random graph: 5 emergency-brake cycles); a
+    drive slowing at its emergency deceleration still stepped its speed beyond what it can (issue 38).
+    """
+    scenario, verified = plan("h", "exact")
+    vehicle = scenario.limits.vehicles[0]
+    accelerations, speeds = [], []
+
+    def observe(executor, measured, command):
+        accelerations.append(measured[0].acceleration)
+        speeds.append(abs(measured[0].velocity))
+
+    result, _ = simulate(
+        scenario, parse_faults(scenario, ["slow:agv1@3=0.2"]), verified=verified, observer=observe
+    )
+    assert result.reached_goal
+    assert result.violations == 0
+    assert result.emergency_brakes == 0
+    assert max(speeds[290:310]) > 0.9  # it was at speed when the cap came
+    assert min(accelerations) >= -vehicle.max_acceleration - 1e-9
+    assert np.max(np.abs(np.diff(speeds))) <= vehicle.max_acceleration * 0.01 * (1 + 1e-6)
+    settled = 300 + math.ceil((max(speeds[290:310]) - 0.2) / vehicle.max_acceleration / 0.01) + 2
+    assert max(speeds[settled:]) <= 0.2 + 1e-9  # and then kept to the cap
+
+
+def test_a_vehicle_that_stays_put_through_a_re_plan_on_a_track_graph_drives_its_next_move_the_right_way():
+    """A plan in which a vehicle does not move keeps the way its axis runs.
+
+    agv1's axis runs against ``s`` (it starts by driving towards J); a new goal for agv2 leaves it
+    where it stands; its own next goal must then be driven towards A (it drove towards J).
+    """
+    track = TrackGraph.from_edges({"a": ("J", "A", 10.0), "b": ("J", "B", 10.0), "c": ("J", "C", 10.0)})
+    drive = VehicleLimits(max_velocity=1.0, max_acceleration=0.5, max_jerk=1.0)
+    limits = Limits((drive, drive), 1.5)
+    scenario = GraphScenario(track, limits, ("agv1", "agv2"), ("a:8", "b:5"), ("a:3", "b:5"))
+    verified = schedule_for_execution(scenario, method="exact")
+    final = []
+
+    def observe(executor, measured, command):
+        final[:] = measured
+
+    faults = parse_faults(scenario, ["goal:agv2@12=b:8", "goal:agv1@30=a:9"])
+    result, _ = simulate(scenario, faults, verified=verified, observer=observe)
+    assert result.reached_goal, result.summary()
+    assert result.replans == 2
+    assert not any("off its setpoints" in e.detail for e in result.events), result.events
+    assert (final[0].leg, final[1].leg) == (0, 1)
+    assert final[0].s == pytest.approx(9.0, abs=0.05)
+    assert final[1].s == pytest.approx(8.0, abs=0.05)
+
+
+@pytest.mark.parametrize(
+    ("seed", "k", "specs", "emergency"),
+    [
+        # a jump back leaves the drive closing the gap faster than planned: restarted at that
+        # speed, it could not stop at its reversal and waited there for ever
+        (9, 7, ("jump:agv1@6.476=-0.04289",), False),
+        (9, 7, ("jump:agv1@6.476=-0.04289", "slow:agv2@2.121=0.4481"), False),
+        # a lagging drive braked hard stops short of its setpoint; the check took it anywhere up to
+        # the setpoint, too close to the other, and braked both, at rest, for ever
+        (12, 3, ("lag:agv1@4.143=174", "slow:agv1@4.814=1.1585"), True),
+    ],
+    ids=["jump", "jump-slow", "lag-slow"],
+)
+def test_campaign_runs_that_never_reached_the_goal_with_toppra_now_do(seed, k, specs, emergency):
+    scenario = graph_online_campaign(k + 1, seed=seed)[k]
+    verified = schedule_for_execution(scenario, method="toppra")
+    result, _ = simulate(scenario, parse_faults(scenario, specs), verified=verified)
+    assert result.reached_goal, result.summary()
+    assert result.violations == 0
+    if not emergency:
+        assert result.emergency_brakes == 0
+    else:  # the lag hides the drive from its setpoints: braking hard is right, but only until at rest
+        assert result.emergency_brakes < 100
