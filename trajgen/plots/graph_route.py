@@ -1,8 +1,9 @@
 """A route on a track graph drawn from above: the track, where each vehicle starts and ends, its moves.
 
-The geometry is :class:`trajgen.plots.track_layout.TrackLayout`'s; this module only draws it. Each
-move is a line in its vehicle's colour, numbered at its middle in the order of the route and
-arrowed at its end; a hollow circle marks where a vehicle starts, a hollow square where it ends.
+The geometry is :class:`trajgen.plots.track_layout.TrackLayout`'s, the track drawn as every picture
+draws it (:func:`~trajgen.plots.track_drawing.draw_track`). Each move is a line in its vehicle's
+colour, numbered at its middle in the order of the route and arrowed at its end; a hollow circle
+marks where a vehicle starts, a hollow square where it ends.
 """
 
 from __future__ import annotations
@@ -10,12 +11,11 @@ from __future__ import annotations
 from topology import GraphRoute
 from trajgen.errors import InputError
 from trajgen.plots.figure import drawing_axis, finished
+from trajgen.plots.speed import VEHICLE_COLOURS
+from trajgen.plots.track_drawing import draw_move, draw_track, fit_track, mark_end
 from trajgen.plots.track_layout import TrackLayout
 
-__all__ = ["VEHICLE_COLOURS", "plot_graph_route"]
-
-#: Each vehicle's colour (the animation's).
-VEHICLE_COLOURS = ("tab:blue", "tab:orange")
+__all__ = ["plot_graph_route"]
 
 
 def plot_graph_route(route: GraphRoute, *, names: tuple[str, str] = ("vehicle 1", "vehicle 2"), ax=None):
@@ -44,73 +44,20 @@ def plot_graph_route(route: GraphRoute, *, names: tuple[str, str] = ("vehicle 1"
         raise InputError(f"plot_graph_route takes a GraphRoute, got {type(route).__name__}")
     track = route.track
     layout = TrackLayout.of(track)
-    size = layout.extent
     axis = drawing_axis(ax, figsize=(9, 7))
-    for number, line in enumerate(layout.edges):
-        axis.plot(line[:, 0], line[:, 1], color="0.6", linewidth=6, solid_capstyle="round", zorder=1)
-        middle = line[len(line) // 2]
-        axis.annotate(
-            track.edges[number].name,
-            middle,
-            xytext=(0, -12),
-            textcoords="offset points",
-            ha="center",
-            fontsize=8,
-            color="0.35",
-        )
-    axis.plot(layout.nodes[:, 0], layout.nodes[:, 1], "o", color="0.3", markersize=5, zorder=2)
-    for name, (x, y) in zip(track.nodes, layout.nodes, strict=True):
-        axis.annotate(name, (x, y), xytext=(5, 5), textcoords="offset points", fontsize=9, weight="bold")
-    shift = 0.012 * size  # the two vehicles' lines side by side where they share the track
-    for number, move in enumerate(route.moves):
-        colour = VEHICLE_COLOURS[move.vehicle]
-        line = layout.move(route, number) + (shift if move.vehicle == 0 else -shift)
-        axis.plot(line[:, 0], line[:, 1], color=colour, linewidth=2.2, zorder=3)
-        if len(line) >= 2:
-            axis.annotate(
-                "",
-                line[-1],
-                xytext=line[-2],
-                arrowprops={"arrowstyle": "-|>", "color": colour, "lw": 2.2},
-                zorder=4,
-            )
-        middle = line[len(line) // 2]
-        axis.annotate(
-            str(number + 1),
-            middle,
-            ha="center",
-            va="center",
-            fontsize=8,
-            color="white",
-            weight="bold",
-            bbox={"boxstyle": "circle,pad=0.2", "facecolor": colour, "edgecolor": "none"},
-            zorder=5,
-        )
+    fit_track(axis, layout)
+    draw_track(axis, layout, width=6.0, fontsize=8.0)
+    shift = 0.012 * layout.extent  # the two vehicles' lines side by side where they share the track
+    for number, move in enumerate(route.moves, start=1):
+        line = layout.move(route, number - 1) + (shift if move.vehicle == 0 else -shift)
+        draw_move(axis, line, VEHICLE_COLOURS[move.vehicle], number)
     for vehicle in (0, 1):
         colour = VEHICLE_COLOURS[vehicle]
-        start, goal = layout.point(route.start[vehicle]), layout.point(route.goal[vehicle])
-        axis.plot(
-            *start,
-            "o",
-            markersize=12,
-            markerfacecolor="none",
-            markeredgecolor=colour,
-            markeredgewidth=2,
-            zorder=6,
-            label=f"{names[vehicle]}: start {track.name(route.start[vehicle])}",
-        )
-        axis.plot(
-            *goal,
-            "s",
-            markersize=12,
-            markerfacecolor="none",
-            markeredgecolor=colour,
-            markeredgewidth=2,
-            zorder=6,
-            label=f"{names[vehicle]}: goal {track.name(route.goal[vehicle])}",
-        )
-    axis.set_aspect("equal", adjustable="datalim")
-    axis.margins(0.08)
+        for point, goal in ((route.start[vehicle], False), (route.goal[vehicle], True)):
+            what = "goal" if goal else "start"
+            label = f"{names[vehicle]}: {what} {track.name(point)}"
+            mark_end(axis, layout.point(point), goal=goal, colour=colour, label=label)
+    axis.set_aspect("equal", adjustable="box")
     axis.set_xlabel("x [m]" if layout.given else "laid out from the track distances [m]")
     axis.set_ylabel("y [m]" if layout.given else "")
     axis.set_title(

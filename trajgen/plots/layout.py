@@ -20,7 +20,7 @@ from trajgen.errors import InputError
 from trajgen.model.coordination import schedule_times
 from trajgen.plots.figure import drawing_axis, finished
 from trajgen.plots.speed import VEHICLE_COLOURS
-from trajgen.plots.track_drawing import draw_track
+from trajgen.plots.track_drawing import draw_move, draw_track, fit_track, mark_end
 from trajgen.plots.track_layout import TrackLayout
 from trajgen.verification import VerifiedSchedule, require_verified
 
@@ -136,55 +136,23 @@ def plot_layout(verified: VerifiedSchedule, *, names=None, ax=None):
     track = schedule.track
     drawn = TrackLayout.of(track)
     axis = drawing_axis(ax, figsize=(9, 7))
-    every = np.vstack([drawn.nodes, *drawn.edges])
-    margin = 0.12 * drawn.extent
-    axis.set_xlim(float(every[:, 0].min()) - margin, float(every[:, 0].max()) + margin)
-    axis.set_ylim(float(every[:, 1].min()) - margin, float(every[:, 1].max()) + margin)
+    fit_track(axis, drawn)
     draw_track(axis, drawn, width=6.0, fontsize=8.0)
     moves = schedule_moves(schedule)
     shift = 0.012 * drawn.extent  # the vehicles' lines side by side where they share the track
-    for number, move in enumerate(moves):
+    for number, move in enumerate(moves, start=1):
         colour = VEHICLE_COLOURS[move.vehicle % len(VEHICLE_COLOURS)]
         line = _polyline(drawn, move) + (shift if move.vehicle % 2 == 0 else -shift)
-        axis.plot(line[:, 0], line[:, 1], color=colour, linewidth=2.2, zorder=3)
-        if len(line) >= 2:
-            axis.annotate(
-                "",
-                line[-1],
-                xytext=line[-2],
-                arrowprops={"arrowstyle": "-|>", "color": colour, "lw": 2.2},
-                zorder=4,
-            )
-        along = np.concatenate([[0.0], np.cumsum(np.hypot(*np.diff(line, axis=0).T))])
         # a third of the way, not half: on a junction the middle of many moves is the junction
-        third = np.array([np.interp(along[-1] / 3.0, along, line[:, k]) for k in (0, 1)])
-        axis.annotate(
-            str(number + 1),
-            third,
-            ha="center",
-            va="center",
-            fontsize=8,
-            color="white",
-            weight="bold",
-            bbox={"boxstyle": "circle,pad=0.2", "facecolor": colour, "edgecolor": "none"},
-            zorder=5,
-        )
+        draw_move(axis, line, colour, number, at=1.0 / 3.0)
     ends = schedule.state([0.0, schedule.duration])
     travel = [sum(move.length for move in moves if move.vehicle == v) for v in range(count)]
     for vehicle in range(count):
         colour = VEHICLE_COLOURS[vehicle % len(VEHICLE_COLOURS)]
         points = drawn.points(ends.edge[vehicle], ends.s[vehicle])
-        for point, marker, what in ((points[0], "o", "start"), (points[1], "s", "goal")):
-            axis.plot(
-                *point,
-                marker,
-                markersize=12,
-                markerfacecolor="none",
-                markeredgecolor=colour,
-                markeredgewidth=2,
-                zorder=6,
-                label=f"{names[vehicle]} {what}",
-            )
+        for point, goal in ((points[0], False), (points[1], True)):
+            what = "goal" if goal else "start"
+            mark_end(axis, point, goal=goal, colour=colour, label=f"{names[vehicle]} {what}")
     axis.set_aspect("equal", adjustable="box")
     axis.set_xlabel("x [m]" if drawn.given else "laid out from the track distances [m]")
     axis.set_ylabel("y [m]" if drawn.given else "")

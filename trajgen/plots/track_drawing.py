@@ -13,7 +13,7 @@ import numpy as np
 from topology import TrackGraph
 from trajgen.plots.track_layout import TrackLayout
 
-__all__ = ["dead_ends", "draw_track"]
+__all__ = ["dead_ends", "draw_move", "draw_track", "fit_track", "mark_end"]
 
 
 def dead_ends(track: TrackGraph) -> set[int]:
@@ -23,6 +23,14 @@ def dead_ends(track: TrackGraph) -> set[int]:
         for node in track.ends(k):
             degree[node] += 1
     return {int(n) for n in np.nonzero(degree == 1)[0]}
+
+
+def fit_track(axis, drawn: TrackLayout) -> None:
+    """Set ``axis``'s limits to the whole track with a margin of 12 % of its extent (room for labels)."""
+    every = np.vstack([drawn.nodes, *drawn.edges])
+    margin = 0.12 * drawn.extent
+    axis.set_xlim(float(every[:, 0].min()) - margin, float(every[:, 0].max()) + margin)
+    axis.set_ylim(float(every[:, 1].min()) - margin, float(every[:, 1].max()) + margin)
 
 
 def draw_track(axis, drawn: TrackLayout, *, width: float = 7.0, fontsize: float = 9.0) -> list[np.ndarray]:
@@ -78,3 +86,55 @@ def draw_track(axis, drawn: TrackLayout, *, width: float = 7.0, fontsize: float 
             continue
         axis.annotate(name, (x, y), xytext=(7, 7), textcoords="offset points", fontsize=fontsize, color="0.3")
     return labels
+
+
+def draw_move(axis, line: np.ndarray, colour: str, number: int, *, at: float = 0.5) -> None:
+    """One move drawn: its line in ``colour``, arrowed at its end, ``number`` in a disc ``at`` along it.
+
+    Parameters
+    ----------
+    axis : matplotlib Axes
+    line : ndarray, shape (m, 2)
+        Where the move runs, metres, in the order it is driven.
+    colour : str
+    number : int
+        Written in the disc (the move's place in the order).
+    at : float, optional
+        Fraction of the line's length where the number sits (default the middle).
+    """
+    axis.plot(line[:, 0], line[:, 1], color=colour, linewidth=2.2, zorder=3)
+    if len(line) >= 2:
+        axis.annotate(
+            "",
+            line[-1],
+            xytext=line[-2],
+            arrowprops={"arrowstyle": "-|>", "color": colour, "lw": 2.2},
+            zorder=4,
+        )
+    along = np.concatenate([[0.0], np.cumsum(np.hypot(*np.diff(line, axis=0).T))])
+    where = [np.interp(at * along[-1], along, line[:, k]) for k in (0, 1)]
+    axis.annotate(
+        str(number),
+        where,
+        ha="center",
+        va="center",
+        fontsize=8,
+        color="white",
+        weight="bold",
+        bbox={"boxstyle": "circle,pad=0.2", "facecolor": colour, "edgecolor": "none"},
+        zorder=5,
+    )
+
+
+def mark_end(axis, point, *, goal: bool, colour: str, label: str) -> None:
+    """A vehicle's start (hollow circle) or goal (hollow square) at ``point`` (x, y in metres)."""
+    axis.plot(
+        *point,
+        "s" if goal else "o",
+        markersize=12,
+        markerfacecolor="none",
+        markeredgecolor=colour,
+        markeredgewidth=2,
+        zorder=6,
+        label=label,
+    )
