@@ -1,4 +1,4 @@
-"""Scenarios: the shipped swap and crossing, random scenarios of 3 to 8 legs, track graphs, every bad-file case."""
+"""Scenarios: the shipped swap and crossing, random ones of 3 to 8 legs, track graphs, every bad file."""
 
 from __future__ import annotations
 
