@@ -26,8 +26,9 @@ _STEP = re.compile(r"\.(\w+)|\[(\d+)\]")
 
 
 def _fields(value: object) -> list[str]:
+    """A dataclass's fields, but its caches (``compare=False``: made from the others when asked)."""
     if dataclasses.is_dataclass(value) and not isinstance(value, type):
-        return [f.name for f in dataclasses.fields(value)]
+        return [f.name for f in dataclasses.fields(value) if f.compare]
     return []
 
 

@@ -28,7 +28,7 @@ from trajgen.errors import InputError
 from trajgen.execution.goals import goal_refusal, graph_schedule_from_rest, schedule_from_rest
 from trajgen.execution.messages import VehicleState, check_measured_numbers, checked_state
 from trajgen.execution.motion import GraphPlanPlayer, PlanPlayer
-from trajgen.model.coordination import schedule_times, schedule_waypoints
+from trajgen.model.coordination import schedule_paths, schedule_times, schedule_waypoints
 from trajgen.model.graph_paths import GraphPath, graph_paths
 from trajgen.model.graph_schedule import GraphSchedule
 from trajgen.model.graph_vehicle_path import GraphMetric, GraphVehiclePath
@@ -51,7 +51,7 @@ class LoadedPlan:
     paths : tuple of 2 VehiclePath or 2 GraphVehiclePath
         Each vehicle's path, continuing its own axis.
     diagram_paths : tuple of 2
-        The paths the coordination diagram takes (``VehiclePath`` or ``GraphPath``).
+        The paths the coordination diagram takes: ``GraphPath`` s on the track graph (a junction's too).
     times : ndarray
         The plan's instants for the diagram (:func:`~trajgen.model.coordination.schedule_times`).
     player : PlanPlayer
@@ -88,7 +88,7 @@ class JunctionTrack:
         """
         schedule = verified.schedule
         player = PlanPlayer.of(verified)
-        times = schedule_times(schedule)
+        diagram_paths, times, _ = schedule_paths(schedule)  # on the junction's track graph
         waypoints = schedule_waypoints(schedule, times)
         paths = []
         for v in (0, 1):
@@ -100,8 +100,7 @@ class JunctionTrack:
                 if first.legs and first.legs[0] != leg:  # it leaves the junction on another leg: ds flips
                     sign = -sign
             paths.append(VehiclePath.from_waypoints(waypoints, v, axis_start=start, orientation=sign))
-        pair = (paths[0], paths[1])
-        return LoadedPlan(pair, pair, times, player)
+        return LoadedPlan((paths[0], paths[1]), diagram_paths, times, player)
 
     def project(self, path: VehiclePath, leg: int, s: float, near: float, slack: float) -> float | None:
         """The travel at which ``path`` passes ``(leg, s)`` nearest ``near`` (:meth:`VehiclePath.project`)."""

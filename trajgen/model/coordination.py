@@ -1,10 +1,11 @@
 """The coordination diagram of a plan: its conflicts, the order it keeps at each, the frontiers.
 
 Each vehicle drives its path of the plan in *travel* coordinates ``p`` (metres
-driven along its own path, cusps included, so ``p`` never decreases). On each
-pair of path segments the track distance between the vehicles is affine in
-``(p1, p2)`` (``|s1 - s2|`` on one leg, ``s1 + s2`` across the junction), so the
-obstacle region ``{(p1, p2): distance < d}`` is a union of convex polygons.
+driven along its own path, cusps included, so ``p`` never decreases), on the
+schedule's track graph (a junction's legs are its edges). On each pair of path
+segments each way between the vehicles is affine in ``(p1, p2)``, so the obstacle
+region ``{(p1, p2): distance < d}`` is a union of convex polygons
+(:func:`~trajgen.model.graph_cells.too_close_polygons`, one code for every track).
 Its connected parts are the **conflicts**. The plan passes each conflict on one
 side: the vehicle that passes first is the conflict's **leader**, the other its
 **follower** (docs/online.md, 'The executor').
@@ -26,8 +27,8 @@ import numpy as np
 
 from limits import VehicleLimits
 from trajgen.model.graph_cells import too_close_polygons
+from trajgen.model.graph_paths import GraphPath, path_through
 from trajgen.model.graph_schedule import GraphSchedule
-from trajgen.model.paths import VehiclePath
 from trajgen.model.pieces import Pieces, kinematics_polynomials, schedule_pieces
 from trajgen.model.values import sorted_unique
 
@@ -45,8 +46,6 @@ __all__ = [
 
 #: A convex polygon of the diagram: its vertices ``(p1, p2)`` in order, metres of travel.
 Polygon = tuple[tuple[float, float], ...]
-#: Polygons of less area than this (m²) are boundaries, not obstacles (the region is open).
-_AREA = 1e-12
 #: Round-off of the diagram's geometry, metres of travel.
 _TOUCH = 1e-9
 #: Two polygons that share a stretch longer than this (metres) are one conflict; a point is not.
@@ -164,28 +163,6 @@ def _area(polygon: list[tuple[float, float]]) -> float:
     )
 
 
-def _segments(path: VehiclePath) -> list[tuple[int, float, float, float, float]]:
-    """(leg, travel at start, travel at end, s at start, ds/dp) of each segment of a path."""
-    out = []
-    for k, leg in enumerate(path.legs):
-        start = path.starts[k]
-        end = path.starts[k + 1] if k + 1 < len(path.legs) else path.length
-        out.append((leg, start, end, path.s_from[k], 1.0 if path.s_to[k] > path.s_from[k] else -1.0))
-    return out
-
-
-def _obstacle(first, second, separation: float) -> list[tuple[float, float]]:
-    """The closed part of one segment pair's rectangle where the track distance is at most ``separation``."""
-    leg1, a1, b1, s1, sign1 = first
-    leg2, a2, b2, s2, sign2 = second
-    c1, c2 = s1 - sign1 * a1, s2 - sign2 * a2  # s = c + sign * p on the segment
-    polygon = [(a1, a2), (b1, a2), (b1, b2), (a1, b2)]
-    if leg1 != leg2:  # across the junction: s1 + s2
-        return _clip(polygon, sign1, sign2, separation - c1 - c2)
-    polygon = _clip(polygon, sign1, -sign2, separation - c1 + c2)  # s1 - s2 <= d
-    return _clip(polygon, -sign1, sign2, separation + c1 - c2) if polygon else polygon  # s2 - s1 <= d
-
-
 def _joined(p: Polygon, q: Polygon) -> bool:
     """Whether two convex polygons share more than a point: an edge stretch or some area.
 
@@ -257,8 +234,9 @@ class CoordinationDiagram:
 
     Parameters
     ----------
-    paths : tuple of 2 VehiclePath, or 2 GraphPath on a track graph
-        Each vehicle's path of the plan, in travel coordinates.
+    paths : tuple of 2 GraphPath
+        Each vehicle's path of the plan on the schedule's track graph (a junction's too:
+        :func:`schedule_paths`), in travel coordinates.
     separation : float
         Track distance the conflicts keep, metres.
     schedule : Schedule or GraphSchedule
@@ -270,23 +248,16 @@ class CoordinationDiagram:
 
     __slots__ = ("_by_follower", "_chain_table", "_last", "conflicts", "paths", "separation")
 
-    def __init__(self, paths: tuple[VehiclePath, VehiclePath], separation: float, schedule, times) -> None:
+    def __init__(self, paths: tuple[GraphPath, ...], separation: float, schedule, times) -> None:
         self.paths = paths
         self.separation = float(separation)
         polygons: list[Polygon] = []
         where: list[tuple[int, int]] = []
-        if isinstance(schedule, GraphSchedule):  # the convex parts of each cell, one per way
-            for part in too_close_polygons(schedule.track, paths, self.separation):
-                polygons.append(part.polygon)
-                where.append(part.segments)
-        else:
-            first, second = _segments(paths[0]), _segments(paths[1])
-            for i, a in enumerate(first):
-                for j, b in enumerate(second):
-                    polygon = _obstacle(a, b, self.separation)
-                    if len(polygon) >= 3 and _area(polygon) > _AREA:
-                        polygons.append(tuple(polygon))
-                        where.append((i, j))
+        for part in too_close_polygons(
+            schedule.track, paths, self.separation
+        ):  # convex, one per cell and way
+            polygons.append(part.polygon)
+            where.append(part.segments)
         parent = list(range(len(polygons)))
 
         def root(k: int) -> int:
@@ -526,13 +497,14 @@ def schedule_waypoints(schedule, times: np.ndarray | None = None) -> list[tuple[
 
 def schedule_paths(
     schedule, pieces: Pieces | None = None
-) -> tuple[tuple[VehiclePath, VehiclePath], np.ndarray, np.ndarray]:
+) -> tuple[tuple[GraphPath, ...], np.ndarray, np.ndarray]:
     """Both vehicles' paths of a schedule, the instants of :func:`schedule_times`, and the travel there.
 
     Returns
     -------
-    paths : tuple of 2 VehiclePath (2 GraphPath of a GraphSchedule)
-        Travel coordinates, each vehicle's axis as the schedule's.
+    paths : tuple of 2 GraphPath
+        On the schedule's track graph, in travel coordinates: a track graph's schedule's own; a
+        junction's through its places at the instants (:func:`~trajgen.model.graph_paths.path_through`).
     times : ndarray, shape (n,)
         Seconds.
     travel : ndarray, shape (2, n)
@@ -542,8 +514,9 @@ def schedule_paths(
     times = schedule_times(schedule, pieces)
     if isinstance(schedule, GraphSchedule):  # its paths are the route's, its travel the schedule's
         return schedule.paths, times, schedule.travel(times)[:, 0]
-    waypoints = schedule_waypoints(schedule, times)
-    axis = schedule.state(times).axis
-    paths = tuple(VehiclePath.from_waypoints(waypoints, v, axis_start=float(axis[v, 0])) for v in (0, 1))
-    travel = np.concatenate([np.zeros((2, 1)), np.cumsum(np.abs(np.diff(axis, axis=1)), axis=1)], axis=1)
-    return (paths[0], paths[1]), times, travel
+    state = schedule.state(times)  # between two of the times no vehicle turns: it drives from one to the next
+    paths = tuple(path_through(schedule.track, state.edge[v], state.s[v]) for v in range(state.edge.shape[0]))
+    travel = np.concatenate(
+        [np.zeros((2, 1)), np.cumsum(np.abs(np.diff(state.axis, axis=1)), axis=1)], axis=1
+    )
+    return paths, times, travel

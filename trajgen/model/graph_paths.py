@@ -19,7 +19,7 @@ from topology import EdgePoint, GraphRoute, TrackGraph
 from trajgen.model.paths import MOVE_RESOLUTION
 from trajgen.model.values import ArrayValue, readonly
 
-__all__ = ["GraphPath", "graph_paths"]
+__all__ = ["GraphPath", "graph_paths", "path_through"]
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -147,28 +147,71 @@ def graph_paths(route: GraphRoute) -> tuple[GraphPath, GraphPath]:
     >>> first.length + second.length == route.length
     True
     """
-    paths = []
-    for vehicle in range(2):
-        segments = _segments(route.track, route, vehicle)
-        lengths = [abs(s_to - s_from) for _, s_from, s_to in segments]
-        headings = []
-        heading = 1
-        for k, (edge, s_from, s_to) in enumerate(segments):
-            if (
-                k
-                and edge == segments[k - 1][0]
-                and (s_to - s_from) * (segments[k - 1][2] - segments[k - 1][1]) < 0.0
-            ):
-                heading = -heading  # turns back on its edge: a cusp
-            headings.append(heading)
-        paths.append(
-            GraphPath(
-                edges=np.array([edge for edge, _, _ in segments], dtype=int),
-                s_from=np.array([s for _, s, _ in segments]),
-                s_to=np.array([s for _, _, s in segments]),
-                starts=np.concatenate([[0.0], np.cumsum(lengths)]),
-                headings=np.array(headings, dtype=int),
-                home=route.start[vehicle],
+    return tuple(
+        _path_of(_segments(route.track, route, vehicle), route.start[vehicle]) for vehicle in range(2)
+    )
+
+
+def _path_of(segments: list[list], home: EdgePoint) -> GraphPath:
+    """The path of ``[edge, s_from, s_to]`` segments in order: its heading flips where it turns back."""
+    lengths = [abs(s_to - s_from) for _, s_from, s_to in segments]
+    headings = []
+    heading = 1
+    for k, (edge, s_from, s_to) in enumerate(segments):
+        if (
+            k
+            and edge == segments[k - 1][0]
+            and (s_to - s_from) * (segments[k - 1][2] - segments[k - 1][1]) < 0.0
+        ):
+            heading = -heading  # turns back on its edge: a cusp
+        headings.append(heading)
+    return GraphPath(
+        edges=np.array([edge for edge, _, _ in segments], dtype=int),
+        s_from=np.array([s for _, s, _ in segments]),
+        s_to=np.array([s for _, _, s in segments]),
+        starts=np.concatenate([[0.0], np.cumsum(lengths)]),
+        headings=np.array(headings, dtype=int),
+        home=home,
+    )
+
+
+def path_through(track: TrackGraph, edges, s) -> GraphPath:
+    """The path through the places ``(edges[i], s[i])`` in order, between two of them not turning back.
+
+    Between places on two edges the vehicle passes the node they share (a junction's ``O``); a
+    segment on one edge one way is merged. The places of a junction's schedule at its own instants
+    (:func:`~trajgen.model.coordination.schedule_times`) give the path the schedule drives.
+
+    Raises
+    ------
+    ValueError
+        Two consecutive places on edges that share no node.
+    """
+    edges = [int(e) for e in edges]
+    s = [float(x) for x in s]
+    segments: list[list] = []
+
+    def add(edge: int, s_a: float, s_b: float) -> None:
+        if abs(s_b - s_a) <= MOVE_RESOLUTION:
+            return
+        last = segments[-1] if segments else None
+        if last is not None and last[0] == edge and (last[2] - last[1]) * (s_b - s_a) > 0.0:
+            last[2] = s_b
+        else:
+            segments.append([edge, s_a, s_b])
+
+    for (e_a, s_a), (e_b, s_b) in zip(
+        zip(edges, s, strict=True), zip(edges[1:], s[1:], strict=True), strict=False
+    ):
+        if e_a == e_b:
+            add(e_a, s_a, s_b)
+            continue
+        shared = sorted(set(track.ends(e_a)) & set(track.ends(e_b)))
+        if not shared:
+            raise ValueError(
+                f"places on edges {e_a} and {e_b} share no node: expected a path along the track"
             )
-        )
-    return paths[0], paths[1]
+        node = shared[0]
+        add(e_a, s_a, 0.0 if track.ends(e_a)[0] == node else track.length(e_a))
+        add(e_b, 0.0 if track.ends(e_b)[0] == node else track.length(e_b), s_b)
+    return _path_of(segments, EdgePoint(edges[0], s[0]) if edges else EdgePoint(0, 0.0))
