@@ -189,16 +189,14 @@ def _joined(p: Polygon, q: Polygon) -> bool:
 class _Curve:
     """The plan's curve ``(p1(t), p2(t))``: travel from each vehicle's axis, exact between samples.
 
-    On a track graph the schedule's travel itself.
+    Between two of the plan's instants no vehicle turns, so its travel there is the travel at the
+    instant before plus how far its axis has moved since (on every track: a track graph's schedule
+    signs its axis by its path's heading).
     """
 
     def __init__(self, schedule, times: np.ndarray) -> None:
         self.schedule = schedule
         self.times = times
-        self.graph = isinstance(schedule, GraphSchedule)
-        if self.graph:
-            self.travel = schedule.travel(times)[:, 0]
-            return
         axis = schedule.state(times).axis  # (2, n)
         self.axis = axis
         self.travel = np.concatenate(
@@ -207,8 +205,6 @@ class _Curve:
 
     def at(self, t: np.ndarray, k: int) -> np.ndarray:
         """Both vehicles' travel at times ``t`` of ``[times[k], times[k + 1]]``, shape (2, n)."""
-        if self.graph:
-            return self.schedule.travel(t)[:, 0]
         axis = self.schedule.state(t).axis
         return self.travel[:, k : k + 1] + np.abs(axis - self.axis[:, k : k + 1])
 

@@ -10,8 +10,6 @@ from trajgen.errors import InputError
 from trajgen.methods import METHODS
 from trajgen.model.analysis import travelled
 from trajgen.model.coordination import CoordinationDiagram, schedule_paths
-from trajgen.model.graph_cells import too_close_polygons
-from trajgen.model.graph_schedule import GraphSchedule
 from trajgen.model.summary import class_label
 from trajgen.plots.figure import drawing_area, finished, polygon_patch, wrapped
 from trajgen.plots.speed import VEHICLE_COLOURS, plot_period
@@ -29,25 +27,16 @@ _PALETTE = ("tab:blue", "tab:green", "tab:red", "tab:purple", "tab:brown", "tab:
 METHOD_COLOURS = {name: _PALETTE[k % len(_PALETTE)] for k, name in enumerate(METHODS.names)}
 
 
-def _too_close(schedule, required: float, curve: np.ndarray):
+def _too_close(schedule, required: float):
     """``(leader, polygon)`` of every convex part of the too-close region of ``schedule``'s paths.
 
-    On a junction, the conflicts of :class:`~trajgen.model.coordination.CoordinationDiagram`; on a
-    track graph, :func:`~trajgen.model.graph_cells.too_close_polygons`, each led by the vehicle the
-    schedule's curve (``curve``, its travel, shape (2, n)) lets pass first: the part lies above the
-    curve where vehicle 1 goes first.
+    The conflicts of :class:`~trajgen.model.coordination.CoordinationDiagram` on every track (a
+    junction's paths are on its track graph too), each part led by the vehicle the plan lets pass
+    first.
     """
-    if not isinstance(schedule, GraphSchedule):
-        paths, times, _ = schedule_paths(schedule)
-        diagram = CoordinationDiagram(paths, required, schedule, times)
-        return [(conflict.leader, polygon) for conflict in diagram.conflicts for polygon in conflict.polygons]
-    parts = []
-    for part in too_close_polygons(schedule.track, schedule.paths, required):
-        x, y = np.mean(np.array(part.polygon), axis=0)
-        below = curve[1][curve[0] <= x]  # the curve is monotone: its height where it reaches x
-        height = float(below.max()) if below.size else 0.0
-        parts.append((0 if y > height else 1, part.polygon))
-    return parts
+    paths, times, _ = schedule_paths(schedule)
+    diagram = CoordinationDiagram(paths, required, schedule, times)
+    return [(conflict.leader, polygon) for conflict in diagram.conflicts for polygon in conflict.polygons]
 
 
 def plot_coordination(verified: Mapping[str, VerifiedSchedule], *, figure=None):
@@ -90,7 +79,7 @@ def plot_coordination(verified: Mapping[str, VerifiedSchedule], *, figure=None):
         reference = schedules[names[0]]
         required = max(reference.limits.min_separation, reference.route.min_separation)
         labelled: set[int] = set()
-        for leader, polygon in _too_close(reference, required, distances[names[0]]):
+        for leader, polygon in _too_close(reference, required):
             label = None if leader in labelled else f"too close: vehicle {leader + 1} passes first"
             labelled.add(leader)
             patch = polygon_patch(
