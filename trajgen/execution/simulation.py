@@ -270,7 +270,9 @@ def simulate(
     limits = scenario.limits
     horizon = _time_limit(verified.schedule.duration, faults, limits, scenario.track)
     pending = sorted((f for f in faults if f.kind in (FaultKind.JUMP, FaultKind.GOAL)), key=lambda f: f.time)
-    spool = Trace(verified.schedule.track, trace) if trace is not None else None
+    spool = (
+        Trace(verified.schedule.track, trace, verified.schedule.limits.count) if trace is not None else None
+    )
     plot = Decimated(PLOT_SAMPLES)
     bodies = plant.bodies
     distance = SeparationWatch(scenario.track, bodies, limits.min_separation)
