@@ -12,6 +12,7 @@ import dataclasses
 import functools
 import itertools
 import math
+import random
 
 import numpy as np
 import pytest
@@ -26,7 +27,7 @@ from tests.support.graph_cases import EXAMPLES
 from tests.support.graph_rows import ScenarioFile
 from tests.support.helpers import conf, execution_plan
 from topology import YGraph, plan
-from trajgen import Exact, Optimal, certify, load_scenario, verify
+from trajgen import Exact, Optimal, certify, load_scenario, make_schedule, verify
 from trajgen.model.coordination import (
     CoordinationDiagram,
     earliest_rest,
@@ -35,6 +36,7 @@ from trajgen.model.coordination import (
     stopping_distance,
     stopping_distances,
 )
+from trajgen.scenario.sampling import random_scenarios, random_track
 from trajgen.verification.braking_rule import BRAKING_RULE_TOLERANCE, braking_rule_failures
 
 SWAP = REPO / "examples" / "swap.toml"
@@ -431,3 +433,41 @@ def test_the_rule_check_costs_about_the_same_on_a_schedule_a_hundred_times_longe
     assert durations[1] > 90.0 * durations[0]
     assert costs[1] < 5.0 * costs[0], costs
     assert costs[1] < 30_000, costs
+
+
+@pytest.mark.parametrize("legs", [3, 4, 6, 8])
+def test_a_junctions_path_through_its_places_is_where_its_schedule_is_at_every_instant(legs):
+    """Agreement of two computations on seeded random junctions: a path and the schedule's state.
+
+    The path is built from the places at the plan's instants; the state is read between them.
+    """
+    rng = random.Random(f"paths-{legs}")
+    track = random_track(rng, leg_count=legs, lengths=(2.0, 20.0))
+    for scenario in random_scenarios(6, seed=legs, track=track, limits=Limits((AGV, AGV), 1.5)):
+        for method in ("exact", "toppra"):
+            schedule = make_schedule(scenario.route(), scenario.limits, method=method)
+            paths, times, travel = schedule_paths(schedule)
+            for v, path in enumerate(paths):
+                assert path.length == pytest.approx(travel[v, -1], abs=1e-9)
+            # halfway between the instants, where no vehicle turns: travel from the axis, place from the path
+            middle = 0.5 * (times[:-1] + times[1:])
+            state = schedule.state(middle)
+            moved = np.abs(state.axis - schedule.state(times[:-1]).axis)
+            for v, path in enumerate(paths):
+                edge, s = path.locate(travel[v, :-1] + moved[v])
+                apart = schedule.track.distances(edge, s, state.edge[v], state.s[v])
+                assert np.max(apart) <= 1e-9, (scenario.start, scenario.goal, method, v)
+
+
+def test_a_path_through_places_on_edges_that_share_no_node_is_refused():
+    from topology import TrackGraph
+    from trajgen.model.graph_paths import path_through
+
+    track = TrackGraph.from_edges({"a": ("A", "J", 5.0), "b": ("J", "K", 5.0), "c": ("K", "C", 5.0)})
+    path = path_through(track, [0, 1, 2], [1.0, 2.5, 4.0])
+    assert path.length == pytest.approx(4.0 + 5.0 + 4.0)
+    assert path.edges.tolist() == [0, 1, 2]
+    with pytest.raises(
+        ValueError, match=r"places on edges 0 and 2 share no node: expected a path along the track"
+    ):
+        path_through(track, [0, 2], [1.0, 4.0])
