@@ -1009,6 +1009,8 @@ def test_the_layout_refuses_names_that_are_not_one_per_vehicle():
         InputError, match=r"plot_layout names must be 2 strings, one per vehicle, got \('a',\)"
     ):
         plot_layout(case("y").verified("exact"), names=("a",))
+    with pytest.raises(InputError, match=r"plot_layout names must be 2 strings, one per vehicle, got 'ab'"):
+        plot_layout(case("y").verified("exact"), names="ab")  # one name, not two
     with pytest.raises(UnverifiedScheduleError, match="plot_layout"):
         plot_layout(case("y").verified("exact").schedule)
 

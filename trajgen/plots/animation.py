@@ -19,13 +19,10 @@ texts) is computed apart from the drawing, in :mod:`trajgen.plots.animation_layo
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
 
 import numpy as np
 
 from topology import TrackGraph
-from topology.validation import short_repr
-from trajgen.errors import InputError
 from trajgen.plots.animation_layout import (
     DEFAULT_FPS,
     DEFAULT_MAX_FRAMES,
@@ -43,7 +40,7 @@ from trajgen.plots.animation_layout import (
     playback,
     speed_text,
 )
-from trajgen.plots.figure import frame_painter, new_figure
+from trajgen.plots.figure import checked_names, frame_painter, new_figure
 from trajgen.plots.speed import VEHICLE_COLOURS
 from trajgen.plots.track_drawing import draw_track
 from trajgen.plots.track_layout import TrackLayout
@@ -263,17 +260,6 @@ class _Scene:
         return self.paint()
 
 
-def _check_names(names: object, count: int) -> tuple[str, ...]:
-    if (
-        not isinstance(names, Sequence)
-        or isinstance(names, str)
-        or len(names) != count
-        or not all(isinstance(name, str) for name in names)
-    ):
-        raise InputError(f"animation names must be {count} strings, one per vehicle, got {short_repr(names)}")
-    return tuple(names)
-
-
 class Animation:
     """A schedule played on the track seen from above: its frames, made one at a time when asked.
 
@@ -350,7 +336,7 @@ def animate(
         ``names`` is not one string per vehicle.
     """
     schedule = require_verified(verified, "animate").schedule
-    names = _check_names(names, schedule.limits.count)
+    names = checked_names(names, schedule.limits.count, what="animation")
     play = playback(schedule.duration, fps=fps, max_frames=max_frames)
     geometry = frame_geometry(verified, play.times())
     layout = frame_layout(schedule.track, geometry)

@@ -8,9 +8,14 @@ line) that write files.
 from __future__ import annotations
 
 import io
+from collections.abc import Sequence
+
+from topology.validation import short_repr
+from trajgen.errors import InputError
 
 __all__ = [
     "PNG_DPI",
+    "checked_names",
     "drawing_area",
     "drawing_axis",
     "finished",
@@ -232,3 +237,24 @@ def time_label(axis, t: float, height: float, text: str, *, colour) -> None:
         color=colour,
         bbox={"facecolor": "white", "alpha": 0.7, "edgecolor": "none", "pad": 1},
     )
+
+
+def checked_names(names: object, count: int, *, what: str) -> tuple[str, ...]:
+    """The vehicles' names a picture writes: one string per vehicle (``None``: ``vehicle 1``, ...).
+
+    Raises
+    ------
+    InputError
+        Not ``count`` strings (a single string is one name, not a sequence of them); the message
+        names ``what`` asked and the value given.
+    """
+    if names is None:
+        return tuple(f"vehicle {k}" for k in range(1, count + 1))
+    if (
+        not isinstance(names, Sequence)
+        or isinstance(names, str)
+        or len(names) != count
+        or not all(isinstance(name, str) for name in names)
+    ):
+        raise InputError(f"{what} names must be {count} strings, one per vehicle, got {short_repr(names)}")
+    return tuple(names)

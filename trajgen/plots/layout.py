@@ -16,9 +16,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from topology import TrackGraph
-from trajgen.errors import InputError
 from trajgen.model.coordination import schedule_times
-from trajgen.plots.figure import drawing_axis, finished
+from trajgen.plots.figure import checked_names, drawing_axis, finished
 from trajgen.plots.speed import VEHICLE_COLOURS
 from trajgen.plots.track_drawing import draw_move, draw_track, fit_track, mark_end
 from trajgen.plots.track_layout import TrackLayout
@@ -130,9 +129,7 @@ def plot_layout(verified: VerifiedSchedule, *, names=None, ax=None):
     """
     schedule = require_verified(verified, "plot_layout").schedule
     count = schedule.limits.count
-    names = tuple(f"vehicle {v + 1}" for v in range(count)) if names is None else tuple(names)
-    if len(names) != count or not all(isinstance(name, str) for name in names):
-        raise InputError(f"plot_layout names must be {count} strings, one per vehicle, got {names!r}")
+    names = checked_names(names, count, what="plot_layout")
     track = schedule.track
     drawn = TrackLayout.of(track)
     axis = drawing_axis(ax, figsize=(9, 7))
