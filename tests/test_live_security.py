@@ -214,6 +214,11 @@ def test_tls_with_the_right_ca_connects(tls_broker, certificates):
     assert _connects(_vehicle(settings))
 
 
+#: Seconds within which an order the broker drops is reported for every vehicle (a vehicle's 4 sends
+#: take about 4 s; the rest is room for a loaded machine, where a CI run saw 5 s not enough).
+REPORTED_WITHIN_S = 15.0
+
+
 def test_an_acl_that_forbids_the_masters_orders_is_reported_within_seconds_naming_each_vehicle(tmp_path):
     from tests.support.helpers import execution_plan, scenario_vehicle
     from trajgen.live.master import LiveMaster
@@ -249,7 +254,8 @@ def test_an_acl_that_forbids_the_masters_orders_is_reported_within_seconds_namin
     began = time.monotonic()
     master.start()
     try:
-        while time.monotonic() - began < 5.0:
+        # 4 sends on a back-off driven by the states: about 4 s each, later on a loaded machine
+        while time.monotonic() - began < REPORTED_WITHIN_S:
             reported = {r["vehicle"] for r in master.log.records() if r["event"] == "order-not-taken"}
             if reported == set(scenario.names):
                 break
@@ -263,7 +269,7 @@ def test_an_acl_that_forbids_the_masters_orders_is_reported_within_seconds_namin
             vehicle.stop()
         broker.stop()
     assert reported == set(scenario.names)
-    assert seconds < 5.0
+    assert seconds < REPORTED_WITHIN_S
     records = [r for r in master.log.records() if r["event"] == "order-not-taken"]
     assert all(r["reports"] == "no order" for r in records)
     assert ended
