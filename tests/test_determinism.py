@@ -3,13 +3,15 @@
 The optimal method's effort is fixed by iteration limits, refinement passes and a tolerance; the
 only wall-clock limit is a safety stop far above the usual solve time. These tests run the
 command line as a user does, twice: first alone with an empty store of compiled NLPs (every
-NLP is built), then beside CPU-bound processes that keep every core busy, with the store the
-first run filled (every NLP is loaded). The CSV files are byte-identical, and so is
-``simulate``'s plan. A forced fallback is reported in the JSON of every command that plans.
+NLP is built), then all the cases at once, topped up with CPU-bound processes so that every core
+stays busy, with the store the first run filled (every NLP is loaded). The CSV files are
+byte-identical, and so is ``simulate``'s plan. A forced fallback is reported in the JSON of every
+command that plans.
 """
 
 from __future__ import annotations
 
+import concurrent.futures
 import contextlib
 import json
 import logging
@@ -75,10 +77,11 @@ def _trajgen(*args: str, store: Path) -> subprocess.CompletedProcess:
 
 
 @contextlib.contextmanager
-def _every_core_busy():
-    """CPU-bound processes, one more than the cores, for as long as the block runs."""
+def _every_core_busy(busy: int):
+    """CPU-bound processes beside ``busy`` runs of ours, one more than the cores in all, for the block."""
     hogs = [
-        subprocess.Popen([sys.executable, "-c", "while True: pass"]) for _ in range((os.cpu_count() or 1) + 1)
+        subprocess.Popen([sys.executable, "-c", "while True: pass"])
+        for _ in range(max(0, (os.cpu_count() or 1) + 1 - busy))
     ]
     try:
         yield
@@ -89,8 +92,8 @@ def _every_core_busy():
             hog.wait()
 
 
-def _schedule_and_simulate(scenario: Path, out: Path, store: Path) -> tuple[dict[str, bytes], dict, dict]:
-    """The CSV files, ``schedule --json`` and ``simulate --json`` of one run."""
+def _schedule_and_simulate(scenario: Path, out: Path, store: Path) -> tuple[dict[str, bytes], list[dict]]:
+    """A junction's CSV files, and its ``schedule --json`` and ``simulate --json``."""
     summary = json.loads(
         _trajgen(
             "schedule", str(scenario), "--method", "optimal", "--csv", str(out), "--json", store=store
@@ -98,36 +101,80 @@ def _schedule_and_simulate(scenario: Path, out: Path, store: Path) -> tuple[dict
     )
     simulated = json.loads(_trajgen("simulate", str(scenario), "--json", store=store).stdout)
     files = {path.name: path.read_bytes() for path in sorted(out.iterdir())}
-    return files, summary, simulated
+    return files, [summary, simulated]
 
 
-@pytest.mark.parametrize("name", ["swap", "crossing", "y"])
-def test_the_optimal_plan_is_byte_identical_alone_and_under_load_built_and_loaded(name, tmp_path):
-    scenario = _scenario(name, tmp_path)
-    store = tmp_path / "store"
-    alone, alone_summary, alone_simulated = _schedule_and_simulate(scenario, tmp_path / "alone", store)
-    assert any(store.rglob("*.nlp")), "the first run keeps the NLPs it built"
-    with _every_core_busy():
-        loaded, loaded_summary, loaded_simulated = _schedule_and_simulate(
-            scenario, tmp_path / "loaded", store
+def _two_dialects(scenario: Path, out: Path, store: Path) -> tuple[dict[str, bytes], list[dict]]:
+    """A track graph's generic CSV and SIMATIC tables, and each ``schedule --json``."""
+    files, summaries = {}, []
+    for dialect in ("generic", "siemens-xy"):
+        folder = out / dialect
+        arguments = ("schedule", str(scenario), "--method", "optimal", "--csv", str(folder))
+        summary = json.loads(_trajgen(*arguments, "--dialect", dialect, "--json", store=store).stdout)
+        summaries.append(summary)
+        files |= {f"{dialect}/{path.name}": path.read_bytes() for path in sorted(folder.iterdir())}
+    return files, summaries
+
+
+#: name: (the scenario file in a folder, the commands run on it, whether its NLPs are stored). The
+#: passing loop's optimal plan solves two classes (agv1 waits on the main line or on the loop) and
+#: keeps the faster, as the H's does, in a fraction of the H's time; a track graph's formulation is
+#: built for each solve, not stored.
+CASES = {
+    "swap": (lambda folder: REPO / "examples" / "swap.toml", _schedule_and_simulate, True),
+    "crossing": (lambda folder: REPO / "examples" / "crossing.toml", _schedule_and_simulate, True),
+    "y": (lambda folder: _scenario("y", folder), _schedule_and_simulate, True),
+    "passing-loop": (lambda folder: REPO / "examples" / "graphs" / "passing-loop.toml", _two_dialects, False),
+}
+
+
+def test_the_optimal_plans_are_byte_identical_alone_and_under_load_built_and_loaded(tmp_path):
+    """Every case alone with an empty store, then every case at once beside CPU-bound processes.
+
+    The loaded runs of all the cases run at the same time, each the others' load, topped up with
+    CPU-bound processes to one more than the cores: every core stays busy without spending a
+    core's time on nothing but load.
+    """
+    runs = {}
+    for name, (scenario_of, commands, stored) in CASES.items():
+        folder = tmp_path / name
+        folder.mkdir()
+        runs[name] = (scenario_of(folder), folder / "store")
+        alone = commands(runs[name][0], folder / "alone", runs[name][1])
+        kept = any(runs[name][1].rglob("*.nlp"))
+        assert kept is stored, f"{name}: the first run keeps the NLPs it built: {kept}, expected {stored}"
+        runs[name] += (alone,)
+    with _every_core_busy(len(CASES)), concurrent.futures.ThreadPoolExecutor(len(CASES)) as pool:
+        loaded = dict(
+            zip(
+                CASES,
+                pool.map(
+                    lambda name: CASES[name][1](runs[name][0], tmp_path / name / "loaded", runs[name][1]),
+                    CASES,
+                ),
+                strict=True,
+            )
         )
-    assert alone
-    assert set(alone) == set(loaded)
-    for file_name, data in alone.items():
-        assert data == loaded[file_name], f"{file_name} differs between the runs"
-    for summary in (alone_summary, loaded_summary, alone_simulated, loaded_simulated):
-        assert (summary["method"], summary["computed_by"], summary["fallback_reason"]) == (
-            "optimal",
-            "optimal",
-            None,
-        )
-        assert summary["time_limit_reached"] is False
-    assert alone_summary["solver"]["built"] is True
-    assert loaded_summary["solver"]["built"] is False
-    assert loaded_summary["solver"]["loaded"] is True
-    assert alone_summary["duration_s"] == loaded_summary["duration_s"]
-    assert alone_simulated["planned_s"] == loaded_simulated["planned_s"]
-    assert alone_simulated["makespan_s"] == loaded_simulated["makespan_s"]
+    for name, (_scenario_path, _store, (alone_files, alone_summaries)) in runs.items():
+        loaded_files, loaded_summaries = loaded[name]
+        assert alone_files, name
+        assert set(alone_files) == set(loaded_files), name
+        for file_name, data in alone_files.items():
+            assert data == loaded_files[file_name], f"{name}: {file_name} differs between the runs"
+        for summary in (*alone_summaries, *loaded_summaries):
+            assert (summary["method"], summary["computed_by"], summary["fallback_reason"]) == (
+                "optimal",
+                "optimal",
+                None,
+            ), name
+            assert summary["time_limit_reached"] is False, name
+        if CASES[name][2]:
+            assert alone_summaries[0]["solver"]["built"] is True, name
+            assert loaded_summaries[0]["solver"]["built"] is False, name
+            assert loaded_summaries[0]["solver"]["loaded"] is True, name
+        for alone_summary, loaded_summary in zip(alone_summaries, loaded_summaries, strict=True):
+            for key in ("duration_s", "planned_s", "makespan_s"):
+                assert alone_summary.get(key) == loaded_summary.get(key), f"{name}: {key}"
 
 
 def _failing_solve(*_arguments, **_options):
@@ -164,40 +211,3 @@ def test_a_forced_fallback_is_reported_in_the_json_and_the_text(command, monkeyp
     assert main([command, scenario]) == 0
     text = capsys.readouterr().out
     assert "exact (fallback from optimal: solver-failed)" in text
-
-
-def test_the_optimal_plan_on_a_track_graph_is_byte_identical_alone_and_under_load(tmp_path):
-    """The passing loop's generic CSV and its SIMATIC tables, alone and beside CPU-bound processes.
-
-    Its optimal plan solves two classes (agv1 waits on the main line or on the loop) and keeps the
-    faster, as the H's does, in a fraction of the H's time.
-    """
-    scenario = REPO / "examples" / "graphs" / "passing-loop.toml"
-    store = tmp_path / "store"
-    runs = []
-    for label in ("alone", "loaded"):
-        with _every_core_busy() if label == "loaded" else contextlib.nullcontext():
-            files = {}
-            for dialect in ("generic", "siemens-xy"):
-                out = tmp_path / label / dialect
-                summary = json.loads(
-                    _trajgen(
-                        "schedule",
-                        str(scenario),
-                        "--method",
-                        "optimal",
-                        "--csv",
-                        str(out),
-                        "--dialect",
-                        dialect,
-                        "--json",
-                        store=store,
-                    ).stdout
-                )
-                assert summary["fallback_reason"] is None
-                files |= {f"{dialect}/{path.name}": path.read_bytes() for path in sorted(out.iterdir())}
-            runs.append((files, summary["duration_s"]))
-    (alone, alone_duration), (loaded, loaded_duration) = runs
-    assert len(alone) == 4
-    assert alone == loaded
-    assert alone_duration == loaded_duration
