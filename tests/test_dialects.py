@@ -17,6 +17,7 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from tests.conftest import REPO
+from tests.support.fleets import FLEETS, SEPARATION, fleet
 from tests.support.graph_cases import CONVOY, TINY_BACK_OFF, random_routes, verified_example
 from tests.support.helpers import LIMITS, MIXED, route_of
 from tests.support.star_scenarios import CROSSING
@@ -987,3 +988,38 @@ def test_the_generic_csv_of_seeded_random_graphs_passes_check():
                 write_profiles(verified, scenario.names, directory)
                 verdict = check_profiles(scenario, directory, jerk=verified.schedule.jerk_limited)
             assert verdict.passed, (seed, method, verdict.failures)
+
+
+# -- any number of vehicles below the planners ------------------------------------------------------------
+
+
+@pytest.mark.parametrize("case", FLEETS, ids=lambda case: case.name)
+def test_every_table_dialect_of_a_fleet_is_verified_as_interpolated_one_table_per_vehicle(case, tmp_path):
+    """Three or four vehicles: each dialect's tables, written and read back, keep every pair apart."""
+    verified, route = case.verified("exact"), case.route()
+    for dialect in TABLE_DIALECTS:
+        tables = plc_tables(verified, dialect)
+        assert len(tables.contents) == len(tables.resampled.tables) == case.count, dialect.name
+        assert tables.check.passed, (dialect.name, tables.check.failures)
+        assert tables.check.report.min_separation >= SEPARATION - 1e-9, dialect.name
+        assert len(tables.check.ratios["velocity"]) == case.count
+    paths = write_profiles(verified, route.names, tmp_path)
+    generic = DIALECTS.lookup("generic")
+    read = tuple(generic.read(path.read_bytes(), source=path.name).table for path in paths)
+    check = check_tables(read, route, case.limits())
+    assert check.passed, check.failures
+    # the generic CSV of the toppra schedule, read back, too (its rows are its points)
+    paths = write_profiles(case.verified("toppra"), route.names, tmp_path / "toppra")
+    read = tuple(generic.read(path.read_bytes(), source=path.name).table for path in paths)
+    assert check_tables(read, route, case.limits(), jerk=False).passed
+
+
+def test_a_fleets_table_that_runs_into_the_vehicle_ahead_is_refused_naming_the_pair():
+    """The convoy's last vehicle's table, hurried: it runs into the middle one before that has moved off."""
+    case = fleet("convoy-of-3")
+    verified, route = case.verified("exact"), case.route()
+    first, second, third = plc_tables(verified, "siemens-xy").resampled.tables
+    check = check_tables((_hurried(first), second, third), route, case.limits())
+    assert not check.passed
+    named = [re.search(r"vehicle 1 (on|and) .*vehicle 2", failure) for failure in check.failures]
+    assert any(named), check.failures

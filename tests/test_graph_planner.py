@@ -16,6 +16,7 @@ import re
 import numpy as np
 import pytest
 
+from tests.support.fleets import FLEETS, SEPARATION, fleet
 from tests.support.grid_oracle import GRID, GridTrack, random_case, shortest_route
 from topology import (
     Configuration,
@@ -30,6 +31,7 @@ from topology import (
     plan,
     plan_graph,
 )
+from trajgen.model.summary import graph_route_summary
 from trajgen.verification.graph_route import verify_graph_route
 
 #: Seeded random cases per kind (the issue asks for at least 500 of each), in chunks run in parallel.
@@ -72,14 +74,15 @@ def _check_moves(route, grid: GridTrack, edges) -> None:
     position = list(route.start)
     for move in route.moves:
         assert track.distance(position[move.vehicle], move.points[0]) == pytest.approx(0.0, abs=1e-9)
-        assert move.standing == position[1 - move.vehicle]
+        assert move.at_start == tuple(position)
+        ((_, still),) = move.standing()
         assert len(move.edges) == len(move.points) - 1
         for (a, b), edge in zip(itertools.pairwise(move.points), move.edges, strict=True):
             name = track.edges[edge].name
             s_a, s_b = track.position_on(a, edge), track.position_on(b, edge)
             assert s_a is not None
             assert s_b is not None
-            standing = grid.index(track.edges[move.standing.edge].name, move.standing.s)
+            standing = grid.index(track.edges[still.edge].name, still.s)
             for k in range(round(min(s_a, s_b) / GRID), round(max(s_a, s_b) / GRID) + 1):
                 gap = grid.steps[standing, grid.point_of[(name, k)]] * GRID
                 assert gap >= route.min_separation - 1e-9, (move, k)
@@ -341,9 +344,13 @@ def test_the_verifier_passes_the_planners_route_with_its_closest_approach():
         ),
         (
             lambda r: dataclasses.replace(
-                r, moves=(dataclasses.replace(r.moves[0], standing=r.track.point("c:1")), *r.moves[1:])
+                r,
+                moves=(
+                    dataclasses.replace(r.moves[0], at_start=(r.moves[0].points[0], r.track.point("c:1"))),
+                    *r.moves[1:],
+                ),
             ),
-            r"the other vehicle is said to stand at c:1, but it is at B",
+            r"vehicle 2 is said to stand at c:1, but it is at B",
         ),
         (
             lambda r: dataclasses.replace(
@@ -364,11 +371,71 @@ def test_a_move_through_the_standing_vehicle_is_caught_between_the_points():
     """Both ends of the move are far from the standing vehicle; it passes through it in between."""
     track = TrackGraph.from_edges({"line": ("W", "E", 20.0)})
     route = plan_graph(track, ("line:2", "line:10"), ("line:2", "line:10"), min_separation=1.5)
-    moved = GraphMove(0, (track.point("line:2"), track.point("line:18")), (0,), 16.0, track.point("line:10"))
+    at_start = (track.point("line:2"), track.point("line:10"))
+    moved = GraphMove(0, (track.point("line:2"), track.point("line:18")), (0,), 16.0, at_start)
     forged = dataclasses.replace(
         route, moves=(moved,), goal=(track.point("line:18"), route.goal[1]), travel=(16.0, 0.0)
     )
     report = verify_graph_route(forged)
     assert not report.passed
     assert report.closest == 0.0
-    assert "along 'line' the vehicles come 0 m apart" in report.failures[0]
+    assert "along 'line' vehicle 1 and vehicle 2 come 0 m apart" in report.failures[0]
+
+
+# -- routes of any number of vehicles (made by hand: the planner plans two) ------------------------------
+
+
+@pytest.mark.parametrize("case", FLEETS, ids=lambda case: case.name)
+def test_a_route_of_three_or_four_vehicles_is_verified_pair_by_pair(case):
+    route = case.route()
+    report = verify_graph_route(route)
+    assert report.passed, report.failures
+    assert report.closest == pytest.approx(SEPARATION, abs=1e-9)  # every case comes the separation close
+    summary = graph_route_summary(route)
+    assert summary["travel_m"] == pytest.approx(list(route.travel))
+    for move, said in zip(route.moves, summary["moves"], strict=True):
+        assert set(said["standing"]) == {route.names[v] for v in range(route.count) if v != move.vehicle}
+
+
+def _standing_at(route, move: int, vehicle: int, point: str):
+    """``route`` with ``vehicle`` said to stand at ``point`` as move ``move`` begins."""
+    at_start = list(route.moves[move].at_start)
+    at_start[vehicle] = route.track.point(point)
+    moves = list(route.moves)
+    moves[move] = dataclasses.replace(moves[move], at_start=tuple(at_start))
+    return dataclasses.replace(route, moves=tuple(moves))
+
+
+@pytest.mark.parametrize(
+    ("tamper", "match"),
+    [
+        (lambda r: dataclasses.replace(r, min_separation=2.5), r"agv2 and agv3 come 2 m apart"),
+        (
+            lambda r: _standing_at(r, 0, 1, "main:11"),
+            r"move 1 \(main:20 -> main:30\): agv2 is said to stand at main:11, but it is at main:10",
+        ),
+        (
+            lambda r: _standing_at(r, 2, 2, "main:20"),
+            r"move 3 \(main:2 -> main:26\): agv3 is said to stand at main:20, but it is at main:30",
+        ),
+        (
+            lambda r: dataclasses.replace(r, moves=r.moves[:2]),
+            r"agv1 ends at main:2: expected its goal main:26",
+        ),
+    ],
+    ids=["separation", "said-to-stand", "the-third-said-to-stand", "short"],
+)
+def test_the_verifier_names_the_vehicles_of_a_fleets_route_it_refuses(tamper, match):
+    report = verify_graph_route(tamper(fleet("convoy-of-3").route()))
+    assert not report.passed
+    assert any(re.search(match, failure) for failure in report.failures), report.failures
+
+
+def test_a_route_whose_counts_disagree_is_refused_naming_them():
+    route = fleet("convoy-of-3").route()
+    with pytest.raises(
+        PositionError, match=r"a route of 3 vehicle\(s\) has 3 goal\(s\), 2 travel\(s\), 3 name"
+    ):
+        dataclasses.replace(route, travel=route.travel[:2])
+    with pytest.raises(PositionError, match=r"moves of \[2\] vehicle\(s\)"):
+        dataclasses.replace(route, moves=(dataclasses.replace(route.moves[0], at_start=route.start[:2]),))

@@ -25,6 +25,7 @@ from PIL import Image
 
 from tests.conftest import REPO
 from tests.support.cases import case
+from tests.support.fleets import FLEETS, SEPARATION
 from tests.support.graph_cases import EXAMPLES
 from tests.support.helpers import LIMITS, animation_gif, conf, legs_cases, legs_id, route_of
 from topology import JUNCTION_INDEX, EdgePoint, Instruction, StarGraph, TrackGraph, YGraph, plan, plan_graph
@@ -1175,3 +1176,50 @@ def test_the_docs_show_a_picture_of_each_example():
         min_separation=1.5,
     )
     assert plot_graph_route(route) is not None
+
+
+# -- any number of vehicles below the planners ------------------------------------------------------------
+
+
+def _pairs_that_conflict(schedule, separation: float, step: float = 0.05) -> int:
+    """Pairs of vehicles whose paths come closer than the separation anywhere, by sampling both paths."""
+    track = schedule.track
+    samples = []
+    for path in schedule.paths:
+        travel = np.linspace(0.0, path.length, max(2, int(path.length / step) + 1))
+        samples.append(path.locate(travel))
+    count = 0
+    for (edge_a, s_a), (edge_b, s_b) in itertools.combinations(samples, 2):
+        a, b = np.meshgrid(np.arange(edge_a.size), np.arange(edge_b.size))
+        apart = track.distances(edge_a[a.ravel()], s_a[a.ravel()], edge_b[b.ravel()], s_b[b.ravel()])
+        count += bool(np.min(apart) < separation - 1e-6)
+    return count
+
+
+@pytest.mark.parametrize("case", FLEETS, ids=lambda case: case.name)
+def test_every_picture_of_a_fleet_shows_every_vehicle(case):
+    """Speed, layout, coordination (a panel per pair that conflicts) and animation for 3 and 4 vehicles."""
+    from trajgen.plots import plot_layout, plot_speed
+
+    verified, names = case.verified("exact"), case.route().names
+    toppra = case.verified("toppra")
+    speed = plot_speed(verified, names=names)
+    for axis in speed.axes[:2]:
+        drawn = [line.get_label() for line in axis.get_lines() if not line.get_label().startswith("_")]
+        assert [label for label in drawn if label in names] == list(names)
+        colours = {to_rgb(line.get_color()) for line in axis.get_lines() if line.get_label() in names}
+        assert len(colours) == case.count  # one colour each
+    layout = plot_layout(verified, names=names)
+    labels = layout.axes[0].get_legend_handles_labels()[1]
+    for name in names:
+        assert f"{name} start" in labels
+        assert f"{name} goal" in labels
+    coordination = plot_coordination({"exact": verified, "toppra": toppra})
+    expected = _pairs_that_conflict(verified.schedule, SEPARATION)
+    assert expected >= 2
+    assert len(coordination.axes) == expected
+    animation = animate(verified, names=names, max_frames=10)
+    frames = list(animation.frames())
+    assert len(frames) == animation.frame_count
+    geometry = frame_geometry(verified, [0.0, verified.schedule.duration])
+    assert geometry.x.shape[0] == case.count

@@ -484,7 +484,7 @@ def test_demo_runs_the_built_in_h_end_to_end(tmp_path, capsys):
     assert main(["demo", "--scenario", "h", "--method", "exact", "--output", str(tmp_path)]) == 0
     out = capsys.readouterr().out
     assert "Demo: the built-in scenario <built-in h.toml> (a track graph, an H of two junctions" in out
-    assert "   2  agv2: D -> A along e, m, a, 20.5 m (the other at c:1.5)" in out  # the route's moves
+    assert "   2  agv2: D -> A along e, m, a, 20.5 m (agv1 at c:1.5)" in out  # the route's moves
     assert "method: exact  duration: 51.500 s  verified: True" in out
     written = sorted(path.name for path in tmp_path.iterdir())
     assert written == GRAPH_RUN_FILES

@@ -8,6 +8,7 @@ Track graphs after: timing the route's moves, the schedule model, its rows and i
 from __future__ import annotations
 
 import dataclasses
+import itertools
 import json
 import math
 
@@ -17,6 +18,7 @@ from hypothesis import assume, given, settings
 
 from limits import Limits, VehicleLimits
 from tests.conftest import REPO
+from tests.support.fleets import FLEETS, SEPARATION
 from tests.support.graph_cases import random_routes, verified_example
 from tests.support.graph_rows import ScenarioFile, check_profiles
 from tests.support.grid_oracle import random_case
@@ -27,6 +29,7 @@ from tests.support.strategies import star_queries
 from topology import (
     JUNCTION_INDEX,
     Configuration,
+    EdgePoint,
     InfeasibleError,
     Position,
     TrackGraph,
@@ -40,6 +43,7 @@ from topology import (
 from trajgen import METHODS, Exact, Schedule, Toppra, certify, make_schedule, verify
 from trajgen.cli import main
 from trajgen.errors import InputError, OptionError, VerificationError
+from trajgen.export import DIALECTS, write_profiles
 from trajgen.export.csv import CsvOptions, profile_chunk_pair
 from trajgen.methods.optimal import Optimal
 from trajgen.model.analysis import lower_bound
@@ -51,6 +55,7 @@ from trajgen.model.schedule import CubicKinematics, FallbackReason, TimingMethod
 from trajgen.pipeline import Outputs, run
 from trajgen.scenario import BuiltinScenario, builtin_scenario, load_scenario
 from trajgen.scenario.sampling import random_scenarios
+from trajgen.verification.graph_route import TrackDistances
 
 SWAP = ((10.0, 10.0, 10.0), ("A:10", "B:10"), ("B:10", "A:10"))
 TRACK = YGraph({"A": 12.0, "B": 8.0, "C": 15.0})
@@ -872,3 +877,51 @@ def test_the_optimal_h_reverses_smoothly_at_the_cusp_and_verifies():
     assert travel[2, k + 2] > 0.4
     state = optimal.state(t[k - 2 : k + 3])
     assert np.ptp(state.acceleration[0]) < 0.01  # along the axis: no step
+
+
+# -- any number of vehicles below the planners ------------------------------------------------------------
+
+
+@pytest.mark.parametrize("method", ["exact", "toppra"])
+@pytest.mark.parametrize("case", FLEETS, ids=lambda case: case.name)
+def test_every_vehicle_of_a_fleet_is_timed_and_its_csv_rows_keep_every_pair_apart(case, method, tmp_path):
+    """Three or four vehicles: verified, and from the CSV rows alone every pair keeps the separation."""
+    verified = case.verified(method)
+    schedule, route = verified.schedule, case.route()
+    assert verified.report.passed, verified.report.failures
+    assert schedule.count == len(verified.report.velocity_ratio) == case.count
+    assert verified.report.min_separation == pytest.approx(SEPARATION, abs=1e-6)
+    if method == "toppra":
+        assert schedule.duration <= case.verified("exact").schedule.duration
+    files = write_profiles(verified, route.names, tmp_path)
+    assert [path.name for path in files] == [f"{name}.csv" for name in route.names]
+    generic = DIALECTS.lookup("generic")
+    rows = [generic.read(path.read_bytes(), source=path.name) for path in files]
+    track = schedule.track
+    distances = TrackDistances(track)  # the verifier's own Dijkstra, not the track's
+    number = {edge.name: k for k, edge in enumerate(track.edges)}
+    places = [
+        [
+            EdgePoint(number[edge], float(s))
+            for edge, s in zip(row.columns["edge"], row.columns["s"], strict=True)
+        ]
+        for row in rows
+    ]
+    assert len({len(p) for p in places}) == 1  # one row per sample, the same instants in every file
+    closest = min(
+        distances.between(a, b)
+        for i, j in itertools.combinations(range(case.count), 2)
+        for a, b in zip(places[i], places[j], strict=True)
+    )
+    assert closest >= SEPARATION - 1e-9
+    for vehicle, goal in enumerate(route.goal):
+        assert distances.between(places[vehicle][-1], goal) <= 1e-9
+
+
+@pytest.mark.parametrize("case", FLEETS, ids=lambda case: case.name)
+def test_optimal_on_more_than_two_vehicles_plays_exact_and_says_why(case):
+    verified = case.verified("optimal")
+    assert verified.schedule.fallback_reason is FallbackReason.SETUP_FAILED
+    assert verified.schedule.duration == case.verified("exact").schedule.duration
+    expected = f"times two vehicles at once, the route moves {case.count}: expected exact or toppra"
+    assert expected in verified.schedule.notes[0]

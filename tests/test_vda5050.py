@@ -27,6 +27,7 @@ from vda5050.domain.order import AcceptanceDecision
 
 from limits import Limits, VehicleLimits
 from tests.conftest import REPO
+from tests.support.fleets import FLEETS, SEPARATION, fleet
 from tests.support.graph_cases import TINY_BACK_OFF, random_routes, verified_example
 from tests.support.graph_rows import ScenarioFile
 from tests.support.star_scenarios import CROSSING, STAR_SCENARIOS, toml_text
@@ -1329,20 +1330,22 @@ def _named(names, a, b):
 
 
 def _drive_at_random_paces(verified, releases, distance, seed: int, step: float = 0.05) -> float:
-    """Both vehicles driven at random paces, each only within its released base; the least distance.
+    """Every vehicle driven at random paces, each only within its released base; the least distance.
 
-    ``distance((edge, s), (edge, s))``: the track distance the caller trusts, metres.
+    ``distance((edge, s), (edge, s))``: the track distance the caller trusts, metres; the least over
+    every pair.
     """
     paths = verified.schedule.paths
+    count = len(paths)
     rng = np.random.default_rng(seed)
     rule = BaseRelease(releases.paths, verified.schedule.limits.min_separation)
-    travel = [0.0, 0.0]
+    travel = [0.0] * count
     closest = math.inf
     for _ in range(200_000):
         if rule.reached == list(rule.last):
             return closest
-        limits = [releases.paths[v].nodes[rule.released[v]].travel for v in (0, 1)]
-        movable = [v for v in (0, 1) if travel[v] < limits[v] - 1e-12]
+        limits = [releases.paths[v].nodes[rule.released[v]].travel for v in range(count)]
+        movable = [v for v in range(count) if travel[v] < limits[v] - 1e-12]
         assert movable, f"deadlock at nodes {rule.reached} (seed {seed})"
         v = int(rng.choice(movable))
         travel[v] = min(travel[v] + rng.uniform(0.2, 1.0) * step, limits[v])
@@ -1350,10 +1353,10 @@ def _drive_at_random_paces(verified, releases, distance, seed: int, step: float 
         while rule.reached[v] < rule.released[v] and nodes[rule.reached[v] + 1].travel <= travel[v] + 1e-12:
             rule.reach(v, rule.reached[v] + 1)
         where = []
-        for u in (0, 1):
+        for u in range(count):
             edge, s = paths[u].locate(travel[u])
             where.append((int(edge[0]), float(s[0])))
-        closest = min(closest, distance(*where))
+        closest = min(closest, *(distance(a, b) for a, b in itertools.combinations(where, 2)))
     pytest.fail(f"not at the goals after 200,000 steps (seed {seed})")
 
 
@@ -1474,3 +1477,50 @@ def test_nodes_less_than_a_micrometre_apart_keep_distinct_ids(tmp_path):
     chained = dataclasses.replace(path, nodes=nodes, edges=path.edges[:2])
     ids = [chained.node_id(k) for k in range(3)]
     assert ids[0] != ids[2], ids
+
+
+# -- any number of vehicles below the planners ------------------------------------------------------------
+
+
+@pytest.mark.parametrize("method", ["exact", "toppra"])
+@pytest.mark.parametrize("case", FLEETS, ids=lambda case: case.name)
+def test_a_fleet_gets_an_order_per_vehicle_and_its_releases_keep_every_pair_apart_whatever_the_timing(
+    case, method
+):
+    """Three or four vehicles: each order valid and taken, and the bases released node by node."""
+    verified, route = case.verified(method), case.route()
+    releases = order_releases(verified)
+    assert len(releases.paths) == case.count
+    messages = render_orders(verified, route.names, options=GRAPH_OPTIONS, releases=releases)
+    documents: dict[str, list[dict]] = {name: [] for name in route.names}
+    for message in messages:
+        documents[route.names[message.vehicle]].append(json.loads(message.data))
+    track = route.track
+    for vehicle, name in enumerate(route.names):
+        assert documents[name], name
+        for document in documents[name]:
+            assert schema_errors(document) == []
+            parse_order(document)
+        receiver = SimulatedVehicle(
+            documents[name][0], *track.xy(route.start[vehicle]), map_id=GRAPH_OPTIONS.map_id
+        )
+        decisions = [receiver.receive(document).decision for document in documents[name]]
+        assert decisions == [AcceptanceDecision.ACCEPT_NEW] + [AcceptanceDecision.ACCEPT_UPDATE] * (
+            len(decisions) - 1
+        )
+
+    def distance(a, b):
+        return float(track.distances([a[0]], [a[1]], [b[0]], [b[1]])[0])
+
+    for pace in range(3):
+        closest = _drive_at_random_paces(verified, releases, distance, pace)
+        assert closest >= SEPARATION - 1e-9, (pace, closest)
+
+
+def test_the_node_plan_of_a_fleet_follows_the_schedules_order_of_arrivals():
+    """The convoy: the front vehicle first, then the middle one, then the last (each behind the next)."""
+    case = fleet("convoy-of-3")
+    releases = order_releases(case.verified("exact"))
+    order = [(release.vehicle, release.update) for release in releases.releases if release.update]
+    assert order == [(1, 1), (0, 1)]  # agv2 once agv3 is at its goal, agv1 once agv2 is
+    assert releases.releases[2].decision_point == 1  # agv3's whole path at once

@@ -1,7 +1,9 @@
 """Each check of the verifier, tampered with once on every case of the table, is caught and placed.
 
 One verifier serves every track: the same tampering of a junction's plan and of a track graph's
-plan fails the same check, with a message in words and details that name the schedule's arrays.
+plan fails the same check, with a message in words and details that name the schedule's arrays. It
+serves any number of vehicles too: the table's cases are joined by routes of three and four vehicles
+made by hand (:mod:`tests.support.fleets`).
 """
 
 from __future__ import annotations
@@ -16,6 +18,7 @@ import pytest
 
 from limits import Limits
 from tests.support.cases import CASES
+from tests.support.fleets import FLEETS
 from topology import plan
 from trajgen import verify
 from trajgen.methods import make_schedule
@@ -113,12 +116,12 @@ CHECKS = {
 
 
 def test_every_case_of_the_table_passes_untouched():
-    for case in CASES:
+    for case in (*CASES, *FLEETS):
         assert case.verified().report.passed, case.name
 
 
 @pytest.mark.parametrize("check", sorted(CHECKS))
-@pytest.mark.parametrize("case", CASES, ids=[case.name for case in CASES])
+@pytest.mark.parametrize("case", [*CASES, *FLEETS], ids=[case.name for case in (*CASES, *FLEETS)])
 def test_each_check_catches_its_tampering_on_every_track(case, check):
     tamper, failure, arrays = CHECKS[check]
     verified = case.verified()
@@ -130,6 +133,34 @@ def test_each_check_catches_its_tampering_on_every_track(case, check):
     text, detail = matching[0]
     assert detail.startswith(text), detail
     assert arrays in detail, detail
+
+
+@pytest.mark.parametrize("case", FLEETS, ids=[case.name for case in FLEETS])
+def test_a_fleets_last_vehicle_too_fast_for_its_own_limit_is_named_with_its_arrays(case):
+    schedule = case.verified().schedule
+    last = schedule.count - 1
+    vehicles = list(schedule.limits.vehicles)
+    vehicles[last] = dataclasses.replace(vehicles[last], max_velocity=0.5 * vehicles[last].max_velocity)
+    report = verify(
+        dataclasses.replace(schedule, limits=Limits(tuple(vehicles), schedule.limits.min_separation))
+    )
+    assert not report.passed
+    assert all(text.startswith(f"vehicle {last + 1} velocity reaches") for text in report.failures), (
+        report.failures
+    )
+    assert f"vehicles[{last}]" in report.details[0]
+    assert f"paths[{last}]" in report.details[0]
+
+
+@pytest.mark.parametrize("case", FLEETS, ids=[case.name for case in FLEETS])
+def test_a_fleets_closest_pair_is_named_when_the_separation_is_raised(case):
+    verified = case.verified()
+    schedule = verified.schedule
+    report = verify(dataclasses.replace(schedule, limits=Limits(schedule.limits.vehicles, 2.5)))
+    assert not report.passed
+    found = [text for text in report.failures if text.startswith("separation 2 m")]
+    assert found, report.failures
+    assert re.search(r"\(vehicle (\d) on '.*', vehicle (\d) on '.*'\)", found[0]), found[0]
 
 
 #: Cases whose optimal plan, made without the braking rule, breaks it: relabelled as a plan for execution,

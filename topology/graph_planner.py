@@ -36,7 +36,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from topology.errors import InfeasibleError, SeparationError
+from topology.errors import InfeasibleError, PositionError, SeparationError
 from topology.track_graph import EdgePoint, TrackGraph
 from topology.validation import check_vehicle_count, finite_real, short_repr
 
@@ -54,27 +54,32 @@ MAX_STATES = 2_000_000
 
 @dataclass(frozen=True, slots=True)
 class GraphMove:
-    """One vehicle's move along the track while the other stands.
+    """One vehicle's move along the track while the others stand.
 
     Attributes
     ----------
     vehicle : int
-        0 or 1.
+        Which vehicle moves: its index in the route's vehicles.
     points : tuple of EdgePoint
         Where it starts, each node it passes, where it ends.
     edges : tuple of int
         The edge it runs along from each point to the next (``len(points) - 1`` of them).
     length : float
         Metres travelled.
-    standing : EdgePoint
-        Where the other vehicle stands meanwhile.
+    at_start : tuple of EdgePoint
+        Every vehicle's point as the move begins, one per vehicle (the moving one's is
+        ``points[0]``); the others stand there throughout.
     """
 
     vehicle: int
     points: tuple[EdgePoint, ...]
     edges: tuple[int, ...]
     length: float
-    standing: EdgePoint
+    at_start: tuple[EdgePoint, ...]
+
+    def standing(self) -> tuple[tuple[int, EdgePoint], ...]:
+        """``(vehicle, point)`` of each vehicle that stands during the move, in vehicle order."""
+        return tuple((v, point) for v, point in enumerate(self.at_start) if v != self.vehicle)
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -89,7 +94,7 @@ class GraphRoute:
     start, goal : tuple of 2 EdgePoint
     moves : tuple of GraphMove
         In order. A new move starts where the other vehicle takes over or the moving one turns back.
-    travel : tuple of 2 float
+    travel : tuple of float
         Metres each vehicle travels; the route minimises their sum.
     critical_points : int
         Critical points of the roadmap before the search (nodes, starts, goals and the points at
@@ -97,24 +102,40 @@ class GraphRoute:
         stands as it reaches them.
     searched : int
         Pairs of critical points the search expanded (how hard the planning was).
-    names : tuple of 2 str
+    names : tuple of str
         The vehicles' names the planner was given (for messages and summaries).
     """
 
     track: TrackGraph
     min_separation: float
-    start: tuple[EdgePoint, EdgePoint]
-    goal: tuple[EdgePoint, EdgePoint]
+    start: tuple[EdgePoint, ...]
+    goal: tuple[EdgePoint, ...]
     moves: tuple[GraphMove, ...]
-    travel: tuple[float, float]
+    travel: tuple[float, ...]
     critical_points: int
     searched: int
-    names: tuple[str, str] = ("vehicle 1", "vehicle 2")
+    names: tuple[str, ...] = ("vehicle 1", "vehicle 2")
+
+    def __post_init__(self) -> None:
+        counts = {len(self.start), len(self.goal), len(self.travel), len(self.names)}
+        counts |= {len(move.at_start) for move in self.moves}
+        if len(counts) != 1 or not all(0 <= move.vehicle < len(self.start) for move in self.moves):
+            raise PositionError(
+                f"a route of {len(self.start)} vehicle(s) has {len(self.goal)} goal(s), "
+                f"{len(self.travel)} travel(s), {len(self.names)} name(s) and moves of "
+                f"{sorted({len(m.at_start) for m in self.moves})} vehicle(s) by vehicles "
+                f"{sorted({m.vehicle for m in self.moves})}: expected one of each per vehicle"
+            )
+
+    @property
+    def count(self) -> int:
+        """How many vehicles the route moves."""
+        return len(self.start)
 
     @property
     def length(self) -> float:
-        """The route's cost, metres: both vehicles' travel."""
-        return self.travel[0] + self.travel[1]
+        """The route's cost, metres: every vehicle's travel."""
+        return sum(self.travel)
 
 
 def plan_graph(
@@ -426,6 +447,7 @@ class _Search:
         current: list[EdgePoint] = []
         along: list[int] = []
         mover = -1
+        began = pairs[0]
         for (before, after), edge in zip(itertools.pairwise(pairs), edges, strict=True):
             vehicle = 0 if self._key(before[0]) != self._key(after[0]) else 1
             step = self._distance(before[vehicle], after[vehicle])
@@ -437,12 +459,12 @@ class _Search:
             )
             if vehicle != mover or back:
                 if current:
-                    moves.append(self._move(mover, current, along, before[1 - mover]))
-                current, along, mover = [before[vehicle]], [], vehicle
+                    moves.append(self._move(mover, current, along, began))
+                current, along, mover, began = [before[vehicle]], [], vehicle, before
             current.append(after[vehicle])
             along.append(edge)
         if current:
-            moves.append(self._move(mover, current, along, pairs[-1][1 - mover]))
+            moves.append(self._move(mover, current, along, began))
         return GraphRoute(
             self.track,
             self.separation,
@@ -464,13 +486,16 @@ class _Search:
         """Whether going a -> b -> c turns back at b (c lies back towards a along b's edge)."""
         return self._distance(a, c) < self._distance(a, b) + self._distance(b, c) - TOLERANCE
 
-    def _move(self, vehicle: int, points: list[EdgePoint], along: list[int], standing) -> GraphMove:
-        """A move through ``points`` along ``along`` (the edge of each step), kept at nodes and ends."""
+    def _move(self, vehicle: int, points: list[EdgePoint], along: list[int], began) -> GraphMove:
+        """A move through ``points`` along ``along`` (the edge of each step), kept at nodes and ends.
+
+        ``began``: every vehicle's point as the move begins.
+        """
         kept = [0] + [k for k in range(1, len(points) - 1) if self.track.node_at(points[k]) is not None]
         kept.append(len(points) - 1)
         length = sum(self._distance(a, b) for a, b in itertools.pairwise(points))
         edges = tuple(along[k] for k in kept[:-1])
-        return GraphMove(vehicle, tuple(points[k] for k in kept), edges, length, standing)
+        return GraphMove(vehicle, tuple(points[k] for k in kept), edges, length, tuple(began))
 
     def _why(self, searched: set[tuple], where) -> str:
         """Which vehicle cannot reach its goal, how close it gets, and where the other blocks it."""

@@ -130,6 +130,13 @@ def solve_graph(method, route: GraphRoute, limits: Limits) -> GraphSchedule:
         A bad route or limits.
     """
     check_graph_request(route, limits)
+    if route.count != 2:
+        # the cells of this formulation are rectangles in the plane of two travels
+        detail = (
+            f"the optimal formulation on a track graph times two vehicles at once, the route moves "
+            f"{route.count}: expected exact or toppra for {route.count}"
+        )
+        return graph_fallback(route, limits, FallbackReason.SETUP_FAILED, detail)
     routes = [route]
     if method.homotopy.value == "fastest":
         others = plan_graph_classes(

@@ -15,6 +15,7 @@ travel (metres driven along their paths) it is a staircase, each move a step alo
 
 from __future__ import annotations
 
+import itertools
 import logging
 
 import numpy as np
@@ -54,17 +55,17 @@ def check_graph_request(route: object, limits: object) -> tuple[GraphRoute, Limi
 
 
 def travel_corners(route: GraphRoute) -> tuple[np.ndarray, np.ndarray]:
-    """The route as a staircase in the plane of both travels.
+    """The route as a staircase in the space of every vehicle's travel.
 
     Returns
     -------
-    corners : ndarray, shape (m + 1, 2)
-        Both vehicles' travel before the first move and after each, metres.
+    corners : ndarray, shape (m + 1, count)
+        Every vehicle's travel before the first move and after each, metres.
     movers : ndarray of int, shape (m,)
         The vehicle each move moves.
     """
     moves = [move for move in route.moves if move.length > 0.0]
-    corners = np.zeros((len(moves) + 1, 2))
+    corners = np.zeros((len(moves) + 1, len(route.start)))
     for k, move in enumerate(moves):
         corners[k + 1] = corners[k]
         corners[k + 1, move.vehicle] += move.length
@@ -95,21 +96,24 @@ def moves_one_at_a_time(route: GraphRoute, limits: Limits, method, *, jerk: bool
     return GraphSchedule(route, limits, method, graph_paths(route), tuple(sections), jerk_limited=jerk)
 
 
-def _distances(track: TrackGraph, paths: tuple[GraphPath, GraphPath], points: np.ndarray) -> np.ndarray:
-    """Track distance between the vehicles at travel points ``points``, shape (n, 2) -> (n,)."""
-    edge_1, s_1 = paths[0].locate(points[:, 0])
-    edge_2, s_2 = paths[1].locate(points[:, 1])
-    return track.distances(edge_1, s_1, edge_2, s_2)
+def _distances(track: TrackGraph, paths: tuple[GraphPath, ...], points: np.ndarray) -> np.ndarray:
+    """Least track distance between any two vehicles at travel points ``points``, shape (n, V) -> (n,)."""
+    located = [path.locate(points[:, v]) for v, path in enumerate(paths)]
+    least = np.full(points.shape[0], np.inf)
+    for (edge_1, s_1), (edge_2, s_2) in itertools.combinations(located, 2):
+        np.minimum(least, track.distances(edge_1, s_1, edge_2, s_2), out=least)
+    return least
 
 
 def _safe_blend(
-    corners: np.ndarray, corner: int, track: TrackGraph, paths: tuple[GraphPath, GraphPath], required: float
+    corners: np.ndarray, corner: int, track: TrackGraph, paths: tuple[GraphPath, ...], required: float
 ) -> Blend | None:
     """The largest blend at ``corners[corner]`` whose whole triangle keeps ``required`` metres, or None.
 
-    The track distance changes by at most ``|dp1| + |dp2|`` between two points of the travel plane,
-    so a grid of the triangle with spacing ``h`` per axis that keeps ``required + h`` keeps
-    ``required`` everywhere in it; the blend and the corner both lie in the triangle, which then holds
+    The track distance of two vehicles changes by at most ``|dp_i| + |dp_j|`` between two points of
+    the travel space (the triangle moves only the two vehicles of the hand-over), so a grid of the
+    triangle with spacing ``h`` per axis on which every pair keeps ``required + h`` keeps ``required``
+    everywhere in it; the blend and the corner both lie in the triangle, which then holds
     no part of a conflict, so the blend passes every conflict on the route's side.
     """
     before, point, after = corners[corner - 1], corners[corner], corners[corner + 1]

@@ -160,30 +160,27 @@ def _progress_limits(delta: np.ndarray, limits: Limits) -> tuple[float, float, f
 
 def piece_profiles(
     start: np.ndarray, end: np.ndarray, limits: Limits, *, jerk: bool = True
-) -> tuple[PiecewiseCubic, PiecewiseCubic]:
-    """Both axes along one straight piece, rest to rest, time-optimal under the scaled limits.
+) -> tuple[PiecewiseCubic, ...]:
+    """Every vehicle's axis along one straight piece, rest to rest, time-optimal under the scaled limits.
 
     Parameters
     ----------
-    start, end : ndarray, shape (2,)
-        Axes of both vehicles at the piece's ends, metres.
+    start, end : ndarray, shape (m,)
+        Axes (or travels) of the m vehicles at the piece's ends, metres.
     limits : Limits
     jerk : bool
         S-curve (jerk-limited) if True, else trapezoid (velocity and acceleration only).
     """
     delta = end - start
     if not np.any(delta):  # nothing moves (start is the goal): at rest, zero duration
-        return (
-            PiecewiseCubic.from_phases(float(start[0]), []),
-            PiecewiseCubic.from_phases(float(start[1]), []),
-        )
+        return tuple(PiecewiseCubic.from_phases(float(value), []) for value in start)
     v, a, j = _progress_limits(delta, limits)
     if jerk:
         phases = [(d, np.nan, value) for d, value in scurve_phases(1.0, v, a, j)]
     else:
         phases = [(d, value, 0.0) for d, value in trapezoid_phases(1.0, v, a)]
     profiles = []
-    for vehicle in range(2):
+    for vehicle in range(len(start)):
         scaled = [(d, acc * delta[vehicle], jk * delta[vehicle]) for d, acc, jk in phases]
         profiles.append(PiecewiseCubic.from_phases(float(start[vehicle]), scaled, end=float(end[vehicle])))
-    return profiles[0], profiles[1]
+    return tuple(profiles)

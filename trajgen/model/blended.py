@@ -79,7 +79,7 @@ class BlendedPath(ArrayValue):
             if length > 0.0:
                 p0.append(point)
                 d1.append((target - point) / length)
-                d2.append(np.zeros(2))
+                d2.append(np.zeros(vertices.shape[1]))
                 s += length
                 starts.append(s)
             if blend is not None:
@@ -103,8 +103,8 @@ class BlendedPath(ArrayValue):
     # TOPPRA's geometric path interface
     @property
     def dof(self) -> int:
-        """Degrees of freedom: the two signed axes."""
-        return 2
+        """Degrees of freedom: one coordinate per vehicle (its signed axis or its travel)."""
+        return int(self.vertices.shape[1])
 
     @property
     def path_interval(self) -> np.ndarray:
@@ -135,9 +135,9 @@ class BlendedPath(ArrayValue):
         elif order == 1:
             out = self._d1[k] + h * self._d2[k]
         elif order == 2:
-            out = np.broadcast_to(self._d2[k], (ss.size, 2)).copy()
+            out = np.broadcast_to(self._d2[k], (ss.size, self.dof)).copy()
         else:
-            out = np.zeros((ss.size, 2))
+            out = np.zeros((ss.size, self.dof))
         return out
 
     def eval(self, ss):
@@ -207,7 +207,7 @@ class ToppraKinematics(ArrayValue, Kinematics):
         q = self.path.on_piece(piece, s, 0)
         dq = self.path.on_piece(piece, s, 1)
         ddq = self.path.on_piece(piece, s, 2)
-        out = np.empty((2, 4, t.size))
+        out = np.empty((self.path.dof, 4, t.size))
         out[:, 0] = q.T
         out[:, 1] = (dq * sd[:, None]).T
         out[:, 2] = (ddq * (sd * sd)[:, None] + dq * sdd[:, None]).T

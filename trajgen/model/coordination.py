@@ -20,6 +20,7 @@ control cycle.
 
 from __future__ import annotations
 
+import itertools
 import math
 from dataclasses import dataclass, field
 
@@ -36,6 +37,7 @@ __all__ = [
     "Conflict",
     "CoordinationDiagram",
     "Polygon",
+    "SchedulePair",
     "earliest_rest",
     "schedule_paths",
     "schedule_times",
@@ -351,6 +353,35 @@ class CoordinationDiagram:
     def leading(self, vehicle: int, travel: float) -> tuple[Conflict, ...]:
         """The conflicts ``vehicle`` leads that it has not yet passed at ``travel``."""
         return tuple(c for c in self.conflicts if c.leader == vehicle and c.high[vehicle] > travel)
+
+
+@dataclass(frozen=True, slots=True)
+class SchedulePair:
+    """Two vehicles of a schedule of any number, as the schedule of two a coordination diagram reads.
+
+    Attributes
+    ----------
+    schedule : Schedule or GraphSchedule
+    pair : tuple of 2 int
+        The two vehicles' indices in ``schedule``, in the diagram's order.
+    """
+
+    schedule: object
+    pair: tuple[int, int]
+
+    @property
+    def track(self):
+        """The schedule's track graph."""
+        return self.schedule.track
+
+    def state(self, t):
+        """The two vehicles' states at times ``t`` (:meth:`~trajgen.model.state.TrackState.of`)."""
+        return self.schedule.state(t).of(self.pair)
+
+    @classmethod
+    def every(cls, schedule, count: int) -> tuple[SchedulePair, ...]:
+        """Every pair of ``count`` vehicles of ``schedule``, in the order of ``itertools.combinations``."""
+        return tuple(cls(schedule, pair) for pair in itertools.combinations(range(count), 2))
 
 
 def stopping_distance(

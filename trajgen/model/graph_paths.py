@@ -135,8 +135,8 @@ def _segments(track: TrackGraph, route: GraphRoute, vehicle: int) -> list[list]:
     return segments
 
 
-def graph_paths(route: GraphRoute) -> tuple[GraphPath, GraphPath]:
-    """Both vehicles' paths along ``route``, in travel coordinates.
+def graph_paths(route: GraphRoute) -> tuple[GraphPath, ...]:
+    """Every vehicle's path along ``route``, in travel coordinates, in the route's vehicle order.
 
     Examples
     --------
@@ -148,7 +148,8 @@ def graph_paths(route: GraphRoute) -> tuple[GraphPath, GraphPath]:
     True
     """
     return tuple(
-        _path_of(_segments(route.track, route, vehicle), route.start[vehicle]) for vehicle in range(2)
+        _path_of(_segments(route.track, route, vehicle), route.start[vehicle])
+        for vehicle in range(len(route.start))
     )
 
 

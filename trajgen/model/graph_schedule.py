@@ -1,7 +1,7 @@
-"""Schedules on a track graph: both vehicles' travel over time along their paths (the data model).
+"""Schedules on a track graph: every vehicle's travel over time along its path (the data model).
 
 A :class:`GraphSchedule` holds each vehicle's path (:class:`~trajgen.model.graph_paths.GraphPath`)
-and both vehicles' travel ``p(t)`` as consecutive :class:`GraphSection` s, each piecewise cubic
+and every vehicle's travel ``p(t)`` as consecutive :class:`GraphSection` s, each piecewise cubic
 (:class:`~trajgen.model.schedule.CubicKinematics`) or a TOPPRA section
 (:class:`~trajgen.model.blended.ToppraKinematics`) in the plane of both travels.
 The signed axis, velocity, acceleration and jerk a controller reads are the travel's, signed by the
@@ -12,6 +12,7 @@ path's heading (which flips only where the vehicle is at rest). Made by the timi
 
 from __future__ import annotations
 
+import itertools
 from dataclasses import dataclass
 
 import numpy as np
@@ -33,7 +34,7 @@ from trajgen.model.state import TrackState
 __all__ = ["GraphSchedule", "GraphSection", "GraphState"]
 
 
-#: A stretch of a schedule on a track graph: both vehicles' travel (metres along their paths) over
+#: A stretch of a schedule on a track graph: every vehicle's travel (metres along its path) over
 #: the section's local time (``start_time``, ``kinematics``, ``duration``).
 GraphSection = TimedSection
 
@@ -45,7 +46,7 @@ GraphState = TrackState
 
 @dataclass(frozen=True, slots=True)
 class GraphSchedule:
-    """A timed motion of both vehicles along a route on a track graph.
+    """A timed motion of vehicles along a route on a track graph (any number: ``count``).
 
     Attributes
     ----------
@@ -54,7 +55,7 @@ class GraphSchedule:
     limits : Limits
     method : TimingMethod
         The method, with its options, that computed the motion.
-    paths : tuple of 2 GraphPath
+    paths : tuple of GraphPath
         Each vehicle's path along the route.
     sections : tuple of GraphSection
         Consecutive in time, the first at t = 0: each vehicle's travel from 0 to its path's length.
@@ -77,7 +78,7 @@ class GraphSchedule:
     route: GraphRoute
     limits: Limits
     method: object
-    paths: tuple[GraphPath, GraphPath]
+    paths: tuple[GraphPath, ...]
     sections: tuple[GraphSection, ...]
     jerk_limited: bool
     notes: tuple[str, ...] = ()
@@ -111,19 +112,19 @@ class GraphSchedule:
 
     @property
     def duration(self) -> float:
-        """Makespan: time until both vehicles are at rest at their goals, seconds."""
+        """Makespan: time until every vehicle is at rest at its goal, seconds."""
         last = self.sections[-1]
         return last.start_time + last.duration
 
     def travel(self, t) -> np.ndarray:
-        """Both vehicles' travel (m), its velocity, acceleration and jerk at times ``t``, shape (2, 4, n).
+        """Every vehicle's travel (m), its velocity, acceleration and jerk at times ``t``, shape (V, 4, n).
 
         Travel never decreases; :meth:`state` signs its derivatives by each path's heading.
         """
         t = np.clip(np.atleast_1d(np.asarray(t, dtype=float)), 0.0, self.duration)
         starts = np.array([section.start_time for section in self.sections])
         index = np.clip(np.searchsorted(starts, t, side="right") - 1, 0, len(self.sections) - 1)
-        values = np.zeros((2, 4, t.size))  # travel, its velocity, acceleration, jerk
+        values = np.zeros((len(self.paths), 4, t.size))  # travel, its velocity, acceleration, jerk
         for k, section in enumerate(self.sections):
             mask = index == k
             if mask.any():
@@ -134,7 +135,7 @@ class GraphSchedule:
         return values
 
     def state(self, t) -> TrackState:
-        """States of both vehicles at times ``t`` (seconds, clipped to [0, duration])."""
+        """States of every vehicle at times ``t`` (seconds, clipped to [0, duration])."""
         t = np.clip(np.atleast_1d(np.asarray(t, dtype=float)), 0.0, self.duration)
         values = self.travel(t)
         travel = values[:, 0]
@@ -156,9 +157,27 @@ class GraphSchedule:
             travel=travel,
         )
 
+    @property
+    def count(self) -> int:
+        """How many vehicles the schedule moves."""
+        return len(self.paths)
+
+    def pair_distances(self, state: TrackState) -> np.ndarray:
+        """Track distance of every pair of vehicles in ``state``, metres, shape (P, n).
+
+        Pairs in the order of ``itertools.combinations(range(count), 2)``.
+        """
+        return np.array(
+            [
+                self.track.distances(state.edge[i], state.s[i], state.edge[j], state.s[j])
+                for i, j in itertools.combinations(range(len(self.paths)), 2)
+            ]
+        ).reshape(-1, np.shape(state.t)[0])
+
     def distances(self, state: TrackState) -> np.ndarray:
-        """Track distance between the vehicles in ``state`` (this schedule's, at some times), metres, (n,)."""
-        return self.track.distances(state.edge[0], state.s[0], state.edge[1], state.s[1])
+        """The least track distance between any two vehicles in ``state`` (this schedule's), metres, (n,)."""
+        pairs = self.pair_distances(state)
+        return np.min(pairs, axis=0) if pairs.size else np.full(np.shape(state.t), np.inf)
 
     def sample(self, period: float) -> TrackState:
         """States every ``period`` seconds from t = 0, plus a last sample exactly at the goal."""

@@ -112,15 +112,19 @@ def shift(c: np.ndarray, delta: np.ndarray) -> np.ndarray:
 
 
 def cubic_pieces(kinematics: CubicKinematics) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Breakpoints (m + 1,), axis polynomials (2, m, DEGREE + 1), knot intervals (2, m): a cubic section."""
+    """Breakpoints (m + 1,), axis polynomials (V, m, DEGREE + 1), knot intervals (V, m): a cubic section.
+
+    V is the number of vehicles.
+    """
     duration = kinematics.duration
     times = sorted_unique(
         np.concatenate([np.clip(p.times, 0.0, duration) for p in kinematics.vehicles] + [[0.0]])
     )
     times = np.append(times[times < duration], duration) if duration > 0 else np.array([0.0, 0.0])
     begin = times[:-1]
-    coefficients = np.zeros((2, begin.size, DEGREE + 1))
-    intervals = np.zeros((2, begin.size), dtype=int)
+    count = len(kinematics.vehicles)
+    coefficients = np.zeros((count, begin.size, DEGREE + 1))
+    intervals = np.zeros((count, begin.size), dtype=int)
     for vehicle, profile in enumerate(kinematics.vehicles):
         k = np.clip(np.searchsorted(profile.times, begin, side="right") - 1, 0, len(profile.jerk) - 1)
         intervals[vehicle] = k
@@ -153,20 +157,21 @@ def toppra_pieces(kinematics) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     p0 = path.on_piece(piece, piece_start, 0)  # (m, 2): the piece's polynomial at its own start
     d1 = path.on_piece(piece, piece_start, 1)
     d2 = path.on_piece(piece, piece_start, 2)
-    coefficients = np.zeros((2, grid.size - 1, DEGREE + 1))
-    for vehicle in range(2):
+    count = p0.shape[1]
+    coefficients = np.zeros((count, grid.size - 1, DEGREE + 1))
+    for vehicle in range(count):
         a, b, c = p0[:, vehicle], d1[:, vehicle], 0.5 * d2[:, vehicle]  # q = a + b u + c u^2
         coefficients[vehicle, :, 0] = a + b * alpha + c * alpha**2
         coefficients[vehicle, :, 1] = b * beta + 2.0 * c * alpha * beta
         coefficients[vehicle, :, 2] = b * gamma + c * (beta**2 + 2.0 * alpha * gamma)
         coefficients[vehicle, :, 3] = 2.0 * c * beta * gamma
         coefficients[vehicle, :, 4] = c * gamma**2
-    intervals = np.tile(np.arange(grid.size - 1), (2, 1))
+    intervals = np.tile(np.arange(grid.size - 1), (count, 1))
     return np.asarray(times, dtype=float), coefficients, intervals
 
 
 def kinematics_polynomials(kinematics) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Breakpoints (m + 1,), both vehicles' polynomials (2, m, DEGREE + 1) and intervals (2, m) of a section.
+    """Breakpoints (m + 1,), every vehicle's polynomials (V, m, DEGREE + 1) and intervals (V, m) of a section.
 
     Raises
     ------

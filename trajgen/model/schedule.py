@@ -254,23 +254,23 @@ class Kinematics(abc.ABC):
 
 @dataclass(frozen=True, slots=True)
 class CubicKinematics(Kinematics):
-    """Both vehicles as piecewise cubics (constant jerk between breakpoints).
+    """Every vehicle as a piecewise cubic (constant jerk between breakpoints).
 
     Attributes
     ----------
-    vehicles : tuple of 2 PiecewiseCubic
-        Signed axis of vehicle 1 and vehicle 2 over the section's local time.
+    vehicles : tuple of PiecewiseCubic
+        Each vehicle's signed axis (its travel, on a track graph) over the section's local time.
     """
 
-    vehicles: tuple[PiecewiseCubic, PiecewiseCubic]
+    vehicles: tuple[PiecewiseCubic, ...]
 
     @property
     def duration(self) -> float:
-        """Length of the section, seconds: the later of the two vehicles' ends."""
-        return max(self.vehicles[0].duration, self.vehicles[1].duration)
+        """Length of the section, seconds: the latest of the vehicles' ends."""
+        return max(profile.duration for profile in self.vehicles)
 
     def evaluate(self, t: np.ndarray) -> np.ndarray:
-        """Axis, velocity, acceleration, jerk of both vehicles; shape (2, 4, n)."""
+        """Axis, velocity, acceleration, jerk of every vehicle; shape (m, 4, n)."""
         return np.stack([profile.evaluate(t) for profile in self.vehicles])
 
 

@@ -55,6 +55,15 @@ class TrackState(ArrayValue):
         if self.travel is not None:
             object.__setattr__(self, "travel", frozen(np.asarray(self.travel)))
 
+    def of(self, vehicles) -> TrackState:
+        """The states of ``vehicles`` only (indices, in that order), at the same times."""
+        rows = list(vehicles)
+        return TrackState(
+            self.t,
+            *(getattr(self, name)[rows] for name in _ARRAYS if name != "t"),
+            travel=None if self.travel is None else self.travel[rows],
+        )
+
     @property
     def leg(self) -> np.ndarray:
         """The edge, or ``JUNCTION_INDEX`` (-1) where a vehicle is at its edge's ``from`` node, shape (m, n).

@@ -12,6 +12,7 @@ brackets.
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 
 from topology import GraphRoute, Homotopy, Instruction, Route, WayRound
 
@@ -180,13 +181,15 @@ def route_summary(route: Route) -> dict:
     return summary
 
 
-def graph_route_summary(route: GraphRoute, names: tuple[str, str] = ("vehicle 1", "vehicle 2")) -> dict:
+def graph_route_summary(route: GraphRoute, names: Sequence[str] | None = None) -> dict:
     """A JSON-ready summary of a route on a track graph: each vehicle's travel and the moves.
 
     Each move names the vehicle, where it starts and ends (``EDGE:s`` or a node), the nodes it
-    passes, the edges it runs along, its length and where the other vehicle stands meanwhile.
+    passes, the edges it runs along, its length and where each other vehicle stands meanwhile
+    (``standing``: name to place). ``names``: the vehicles' (default the route's).
     """
     track = route.track
+    names = route.names if names is None else tuple(names)
     return {
         "track": {"nodes": len(track.nodes), "edges": track.edge_count, "length_m": track.total_length},
         "min_separation_m": route.min_separation,
@@ -202,7 +205,7 @@ def graph_route_summary(route: GraphRoute, names: tuple[str, str] = ("vehicle 1"
                 "via": [track.name(p) for p in move.points[1:-1]],
                 "edges": [track.edges[e].name for e in move.edges],
                 "length_m": move.length,
-                "other_at": track.name(move.standing),
+                "standing": {names[v]: track.name(point) for v, point in move.standing()},
             }
             for move in route.moves
         ],
@@ -211,20 +214,22 @@ def graph_route_summary(route: GraphRoute, names: tuple[str, str] = ("vehicle 1"
     }
 
 
-def format_graph_route(route: GraphRoute, names: tuple[str, str] = ("vehicle 1", "vehicle 2")) -> str:
-    """Human-readable multi-line description of a route on a track graph."""
+def format_graph_route(route: GraphRoute, names: Sequence[str] | None = None) -> str:
+    """Human-readable multi-line description of a route on a track graph (``names``: as the summary's)."""
+    names = route.names if names is None else tuple(names)
     summary = graph_route_summary(route, names)
+    travel = ", ".join(f"{name} {metres:g} m" for name, metres in zip(names, route.travel, strict=True))
     lines = [
         f"track: {summary['track']['nodes']} nodes, {summary['track']['edges']} edges, "
         f"{summary['track']['length_m']:g} m; minimum separation {route.min_separation:g} m",
-        f"travel: {names[0]} {route.travel[0]:g} m, {names[1]} {route.travel[1]:g} m "
-        f"({route.length:g} m in all, the least of any one-at-a-time route)",
+        f"travel: {travel} ({route.length:g} m in all, the least of any one-at-a-time route)",
         f"moves ({len(route.moves)}):",
     ]
     for number, move in enumerate(summary["moves"], start=1):
         lines.append(
             f"  {number:2d}  {move['vehicle']}: {move['from']} -> {move['to']} along "
-            f"{', '.join(move['edges'])}, {move['length_m']:g} m (the other at {move['other_at']})"
+            f"{', '.join(move['edges'])}, {move['length_m']:g} m "
+            f"({', '.join(f'{name} at {place}' for name, place in move['standing'].items())})"
         )
     return "\n".join(lines)
 

@@ -41,13 +41,24 @@ from trajgen.plots.animation_layout import (
     speed_text,
 )
 from trajgen.plots.figure import checked_names, frame_painter, new_figure
-from trajgen.plots.speed import VEHICLE_COLOURS
+from trajgen.plots.speed import vehicle_colour
 from trajgen.plots.track_drawing import draw_track
 from trajgen.plots.track_layout import TrackLayout
 from trajgen.progress import progress
 from trajgen.verification import VerifiedSchedule, require_verified
 
 __all__ = ["Animation", "animate"]
+
+
+def _speed_places(count: int) -> list[tuple[float, str]]:
+    """Where each vehicle's speed is written across the top: ``(x, alignment)``, the first at the left."""
+    if count == 1:
+        return [(0.03, "left")]
+    places = []
+    for v in range(count):
+        alignment = "left" if v == 0 else "right" if v == count - 1 else "center"
+        places.append((0.03 + 0.94 * v / (count - 1), alignment))
+    return places
 
 
 def _round_length(target: float) -> float:
@@ -106,10 +117,8 @@ class _Scene:
         self.clock = figure.text(0.03, 0.915, "", ha="left", va="center", fontsize=12, family="monospace")
         figure.text(0.97, 0.915, play.label, ha="right", va="center", fontsize=12, weight="bold")
         self.speeds = [
-            figure.text(
-                x, 0.875, "", ha=ha, va="center", fontsize=11, color=VEHICLE_COLOURS[v], weight="bold"
-            )
-            for v, (x, ha) in enumerate(((0.03, "left"), (0.97, "right")))
+            figure.text(x, 0.875, "", ha=ha, va="center", fontsize=11, color=vehicle_colour(v), weight="bold")
+            for v, (x, ha) in enumerate(_speed_places(len(names)))
         ]
         self.vehicles = self._draw_track(schedule.track, layout)
         self.bar, self.minimum, self.bar_value = self._draw_bar(layout)
@@ -152,7 +161,7 @@ class _Scene:
                     marker,
                     markersize=13,
                     markerfacecolor="none",
-                    markeredgecolor=VEHICLE_COLOURS[v],
+                    markeredgecolor=vehicle_colour(v),
                     markeredgewidth=1.5,
                     zorder=3,
                     label=f"{self.names[v]} {what}",
@@ -180,7 +189,7 @@ class _Scene:
         radius = 0.5 * self.geometry.min_separation
         vehicles = []
         for v in range(len(self.names)):
-            colour = VEHICLE_COLOURS[v]
+            colour = vehicle_colour(v)
             disc = axis.fill(*_disc(0.0, 0.0, radius).T, color=colour, alpha=0.3, linewidth=0, zorder=4)[0]
             dot = axis.plot(
                 [0.0], [0.0], "o", color=colour, markersize=10, markeredgecolor="black", markeredgewidth=0.8
@@ -301,7 +310,7 @@ class Animation:
 def animate(
     verified: VerifiedSchedule,
     *,
-    names: tuple[str, str] = ("vehicle 1", "vehicle 2"),
+    names=None,
     fps: int = DEFAULT_FPS,
     max_frames: int = DEFAULT_MAX_FRAMES,
 ) -> Animation:

@@ -1,4 +1,4 @@
-"""``coordination.png``: both vehicles' travel, the too-close region drawn exactly, per pair of paths."""
+"""``coordination.png``: two vehicles' travel, the too-close region drawn exactly, per paths and pair."""
 
 from __future__ import annotations
 
@@ -9,10 +9,10 @@ import numpy as np
 from trajgen.errors import InputError
 from trajgen.methods import METHODS
 from trajgen.model.analysis import travelled
-from trajgen.model.coordination import CoordinationDiagram, schedule_paths
+from trajgen.model.coordination import CoordinationDiagram, SchedulePair, schedule_paths
 from trajgen.model.summary import class_label
 from trajgen.plots.figure import drawing_area, finished, polygon_patch, wrapped
-from trajgen.plots.speed import VEHICLE_COLOURS, plot_period
+from trajgen.plots.speed import plot_period, vehicle_colour
 from trajgen.verification import VerifiedSchedule, require_verified
 
 __all__ = ["METHOD_COLOURS", "plot_coordination"]
@@ -27,26 +27,37 @@ _PALETTE = ("tab:blue", "tab:green", "tab:red", "tab:purple", "tab:brown", "tab:
 METHOD_COLOURS = {name: _PALETTE[k % len(_PALETTE)] for k, name in enumerate(METHODS.names)}
 
 
-def _too_close(schedule, required: float):
-    """``(leader, polygon)`` of every convex part of the too-close region of ``schedule``'s paths.
+def _too_close(schedule, required: float) -> list[tuple[tuple[int, int], list]]:
+    """Per pair of vehicles, ``(leader, polygon)`` of every convex part of its too-close region.
 
     The conflicts of :class:`~trajgen.model.coordination.CoordinationDiagram` on every track (a
-    junction's paths are on its track graph too), each part led by the vehicle the plan lets pass
-    first.
+    junction's paths are on its track graph too), each part led by the vehicle (of the pair) the
+    plan lets pass first. Two vehicles have their pair drawn whether or not they conflict; of more,
+    the pairs that conflict (the first pair if none does).
     """
     paths, times, _ = schedule_paths(schedule)
-    diagram = CoordinationDiagram(paths, required, schedule, times)
-    return [(conflict.leader, polygon) for conflict in diagram.conflicts for polygon in conflict.polygons]
+    drawn = []
+    for view in SchedulePair.every(schedule, len(paths)):
+        diagram = CoordinationDiagram(tuple(paths[v] for v in view.pair), required, view, times)
+        parts = [
+            (view.pair[conflict.leader], polygon)
+            for conflict in diagram.conflicts
+            for polygon in conflict.polygons
+        ]
+        if parts or len(paths) == 2:
+            drawn.append((view.pair, parts))
+    return drawn or [((0, 1), [])]
 
 
 def plot_coordination(verified: Mapping[str, VerifiedSchedule], *, figure=None):
-    """The coordination diagram: both vehicles' travel, one panel per pair of paths.
+    """The coordination diagram: two vehicles' travel, one panel per set of paths and pair of vehicles.
 
     Each panel holds the schedules that drive the same paths (the route's paths for ``exact`` and
     ``toppra``; ``optimal`` may take the other homotopy class or park shallower, so its paths, and
     therefore its axes and its too-close region, differ: the figure says so). The too-close region
     is drawn exactly, as the convex polygons of :class:`~trajgen.model.coordination.CoordinationDiagram`.
-    A schedule's curve must stay out of the shaded region of its panel.
+    A schedule's curve must stay out of the shaded region of its panel. With more than two vehicles,
+    each set of paths has a panel per pair of vehicles that conflict.
 
     Parameters
     ----------
@@ -73,31 +84,39 @@ def plot_coordination(verified: Mapping[str, VerifiedSchedule], *, figure=None):
     for name, distance in distances.items():
         key = tuple(np.round(distance[:, -1], 6))  # same paths drive the same distances
         groups.setdefault(key, []).append(name)
-    area = drawing_area(figure, figsize=(_PANEL_IN * len(groups), 5.4 if len(groups) > 1 else 5.0))
-    panels = area.subplots(1, len(groups), squeeze=False)[0]
-    for axis, names in zip(panels, groups.values(), strict=True):
+    panels_of = [
+        (names, pair, parts)
+        for names in groups.values()
+        for pair, parts in _too_close(
+            schedules[names[0]],
+            max(schedules[names[0]].limits.min_separation, schedules[names[0]].route.min_separation),
+        )
+    ]
+    area = drawing_area(figure, figsize=(_PANEL_IN * len(panels_of), 5.4 if len(panels_of) > 1 else 5.0))
+    panels = area.subplots(1, len(panels_of), squeeze=False)[0]
+    for axis, (names, pair, parts) in zip(panels, panels_of, strict=True):
         reference = schedules[names[0]]
         required = max(reference.limits.min_separation, reference.route.min_separation)
         labelled: set[int] = set()
-        for leader, polygon in _too_close(reference, required):
+        for leader, polygon in parts:
             label = None if leader in labelled else f"too close: vehicle {leader + 1} passes first"
             labelled.add(leader)
             patch = polygon_patch(
-                polygon, facecolor=VEHICLE_COLOURS[leader], alpha=0.3, edgecolor="none", label=label
+                polygon, facecolor=vehicle_colour(leader), alpha=0.3, edgecolor="none", label=label
             )
             axis.add_patch(patch)
         for name in names:
             axis.plot(
-                distances[name][0],
-                distances[name][1],
+                distances[name][pair[0]],
+                distances[name][pair[1]],
                 color=METHOD_COLOURS.get(name, "black"),
                 linewidth=2.0,
                 zorder=3,
                 label=f"{name} ({schedules[name].duration:.1f} s)",
             )
         axis.margins(0.04)  # a curve along a path's end (one vehicle waits) stays clear of the frame
-        axis.set_xlabel("vehicle 1 travelled [m]")
-        axis.set_ylabel("vehicle 2 travelled [m]")
+        axis.set_xlabel(f"vehicle {pair[0] + 1} travelled [m]")
+        axis.set_ylabel(f"vehicle {pair[1] + 1} travelled [m]")
         title = f"paths of {', '.join(names)}: class {class_label(reference.route)}"
         axis.set_title(
             wrapped(

@@ -11,7 +11,7 @@ from __future__ import annotations
 from topology import GraphRoute
 from trajgen.errors import InputError
 from trajgen.plots.figure import drawing_axis, finished
-from trajgen.plots.speed import VEHICLE_COLOURS
+from trajgen.plots.speed import vehicle_colour
 from trajgen.plots.track_drawing import draw_move, draw_track, fit_track, mark_end
 from trajgen.plots.track_layout import TrackLayout
 
@@ -50,9 +50,9 @@ def plot_graph_route(route: GraphRoute, *, names: tuple[str, str] = ("vehicle 1"
     shift = 0.012 * layout.extent  # the two vehicles' lines side by side where they share the track
     for number, move in enumerate(route.moves, start=1):
         line = layout.move(route, number - 1) + (shift if move.vehicle == 0 else -shift)
-        draw_move(axis, line, VEHICLE_COLOURS[move.vehicle], number)
-    for vehicle in (0, 1):
-        colour = VEHICLE_COLOURS[vehicle]
+        draw_move(axis, line, vehicle_colour(move.vehicle), number)
+    for vehicle in range(route.count):
+        colour = vehicle_colour(vehicle)
         for point, goal in ((route.start[vehicle], False), (route.goal[vehicle], True)):
             what = "goal" if goal else "start"
             label = f"{names[vehicle]}: {what} {track.name(point)}"

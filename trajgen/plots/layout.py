@@ -18,7 +18,7 @@ import numpy as np
 from topology import TrackGraph
 from trajgen.model.coordination import schedule_times
 from trajgen.plots.figure import checked_names, drawing_axis, finished
-from trajgen.plots.speed import VEHICLE_COLOURS
+from trajgen.plots.speed import vehicle_colour
 from trajgen.plots.track_drawing import draw_move, draw_track, fit_track, mark_end
 from trajgen.plots.track_layout import TrackLayout
 from trajgen.verification import VerifiedSchedule, require_verified
@@ -138,14 +138,14 @@ def plot_layout(verified: VerifiedSchedule, *, names=None, ax=None):
     moves = schedule_moves(schedule)
     shift = 0.012 * drawn.extent  # the vehicles' lines side by side where they share the track
     for number, move in enumerate(moves, start=1):
-        colour = VEHICLE_COLOURS[move.vehicle % len(VEHICLE_COLOURS)]
+        colour = vehicle_colour(move.vehicle)
         line = _polyline(drawn, move) + (shift if move.vehicle % 2 == 0 else -shift)
         # a third of the way, not half: on a junction the middle of many moves is the junction
         draw_move(axis, line, colour, number, at=1.0 / 3.0)
     ends = schedule.state([0.0, schedule.duration])
     travel = [sum(move.length for move in moves if move.vehicle == v) for v in range(count)]
     for vehicle in range(count):
-        colour = VEHICLE_COLOURS[vehicle % len(VEHICLE_COLOURS)]
+        colour = vehicle_colour(vehicle)
         points = drawn.points(ends.edge[vehicle], ends.s[vehicle])
         for point, goal in ((points[0], False), (points[1], True)):
             what = "goal" if goal else "start"

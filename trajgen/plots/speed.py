@@ -10,7 +10,7 @@ import numpy as np
 
 from trajgen.model.pieces import kinematics_polynomials
 from trajgen.model.summary import class_label
-from trajgen.plots.figure import drawing_area, finished
+from trajgen.plots.figure import checked_names, drawing_area, finished
 from trajgen.verification import VerifiedSchedule, require_verified
 
 __all__ = [
@@ -99,13 +99,13 @@ def acceleration_steps(schedule) -> tuple[np.ndarray, np.ndarray]:
     return times[shown], np.where(real, steps, 0.0)[:, shown]
 
 
-def _draw_steps(axis, schedule, names: tuple[str, str]) -> None:
+def _draw_steps(axis, schedule, names: tuple[str, ...]) -> None:
     """The jerk panel of a schedule that does not limit jerk: a stem at each step of ``a``, as long as it."""
     times, steps = acceleration_steps(schedule)
     axis.axhline(0.0, color="0.5", linewidth=0.8)
-    for vehicle in range(2):
+    for vehicle in range(len(names)):
         at = steps[vehicle] != 0.0
-        colour = VEHICLE_COLOURS[vehicle]
+        colour = vehicle_colour(vehicle)
         axis.vlines(times[at], 0.0, steps[vehicle, at], color=colour, linewidth=1.2)
         axis.plot(
             times[at],
@@ -123,10 +123,8 @@ def _draw_steps(axis, schedule, names: tuple[str, str]) -> None:
     )
 
 
-def plot_speed(
-    verified: VerifiedSchedule, *, names: tuple[str, str] = ("vehicle 1", "vehicle 2"), figure=None
-):
-    """``v``, ``a``, ``j`` over time for both vehicles with their limit lines, one axis each.
+def plot_speed(verified: VerifiedSchedule, *, names=None, figure=None):
+    """``v``, ``a``, ``j`` over time for every vehicle with their limit lines, one axis each.
 
     Each is along the vehicle's own axis, which grows in the direction of its first move: a
     negative ``v`` is a vehicle moving against it, backing out of a side leg it entered to make
@@ -135,8 +133,8 @@ def plot_speed(
     Parameters
     ----------
     verified : VerifiedSchedule
-    names : pair of str
-        Legend labels.
+    names : sequence of str, optional
+        Legend labels, one per vehicle (default ``vehicle 1``, ...).
     figure : matplotlib Figure or SubFigure, optional
         Where to draw the three axes (default: a new Figure of 10.5 x 7.5 inches).
 
@@ -145,6 +143,8 @@ def plot_speed(
     matplotlib.figure.Figure
     """
     schedule = require_verified(verified, "plot_speed").schedule
+    count = schedule.limits.count
+    names = checked_names(names, count, what="plot_speed")
     state = schedule.sample(plot_period(schedule.duration))
     area = drawing_area(figure, figsize=(10.5, 7.5))
     axes = area.subplots(3, 1, sharex=True)
@@ -157,16 +157,16 @@ def plot_speed(
         if limit_name == "max_jerk" and not schedule.jerk_limited:
             _draw_steps(axis, schedule, names)
         else:
-            for vehicle in range(2):
-                axis.plot(state.t, values[vehicle], color=VEHICLE_COLOURS[vehicle], label=names[vehicle])
-            limits = [getattr(schedule.limits.vehicles[vehicle], limit_name) for vehicle in range(2)]
-            shared = limits[0] == limits[1]  # one black line for both, else one per vehicle in its colour
-            for vehicle in (0,) if shared else (0, 1):
-                whose = "both" if shared else names[vehicle]
+            for vehicle in range(count):
+                axis.plot(state.t, values[vehicle], color=vehicle_colour(vehicle), label=names[vehicle])
+            limits = [getattr(schedule.limits.vehicles[vehicle], limit_name) for vehicle in range(count)]
+            shared = len(set(limits)) == 1  # one black line for all, else one per vehicle in its colour
+            for vehicle in (0,) if shared else range(count):
+                whose = ("both" if count == 2 else "all") if shared else names[vehicle]
                 for sign in (1, -1):
                     axis.axhline(
                         sign * limits[vehicle],
-                        color="black" if shared else VEHICLE_COLOURS[vehicle],
+                        color="black" if shared else vehicle_colour(vehicle),
                         linestyle="--",
                         linewidth=0.9,
                         label=f"limit ±{limits[vehicle]:g} {unit} ({whose})" if sign == 1 else None,

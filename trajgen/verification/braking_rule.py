@@ -29,7 +29,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from limits import VehicleLimits
-from trajgen.model.coordination import CoordinationDiagram, schedule_paths, stopping_distances
+from trajgen.model.coordination import CoordinationDiagram, SchedulePair, schedule_paths, stopping_distances
 from trajgen.model.pieces import Pieces
 from trajgen.model.values import sorted_unique
 
@@ -151,8 +151,14 @@ def braking_rule_failures(
     if schedule.duration <= 0.0:
         return []
     paths, times, travel = schedule_paths(schedule, pieces)
-    diagram = CoordinationDiagram(paths, separation, schedule, times)
-    if not diagram.conflicts:
+    count = len(paths)
+    # a diagram per pair of vehicles; a vehicle's frontier is the least over the pairs it follows in
+    diagrams = []
+    for view in SchedulePair.every(schedule, count):
+        diagram = CoordinationDiagram(tuple(paths[v] for v in view.pair), separation, view, times)
+        if diagram.conflicts:
+            diagrams.append((view.pair, diagram))
+    if not diagrams:
         return []
     vehicles = schedule.limits.vehicles
     emergency = np.array([v.emergency_braking for v in vehicles])[:, None]
@@ -161,14 +167,16 @@ def braking_rule_failures(
     tips = [np.array([*path.stops, path.length]) for path in paths]
 
     def reversal(p: np.ndarray) -> np.ndarray:
-        """The next reversal (or end) ahead of travel ``p``, per vehicle; (2, n)."""
+        """The next reversal (or end) ahead of travel ``p``, per vehicle; (V, n)."""
         out = np.empty_like(p)
-        for i in (0, 1):
+        for i in range(count):
             out[i] = tips[i][np.minimum(np.searchsorted(tips[i], p[i], side="left"), tips[i].size - 1)]
         return out
 
     def margins(t: np.ndarray, step: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """Margins ``F_j(e_i) - r_j`` at times ``t`` and how far they can fall in ``step``; (2, n) each.
+        """Margins ``F_j - r_j`` at times ``t`` and how far they can fall in ``step``; (V, n) each.
+
+        ``F_j``: the least over the pairs of ``j``'s frontier from the other's earliest rest ``e_i``.
 
         A margin is ``inf`` where no conflict binds the vehicle.
         """
@@ -185,18 +193,23 @@ def braking_rule_failures(
         direction = np.where(moved != 0.0, np.sign(moved), np.sign(state.velocity))
         speed = np.abs(state.velocity)
         earliest = np.minimum(p + speed * speed / (2.0 * emergency), np.maximum(reversal(p), p))
-        out, fall = np.empty((2, t.size)), np.empty((2, t.size))
-        for j in (0, 1):
+        frontier = np.full((count, t.size), np.inf)
+        for pair, diagram in diagrams:
+            for side, j in enumerate(pair):
+                other = pair[1 - side]
+                np.minimum(frontier[j], diagram.frontiers(side, earliest[other]), out=frontier[j])
+        out, fall = np.empty((count, t.size)), np.empty((count, t.size))
+        for j in range(count):
             acceleration = direction[j] * state.acceleration[j]
             stop = p[j] + stopping_distances(
                 speed[j], acceleration, vehicles[j], jerk_limited=schedule.jerk_limited
             )
-            out[j] = diagram.frontiers(j, earliest[1 - j]) - stop
+            out[j] = frontier[j] - stop
             rate = stop_point_rate(vehicles[j], speed[j], acceleration, step, schedule.jerk_limited)
             fall[j] = np.where(steady[j], speed[j], rate) * step
         return out, fall
 
-    worst: list[BrakingRuleFailure | None] = [None, None]
+    worst: list[BrakingRuleFailure | None] = [None] * count
     grid = sorted_unique(np.concatenate([times, np.linspace(0.0, schedule.duration, 64)]))
     starts, ends = grid[:-1], grid[1:]
     evaluations = 0
@@ -206,7 +219,7 @@ def braking_rule_failures(
             k = int(np.argmin(ends - starts))
             return [BrakingRuleFailure(0, float(starts[k]), math.nan)]
         values, fall = margins(starts, ends - starts)
-        for j in (0, 1):
+        for j in range(count):
             bad = np.nonzero(values[j] < -BRAKING_RULE_TOLERANCE)[0]
             if bad.size:
                 k = bad[np.argmin(values[j, bad])]

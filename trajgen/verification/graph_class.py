@@ -1,8 +1,9 @@
 """The class check of a schedule on a track graph: it passes every conflict in its route's order.
 
-Each convex part of the region closer than the separation, in the plane of both vehicles' travel,
-must lie on the same side of the schedule's curve as of the route's (the class is the order of
-passing at each conflict). Part of :func:`~trajgen.verification.graph_schedule.verify_graph_schedule`.
+For every pair of vehicles, each convex part of the region closer than the separation, in the plane
+of the two vehicles' travel, must lie on the same side of the schedule's curve as of the route's (the
+class is the order of passing at each conflict). Part of
+:func:`~trajgen.verification.graph_schedule.verify_graph_schedule`.
 """
 
 from __future__ import annotations
@@ -48,10 +49,15 @@ def _centroid(polygon: list) -> tuple[float, float, float]:
     return 0.5 * abs(area), cx / (3.0 * area), cy / (3.0 * area)
 
 
-def _too_close_parts(schedule: GraphSchedule, distances: TrackDistances) -> list[tuple[float, float]]:
-    """A point inside each convex part of the region closer than the separation, in the travel plane."""
+def _too_close_parts(
+    schedule: GraphSchedule, distances: TrackDistances, pair: tuple[int, int]
+) -> list[tuple[float, float]]:
+    """A point inside each convex part of the region where the ``pair`` of vehicles is too close.
+
+    In the plane of the two vehicles' travel.
+    """
     required = schedule.limits.min_separation
-    first, second = schedule.paths
+    first, second = (schedule.paths[v] for v in pair)
     points = []
     for k1, k2 in itertools.product(range(first.edges.size), range(second.edges.size)):
         e1, e2 = int(first.edges[k1]), int(second.edges[k2])
@@ -83,18 +89,22 @@ def _too_close_parts(schedule: GraphSchedule, distances: TrackDistances) -> list
     return points
 
 
-def _route_curve(schedule: GraphSchedule) -> np.ndarray:
-    """The route's moves as a monotone staircase in the travel plane, shape (m + 1, 2)."""
+def _route_curve(schedule: GraphSchedule, pair: tuple[int, int]) -> np.ndarray:
+    """The route's moves as a monotone staircase in the ``pair``'s travel plane, shape (m + 1, 2).
+
+    Moves of the other vehicles are steps of no length there.
+    """
     corners = [(0.0, 0.0)]
     for move in schedule.route.moves:
         here = list(corners[-1])
-        here[move.vehicle] += move.length
+        if move.vehicle in pair:
+            here[pair.index(move.vehicle)] += move.length
         corners.append((here[0], here[1]))
     return np.array(corners)
 
 
 def _side_of_polyline(curve: np.ndarray, point: tuple[float, float]) -> int:
-    """+1 if the point lies above the monotone polyline (vehicle 1 passes first), -1 below, 0 on it."""
+    """+1 if the point lies above the monotone polyline (the pair's first passes first), -1 below, 0 on it."""
     x, y = point
     lows, highs = [], []
     for (x0, y0), (x1, y1) in itertools.pairwise(curve):
@@ -111,10 +121,10 @@ def _side_of_polyline(curve: np.ndarray, point: tuple[float, float]) -> int:
     return 1 if y > max(highs) + POSITION_TOLERANCE else (-1 if y < min(lows) - POSITION_TOLERANCE else 0)
 
 
-def _side_of_schedule(pieces, point: tuple[float, float]) -> int:
-    """The same side test for the schedule's curve (travel of both vehicles, piece by piece)."""
+def _side_of_schedule(pieces, point: tuple[float, float], pair: tuple[int, int]) -> int:
+    """The same side test for the schedule's curve (travel of the pair, piece by piece)."""
     x, y = point
-    first, second = pieces.travel
+    first, second = (pieces.travel[v] for v in pair)
     begin = first[:, 0]
     end = polynomials.evaluate(first, pieces.length)
     lo, hi = np.minimum(begin, end), np.maximum(begin, end)
@@ -138,20 +148,23 @@ def _side_of_schedule(pieces, point: tuple[float, float]) -> int:
 
 
 def check_class(schedule: GraphSchedule, pieces, distances: TrackDistances, failures: list[str]) -> bool:
-    """Whether every part of the too-close region lies on the same side of the schedule as of the route."""
-    route_curve = _route_curve(schedule)
-    for point in _too_close_parts(schedule, distances):
-        planned, timed = _side_of_polyline(route_curve, point), _side_of_schedule(pieces, point)
-        if planned and timed and planned != timed:
-            first = "vehicle 1" if planned > 0 else "vehicle 2"
-            k = int(np.clip(np.searchsorted(pieces.travel[0][:, 0], point[0], side="right") - 1, 0, None))
-            failures.append(
-                Finding(
-                    "the schedule passes a conflict in another order than the route (at travel "
-                    f"{point[0]:.3f} m, {point[1]:.3f} m the route lets {first} pass first): another class "
-                    "than the route's",
-                    pieces.arrays(schedule, min(k, pieces.count - 1)),
+    """Whether, for every pair, each part of its too-close region lies on the same side as the route's."""
+    for pair in itertools.combinations(range(len(schedule.paths)), 2):
+        route_curve = _route_curve(schedule, pair)
+        for point in _too_close_parts(schedule, distances, pair):
+            planned, timed = _side_of_polyline(route_curve, point), _side_of_schedule(pieces, point, pair)
+            if planned and timed and planned != timed:
+                first = pair[0] if planned > 0 else pair[1]
+                track = pieces.travel[pair[0]][:, 0]
+                k = int(np.clip(np.searchsorted(track, point[0], side="right") - 1, 0, None))
+                failures.append(
+                    Finding(
+                        "the schedule passes a conflict in another order than the route (at travel "
+                        f"{point[0]:.3f} m of vehicle {pair[0] + 1} and {point[1]:.3f} m of vehicle "
+                        f"{pair[1] + 1} the route lets vehicle {first + 1} pass first): another class than "
+                        "the route's",
+                        pieces.arrays(schedule, min(k, pieces.count - 1), pair),
+                    )
                 )
-            )
-            return False
+                return False
     return True

@@ -8,7 +8,8 @@ own edge, of ``|s - s_q|``; so its minimum over a stretch is at the stretch's en
 stretch passes ``q``. Nothing is sampled.
 
 Also checked: each vehicle starts and ends where the route says, each move starts where its vehicle
-is, the standing vehicle is where the other one is, the travel adds up, every number is finite.
+is, each standing vehicle is where it is said to be, the travel adds up, every number is finite. Every
+pair of vehicles is checked: a route may move any number.
 """
 
 from __future__ import annotations
@@ -35,7 +36,7 @@ class GraphRouteReport:
     ----------
     passed : bool
     closest : float
-        The least track distance between the vehicles over the whole route, metres.
+        The least track distance between any two vehicles over the whole route, metres.
     closest_move : int or None
         The move (0-based) where it is least; ``None`` for a route without moves.
     failures : tuple of str
@@ -129,19 +130,30 @@ def verify_graph_route(route: GraphRoute) -> GraphRouteReport:
     track, separation = route.track, route.min_separation
     distances = TrackDistances(track)
     failures: list[str] = []
+    count = len(route.start)
     where = list(route.start)
-    travel = [0.0, 0.0]
-    closest, closest_move = distances.between(where[0], where[1]), None
+    travel = [0.0] * count
+    names = route.names if len(route.names) == count else tuple(f"vehicle {v + 1}" for v in range(count))
+    closest, closest_move, first = math.inf, None, None
+    for a, b in itertools.combinations(range(count), 2):
+        gap = distances.between(where[a], where[b])
+        if gap < closest:
+            closest, first = gap, (a, b)
     for number, move in enumerate(route.moves):
         label = f"move {number + 1} ({track.name(move.points[0])} -> {track.name(move.points[-1])})"
-        numbers = [move.length, move.standing.s, *(p.s for p in move.points)]
+        numbers = [move.length, *(p.s for p in move.at_start), *(p.s for p in move.points)]
         if not all(math.isfinite(value) for value in numbers):
             failures.append(f"{label}: a number is not finite: expected finite metres")
             break
-        if move.vehicle not in (0, 1) or len(move.edges) != len(move.points) - 1:
+        if (
+            not 0 <= move.vehicle < count
+            or len(move.edges) != len(move.points) - 1
+            or len(move.at_start) != count
+        ):
             failures.append(
-                f"{label}: vehicle {move.vehicle!r} or {len(move.edges)} edges for "
-                f"{len(move.points)} points: expected vehicle 0 or 1 and one edge per step"
+                f"{label}: vehicle {move.vehicle!r}, {len(move.edges)} edges for {len(move.points)} "
+                f"points and {len(move.at_start)} places: expected a vehicle from 0 to {count - 1}, one "
+                f"edge per step and one place per vehicle"
             )
             break
         if distances.between(where[move.vehicle], move.points[0]) > ROUTE_TOLERANCE:
@@ -149,12 +161,12 @@ def verify_graph_route(route: GraphRoute) -> GraphRouteReport:
                 f"{label}: starts at {track.name(move.points[0])}, but the vehicle is at "
                 f"{track.name(where[move.vehicle])}"
             )
-        standing = where[1 - move.vehicle]
-        if distances.between(standing, move.standing) > ROUTE_TOLERANCE:
-            failures.append(
-                f"{label}: the other vehicle is said to stand at {track.name(move.standing)}, but "
-                f"it is at {track.name(standing)}"
-            )
+        for other, said in move.standing():
+            if distances.between(where[other], said) > ROUTE_TOLERANCE:
+                failures.append(
+                    f"{label}: {names[other]} is said to stand at {track.name(said)}, but it is at "
+                    f"{track.name(where[other])}"
+                )
         length = 0.0
         for (a, b), edge in zip(itertools.pairwise(move.points), move.edges, strict=True):
             s_a, s_b = track.position_on(a, edge), track.position_on(b, edge)
@@ -165,29 +177,36 @@ def verify_graph_route(route: GraphRoute) -> GraphRouteReport:
                 )
                 continue
             length += abs(s_b - s_a)
-            least = distances.least_along(standing, edge, min(s_a, s_b), max(s_a, s_b))
-            if least < closest:
-                closest, closest_move = least, number
-            if least < separation - ROUTE_TOLERANCE:
-                failures.append(
-                    f"{label}: along {track.edges[edge].name!r} the vehicles come {least:.6g} m apart: "
-                    f"expected at least the minimum separation {separation:g} m"
-                )
+            for other in range(count):
+                if other == move.vehicle:
+                    continue
+                least = distances.least_along(where[other], edge, min(s_a, s_b), max(s_a, s_b))
+                if least < closest:
+                    closest, closest_move = least, number
+                if least < separation - ROUTE_TOLERANCE:
+                    failures.append(
+                        f"{label}: along {track.edges[edge].name!r} {names[move.vehicle]} and "
+                        f"{names[other]} come {least:.6g} m apart: expected at least the minimum "
+                        f"separation {separation:g} m"
+                    )
         if abs(length - move.length) > ROUTE_TOLERANCE * max(1.0, length):
             failures.append(f"{label}: its length is {move.length!r} m, its edges add up to {length!r} m")
         travel[move.vehicle] += length
         where[move.vehicle] = move.points[-1]
-    for vehicle in (0, 1):
+    for vehicle in range(count):
         if distances.between(where[vehicle], route.goal[vehicle]) > ROUTE_TOLERANCE:
             failures.append(
-                f"vehicle {vehicle + 1} ends at {track.name(where[vehicle])}: expected its goal "
+                f"{names[vehicle]} ends at {track.name(where[vehicle])}: expected its goal "
                 f"{track.name(route.goal[vehicle])}"
             )
         if abs(travel[vehicle] - route.travel[vehicle]) > ROUTE_TOLERANCE * max(1.0, travel[vehicle]):
             failures.append(
-                f"vehicle {vehicle + 1} travels {travel[vehicle]!r} m by its moves: the route "
+                f"{names[vehicle]} travels {travel[vehicle]!r} m by its moves: the route "
                 f"says {route.travel[vehicle]!r} m"
             )
-    if closest < separation - ROUTE_TOLERANCE and closest_move is None:
-        failures.append(f"the vehicles start {closest:.6g} m apart: expected at least {separation:g} m")
+    if closest < separation - ROUTE_TOLERANCE and closest_move is None and first is not None:
+        failures.append(
+            f"{names[first[0]]} and {names[first[1]]} start {closest:.6g} m apart: expected at least "
+            f"{separation:g} m"
+        )
     return GraphRouteReport(not failures, closest, closest_move, tuple(failures))

@@ -4,10 +4,11 @@ Independent of how the schedule was computed and of the planner's code. The sche
 polynomial pieces: at every knot of either vehicle's travel and wherever a vehicle passes from one
 segment of its path to the next. On a piece each vehicle's travel is one cubic and each vehicle is on
 one edge, so its metres ``s`` from the edge's ``from`` node are a cubic too, and the track distance
-between the vehicles is the least of at most five of them: through each pair of edge ends (the node
+between two vehicles is the least of at most five of them: through each pair of edge ends (the node
 distances from this package's own Dijkstra, :class:`~trajgen.verification.graph_route.TrackDistances`)
 and, on one edge, ``|s1 - s2|``. Their minima are taken in closed form
-(:func:`~trajgen.model.polynomials.extrema`); nothing is sampled.
+(:func:`~trajgen.model.polynomials.extrema`); nothing is sampled. Every pair of vehicles is checked: a
+schedule may move any number.
 
 Checked: the paths follow the route's moves from its start to its goal, travel starts at 0 and ends at
 each path's length at rest, never runs backwards, the vehicles are at rest where a path turns back,
@@ -75,8 +76,8 @@ class _Pieces:
         else:
             start, length, travel, origin = start[keep], length[keep], travel[:, keep], origin[:, keep]
         self.start, self.length, self.travel = start, length, travel
-        self.interval, self.section = origin[:2], origin[2]
-        middle = np.stack([polynomials.evaluate(travel[v], 0.5 * length) for v in range(2)])
+        self.interval, self.section = origin[:-1], origin[-1]
+        middle = np.stack([polynomials.evaluate(travel[v], 0.5 * length) for v in range(len(travel))])
         self.segment = np.stack(
             [
                 np.clip(
@@ -94,9 +95,11 @@ class _Pieces:
     def count(self) -> int:
         return int(self.length.size)
 
-    def arrays(self, schedule: GraphSchedule, k: int, vehicles: tuple[int, ...] = (0, 1)) -> str:
-        """The arrays that define piece ``k`` of the given vehicles, by their paths (for the findings)."""
+    def arrays(self, schedule: GraphSchedule, k: int, vehicles: tuple[int, ...] | None = None) -> str:
+        """The arrays that define piece ``k`` of the given vehicles (all: ``None``), by their paths."""
         section = int(self.section[k])
+        if vehicles is None:
+            vehicles = tuple(range(len(schedule.paths)))
         kinematics = schedule.sections[section].kinematics
         named = []
         for vehicle in vehicles:
@@ -116,8 +119,8 @@ class _Pieces:
 
 
 def _track_polynomials(schedule: GraphSchedule, pieces: _Pieces) -> tuple[np.ndarray, np.ndarray]:
-    """Edge (2, n) and metres from its ``from`` node as polynomials (2, n, DEGREE + 1) on each piece."""
-    edges = np.zeros((2, pieces.count), dtype=int)
+    """Edge (V, n) and metres from its ``from`` node as polynomials (V, n, DEGREE + 1) on each piece."""
+    edges = np.zeros((len(schedule.paths), pieces.count), dtype=int)
     s = np.zeros_like(pieces.travel)
     for vehicle, path in enumerate(schedule.paths):
         if path.edges.size == 0:
@@ -264,7 +267,8 @@ def _check_motion(schedule: GraphSchedule, pieces: _Pieces, failures: list[str])
     names = [("velocity", "max_velocity", "m/s"), ("acceleration", "max_acceleration", "m/s^2")]
     if schedule.jerk_limited:
         names.append(("jerk", "max_jerk", "m/s^3"))
-    ratios: list = [[0.0, 0.0], [0.0, 0.0], [0.0, 0.0] if schedule.jerk_limited else None]
+    count = len(schedule.paths)
+    ratios: list = [[0.0] * count, [0.0] * count, [0.0] * count if schedule.jerk_limited else None]
     if schedule.checked_limits is not None:  # a table read back: the rest is checked from its points
         names = names[: schedule.checked_limits]
     end_tolerance = POSITION_TOLERANCE if schedule.end_tolerance is None else schedule.end_tolerance
@@ -393,8 +397,11 @@ def _check_motion(schedule: GraphSchedule, pieces: _Pieces, failures: list[str])
     return ratios, start_error, goal_error
 
 
-def _distance_terms(schedule: GraphSchedule, distances: TrackDistances, edges: np.ndarray, s: np.ndarray):
-    """The four ways of the track distance on each piece, shape (n, 4, DEGREE + 1), and ``s1 - s2``."""
+def _distance_terms(distances: TrackDistances, edges: np.ndarray, s: np.ndarray):
+    """The four ways of the track distance on each piece, shape (n, 4, DEGREE + 1), and ``s1 - s2``.
+
+    ``edges`` (2, n) and ``s`` (2, n, DEGREE + 1): the two vehicles of one pair.
+    """
     n = edges.shape[1]
     ends = np.array(distances.ends, dtype=int)
     lengths = np.array(distances.lengths)
@@ -442,14 +449,15 @@ def _backwards(
 
 
 def _closest_on_pieces(
-    schedule: GraphSchedule, distances: TrackDistances, edges: np.ndarray, s: np.ndarray, length: np.ndarray
+    distances: TrackDistances, edges: np.ndarray, s: np.ndarray, length: np.ndarray
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Least track distance on each piece, when (from the piece's start) and whether they pass there.
+    """Least track distance of a pair on each piece, when (from the piece's start), whether they pass there.
 
-    Returns three arrays of shape (n,): the least distance (m), its time from the piece's start (s),
-    whether the vehicles pass each other on one edge.
+    ``edges`` (2, n) and ``s`` (2, n, DEGREE + 1) are the pair's. Returns three arrays of shape (n,):
+    the least distance (m), its time from the piece's start (s), whether the two pass each other on
+    one edge.
     """
-    terms, along = _distance_terms(schedule, distances, edges, s)
+    terms, along = _distance_terms(distances, edges, s)
     count = length.size
     low, t_low, _, _ = polynomials.extrema(terms.reshape(-1, terms.shape[2]), np.repeat(length, 4))
     low, t_low = low.reshape(-1, 4), t_low.reshape(-1, 4)
@@ -470,42 +478,62 @@ def _closest_on_pieces(
 def _check_separation(
     schedule: GraphSchedule, pieces: _Pieces, distances: TrackDistances, failures: list[str]
 ) -> float:
-    """The least track distance over the whole schedule, in closed form."""
+    """The least track distance between any two vehicles over the whole schedule, in closed form."""
     edges, s = _track_polynomials(schedule, pieces)
+    least = math.inf
+    for pair in itertools.combinations(range(len(schedule.paths)), 2):
+        closest = _check_pair(schedule, pieces, distances, failures, pair, edges[list(pair)], s[list(pair)])
+        if math.isnan(closest):
+            return math.nan
+        least = min(least, closest)
+    return least
+
+
+def _check_pair(
+    schedule: GraphSchedule,
+    pieces: _Pieces,
+    distances: TrackDistances,
+    failures: list[str],
+    pair: tuple[int, int],
+    edges: np.ndarray,
+    s: np.ndarray,
+) -> float:
+    """The least track distance between the ``pair`` of vehicles (``edges``, ``s``: theirs), metres."""
     closest, when, crossing = np.empty(pieces.count), np.empty(pieces.count), np.empty(pieces.count, bool)
     # in blocks of pieces: a table read back has a piece per row, up to a million
     for first in range(0, pieces.count, _BLOCK):
         block = slice(first, min(first + _BLOCK, pieces.count))
         closest[block], when[block], crossing[block] = _closest_on_pieces(
-            schedule, distances, edges[:, block], s[:, block], pieces.length[block]
+            distances, edges[:, block], s[:, block], pieces.length[block]
         )
     if not np.all(np.isfinite(closest)):
         k = int(np.argmax(~np.isfinite(closest)))
         failures.append(
             Finding(
                 f"the track distance is not finite from t={pieces.start[k]:.6f} s: expected finite numbers",
-                pieces.arrays(schedule, k),
+                pieces.arrays(schedule, k, pair),
             )
         )
         return math.nan
     k = int(np.argmin(closest))
     required = schedule.limits.min_separation
+    one, other = (f"vehicle {v + 1}" for v in pair)
     if crossing.any():
         j = int(np.argmax(crossing))
         failures.append(
             Finding(
-                f"the vehicles pass each other on edge {schedule.track.edges[edges[0, j]].name!r} between "
-                f"t={pieces.start[j]:.6f} s and t={pieces.start[j] + pieces.length[j]:.6f} s",
-                pieces.arrays(schedule, j),
+                f"{one} and {other} pass each other on edge {schedule.track.edges[edges[0, j]].name!r} "
+                f"between t={pieces.start[j]:.6f} s and t={pieces.start[j] + pieces.length[j]:.6f} s",
+                pieces.arrays(schedule, j, pair),
             )
         )
     elif closest[k] < required - _separation_slack(schedule):
         failures.append(
             Finding(
                 f"separation {closest[k]:.9g} m at t={pieces.start[k] + when[k]:.6f} s is below the minimum "
-                f"{required:g} m (vehicle 1 on {schedule.track.edges[edges[0, k]].name!r}, vehicle 2 on "
+                f"{required:g} m ({one} on {schedule.track.edges[edges[0, k]].name!r}, {other} on "
                 f"{schedule.track.edges[edges[1, k]].name!r})",
-                pieces.arrays(schedule, k),
+                pieces.arrays(schedule, k, pair),
             )
         )
     return float(closest[k])
@@ -515,18 +543,20 @@ def verify_graph_schedule(schedule: GraphSchedule) -> VerificationReport:
     """Check a schedule on a track graph independently of how it was computed (see the module)."""
     own = array_failures(schedule)
     if own:  # the motion is read from these numbers: broken ones make every other check meaningless
-        return VerificationReport.failed(tuple(own))
+        return VerificationReport.failed(tuple(own), count=len(schedule.paths))
     failures: list[str] = []
     distances = TrackDistances(schedule.track)
     _check_paths(schedule, distances, failures)
     if failures:
-        return VerificationReport.failed(tuple(failures))
+        return VerificationReport.failed(tuple(failures), count=len(schedule.paths))
     try:
         pieces = _Pieces(schedule)
     except UncheckableKinematicsError as error:
         known = (CubicKinematics, ToppraKinematics)
         k = next((k for k, s in enumerate(schedule.sections) if type(s.kinematics) not in known), 0)
-        return VerificationReport.failed((Finding(str(error), f"sections[{k}].kinematics"),))
+        return VerificationReport.failed(
+            (Finding(str(error), f"sections[{k}].kinematics"),), count=len(schedule.paths)
+        )
     ratios, start_error, goal_error = _check_motion(schedule, pieces, failures)
     closest = _check_separation(schedule, pieces, distances, failures)
     same_class = check_class(schedule, pieces, distances, failures)
@@ -542,9 +572,9 @@ def verify_graph_schedule(schedule: GraphSchedule) -> VerificationReport:
         pieces=pieces.count,
         min_separation=closest,
         separation_margin=closest - schedule.limits.min_separation,
-        velocity_ratio=(ratios[0][0], ratios[0][1]),
-        acceleration_ratio=(ratios[1][0], ratios[1][1]),
-        jerk_ratio=None if ratios[2] is None else (ratios[2][0], ratios[2][1]),
+        velocity_ratio=tuple(ratios[0]),
+        acceleration_ratio=tuple(ratios[1]),
+        jerk_ratio=None if ratios[2] is None else tuple(ratios[2]),
         start_error=start_error,
         goal_error=goal_error,
         regions_match=same_class,

@@ -82,12 +82,12 @@ class VerificationReport:
     pieces : int
         Number of polynomial pieces checked.
     min_separation : float
-        Smallest track distance between the vehicles, metres.
+        Smallest track distance between any two vehicles, metres.
     separation_margin : float
         ``min_separation - required``, metres (negative: violated).
-    velocity_ratio, acceleration_ratio : tuple of 2 float
+    velocity_ratio, acceleration_ratio : tuple of float
         Per vehicle, largest ``|value| / limit`` (1.0 is at the limit).
-    jerk_ratio : tuple of 2 float or None
+    jerk_ratio : tuple of float or None
         The same for jerk; ``None`` when the schedule does not limit jerk.
     start_error, goal_error : float
         Track distance of the schedule's first and last positions from the route's, metres.
@@ -105,9 +105,9 @@ class VerificationReport:
     pieces: int
     min_separation: float
     separation_margin: float
-    velocity_ratio: tuple[float, float]
-    acceleration_ratio: tuple[float, float]
-    jerk_ratio: tuple[float, float] | None
+    velocity_ratio: tuple[float, ...]
+    acceleration_ratio: tuple[float, ...]
+    jerk_ratio: tuple[float, ...] | None
     start_error: float
     goal_error: float
     regions_match: bool
@@ -137,8 +137,11 @@ class VerificationReport:
         )
 
     @classmethod
-    def failed(cls, failures: tuple[str, ...], *, pieces: int = 0) -> VerificationReport:
-        """The report of a motion that could not be checked further (its figures are NaN)."""
+    def failed(cls, failures: tuple[str, ...], *, pieces: int = 0, count: int = 0) -> VerificationReport:
+        """The report of a motion that could not be checked further (its figures are NaN).
+
+        ``count``: the motion's vehicles, each given a NaN ratio (none where it is not known).
+        """
         nan = float("nan")
         return cls(
             passed=False,
@@ -146,8 +149,8 @@ class VerificationReport:
             pieces=pieces,
             min_separation=nan,
             separation_margin=nan,
-            velocity_ratio=(nan, nan),
-            acceleration_ratio=(nan, nan),
+            velocity_ratio=(nan,) * count,
+            acceleration_ratio=(nan,) * count,
             jerk_ratio=None,
             start_error=nan,
             goal_error=nan,

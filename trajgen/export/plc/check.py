@@ -54,10 +54,10 @@ class ProfileCheck:
     Attributes
     ----------
     dialect : Dialect
-    files : tuple of 2 Path
+    files : tuple of Path
     problems : tuple of str
         What in the files' format a controller would not take.
-    tables : tuple of 2 ProfileTable
+    tables : tuple of ProfileTable
         The tables as read.
     check : TableCheck
         The tables' verdict along the route of the class that fits them best.
@@ -70,9 +70,9 @@ class ProfileCheck:
     """
 
     dialect: Dialect
-    files: tuple[Path, Path]
+    files: tuple[Path, ...]
     problems: tuple[str, ...]
-    tables: tuple[ProfileTable, ProfileTable]
+    tables: tuple[ProfileTable, ...]
     check: TableCheck
     jerk_checked: bool = True
     record: ScheduleRecord | None = None
@@ -116,7 +116,7 @@ class ProfileCheck:
 
 def profile_files(
     scenario: Scenario | GraphScenario, directory: str | Path, dialect: Dialect
-) -> tuple[Path, Path]:
+) -> tuple[Path, ...]:
     """The two files of ``dialect`` for the scenario's vehicles in ``directory``."""
     if isinstance(dialect, TableDialect):
         return table_paths(dialect, scenario.names, directory)

@@ -42,7 +42,7 @@ class PlcTables:
         The tables and their error against the schedule.
     check : TableCheck
         The verdict on the tables as read back from ``contents``.
-    contents : tuple of 2 bytes
+    contents : tuple of bytes
         The files of vehicle 1 and vehicle 2.
     """
 
@@ -50,7 +50,7 @@ class PlcTables:
     max_points: int
     resampled: Resampled
     check: TableCheck
-    contents: tuple[bytes, bytes]
+    contents: tuple[bytes, ...]
 
     def summary(self) -> dict:
         """JSON-ready figures of the export (``export`` in ``trajgen schedule --json``)."""
@@ -81,7 +81,7 @@ def check_dialect_method(dialect: TableDialect, jerk_limited: bool) -> None:
         )
 
 
-def _written_above(dialect: TableDialect, contents: tuple[bytes, bytes], limits: Limits) -> float:
+def _written_above(dialect: TableDialect, contents: tuple[bytes, ...], limits: Limits) -> float:
     """How far the largest velocity a velocity table writes is above its limit as written (<= 1: not).
 
     The ratio of the largest written ``|v|`` to the largest number of the file's decimals at most
@@ -109,7 +109,7 @@ def table_paths(dialect: TableDialect, names: Sequence[str], directory: str | Pa
 def plc_tables(
     verified: VerifiedSchedule, dialect: TableDialect | str, *, max_points: int | None = None
 ) -> PlcTables:
-    """Both vehicles' tables in ``dialect``, at most ``max_points`` points each, verified as written.
+    """Every vehicle's table in ``dialect``, at most ``max_points`` points each, verified as written.
 
     Parameters
     ----------
@@ -183,7 +183,7 @@ def write_tables(
     dialect: TableDialect | str,
     max_points: int | None = None,
 ) -> tuple[Path, ...]:
-    """Write both vehicles' tables in a PLC ``dialect`` into ``directory``, both or neither.
+    """Write every vehicle's table in a PLC ``dialect`` into ``directory``, all or none.
 
     The tables are those of :func:`plc_tables` (verified as their controllers interpolate them);
     the output paths are checked before anything is computed.

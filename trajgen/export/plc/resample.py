@@ -53,17 +53,17 @@ class Resampled:
     tables : tuple of 2 ProfileTable
     time_scale : float
         The tables run this many times as long as the schedule (1.0: not slowed).
-    position_error : tuple of 2 float
+    position_error : tuple of float
         Worst distance of each interpolated table from the schedule, metres
         (in the table's own time: the schedule's time multiplied by ``time_scale``).
-    velocity_error : tuple of 2 float
+    velocity_error : tuple of float
         Worst velocity difference, m/s, likewise.
     """
 
-    tables: tuple[ProfileTable, ProfileTable]
+    tables: tuple[ProfileTable, ...]
     time_scale: float
-    position_error: tuple[float, float]
-    velocity_error: tuple[float, float]
+    position_error: tuple[float, ...]
+    velocity_error: tuple[float, ...]
 
     def summary(self) -> dict:
         """JSON-ready figures."""
@@ -203,7 +203,7 @@ def _errors(table: ProfileTable, grid: np.ndarray, axis: np.ndarray, velocity: n
 
 
 def _closest_approaches(schedule: Schedule | GraphSchedule, grid: np.ndarray, state) -> np.ndarray:
-    """Times of the grid where the vehicles' track distance has a local minimum near the separation."""
+    """Times of the grid where the least distance of two vehicles has a local minimum near the separation."""
     separation = schedule.limits.min_separation
     distance = schedule.distances(state)
     if distance.size < 3:
@@ -317,7 +317,7 @@ def resample(
     decimals: int = 9,
     min_scale: float = 1.0,
 ) -> Resampled:
-    """Tables of both vehicles with at most ``max_points`` points each, for ``interpolation``.
+    """Tables of every vehicle with at most ``max_points`` points each, for ``interpolation``.
 
     Parameters
     ----------
@@ -349,12 +349,15 @@ def resample(
     grid, boundaries = _reference_times(schedule, decimals, max_points)
     state = schedule.state(grid)
     critical = _closest_approaches(schedule, grid, state)
+    count = schedule.limits.count
     points = [
         _points(schedule, vehicle, interpolation, max_points, grid, boundaries, state, critical)
-        for vehicle in range(2)
+        for vehicle in range(count)
     ]
     times = [p[0] for p in points]
-    tables = tuple(_table(schedule, v, times[v], interpolation, 1.0, anchors=points[v][1]) for v in range(2))
+    tables = tuple(
+        _table(schedule, v, times[v], interpolation, 1.0, anchors=points[v][1]) for v in range(count)
+    )
     ratios = limit_ratios(tables, schedule.limits, jerk=schedule.jerk_limited)
     scale = slowdown(ratios)
     if scale > 1.0 + 1e-9:
@@ -366,16 +369,18 @@ def resample(
             _table(
                 schedule, v, np.round(times[v] * scale, decimals), interpolation, scale, anchors=points[v][1]
             )
-            for v in range(2)
+            for v in range(count)
         )
     else:
         scale = 1.0
     fine = np.sort(np.concatenate([grid, 0.5 * (grid[:-1] + grid[1:])]))  # between the candidates too
     fine_state = schedule.state(fine)
-    errors = [_errors(tables[v], fine, fine_state.axis[v], fine_state.velocity[v], scale) for v in range(2)]
+    errors = [
+        _errors(tables[v], fine, fine_state.axis[v], fine_state.velocity[v], scale) for v in range(count)
+    ]
     return Resampled(
         tables,
         scale,
-        (float(errors[0][0].max()), float(errors[1][0].max())),
-        (float(errors[0][1].max()), float(errors[1][1].max())),
+        tuple(float(position.max()) for position, _ in errors),
+        tuple(float(velocity.max()) for _, velocity in errors),
     )

@@ -7,6 +7,8 @@ hold there to the file's round-off.
 
 from __future__ import annotations
 
+import itertools
+
 import numpy as np
 
 from trajgen.export.plc.tables import ProfileTable
@@ -39,14 +41,14 @@ def row_places(
     return edge, on_edge, np.abs(s - on_edge)
 
 
-def row_separation(tables: tuple[ProfileTable, ProfileTable], schedule: GraphSchedule) -> list[str]:
-    """At the points of a table judged by its points only, the separation holds to their round-off.
+def row_separation(tables: tuple[ProfileTable, ...], schedule: GraphSchedule) -> list[str]:
+    """At the points of tables judged by their points only, every pair keeps the separation to round-off.
 
     The verifier holds such a table (a generic CSV) to its tolerance between the points, where the
     cubic is the reader's; at the points themselves the file says where the vehicles are. A vehicle
     the rows move past the end of its path's edge, or that moves at all where its path stays put,
     has that much less separation. The round-off allowed is at most a nanometre file's
-    (:data:`ROW_ROUND_OFF`).
+    (:data:`ROW_ROUND_OFF`). The closest pair is reported.
     """
     if min(table.interpolation.closed_form for table in tables) > 0:
         return []
@@ -54,22 +56,23 @@ def row_separation(tables: tuple[ProfileTable, ProfileTable], schedule: GraphSch
     travel = schedule.travel(times)[:, 0]
     track = schedule.track
     lengths = np.array([edge.length for edge in track.edges])
-    (edge_1, s_1, over_1), (edge_2, s_2, over_2) = (
-        row_places(path, travel[v], lengths) for v, path in enumerate(schedule.paths)
-    )
-    apart = track.distances(edge_1, s_1, edge_2, s_2) - over_1 - over_2
+    places = [row_places(path, travel[v], lengths) for v, path in enumerate(schedule.paths)]
     round_off = min(max(t.round_off for t in tables), ROW_ROUND_OFF)
     allowed = schedule.limits.min_separation - POSITION_TOLERANCE - 2.0 * round_off
-    k = int(np.argmin(apart))
-    if apart[k] >= allowed:
+    worst = None
+    for i, j in itertools.combinations(range(len(places)), 2):
+        (edge_1, s_1, over_1), (edge_2, s_2, over_2) = places[i], places[j]
+        apart = track.distances(edge_1, s_1, edge_2, s_2) - over_1 - over_2
+        k = int(np.argmin(apart))
+        if apart[k] < allowed and (worst is None or apart[k] < worst[0]):
+            worst = (float(apart[k]), k, (i, j))
+    if worst is None:
         return []
-    past = (
-        f", {1e6 * (over_1[k] + over_2[k]):.3g} µm of it off its path or where it stands"
-        if (over_1[k] + over_2[k] > 0.0)
-        else ""
-    )
+    gap, k, (i, j) = worst
+    over = places[i][2][k] + places[j][2][k]
+    past = f", {1e6 * over:.3g} µm of it off its path or where it stands" if over > 0.0 else ""
     return [
-        f"separation {apart[k]:.9g} m at the row at t={times[k]:.6f} s is below the minimum "
-        f"{schedule.limits.min_separation:g} m (vehicle 1 on {track.edges[edge_1[k]].name!r}, "
-        f"vehicle 2 on {track.edges[edge_2[k]].name!r}{past})"
+        f"separation {gap:.9g} m at the row at t={times[k]:.6f} s is below the minimum "
+        f"{schedule.limits.min_separation:g} m (vehicle {i + 1} on {track.edges[places[i][0][k]].name!r}, "
+        f"vehicle {j + 1} on {track.edges[places[j][0][k]].name!r}{past})"
     ]

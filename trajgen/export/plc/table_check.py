@@ -278,24 +278,24 @@ class TableMotion(TimingMethod):
 
     Parameters
     ----------
-    tables : tuple of 2 ProfileTable
-        Vehicle 1's and vehicle 2's tables: each the signed axis of its vehicle.
-    orientations : tuple of 2 int
+    tables : tuple of ProfileTable
+        One per vehicle: each the signed axis of its vehicle.
+    orientations : tuple of int
         ``ds/d axis`` of each vehicle at its start: +1 if its axis grows away from
         the junction (the first move of a schedule is its axis's positive direction).
     jerk : bool
         Whether the tables are held to the jerk limits (default True).
-    motions : tuple of 2 PiecewiseCubic, optional
+    motions : tuple of PiecewiseCubic, optional
         The tables' :meth:`ProfileTable.motion`, if already computed.
     """
 
     name: ClassVar[str] = "table"
     summary: ClassVar[str] = "the motion of two interpolated profile tables"
 
-    tables: tuple[ProfileTable, ProfileTable]
+    tables: tuple[ProfileTable, ...]
     orientations: tuple[int, int] = (1, 1)
     jerk: bool = True
-    motions: tuple[PiecewiseCubic, PiecewiseCubic] | None = field(default=None, compare=False, repr=False)
+    motions: tuple[PiecewiseCubic, ...] | None = field(default=None, compare=False, repr=False)
 
     @property
     def jerk_limited(self) -> bool:
@@ -473,8 +473,8 @@ def _orientations(route: Route) -> list[tuple[int, int]]:
 
 
 def _check_graph_tables(
-    tables: tuple[ProfileTable, ProfileTable],
-    motions: tuple[PiecewiseCubic, PiecewiseCubic],
+    tables: tuple[ProfileTable, ...],
+    motions: tuple[PiecewiseCubic, ...],
     route: GraphRoute,
     limits: Limits,
     *,
@@ -498,13 +498,14 @@ def _check_graph_tables(
 
 
 def check_tables(
-    tables: tuple[ProfileTable, ProfileTable], route: Route | GraphRoute, limits: Limits, *, jerk: bool = True
+    tables: tuple[ProfileTable, ...], route: Route | GraphRoute, limits: Limits, *, jerk: bool = True
 ) -> TableCheck:
-    """Verify two profile tables as their controllers interpolate them, along ``route``.
+    """Verify profile tables, one per vehicle, as their controllers interpolate them, along ``route``.
 
     Parameters
     ----------
-    tables : tuple of 2 ProfileTable
+    tables : tuple of ProfileTable
+        One per vehicle.
     route : Route or GraphRoute
         The route the tables follow (its homotopy class is checked; on a track graph, its
         class: which vehicle passes first at each conflict, and each vehicle's path).
@@ -530,7 +531,7 @@ def check_tables(
                 f"(previous {table.times[k - 1]:.9g} s)"
             )
     if failures:
-        report = VerificationReport.failed(tuple(failures))
+        report = VerificationReport.failed(tuple(failures), count=len(tables))
         return TableCheck(False, tuple(failures), report, {}, route)
     units = {"velocity": "m/s", "acceleration": "m/s^2", "jerk": "m/s^3"}
     for vehicle, table in enumerate(tables):

@@ -288,7 +288,7 @@ def difference_checks(table: ProfileTable, limits, *, jerk: bool) -> list[Differ
     return checks
 
 
-def limit_ratios(tables: tuple[ProfileTable, ProfileTable], limits: Limits, *, jerk: bool = True) -> dict:
+def limit_ratios(tables: tuple[ProfileTable, ...], limits: Limits, *, jerk: bool = True) -> dict:
     """Largest |v|, |a|, |j| over each limit per vehicle as the controllers interpolate the tables.
 
     Closed form within the interpolated pieces; divided differences where the
@@ -298,9 +298,11 @@ def limit_ratios(tables: tuple[ProfileTable, ProfileTable], limits: Limits, *, j
     Returns
     -------
     dict
-        ``{"velocity": (r1, r2), "acceleration": (r1, r2), "jerk": (r1, r2) or None}``.
+        ``{"velocity": (r1, r2, ...), "acceleration": (...), "jerk": (...) or None}``, one per table.
     """
-    ratios: dict[str, list[float]] = {"velocity": [0.0, 0.0], "acceleration": [0.0, 0.0], "jerk": [0.0, 0.0]}
+    ratios: dict[str, list[float]] = {
+        name: [0.0] * len(tables) for name in ("velocity", "acceleration", "jerk")
+    }
     for vehicle, table in enumerate(tables):
         vehicle_limits = limits.vehicles[vehicle]
         motion = table.motion()

@@ -1,4 +1,4 @@
-"""VDA 5050 2.1.0 orders of both vehicles as the files of a run, committed all or none.
+"""VDA 5050 2.1.0 orders of every vehicle as the files of a run, committed all or none.
 
 The files are ``<vehicle name>/order-NNN.json`` and ``manifest.json``; the renderers
 (:mod:`trajgen.export.vda5050.messages`) return bytes, and :func:`write_orders` commits every

@@ -262,12 +262,12 @@ def render_orders(
     releases: OrderReleases | None = None,
     plan: OrderReleases | None = None,
 ) -> tuple[OrderMessage, ...]:
-    """Every VDA 5050 order message of both vehicles, in the order they are sent.
+    """Every VDA 5050 order message of every vehicle, in the order they are sent.
 
     Parameters
     ----------
     verified : VerifiedSchedule
-    names : sequence of 2 str
+    names : sequence of str
         Vehicle names (folder names, default serial numbers).
     options : Vda5050Options
     releases : OrderReleases, optional
@@ -390,7 +390,7 @@ def render_manifest(
     Parameters
     ----------
     verified : VerifiedSchedule
-    names : sequence of 2 str
+    names : sequence of str
     messages : sequence of OrderMessage
         From :func:`render_orders` with the same arguments.
     options : Vda5050Options

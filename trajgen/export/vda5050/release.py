@@ -1,4 +1,4 @@
-"""The order updates of both vehicles: which base each VDA 5050 order or order update releases, and when.
+"""The order updates of the vehicles: which base each VDA 5050 order or order update releases, and when.
 
 A VDA 5050 order carries no timing: a vehicle drives its *base* (released
 nodes and edges) at its own pace, at most ``maxSpeed`` on each edge, and
@@ -32,6 +32,7 @@ slower (:attr:`OrderReleases.planned_duration`).
 
 from __future__ import annotations
 
+import itertools
 import math
 from dataclasses import dataclass
 
@@ -43,7 +44,11 @@ from trajgen.model.graph_schedule import GraphSchedule
 from trajgen.model.pieces import schedule_pieces
 from trajgen.verification import POSITION_TOLERANCE, VerifiedSchedule, require_verified
 
-__all__ = ["BaseRelease", "OrderReleases", "Release", "order_releases"]
+__all__ = ["NODE_PLAN_STATES", "BaseRelease", "OrderReleases", "Release", "order_releases"]
+
+#: Joint states of the vehicles' nodes the node plan may find to lead nowhere before it gives up (its
+#: search budget, in states, never in time).
+NODE_PLAN_STATES = 1_000_000
 
 
 @dataclass(frozen=True, slots=True)
@@ -53,7 +58,7 @@ class Release:
     Attributes
     ----------
     vehicle : int
-        0 or 1.
+        Its index among the vehicles.
     update : int
         The ``orderUpdateId``.
     first : int
@@ -87,37 +92,37 @@ class OrderReleases:
 
     Attributes
     ----------
-    paths : tuple of 2 OrderPath (a junction) or 2 GraphOrderPath (a track graph)
+    paths : tuple of OrderPath (a junction) or of GraphOrderPath (a track graph), one per vehicle
     releases : tuple of Release
         By ``send_at`` (and in the replay's order at equal times).
     planned_duration : float
-        When both vehicles reach their goals in the replay (the schedule's duration plus the waits), s.
+        When every vehicle reaches its goal in the replay (the schedule's duration plus the waits), s.
     """
 
-    paths: tuple[OrderPath, OrderPath] | tuple[GraphOrderPath, GraphOrderPath]
+    paths: tuple[OrderPath, ...] | tuple[GraphOrderPath, ...]
     releases: tuple[Release, ...]
     planned_duration: float
 
 
 class BaseRelease:
-    """The release rule of both vehicles' bases: how far each may be released, from the nodes reached.
+    """The release rule of the vehicles' bases: how far each may be released, from the nodes reached.
 
     The order of the track is a *node plan*: a sequence of moves, each taking one vehicle to its next
-    node while the other stands at a node, every move keeping the separation, that follows the
-    schedule's order of arrivals wherever the nodes allow it. A vehicle's edge is released once the
+    node while the others stand at nodes, every move keeping the separation, that follows the
+    schedule's order of arrivals wherever the nodes allow it. A vehicle's edge is released once every
     other vehicle has reached the node the plan has it at during that move, and its track keeps the
-    separation from the other vehicle's claim (the stretch from the last node it reached to its
+    separation from every other vehicle's claim (the stretch from the last node it reached to its
     decision point); so the vehicles follow the plan (with more motion at once where the claims allow
     it) and cannot deadlock. "Reached the node" is relaxed to "left every edge the plan drives
     before, and that comes closer than the separation".
 
-    Only the nodes reached move the releases on, never the time: whatever the timing of either
+    Only the nodes reached move the releases on, never the time: whatever the timing of any
     vehicle within its base, the claims stay apart. This is what the live master runs
     (:mod:`trajgen.live`), on the nodes the vehicles report.
 
     Parameters
     ----------
-    paths : tuple of 2 OrderPath or GraphOrderPath
+    paths : tuple of OrderPath or GraphOrderPath, one per vehicle
         Both vehicles' paths, on a junction or on a track graph: each node and edge has a
         ``claim``, and the path's ``gap`` is the track distance between two claims.
     separation : float
@@ -129,7 +134,7 @@ class BaseRelease:
         No sequence of moves between the nodes keeps the separation.
     """
 
-    def __init__(self, paths: tuple[OrderPath, OrderPath], separation: float) -> None:
+    def __init__(self, paths: tuple[OrderPath, ...] | tuple[GraphOrderPath, ...], separation: float) -> None:
         self.paths = paths
         # conflict: closer than the separation (verifier's tolerance); at 0, touching
         self.threshold = max(separation - POSITION_TOLERANCE, POSITION_TOLERANCE)
@@ -138,72 +143,110 @@ class BaseRelease:
         self.gap = paths[0].gap
         self.after = self._node_plan()
         #: per vehicle, the last node it reached and the index of its decision point
-        self.reached = [0, 0]
-        self.released = [0, 0]
-        for vehicle in (0, 1):
+        self.reached = [0] * len(paths)
+        self.released = [0] * len(paths)
+        for vehicle in range(len(paths)):
             self.released[vehicle] = self._extend(vehicle)
 
     @property
-    def last(self) -> tuple[int, int]:
+    def last(self) -> tuple[int, ...]:
         """Each vehicle's goal node index."""
-        return (len(self.points[0]) - 1, len(self.points[1]) - 1)
+        return tuple(len(points) - 1 for points in self.points)
 
     def apart(self, first, second) -> bool:
         """Whether two claims (a node's or an edge's ``claim``) keep the separation."""
         return self.gap(first, second) >= self.threshold
 
-    def _node_plan(self) -> tuple[list[int], list[int]]:
-        """Per vehicle and edge, the node the other vehicle must have reached before the edge is released."""
+    def _moves(self, state: tuple[int, ...], arrival) -> list[int]:
+        """The vehicles that may drive their next edge from ``state``, the schedule's next arrival first.
+
+        A vehicle may move while every other stands at its node of ``state`` and keeps the
+        separation from the edge.
+        """
         last = self.last
-
-        def move(vehicle: int, k: int, other_node: int) -> bool:
-            """Whether ``vehicle`` may drive its edge ``k`` while the other stands at ``other_node``."""
-            return k < last[vehicle] and self.apart(
-                self.stretches[vehicle][k], self.points[1 - vehicle][other_node]
+        movers = [
+            v
+            for v in range(len(state))
+            if state[v] < last[v]
+            and all(
+                self.apart(self.stretches[v][state[v]], self.points[o][state[o]])
+                for o in range(len(state))
+                if o != v
             )
+        ]
+        return sorted(movers, key=lambda v: (arrival[v][state[v] + 1], v))
 
-        # which states (node of vehicle 1, node of vehicle 2) still lead to both goals
-        reach = [[False] * (last[1] + 1) for _ in range(last[0] + 1)]
-        for k in range(last[0], -1, -1):
-            for j in range(last[1], -1, -1):
-                reach[k][j] = self.apart(self.points[0][k], self.points[1][j]) and (
-                    (k, j) == last
-                    or (move(0, k, j) and reach[k + 1][j])
-                    or (move(1, j, k) and reach[k][j + 1])
-                )
-        if not reach[0][0]:
+    def _apart_at(self, state: tuple[int, ...]) -> bool:
+        """Whether every two vehicles standing at their nodes of ``state`` keep the separation."""
+        return all(
+            self.apart(self.points[i][state[i]], self.points[j][state[j]])
+            for i, j in itertools.combinations(range(len(state)), 2)
+        )
+
+    def _node_plan(self) -> tuple[list[tuple[int, ...]], ...]:
+        """Per vehicle and edge, the node each other vehicle must have reached before the edge is released.
+
+        The node plan is the first sequence of moves, in the order of preference of :meth:`_moves`
+        (the schedule's order of arrivals), that leads every vehicle to its goal: a depth-first
+        search over the vehicles' nodes that remembers the states found to lead nowhere, at most
+        :data:`NODE_PLAN_STATES` of them.
+        """
+        last = self.last
+        count = len(last)
+        arrival = [[n.arrival for n in path.nodes] for path in self.paths]
+        start = (0,) * count
+        dead: set[tuple[int, ...]] = set()
+        plan: list[tuple[int, tuple[int, ...]]] = []  # (mover, state before the move)
+        stack = [(start, iter(self._moves(start, arrival)))] if self._apart_at(start) else []
+        while stack and stack[-1][0] != last:
+            state, options = stack[-1]
+            following = None
+            for mover in options:
+                after = (*state[:mover], state[mover] + 1, *state[mover + 1 :])
+                if after not in dead and self._apart_at(after):
+                    following = (mover, after)
+                    break
+            if following is None:
+                dead.add(state)
+                stack.pop()
+                if plan:
+                    plan.pop()
+                if len(dead) > NODE_PLAN_STATES:
+                    raise ScheduleError(
+                        f"VDA 5050 orders: the node plan searched {NODE_PLAN_STATES:,} states of the "
+                        "vehicles' nodes (NODE_PLAN_STATES) without finding an order of their edges"
+                    )
+                continue
+            mover, after = following
+            plan.append((mover, state))
+            stack.append((after, iter(self._moves(after, arrival))))
+        if not stack:
             raise ScheduleError(
-                "VDA 5050 orders: no order of the two paths' edges keeps the minimum separation "
+                "VDA 5050 orders: no order of the paths' edges keeps the minimum separation "
                 "node by node (the schedule relies on the vehicles' timing between nodes)"
             )
-        at: tuple[list[int], list[int]] = ([0] * last[0], [0] * last[1])  # the other's node during a move
-        k = j = 0
-        arrival = [[n.arrival for n in path.nodes] for path in self.paths]
-        while (k, j) != last:
-            first = move(0, k, j) and reach[k + 1][j]
-            second = move(1, j, k) and reach[k][j + 1]
-            if first and second:  # both may go: the one the schedule has arrive first
-                first = arrival[0][k + 1] <= arrival[1][j + 1]
-            if first:
-                at[0][k] = j
-                k += 1
-            else:
-                at[1][j] = k
-                j += 1
-        # only the other's conflicting edges that the plan drives first must be behind it
+        at: list[list[tuple[int, ...]]] = [[start] * last[v] for v in range(count)]  # the others' nodes
+        for mover, state in plan:
+            at[mover][state[mover]] = state
+        # only the others' conflicting edges that the plan drives first must be behind it
         return tuple(
             [
-                max(
-                    (
-                        f + 1
-                        for f in range(at[vehicle][edge])
-                        if not self.apart(stretch, self.stretches[1 - vehicle][f])
-                    ),
-                    default=0,
+                tuple(
+                    0
+                    if other == vehicle
+                    else max(
+                        (
+                            f + 1
+                            for f in range(at[vehicle][edge][other])
+                            if not self.apart(stretch, self.stretches[other][f])
+                        ),
+                        default=0,
+                    )
+                    for other in range(count)
                 )
                 for edge, stretch in enumerate(self.stretches[vehicle])
             ]
-            for vehicle in (0, 1)
+            for vehicle in range(count)
         )
 
     def claim(self, vehicle: int) -> list[tuple[int, float, float]]:
@@ -212,11 +255,12 @@ class BaseRelease:
         return [self.points[vehicle][first], *self.stretches[vehicle][first:last]]
 
     def _allowed(self, vehicle: int, edge: int) -> bool:
-        other = 1 - vehicle
-        if self.reached[other] < self.after[vehicle][edge]:
+        needed = self.after[vehicle][edge]
+        others = [other for other in range(len(self.paths)) if other != vehicle]
+        if any(self.reached[other] < needed[other] for other in others):
             return False
         stretch = self.stretches[vehicle][edge]
-        return all(self.apart(stretch, held) for held in self.claim(other))
+        return all(self.apart(stretch, held) for other in others for held in self.claim(other))
 
     def _extend(self, vehicle: int) -> int:
         edge = self.released[vehicle]
@@ -225,12 +269,12 @@ class BaseRelease:
         return edge
 
     def reach(self, vehicle: int, node: int) -> list[tuple[int, int, int]]:
-        """Record that ``vehicle`` reached ``node``; the releases that follow, the other vehicle's first.
+        """Record that ``vehicle`` reached ``node``; the releases that follow, the other vehicles' first.
 
         Parameters
         ----------
         vehicle : int
-            0 or 1.
+            Its index among the vehicles.
         node : int
             Index of the node on its path, at most its decision point (a vehicle does not drive
             past its base). A node at or before the last one reached changes nothing.
@@ -238,6 +282,7 @@ class BaseRelease:
         Returns
         -------
         list of (vehicle, previous decision point, new decision point)
+            The others' first, in vehicle order, then its own.
 
         Raises
         ------
@@ -253,7 +298,7 @@ class BaseRelease:
             return []
         self.reached[vehicle] = node
         releases = []
-        for each in (1 - vehicle, vehicle):
+        for each in (*(other for other in range(len(self.paths)) if other != vehicle), vehicle):
             end = self._extend(each)
             if end != self.released[each]:
                 releases.append((each, self.released[each], end))
@@ -264,25 +309,26 @@ class BaseRelease:
 class _Replay:
     """Both paths replayed node by node in the schedule's order; a vehicle waits at its decision point."""
 
-    def __init__(self, paths: tuple[OrderPath, OrderPath], separation: float) -> None:
+    def __init__(self, paths: tuple[OrderPath, ...] | tuple[GraphOrderPath, ...], separation: float) -> None:
         self.paths = paths
         self.rule = BaseRelease(paths, separation)
-        self.delay = [0.0, 0.0]
+        self.delay = [0.0] * len(paths)
 
     def time_of(self, vehicle: int, node: int) -> float:
         return self.paths[vehicle].nodes[node].arrival + self.delay[vehicle]
 
     def run(self) -> tuple[list[Release], float]:
         rule = self.rule
-        releases = [Release(v, 0, 0, rule.released[v], 0.0, None, 0.0, None) for v in (0, 1)]
-        counts = [1, 1]
+        count = len(self.paths)
+        releases = [Release(v, 0, 0, rule.released[v], 0.0, None, 0.0, None) for v in range(count)]
+        counts = [1] * count
         last = list(rule.last)
         while rule.reached != last:
-            movable = [v for v in (0, 1) if rule.reached[v] < rule.released[v]]
+            movable = [v for v in range(count) if rule.reached[v] < rule.released[v]]
             if not movable:
                 raise ScheduleError(
                     "VDA 5050 orders: the releases deadlock at nodes "
-                    f"{rule.reached[0]} and {rule.reached[1]}: the schedule's order of the track "
+                    f"{', '.join(str(node) for node in rule.reached)}: the schedule's order of the track "
                     "cannot be released node by node"
                 )
             mover = min(movable, key=lambda v: (self.time_of(v, rule.reached[v] + 1), v))
@@ -297,7 +343,7 @@ class _Replay:
                     )
                 )
                 counts[vehicle] += 1
-        finish = max(self.time_of(v, last[v]) for v in (0, 1))
+        finish = max(self.time_of(v, last[v]) for v in range(count))
         return releases, finish
 
 
@@ -328,10 +374,11 @@ def order_releases(verified: VerifiedSchedule, *, spacing: float | None = None) 
     usable = isinstance(spacing, int | float) and not isinstance(spacing, bool) and math.isfinite(spacing)
     if spacing is not None and not (usable and spacing > 0):
         raise InputError(f"release spacing {short_repr(spacing)} m is not allowed: expected a number > 0")
+    count = schedule.limits.count
     if isinstance(schedule, GraphSchedule):
-        paths = tuple(graph_vehicle_path(schedule, v, spacing=spacing) for v in (0, 1))
+        paths = tuple(graph_vehicle_path(schedule, v, spacing=spacing) for v in range(count))
     else:
         pieces = schedule_pieces(schedule)
-        paths = tuple(vehicle_path(schedule, pieces, v, spacing=spacing) for v in (0, 1))
+        paths = tuple(vehicle_path(schedule, pieces, v, spacing=spacing) for v in range(count))
     releases, finish = _Replay(paths, schedule.limits.min_separation).run()
     return OrderReleases(paths, tuple(releases), max(finish, schedule.duration))
