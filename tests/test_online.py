@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import collections
 import functools
+import itertools
 import json
 import logging
 import math
@@ -24,6 +25,7 @@ from ruckig import ControlInterface, InputParameter, Ruckig, Trajectory
 
 from limits import ILLUSTRATIVE_LIMITS, Limits, VehicleLimits
 from tests.conftest import REPO
+from tests.support.fleets import FLEETS, SEPARATION
 from tests.support.graph_cases import CONVOY, EXAMPLES, random_routes, verified_example
 from tests.support.helpers import execution_plan, stop_bound
 from topology import JUNCTION_INDEX, Configuration, EdgePoint, Position, StarGraph, TrackGraph, YGraph
@@ -41,7 +43,7 @@ from trajgen.execution import (
     schedule_for_execution,
 )
 from trajgen.execution.braking_check import ServiceBraking, emergency_position
-from trajgen.execution.faults import FaultError
+from trajgen.execution.faults import Fault, FaultError, FaultKind
 from trajgen.execution.messages import Command, Setpoint, checked_state
 from trajgen.execution.plant import GraphBody, GraphShape, Plant
 from trajgen.execution.safety_guard import SafetyGuard
@@ -1124,7 +1126,7 @@ def test_the_guard_takes_a_track_graph_and_measures_its_track_distance():
     first, second = paths[0].locate(0.0), paths[1].locate(0.0)
     apart = metric.distance(*first, *second)
     assert guard.required((Measured(first), Measured(second))) == pytest.approx(
-        min(1.5 - 1e-6, apart - 1e-12)
+        (min(1.5 - 1e-6, apart - 1e-12),)
     )
     at_rest = (PathState(0.0, 0.0, 0.0), PathState(0.0, 0.0, 0.0))
     assert guard.certifies(paths, at_rest, at_rest, guard.required((Measured(first), Measured(second))))
@@ -1576,3 +1578,66 @@ def test_campaign_runs_that_never_reached_the_goal_with_toppra_now_do(seed, k, s
         assert result.emergency_brakes == 0
     else:  # the lag hides the drive from its setpoints: braking hard is right, but only until at rest
         assert result.emergency_brakes < 100
+
+
+# -- any number of vehicles below the planners ------------------------------------------------------------
+
+
+def _fleet_plan(case):
+    """The fleet's exact schedule with the separation 0.2 m under its route's: room for the margins."""
+    limits = Limits(case.limits().vehicles, SEPARATION - 0.2)
+    return certify(make_schedule(case.route(), limits, method="exact"))
+
+
+def _play_fleet(verified, faults=(), *, cycles: int = 100_000):
+    """The executor against the plant (``faults``) until every vehicle is at its goal; the closest pair."""
+    executor = Executor(verified, names=verified.schedule.route.names)
+    plant = Plant(executor, faults, executor.period)
+    metric = GraphMetric(verified.schedule.track)
+    closest = math.inf
+    t = 0.0
+    for _ in range(cycles):
+        measured = plant.measure()
+        if executor.mode is Mode.DONE:
+            break
+        command = executor.step(measured)
+        plant.advance(command, t)
+        t += executor.period
+        places = [(state.leg, state.s) for state in plant.measure()]
+        for (edge_a, s_a), (edge_b, s_b) in itertools.combinations(places, 2):
+            closest = min(closest, metric.distance(edge_a, s_a, edge_b, s_b))
+    return executor, closest
+
+
+@pytest.mark.parametrize("case", FLEETS, ids=lambda case: case.name)
+def test_a_fleet_is_executed_to_every_goal_keeping_every_pair_apart_on_time_when_undisturbed(case):
+    verified = _fleet_plan(case)
+    executor, closest = _play_fleet(verified)
+    assert executor.mode is Mode.DONE
+    assert executor.emergency_brakes == 0
+    assert closest >= verified.schedule.limits.min_separation - 1e-6
+    assert executor.time == pytest.approx(verified.schedule.duration, rel=0.01, abs=0.05)
+    assert len(executor.diagrams) == math.comb(case.count, 2)
+
+
+@pytest.mark.parametrize("stopped", [0, 1, 2])
+@pytest.mark.parametrize("case", FLEETS, ids=lambda case: case.name)
+def test_a_stop_of_any_vehicle_of_a_fleet_holds_its_followers_and_costs_about_its_length(case, stopped):
+    """Each vehicle in turn stops for 4 s halfway through its first move: orders kept, nobody brakes hard.
+
+    The exact plan moves one vehicle at a time, a section each.
+    """
+    verified = _fleet_plan(case)
+    schedule = verified.schedule
+    move = next(k for k, m in enumerate(schedule.route.moves) if m.vehicle == stopped)
+    at = schedule.sections[move].start_time + 0.5 * schedule.sections[move].duration
+    stop = Fault(FaultKind.STOP, stopped, at, 4.0)
+    executor, closest = _play_fleet(verified, (stop,))
+    assert executor.mode is Mode.DONE
+    assert executor.emergency_brakes == 0
+    assert closest >= verified.schedule.limits.min_separation - 1e-6
+    name = schedule.route.names[stopped]
+    assert any(event.kind == "retime" and name in event.detail for event in executor.events)
+    # at most its bound; less where the others, not held by it, drive on meanwhile
+    late = executor.time - schedule.duration
+    assert late <= stop_bound(schedule, 4.0), late

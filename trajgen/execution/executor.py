@@ -1,14 +1,14 @@
 """The online executor: keeps the verified plan's paths and its order at every conflict, lets time stretch.
 
-Each control cycle :meth:`Executor.step` takes both vehicles' measured states
+Each control cycle :meth:`Executor.step` takes every vehicle's measured state
 and returns their setpoints for the end of the cycle. What the plan fixes is
 kept: each vehicle's path (:mod:`trajgen.model.paths`) and, at every conflict of
-the coordination diagram, who passes first (:mod:`trajgen.execution.conflicts`).
+the coordination diagram of each pair of vehicles, who passes first.
 Time is free:
 
 * **Frontier.** Each cycle each vehicle gets the farthest travel it may come
-  to rest at: short of every conflict it follows, where its leader could still
-  come to rest (from the leader's earliest rest point on).
+  to rest at: short of every conflict it follows, with any other vehicle, where
+  its leader could still come to rest (from the leader's earliest rest point on).
 * **Motion** (:mod:`trajgen.execution.motion`). A vehicle on time follows the plan
   while its service braking ends before its frontier; once it departs (a stop,
   a slow drive, a lag, a jump, a frontier that binds), Ruckig drives it
@@ -52,7 +52,7 @@ from trajgen.execution.messages import (
 from trajgen.execution.motion import AT_REST, VehicleMotion
 from trajgen.execution.safety_guard import SafetyGuard
 from trajgen.execution.tracks import execution_track
-from trajgen.model.coordination import CoordinationDiagram, earliest_rest, stopping_distance
+from trajgen.model.coordination import CoordinationDiagram, SchedulePair, earliest_rest, stopping_distance
 from trajgen.model.graph_vehicle_path import GraphVehiclePath
 from trajgen.model.paths import VehiclePath
 from trajgen.scenario.naming import check_vehicle_index
@@ -138,10 +138,11 @@ class Executor:
         self.limits: Limits = Limits(vehicles, float(min_separation))
         self.period = period
         self._guard = SafetyGuard(self.limits, self.graph)
-        self._motions = (VehicleMotion(self.limits.vehicles[0]), VehicleMotion(self.limits.vehicles[1]))
+        count = self.limits.count
+        self._motions = tuple(VehicleMotion(vehicle) for vehicle in self.limits.vehicles)
         self._emergency = tuple(v.emergency_braking for v in self.limits.vehicles)
         window = math.ceil(self.latency / period) + 1
-        self._recent = (collections.deque(maxlen=window), collections.deque(maxlen=window))
+        self._recent = tuple(collections.deque(maxlen=window) for _ in range(count))
         self._time = 0.0
         self.events: list[Event] = []
         self.replans = 0
@@ -149,9 +150,9 @@ class Executor:
         self.emergency_brakes = 0
         self.holds = 0
         self._next_goal: Configuration | None = None
-        self._frontiers = (math.inf, math.inf)
-        self._rebased = [-math.inf, -math.inf]
-        self._load(verified, axis_start=None, orientation=(None, None))
+        self._frontiers = (math.inf,) * count
+        self._rebased = [-math.inf] * count
+        self._load(verified, axis_start=None, orientation=(None,) * count)
 
     def _load(self, verified: VerifiedSchedule, *, axis_start, orientation) -> None:
         """Take ``verified`` as the plan: its paths, conflicts and clock; both vehicles on it.
@@ -165,19 +166,28 @@ class Executor:
         self._goal = schedule.route.goal
         loaded = self._track.load(verified, axis_start=axis_start, orientation=orientation)
         self._plan = loaded.player
-        self._plan_axis0 = [self._plan.state(v, 0.0)[0] for v in (0, 1)]
+        count = self.limits.count
+        self._plan_axis0 = [self._plan.state(v, 0.0)[0] for v in range(count)]
         self._paths = loaded.paths
         # the plan's axis grows in each vehicle's first move (+1 heading at the start); the paths keep the
         # vehicles' own axes, which may run the other way after a re-plan
         self._axis_sign = [p.headings[0] if p.headings else 1 for p in self._paths]
         self._axis_base = [p.axis(0.0) for p in self._paths]
-        self._diagram = CoordinationDiagram(
-            loaded.diagram_paths, self.limits.min_separation + self.position_margin, schedule, loaded.times
+        separation = self.limits.min_separation + self.position_margin
+        # a diagram per pair of vehicles: each vehicle's frontier is the least over the pairs it is in
+        self._diagrams = tuple(
+            (
+                view.pair,
+                CoordinationDiagram(
+                    tuple(loaded.diagram_paths[v] for v in view.pair), separation, view, loaded.times
+                ),
+            )
+            for view in SchedulePair.every(schedule, count)
         )
         self._plan_time = 0.0
-        self._on_plan = [True, True]
-        self._command = [PathState(0.0, 0.0, 0.0), PathState(0.0, 0.0, 0.0)]
-        self._travel = [0.0, 0.0]
+        self._on_plan = [True] * count
+        self._command = [PathState(0.0, 0.0, 0.0) for _ in range(count)]
+        self._travel = [0.0] * count
         for recent in self._recent:
             recent.clear()
         self._mode = Mode.FOLLOWING
@@ -199,37 +209,37 @@ class Executor:
         return self._route
 
     @property
-    def paths(self) -> tuple[VehiclePath, VehiclePath] | tuple[GraphVehiclePath, GraphVehiclePath]:
-        """Both vehicles' paths of the plan, in travel coordinates."""
+    def paths(self) -> tuple[VehiclePath, ...] | tuple[GraphVehiclePath, ...]:
+        """Every vehicle's path of the plan, in travel coordinates."""
         return self._paths
 
     @property
-    def diagram(self) -> CoordinationDiagram:
-        """The plan's coordination diagram: its conflicts and the order kept at each."""
-        return self._diagram
+    def diagrams(self) -> tuple[tuple[tuple[int, int], CoordinationDiagram], ...]:
+        """The plan's coordination diagram of each pair of vehicles: ``((i, j), diagram)``."""
+        return self._diagrams
 
     @property
     def goal(self):
-        """The goal both vehicles are driving to (a Configuration, or two EdgePoints on a track graph)."""
+        """The goal the vehicles are driving to (a Configuration, or an EdgePoint each on a track graph)."""
         return self._goal
 
     @property
-    def travel(self) -> tuple[float, float]:
+    def travel(self) -> tuple[float, ...]:
         """Each vehicle's measured travel along its path at the last cycle, metres."""
-        return self._travel[0], self._travel[1]
+        return tuple(self._travel)
 
     @property
-    def axis_signs(self) -> tuple[int, int]:
+    def axis_signs(self) -> tuple[int, ...]:
         """Each vehicle's own axis against the plan's (+1 or -1): the plan's velocity times this is its."""
-        return self._axis_sign[0], self._axis_sign[1]
+        return tuple(self._axis_sign)
 
     @property
-    def frontiers(self) -> tuple[float, float]:
+    def frontiers(self) -> tuple[float, ...]:
         """Each vehicle's frontier at the last cycle, metres of its travel (``inf``: none binds it)."""
         return self._frontiers
 
     def on_plan(self, vehicle: int) -> bool:
-        """Whether ``vehicle`` (0 or 1) still follows the plan's clock."""
+        """Whether ``vehicle`` (its index) still follows the plan's clock."""
         return self._on_plan[vehicle]
 
     # -- requests --------------------------------------------------------------------------------
@@ -253,7 +263,7 @@ class Executor:
         self._log(
             "goal-accepted",
             f"new goal {self._track.name(candidate[vehicle])} for {self.names[vehicle]}: "
-            "both stop, then re-plan",
+            f"{'both' if self.limits.count == 2 else 'all'} stop, then re-plan",
         )
         return GoalDecision(True)
 
@@ -298,7 +308,8 @@ class Executor:
         along = self._locate(measured)
         if along is None:
             return self._emergency_stop(measured, "a vehicle is off its path beyond the margins")
-        for v in (0, 1):
+        count = self.limits.count
+        for v in range(count):
             if self._departed(v, along[v]):
                 self._leave_plan(v, f"{self.names[v]} is off its setpoints", rebase=along[v])
         if self._next_goal is not None:
@@ -307,9 +318,12 @@ class Executor:
             earliest_rest(s.p, s.v, self._emergency[v], self._paths[v].next_stop(s.p, 0.0))
             for v, s in enumerate(along)
         ]
-        frontiers = (self._diagram.frontier(0, earliest[1]), self._diagram.frontier(1, earliest[0]))
-        self._frontiers = frontiers
-        proposals = [self._propose(v, frontiers[v]) for v in (0, 1)]
+        frontiers = [math.inf] * count
+        for (i, j), diagram in self._diagrams:
+            frontiers[i] = min(frontiers[i], diagram.frontier(0, earliest[j]))
+            frontiers[j] = min(frontiers[j], diagram.frontier(1, earliest[i]))
+        self._frontiers = tuple(frontiers)
+        proposals = [self._propose(v, frontiers[v]) for v in range(count)]
         if any(self._on_plan):
             self._plan_time += self.period
         return self._issue(measured, along, proposals)
@@ -369,14 +383,14 @@ class Executor:
         """Certify the proposals (holding followers or braking hard if need be) and issue them."""
         required = self._guard.required(measured)
         states = [proposal[0] for proposal in proposals]
-        holding = [False, False]
-        certified = self._guard.certifies(self._paths, (states[0], states[1]), along, required)
+        holding = [False] * len(states)
+        certified = self._guard.certifies(self._paths, states, along, required)
         if not certified:
             for order in self._hold_orders():
                 trial = list(states)
                 for v in order:
                     trial[v] = self._motions[v].brake(self._command[v], self.period)[0]
-                if self._guard.certifies(self._paths, (trial[0], trial[1]), along, required, hold=True):
+                if self._guard.certifies(self._paths, trial, along, required, hold=True):
                     certified = True
                     for v in order:
                         holding[v] = True
@@ -399,22 +413,23 @@ class Executor:
         closer to the other than either is. Holding it where it stands, and restarting from there,
         is the way out; else the emergency brake would hold both for ever.
         """
+        count = self.limits.count
         still = [
             v
-            for v in (0, 1)
+            for v in range(count)
             if self._command[v].v <= AT_REST
             and abs(measured[v].velocity) <= self.velocity_tolerance * 0.02
             and abs(self._command[v].p - along[v].p) > 1e-9
         ]
         if not still:
             return None
-        trial = [self._motions[v].brake(self._command[v], self.period)[0] for v in (0, 1)]
+        trial = [self._motions[v].brake(self._command[v], self.period)[0] for v in range(count)]
         for v in still:
             trial[v] = PathState(along[v].p, 0.0, 0.0)
-        if not self._guard.certifies(self._paths, (trial[0], trial[1]), along, required, hold=True):
+        if not self._guard.certifies(self._paths, trial, along, required, hold=True):
             return None
         proposals = []
-        for v in (0, 1):
+        for v in range(count):
             if v in still:
                 reason = f"{self.names[v]} waits where it stands: the braking check"
                 self._leave_plan(v, reason, rebase=trial[v])
@@ -422,27 +437,31 @@ class Executor:
             else:
                 proposals.append((*self._motions[v].brake(self._command[v], self.period), None))
         self.holds += 1
-        return self._emit(proposals, (True, True), certified=True)
+        return self._emit(proposals, (True,) * count, certified=True)
 
     def _hold_orders(self) -> tuple[tuple[int, ...], ...]:
-        """Which vehicles to hold first: the followers of conflicts not yet passed, then both.
+        """Which vehicles to hold first: each follower of a conflict not yet passed, then those, then all.
 
         The one with less room to its frontier first: a vehicle that leads now and follows only at a
         later conflict keeps going, its follower waits.
         """
-        followers = [
-            v
-            for v in (0, 1)
-            if any(c.follower == v for c in self._diagram.leading(1 - v, self._travel[1 - v]))
-        ]
-        followers.sort(key=lambda v: self._frontiers[v] - self._travel[v])
-        orders = [(v,) for v in followers] + [(0, 1)]
-        return tuple(dict.fromkeys(orders))
+        followers = []
+        for (i, j), diagram in self._diagrams:
+            for side, v in enumerate((i, j)):
+                leader = (i, j)[1 - side]
+                if v not in followers and any(
+                    c.follower == side for c in diagram.leading(1 - side, self._travel[leader])
+                ):
+                    followers.append(v)
+        followers.sort(key=lambda v: (self._frontiers[v] - self._travel[v], v))
+        orders = [(v,) for v in followers] + [tuple(sorted(followers)), tuple(range(self.limits.count))]
+        return tuple(order for order in dict.fromkeys(orders) if order)
 
     def _emit(self, proposals, holding, *, certified: bool, emergency: bool = False) -> Command:
         self._time += self.period
         setpoints = []
-        for v in (0, 1):
+        count = self.limits.count
+        for v in range(count):
             state, jerk, axis = proposals[v]
             self._command[v] = state
             leg, s, heading, on_path, branch = self._paths[v].place(state.p)
@@ -456,13 +475,13 @@ class Executor:
             self._command[v].p >= self._paths[v].length - _AT
             and self._command[v].v <= AT_REST
             and abs(self._travel[v] - self._paths[v].length) <= self.position_tolerance
-            for v in (0, 1)
+            for v in range(count)
         ):
             self._mode = Mode.DONE
-            self._log("done", "both vehicles at their goals")
+            self._log("done", f"{'both' if count == 2 else 'all'} vehicles at their goals")
         return Command(
             self._time,
-            (setpoints[0], setpoints[1]),
+            tuple(setpoints),
             self._mode,
             holding,
             certified,
@@ -471,27 +490,29 @@ class Executor:
         )
 
     def _emergency_stop(self, measured, reason: str) -> Command:
-        """Both vehicles brake as hard as they can (the plant applies its emergency brakes)."""
+        """Every vehicle brakes as hard as it can (the plant applies its emergency brakes)."""
         self.emergency_brakes += 1
         self._log("emergency", reason)
-        self._on_plan = [False, False]
+        count = self.limits.count
+        self._on_plan = [False] * count
         proposals = []
-        for v in (0, 1):
+        for v in range(count):
             command = self._command[v]
             proposals.append((*self._motions[v].brake(command, self.period), None))
         if self._mode is Mode.DONE:
             self._mode = Mode.RETIMING
-        return self._emit(proposals, (True, True), certified=False, emergency=True)
+        return self._emit(proposals, (True,) * count, certified=False, emergency=True)
 
     # -- a new goal ------------------------------------------------------------------------------
     def _stop_for_goal(self, measured, along) -> Command:
-        """Both vehicles brake to rest on their paths; once they are, plan from there to the new goal."""
+        """Every vehicle brakes to rest on its path; once all are, plan from there to the new goal."""
+        count = self.limits.count
         if self._mode is not Mode.STOPPING:
-            self._on_plan = [False, False]
+            self._on_plan = [False] * count
             self._mode = Mode.STOPPING
         at_rest = all(
             self._command[v].v <= AT_REST and abs(measured[v].velocity) <= self.velocity_tolerance * 0.02
-            for v in (0, 1)
+            for v in range(count)
         )
         if at_rest:
             goal, self._next_goal = self._next_goal, None
@@ -513,8 +534,8 @@ class Executor:
                 )
             else:
                 # where each vehicle stands (the plan starts there), not its setpoint: no offset carried on
-                axes = [self._paths[v].axis(along[v].p) for v in (0, 1)]
-                orientation = [self._track.orientation(self._paths[v], along[v].p) for v in (0, 1)]
+                axes = [self._paths[v].axis(along[v].p) for v in range(count)]
+                orientation = [self._track.orientation(self._paths[v], along[v].p) for v in range(count)]
                 self.replans += 1
                 self._load(verified, axis_start=axes, orientation=orientation)
                 kind = self._track.describe(verified.schedule.route)
@@ -524,9 +545,9 @@ class Executor:
                     f"{verified.schedule.duration:.3f} s planned",
                 )
                 along = self._locate(measured) or along
-        proposals = [(*self._motions[v].brake(self._command[v], self.period), None) for v in (0, 1)]
+        proposals = [(*self._motions[v].brake(self._command[v], self.period), None) for v in range(count)]
         if self._mode is Mode.STOPPING:
-            return self._emit(proposals, (True, True), certified=True)
+            return self._emit(proposals, (True,) * count, certified=True)
         return self._issue(measured, along, proposals)
 
     # -- measurements ----------------------------------------------------------------------------

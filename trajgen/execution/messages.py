@@ -92,25 +92,28 @@ class Command:
     ----------
     time : float
         The time the setpoints are for, seconds since the executor started.
-    setpoints : tuple of 2 Setpoint
+    setpoints : tuple of Setpoint
+        One per vehicle.
     mode : Mode
-    braking : tuple of 2 bool
-        Whether each vehicle holds (service braking) because the braking invariant says so.
+    braking : tuple of bool
+        Whether each vehicle holds (service braking) because the braking invariant says so (empty:
+        not said).
     certified : bool
         Whether the braking check passed for these setpoints.
     emergency : bool
-        Both vehicles brake as hard as they can: nothing else could be certified.
-    frontiers : tuple of 2 float
-        Each vehicle's frontier this cycle, metres of its travel (``inf``: none binds it).
+        Every vehicle brakes as hard as it can: nothing else could be certified.
+    frontiers : tuple of float
+        Each vehicle's frontier this cycle, metres of its travel (``inf``: none binds it; empty: not
+        said).
     """
 
     time: float
-    setpoints: tuple[Setpoint, Setpoint]
+    setpoints: tuple[Setpoint, ...]
     mode: Mode
-    braking: tuple[bool, bool] = (False, False)
+    braking: tuple[bool, ...] = ()
     certified: bool = True
     emergency: bool = False
-    frontiers: tuple[float, float] = (math.inf, math.inf)
+    frontiers: tuple[float, ...] = ()
 
 
 @dataclass(frozen=True, slots=True)

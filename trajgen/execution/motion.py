@@ -128,7 +128,7 @@ class GraphPlanPlayer(PlanPlayer):
         paths = tuple(GraphVehiclePath.from_path(path, schedule.track) for path in schedule.paths)
         bounds = tuple(path.starts[1:] for path in paths)
         starts, lengths, travel, _ = split_at_values(ends, travel, intervals, bounds, margin=_SPLIT_MARGIN)
-        axis: list[list[list[float]]] = [[], []]
+        axis: list[list[list[float]]] = [[] for _ in paths]
         for v, path in enumerate(paths):
             for k in range(starts.size):
                 row = [float(c) for c in travel[v, k]]

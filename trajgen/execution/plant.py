@@ -1,4 +1,4 @@
-"""The simulated plant: both vehicles' true motion after the executor's setpoints, under faults.
+"""The simulated plant: every vehicle's true motion after the executor's setpoints, under faults.
 
 Each vehicle moves along the track after its setpoints: it lands on each
 setpoint while it is on track, passes the junction onto the leg the setpoint
@@ -180,14 +180,14 @@ class Lag:
 
 
 class Plant:
-    """Both vehicles' true motion under setpoints and faults."""
+    """Every vehicle's true motion under setpoints and faults."""
 
     def __init__(self, executor: Executor, faults: Sequence[Fault], period: float) -> None:
         self.period = period
         self.limits = executor.limits
         self.faults = list(faults)
         size = math.ceil(0.25 / period) + 4
-        self.lags = (Lag(size), Lag(size))
+        self.lags = tuple(Lag(size) for _ in range(executor.limits.count))
         if isinstance(executor.graph, TrackGraph):
             self.lengths = GraphShape(executor.graph)
             self.bodies = [_graph_body(path) for path in executor.paths]
@@ -204,9 +204,9 @@ class Plant:
                 orientation = path.home_orientation
             self.bodies.append(Body(leg, s, orientation, path.axis(0.0), leg))
 
-    def measure(self) -> tuple[VehicleState, VehicleState]:
-        """Both vehicles' measured states."""
-        return self.bodies[0].state(), self.bodies[1].state()
+    def measure(self) -> tuple[VehicleState, ...]:
+        """Every vehicle's measured state."""
+        return tuple(body.state() for body in self.bodies)
 
     def _active(self, kind: FaultKind, vehicle: int, t: float) -> Fault | None:
         found = None
@@ -220,7 +220,7 @@ class Plant:
         self.bodies[fault.vehicle].move(fault.value, self.lengths)
 
     def advance(self, command: Command, t: float) -> None:
-        """Move both vehicles from ``t`` to ``t + period`` after ``command``."""
+        """Move every vehicle from ``t`` to ``t + period`` after ``command``."""
         dt = self.period
         for v, (body, setpoint) in enumerate(zip(self.bodies, command.setpoints, strict=True)):
             self.lags[v].push(command.time, setpoint)

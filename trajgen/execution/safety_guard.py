@@ -1,7 +1,7 @@
-"""The braking invariant, the executor's last defence: both vehicles can always stop apart.
+"""The braking invariant, the executor's last defence: every two vehicles can always stop apart.
 
-Every cycle, before a pair of setpoints is issued, :class:`SafetyGuard` asks the
-:class:`~trajgen.execution.braking_check.BrakingCheck` whether both vehicles, braking at
+Every cycle, before the setpoints are issued, :class:`SafetyGuard` asks the
+:class:`~trajgen.execution.braking_check.BrakingCheck` of each pair of vehicles whether both, braking at
 once from here (each anywhere between its service braking from the commanded
 state and its emergency stop from the measured one), keep the separation until
 both are at rest, certified between its samples too. A follower whose next
@@ -12,6 +12,9 @@ reported. A correct frontier never lets that happen.
 """
 
 from __future__ import annotations
+
+import itertools
+from collections.abc import Sequence
 
 from limits import Limits
 from topology import StarGraph, TrackGraph
@@ -29,7 +32,7 @@ SEPARATION_TOLERANCE = 1e-6
 
 
 class SafetyGuard:
-    """Certifies setpoint pairs against the braking invariant.
+    """Certifies setpoints of every vehicle against the braking invariant, pair by pair.
 
     Parameters
     ----------
@@ -40,13 +43,19 @@ class SafetyGuard:
         (places are an edge and metres from its ``from`` node).
     """
 
-    __slots__ = ("_check", "_limits", "_metric", "separation")
+    __slots__ = ("_checks", "_limits", "_metric", "_pairs", "separation")
 
     def __init__(self, limits: Limits, graph: StarGraph | TrackGraph) -> None:
         vehicles = limits.vehicles
         self._metric = GraphMetric(graph) if isinstance(graph, TrackGraph) else None
         track = self._metric if self._metric is not None else graph.lengths
-        self._check = BrakingCheck(vehicles, tuple(v.emergency_braking for v in vehicles), track)
+        emergency = tuple(v.emergency_braking for v in vehicles)
+        #: every pair of vehicles, in the order of ``itertools.combinations``, and its braking check
+        self._pairs = tuple(itertools.combinations(range(len(vehicles)), 2))
+        self._checks = tuple(
+            BrakingCheck((vehicles[i], vehicles[j]), (emergency[i], emergency[j]), track)
+            for i, j in self._pairs
+        )
         self._limits = vehicles
         self.separation = limits.min_separation
 
@@ -56,31 +65,42 @@ class SafetyGuard:
             return indexed_separation((first[0], first[1], second[0], second[1]))
         return self._metric.distance(first[0], first[1], second[0], second[1])
 
-    def required(self, measured) -> float:
-        """The track distance to keep, metres: the separation, less if a fault already left them closer.
+    def required(self, measured) -> tuple[float, ...]:
+        """The track distance each pair keeps, metres: the separation, less if a fault left them closer.
 
-        Closer than the separation after a fault, the vehicles may only part (to round-off: no ratchet
+        Closer than the separation after a fault, two vehicles may only part (to round-off: no ratchet
         from cycle to cycle).
 
         Parameters
         ----------
-        measured : tuple of 2 VehicleState
-            Their ``leg`` and ``s`` (on a track graph: the edge and metres on it).
+        measured : sequence of VehicleState
+            One per vehicle: its ``leg`` and ``s`` (on a track graph: the edge and metres on it).
+
+        Returns
+        -------
+        tuple of float
+            One per pair of vehicles, in the order of ``itertools.combinations``.
         """
-        apart = self._distance((measured[0].leg, measured[0].s), (measured[1].leg, measured[1].s))
-        return min(self.separation - SEPARATION_TOLERANCE, apart - 1e-12)
+        return tuple(
+            min(
+                self.separation - SEPARATION_TOLERANCE,
+                self._distance((measured[i].leg, measured[i].s), (measured[j].leg, measured[j].s)) - 1e-12,
+            )
+            for i, j in self._pairs
+        )
 
     def certifies(
         self,
-        paths: tuple[VehiclePath, VehiclePath] | tuple[GraphVehiclePath, GraphVehiclePath],
-        commanded: tuple[PathState, PathState],
-        measured: tuple[PathState, PathState],
-        required: float,
+        paths: Sequence[VehiclePath] | Sequence[GraphVehiclePath],
+        commanded: Sequence[PathState],
+        measured: Sequence[PathState],
+        required: Sequence[float],
         *,
         hold: bool = False,
     ) -> bool:
         """Whether braking from ``commanded`` (service) and ``measured`` (emergency) keeps ``required``.
 
+        Every pair of vehicles is checked against its own ``required`` distance (:meth:`required`).
         ``hold``: the setpoints hold vehicles (they brake as the last cycle certified), checked to the
         millimetre; new motion is certified with the check's coarser intervals, whose pessimism keeps
         room for the holds that may follow (:meth:`~trajgen.execution.braking_check.BrakingCheck.clearance`).
@@ -89,14 +109,19 @@ class SafetyGuard:
         distance each vehicle drives, and none drives farther than its service stop from its
         commanded state (it starts there, or at most as far from its measured one as the two differ).
         """
-        travel = 0.0
-        for v in (0, 1):
-            command, measure = commanded[v], measured[v]
+        reach = []
+        for v, (command, measure) in enumerate(zip(commanded, measured, strict=True)):
             stop = stopping_distance(command.v, command.a, self._limits[v])
-            travel += (
+            reach.append(
                 stop + abs(command.p - measure.p) + measure.v * measure.v / self._limits[v].emergency_braking
             )
-        gap = self._distance(paths[0].locate(commanded[0].p), paths[1].locate(commanded[1].p))
-        if gap - travel >= required:
-            return True
-        return self._check.clearance(paths, commanded, measured, required, refine=hold)
+        for (i, j), check, need in zip(self._pairs, self._checks, required, strict=True):
+            gap = self._distance(paths[i].locate(commanded[i].p), paths[j].locate(commanded[j].p))
+            if gap - (reach[i] + reach[j]) >= need:
+                continue
+            pair = (paths[i], paths[j])
+            if not check.clearance(
+                pair, (commanded[i], commanded[j]), (measured[i], measured[j]), need, refine=hold
+            ):
+                return False
+        return True

@@ -13,6 +13,8 @@ from the edge's ``from`` node (a node may be given on any of its edges).
 
 from __future__ import annotations
 
+import itertools
+
 from limits import Limits
 from topology import (
     JUNCTION_INDEX,
@@ -140,7 +142,7 @@ class JunctionTrack:
         return goal_refusal(self.graph, goal, required)
 
     def plan_from_rest(
-        self, limits: Limits, start, goal, *, method: TimingMethod, margin: float, names: tuple[str, str]
+        self, limits: Limits, start, goal, *, method: TimingMethod, margin: float, names: tuple[str, ...]
     ) -> VerifiedSchedule:
         """The verified plan from ``start`` to ``goal`` for execution (:func:`schedule_from_rest`)."""
         return schedule_from_rest(self.graph, limits, start, goal, method=method, margin=margin)
@@ -211,7 +213,7 @@ class GraphTrack:
             start = player.state(v, 0.0)[0] if axis_start is None else axis_start[v]
             sign = None if orientation[v] is None else self._sign_on(path, *orientation[v])
             paths.append(GraphVehiclePath.from_path(path, self.graph, axis_start=start, orientation=sign))
-        return LoadedPlan((paths[0], paths[1]), plan_paths, schedule_times(schedule), player)
+        return LoadedPlan(tuple(paths), plan_paths, schedule_times(schedule), player)
 
     def _sign_on(self, path: GraphPath, edge: int, s: float, sign: int) -> int:
         """``ds / d axis`` on ``path``'s first edge, of a vehicle with ``ds / d axis = sign`` on ``edge``.
@@ -250,9 +252,7 @@ class GraphTrack:
         edge, s = path.locate(p)
         return edge, s, (1 if path.s_to[k] > path.s_from[k] else -1) * path.headings[k]
 
-    def goal_with(
-        self, goal: tuple[EdgePoint, EdgePoint], vehicle: int, position
-    ) -> tuple[EdgePoint, EdgePoint]:
+    def goal_with(self, goal: tuple[EdgePoint, ...], vehicle: int, position) -> tuple[EdgePoint, ...]:
         """``goal`` with ``vehicle``'s goal replaced by ``position`` (``"EDGE:s"``, a node, or an EdgePoint).
 
         Raises
@@ -260,31 +260,33 @@ class GraphTrack:
         InputError
             ``position`` is not on the track.
         """
-        pair = list(goal)
-        pair[vehicle] = self.graph.point(position)
-        return pair[0], pair[1]
+        goals = list(goal)
+        goals[vehicle] = self.graph.point(position)
+        return tuple(goals)
 
-    def goal_refusal(self, goal: tuple[EdgePoint, EdgePoint], required: float) -> str | None:
-        """Why ``goal`` cannot be taken (closer than ``required`` metres of track), or ``None``."""
-        apart = self.graph.distance(goal[0], goal[1])
-        if apart < required:
-            names = [self.graph.name(point) for point in goal]
-            return (
-                f"goal ({names[0]}, {names[1]}) leaves the vehicles {apart:.3f} m apart: expected at "
-                f"least {required:.3f} m"
-            )
+    def goal_refusal(self, goal: tuple[EdgePoint, ...], required: float) -> str | None:
+        """Why ``goal`` cannot be taken (two vehicles closer than ``required`` metres), or ``None``."""
+        for i, j in itertools.combinations(range(len(goal)), 2):
+            apart = self.graph.distance(goal[i], goal[j])
+            if apart < required:
+                names = ", ".join(self.graph.name(point) for point in goal)
+                between = "" if len(goal) == 2 else f" vehicles {i + 1} and {j + 1}"
+                return (
+                    f"goal ({names}) leaves the{between or ' vehicles'} {apart:.3f} m apart: expected at "
+                    f"least {required:.3f} m"
+                )
         return None
 
     def plan_from_rest(
-        self, limits: Limits, start, goal, *, method: TimingMethod, margin: float, names: tuple[str, str]
+        self, limits: Limits, start, goal, *, method: TimingMethod, margin: float, names: tuple[str, ...]
     ) -> VerifiedSchedule:
         """The verified plan from ``start`` to ``goal`` for execution (:func:`graph_schedule_from_rest`)."""
         return graph_schedule_from_rest(
             self.graph, limits, start, goal, method=method, margin=margin, names=names
         )
 
-    def start_of(self, positions: tuple[EdgePoint, EdgePoint]) -> tuple[EdgePoint, EdgePoint]:
-        """Both vehicles' positions as a start."""
+    def start_of(self, positions: tuple[EdgePoint, ...]) -> tuple[EdgePoint, ...]:
+        """Every vehicle's position as a start."""
         return positions
 
     def name(self, what) -> str:
@@ -295,7 +297,8 @@ class GraphTrack:
 
     def describe(self, route: GraphRoute) -> str:
         """The route's moves, as the events name it."""
-        return f"{len(route.moves)} move(s), {route.travel[0]:.3f} m and {route.travel[1]:.3f} m of travel"
+        travel = " and ".join(f"{metres:.3f} m" for metres in route.travel)
+        return f"{len(route.moves)} move(s), {travel} of travel"
 
 
 def execution_track(schedule) -> JunctionTrack | GraphTrack:
