@@ -3,7 +3,8 @@
 Each control cycle :meth:`Executor.step` takes every vehicle's measured state
 and returns their setpoints for the end of the cycle. What the plan fixes is
 kept: each vehicle's path (:mod:`trajgen.model.paths`) and, at every conflict of
-the coordination diagram of each pair of vehicles, who passes first.
+the coordination diagram of each pair of vehicles, who passes first
+(:mod:`trajgen.execution.conflicts`).
 Time is free:
 
 * **Frontier.** Each cycle each vehicle gets the farthest travel it may come
@@ -36,6 +37,7 @@ from limits import Limits
 from topology import Configuration
 from trajgen.errors import InputError, ScheduleError, TrajgenError
 from trajgen.execution.braking_check import PathState
+from trajgen.execution.conflicts import PlanConflicts
 from trajgen.execution.locate import locate_on_path
 from trajgen.execution.messages import (
     PERIOD_RANGE,
@@ -52,7 +54,7 @@ from trajgen.execution.messages import (
 from trajgen.execution.motion import AT_REST, VehicleMotion
 from trajgen.execution.safety_guard import SafetyGuard
 from trajgen.execution.tracks import execution_track
-from trajgen.model.coordination import CoordinationDiagram, SchedulePair, earliest_rest, stopping_distance
+from trajgen.model.coordination import CoordinationDiagram, earliest_rest, stopping_distance
 from trajgen.model.graph_vehicle_path import GraphVehiclePath
 from trajgen.model.paths import VehiclePath
 from trajgen.scenario.naming import check_vehicle_index
@@ -174,16 +176,7 @@ class Executor:
         self._axis_sign = [p.headings[0] if p.headings else 1 for p in self._paths]
         self._axis_base = [p.axis(0.0) for p in self._paths]
         separation = self.limits.min_separation + self.position_margin
-        # a diagram per pair of vehicles: each vehicle's frontier is the least over the pairs it is in
-        self._diagrams = tuple(
-            (
-                view.pair,
-                CoordinationDiagram(
-                    tuple(loaded.diagram_paths[v] for v in view.pair), separation, view, loaded.times
-                ),
-            )
-            for view in SchedulePair.every(schedule, count)
-        )
+        self._conflicts = PlanConflicts(schedule, loaded.diagram_paths, loaded.times, separation)
         self._plan_time = 0.0
         self._on_plan = [True] * count
         self._command = [PathState(0.0, 0.0, 0.0) for _ in range(count)]
@@ -216,7 +209,7 @@ class Executor:
     @property
     def diagrams(self) -> tuple[tuple[tuple[int, int], CoordinationDiagram], ...]:
         """The plan's coordination diagram of each pair of vehicles: ``((i, j), diagram)``."""
-        return self._diagrams
+        return self._conflicts.diagrams
 
     @property
     def goal(self):
@@ -318,11 +311,8 @@ class Executor:
             earliest_rest(s.p, s.v, self._emergency[v], self._paths[v].next_stop(s.p, 0.0))
             for v, s in enumerate(along)
         ]
-        frontiers = [math.inf] * count
-        for (i, j), diagram in self._diagrams:
-            frontiers[i] = min(frontiers[i], diagram.frontier(0, earliest[j]))
-            frontiers[j] = min(frontiers[j], diagram.frontier(1, earliest[i]))
-        self._frontiers = tuple(frontiers)
+        frontiers = self._conflicts.frontiers(earliest)
+        self._frontiers = frontiers
         proposals = [self._propose(v, frontiers[v]) for v in range(count)]
         if any(self._on_plan):
             self._plan_time += self.period
@@ -445,14 +435,7 @@ class Executor:
         The one with less room to its frontier first: a vehicle that leads now and follows only at a
         later conflict keeps going, its follower waits.
         """
-        followers = []
-        for (i, j), diagram in self._diagrams:
-            for side, v in enumerate((i, j)):
-                leader = (i, j)[1 - side]
-                if v not in followers and any(
-                    c.follower == side for c in diagram.leading(1 - side, self._travel[leader])
-                ):
-                    followers.append(v)
+        followers = self._conflicts.followers(self._travel)
         followers.sort(key=lambda v: (self._frontiers[v] - self._travel[v], v))
         orders = [(v,) for v in followers] + [tuple(sorted(followers)), tuple(range(self.limits.count))]
         return tuple(order for order in dict.fromkeys(orders) if order)
