@@ -993,6 +993,7 @@ def test_the_generic_csv_of_seeded_random_graphs_passes_check():
 # -- any number of vehicles below the planners ------------------------------------------------------------
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("case", FLEETS, ids=lambda case: case.name)
 def test_every_table_dialect_of_a_fleet_is_verified_as_interpolated_one_table_per_vehicle(case, tmp_path):
     """Three or four vehicles: each dialect's tables, written and read back, keep every pair apart."""

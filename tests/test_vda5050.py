@@ -1482,6 +1482,7 @@ def test_nodes_less_than_a_micrometre_apart_keep_distinct_ids(tmp_path):
 # -- any number of vehicles below the planners ------------------------------------------------------------
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("method", ["exact", "toppra"])
 @pytest.mark.parametrize("case", FLEETS, ids=lambda case: case.name)
 def test_a_fleet_gets_an_order_per_vehicle_and_its_releases_keep_every_pair_apart_whatever_the_timing(
