@@ -23,9 +23,10 @@ from matplotlib.figure import Figure
 from matplotlib.path import Path as PolygonPath
 from PIL import Image
 
+from limits import Limits, VehicleLimits
 from tests.conftest import REPO
 from tests.support.cases import case
-from tests.support.fleets import FLEETS, SEPARATION
+from tests.support.fleets import FLEETS, SEPARATION, one_at_a_time
 from tests.support.graph_cases import EXAMPLES
 from tests.support.helpers import LIMITS, animation_gif, conf, legs_cases, legs_id, route_of
 from topology import JUNCTION_INDEX, EdgePoint, Instruction, StarGraph, TrackGraph, YGraph, plan, plan_graph
@@ -1223,3 +1224,19 @@ def test_every_picture_of_a_fleet_shows_every_vehicle(case):
     assert len(frames) == animation.frame_count
     geometry = frame_geometry(verified, [0.0, verified.schedule.duration])
     assert geometry.x.shape[0] == case.count
+
+
+def test_the_coordination_of_a_fleet_with_no_conflict_draws_the_pair_that_comes_closest():
+    track = TrackGraph.from_edges({"main": ("W", "E", 100.0)})
+    route = one_at_a_time(
+        track,
+        ("main:10", "main:50", "main:60"),
+        ((0, ("main:10", "main:15")), (1, ("main:50", "main:55")), (2, ("main:60", "main:65"))),
+        separation=SEPARATION,
+        names=("agv1", "agv2", "agv3"),
+    )
+    limits = Limits((VehicleLimits(1.0, 0.5, 1.0),) * 3, SEPARATION)
+    verified = certify(make_schedule(route, limits, method="exact"))
+    figure = plot_coordination({"exact": verified})
+    (axis,) = figure.axes
+    assert (axis.get_xlabel(), axis.get_ylabel()) == ("vehicle 2 travelled [m]", "vehicle 3 travelled [m]")

@@ -216,3 +216,29 @@ def test_the_class_check_catches_a_plan_of_another_class_on_every_track(case):
     ]
     assert found, report.failures
     assert "sections[" in found[0][1]
+
+
+def _without_last_vehicle(schedule, *, paths: bool = True):
+    """The schedule with its last vehicle's motion left out of every section (and its path, if asked)."""
+    sections = tuple(
+        dataclasses.replace(section, kinematics=CubicKinematics(section.kinematics.vehicles[:-1]))
+        for section in schedule.sections
+    )
+    return dataclasses.replace(
+        schedule, sections=sections, paths=schedule.paths[:-1] if paths else schedule.paths
+    )
+
+
+@pytest.mark.parametrize("case", FLEETS, ids=[case.name for case in FLEETS])
+def test_a_schedule_that_leaves_out_a_vehicle_its_route_moves_is_refused(case):
+    schedule = case.verified().schedule
+    count = schedule.count
+    report = verify(_without_last_vehicle(schedule))
+    assert not report.passed
+    assert report.failures[0] == (
+        f"the schedule has {count - 1} path(s), its route moves {count} vehicle(s): expected one per vehicle"
+    )
+    report = verify(_without_last_vehicle(schedule, paths=False))
+    assert not report.passed
+    assert f"section 1 moves {count - 1} vehicle(s), the route {count}" in report.failures[0]
+    assert report.details[0].endswith("sections[0].kinematics")

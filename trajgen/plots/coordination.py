@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import itertools
 from collections.abc import Mapping
 
 import numpy as np
@@ -33,7 +34,7 @@ def _too_close(schedule, required: float) -> list[tuple[tuple[int, int], list]]:
     The conflicts of :class:`~trajgen.model.coordination.CoordinationDiagram` on every track (a
     junction's paths are on its track graph too), each part led by the vehicle (of the pair) the
     plan lets pass first. Two vehicles have their pair drawn whether or not they conflict; of more,
-    the pairs that conflict (the first pair if none does).
+    the pairs that conflict (if none does, the pair that comes closest).
     """
     paths, times, _ = schedule_paths(schedule)
     drawn = []
@@ -46,7 +47,11 @@ def _too_close(schedule, required: float) -> list[tuple[tuple[int, int], list]]:
         ]
         if parts or len(paths) == 2:
             drawn.append((view.pair, parts))
-    return drawn or [((0, 1), [])]
+    if drawn:
+        return drawn
+    state = schedule.sample(plot_period(schedule.duration))
+    closest = np.argmin(np.min(schedule.pair_distances(state), axis=1))
+    return [(tuple(itertools.combinations(range(len(paths)), 2))[int(closest)], [])]
 
 
 def plot_coordination(verified: Mapping[str, VerifiedSchedule], *, figure=None):

@@ -217,7 +217,10 @@ def braking_rule_failures(
         evaluations += starts.size
         if evaluations > _EVALUATIONS:
             k = int(np.argmin(ends - starts))
-            return [BrakingRuleFailure(0, float(starts[k]), math.nan)]
+            # the vehicle whose margin is thinnest there, against what it can lose in the step
+            values, fall = margins(starts[k : k + 1], ends[k : k + 1] - starts[k : k + 1])
+            thinnest = int(np.argmin(values[:, 0] - fall[:, 0]))
+            return [BrakingRuleFailure(thinnest, float(starts[k]), math.nan)]
         values, fall = margins(starts, ends - starts)
         for j in range(count):
             bad = np.nonzero(values[j] < -BRAKING_RULE_TOLERANCE)[0]

@@ -37,7 +37,7 @@ from trajgen.model.schedule import CubicKinematics
 from trajgen.verification.braking_rule import braking_rule_failures, for_execution
 from trajgen.verification.graph_class import check_class
 from trajgen.verification.graph_route import TrackDistances
-from trajgen.verification.integrity import array_failures
+from trajgen.verification.integrity import array_failures, count_failures
 from trajgen.verification.piecewise import allowance, continuity_allowance, time_resolution
 from trajgen.verification.report import (
     POSITION_TOLERANCE,
@@ -541,6 +541,9 @@ def _check_pair(
 
 def verify_graph_schedule(schedule: GraphSchedule) -> VerificationReport:
     """Check a schedule on a track graph independently of how it was computed (see the module)."""
+    counted = count_failures(schedule)
+    if counted:  # every other check reads one path and one motion per vehicle
+        return VerificationReport.failed(tuple(counted), count=len(schedule.route.start))
     own = array_failures(schedule)
     if own:  # the motion is read from these numbers: broken ones make every other check meaningless
         return VerificationReport.failed(tuple(own), count=len(schedule.paths))

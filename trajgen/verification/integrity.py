@@ -27,7 +27,7 @@ from trajgen.model.profiles import PiecewiseCubic
 from trajgen.model.schedule import AxisMap, CubicKinematics
 from trajgen.verification.report import Finding
 
-__all__ = ["array_failures"]
+__all__ = ["array_failures", "count_failures"]
 
 #: Relative round-off allowed between a TOPPRA section's knot times and those its grid and speeds give.
 _TIME_CONSISTENCY = 1e-9
@@ -352,4 +352,45 @@ def array_failures(schedule) -> list[str]:
                 f"{where}.start_time is {float(start)!r} s: {expected}",
             )
         clock = start + section_object.duration
+    return failures
+
+
+def count_failures(schedule) -> list[str]:
+    """A track graph's schedule has a path for every vehicle its route moves, and moves each in every section.
+
+    Parameters
+    ----------
+    schedule : GraphSchedule
+
+    Returns
+    -------
+    list of str
+        Empty if the counts agree; else :class:`~trajgen.verification.report.Finding` objects naming
+        the arrays.
+    """
+    moved = len(schedule.route.start)
+    failures: list[str] = []
+    if len(schedule.paths) != moved:
+        failures.append(
+            Finding(
+                f"the schedule has {len(schedule.paths)} path(s), its route moves {moved} vehicle(s): "
+                "expected one per vehicle",
+                "paths",
+            )
+        )
+    for k, section in enumerate(schedule.sections):
+        kinematics = section.kinematics
+        if type(kinematics) is CubicKinematics:
+            count = len(kinematics.vehicles)
+        elif type(kinematics) is ToppraKinematics:
+            count = kinematics.path.dof
+        else:
+            continue  # refused as kinematics the verifier does not know, below
+        if count != moved:
+            failures.append(
+                Finding(
+                    f"section {k + 1} moves {count} vehicle(s), the route {moved}: expected one per vehicle",
+                    f"sections[{k}].kinematics",
+                )
+            )
     return failures
