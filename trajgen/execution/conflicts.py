@@ -13,7 +13,7 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 
-from trajgen.model.coordination import CoordinationDiagram, SchedulePair
+from trajgen.model.coordination import pair_diagrams
 
 __all__ = ["PlanConflicts"]
 
@@ -40,10 +40,7 @@ class PlanConflicts:
     def __init__(self, schedule, paths: Sequence, times, separation: float) -> None:
         self.count = len(paths)
         #: ``((i, j), diagram)`` for every pair of vehicles, in the order of ``itertools.combinations``
-        self.diagrams = tuple(
-            (view.pair, CoordinationDiagram(tuple(paths[v] for v in view.pair), separation, view, times))
-            for view in SchedulePair.every(schedule, self.count)
-        )
+        self.diagrams = pair_diagrams(schedule, tuple(paths), separation, times)
 
     def frontiers(self, earliest: Sequence[float]) -> tuple[float, ...]:
         """Each vehicle's frontier, metres of its travel (``inf``: nothing binds it).

@@ -39,6 +39,7 @@ __all__ = [
     "Polygon",
     "SchedulePair",
     "earliest_rest",
+    "pair_diagrams",
     "schedule_paths",
     "schedule_times",
     "schedule_waypoints",
@@ -378,10 +379,24 @@ class SchedulePair:
         """The two vehicles' states at times ``t`` (:meth:`~trajgen.model.state.TrackState.of`)."""
         return self.schedule.state(t).of(self.pair)
 
-    @classmethod
-    def every(cls, schedule, count: int) -> tuple[SchedulePair, ...]:
-        """Every pair of ``count`` vehicles of ``schedule``, in the order of ``itertools.combinations``."""
-        return tuple(cls(schedule, pair) for pair in itertools.combinations(range(count), 2))
+
+def pair_diagrams(
+    schedule, paths: tuple[GraphPath, ...], separation: float, times
+) -> tuple[tuple[tuple[int, int], CoordinationDiagram], ...]:
+    """The coordination diagram of every pair of a schedule's vehicles: ``((i, j), diagram)``.
+
+    Pairs in the order of ``itertools.combinations``; ``paths`` and ``times`` as
+    :func:`schedule_paths` gives them, ``separation`` the distance the conflicts keep, metres.
+    """
+    return tuple(
+        (
+            pair,
+            CoordinationDiagram(
+                (paths[pair[0]], paths[pair[1]]), separation, SchedulePair(schedule, pair), times
+            ),
+        )
+        for pair in itertools.combinations(range(len(paths)), 2)
+    )
 
 
 def stopping_distance(

@@ -10,7 +10,7 @@ import numpy as np
 from trajgen.errors import InputError
 from trajgen.methods import METHODS
 from trajgen.model.analysis import travelled
-from trajgen.model.coordination import CoordinationDiagram, SchedulePair, schedule_paths
+from trajgen.model.coordination import pair_diagrams, schedule_paths
 from trajgen.model.summary import class_label
 from trajgen.plots.figure import drawing_area, finished, polygon_patch, wrapped
 from trajgen.plots.speed import plot_period, vehicle_colour
@@ -38,15 +38,14 @@ def _too_close(schedule, required: float) -> list[tuple[tuple[int, int], list]]:
     """
     paths, times, _ = schedule_paths(schedule)
     drawn = []
-    for view in SchedulePair.every(schedule, len(paths)):
-        diagram = CoordinationDiagram(tuple(paths[v] for v in view.pair), required, view, times)
+    for pair, diagram in pair_diagrams(schedule, paths, required, times):
         parts = [
-            (view.pair[conflict.leader], polygon)
+            (pair[conflict.leader], polygon)
             for conflict in diagram.conflicts
             for polygon in conflict.polygons
         ]
         if parts or len(paths) == 2:
-            drawn.append((view.pair, parts))
+            drawn.append((pair, parts))
     if drawn:
         return drawn
     state = schedule.sample(plot_period(schedule.duration))

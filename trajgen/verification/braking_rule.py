@@ -29,7 +29,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from limits import VehicleLimits
-from trajgen.model.coordination import CoordinationDiagram, SchedulePair, schedule_paths, stopping_distances
+from trajgen.model.coordination import pair_diagrams, schedule_paths, stopping_distances
 from trajgen.model.pieces import Pieces
 from trajgen.model.values import sorted_unique
 
@@ -153,11 +153,11 @@ def braking_rule_failures(
     paths, times, travel = schedule_paths(schedule, pieces)
     count = len(paths)
     # a diagram per pair of vehicles; a vehicle's frontier is the least over the pairs it follows in
-    diagrams = []
-    for view in SchedulePair.every(schedule, count):
-        diagram = CoordinationDiagram(tuple(paths[v] for v in view.pair), separation, view, times)
-        if diagram.conflicts:
-            diagrams.append((view.pair, diagram))
+    diagrams = [
+        (pair, diagram)
+        for pair, diagram in pair_diagrams(schedule, paths, separation, times)
+        if diagram.conflicts
+    ]
     if not diagrams:
         return []
     vehicles = schedule.limits.vehicles

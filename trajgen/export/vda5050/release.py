@@ -176,8 +176,15 @@ class BaseRelease:
         ]
         return sorted(movers, key=lambda v: (arrival[v][state[v] + 1], v))
 
-    def _apart_at(self, state: tuple[int, ...]) -> bool:
-        """Whether every two vehicles standing at their nodes of ``state`` keep the separation."""
+    def _apart_at(self, state: tuple[int, ...], moved: int | None = None) -> bool:
+        """Whether every two vehicles standing at their nodes of ``state`` keep the separation.
+
+        ``moved``: the one vehicle that moved into ``state`` from a state that kept it; only its pairs
+        can have changed.
+        """
+        if moved is not None:
+            here = self.points[moved][state[moved]]
+            return all(self.apart(here, self.points[o][state[o]]) for o in range(len(state)) if o != moved)
         return all(
             self.apart(self.points[i][state[i]], self.points[j][state[j]])
             for i, j in itertools.combinations(range(len(state)), 2)
@@ -203,7 +210,7 @@ class BaseRelease:
             following = None
             for mover in options:
                 after = (*state[:mover], state[mover] + 1, *state[mover + 1 :])
-                if after not in dead and self._apart_at(after):
+                if after not in dead and self._apart_at(after, mover):
                     following = (mover, after)
                     break
             if following is None:
