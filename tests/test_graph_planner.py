@@ -15,22 +15,31 @@ import re
 
 import numpy as np
 import pytest
+from hypothesis import assume, given, settings
+from hypothesis import strategies as st
+from numpy.testing import assert_array_equal
 
 from tests.support.fleets import FLEETS, SEPARATION, fleet
 from tests.support.grid_oracle import GRID, GridTrack, random_case, shortest_route
+from tests.support.strategies import resolved, star_queries
 from topology import (
     Configuration,
+    EdgePoint,
     GraphMove,
+    GraphRoute,
     InfeasibleError,
+    OptionError,
     Position,
     PositionError,
     SeparationError,
     StarGraph,
     TrackError,
     TrackGraph,
+    YGraph,
     plan,
     plan_graph,
 )
+from trajgen.model.junction_route import junction_graph_route
 from trajgen.model.summary import graph_route_summary
 from trajgen.verification.graph_route import verify_graph_route
 
@@ -439,3 +448,122 @@ def test_a_route_whose_counts_disagree_is_refused_naming_them():
         dataclasses.replace(route, travel=route.travel[:2])
     with pytest.raises(PositionError, match=r"moves of \[2\] vehicle\(s\)"):
         dataclasses.replace(route, moves=(dataclasses.replace(route.moves[0], at_start=route.start[:2]),))
+
+
+# -- a junction's route on its track graph (the door of the one model) ---------------------------------
+
+
+def _junction_route(start, goal, *, legs=None, homotopy="planned"):
+    track = YGraph(legs or {"A": 10.0, "B": 10.0, "C": 10.0})
+    configuration = [Configuration(*(Position(leg, s) for leg, s in pair)) for pair in (start, goal)]
+    return plan(track, *configuration, min_separation=1.5, homotopy=homotopy)
+
+
+def test_a_junctions_route_on_its_track_graph_is_its_straight_pieces_in_closed_form():
+    """Retract onto the leg ends together, go round the circle, come back together (the paper)."""
+    route = _junction_route((("A", 1.0), ("B", 1.0)), (("B", 5.0), ("A", 5.0)))
+    on_graph = junction_graph_route(route, names=("agv1", "agv2"))
+    track = on_graph.track
+    moves = [(m.vehicle, m.movers, [track.name(p) for p in m.points], m.length) for m in on_graph.moves]
+    assert moves == [
+        (0, (0, 1), ["A:1", "A-end"], 9.0),
+        (1, (0, 1), ["B:1", "B-end"], 9.0),
+        (1, (1,), ["B-end", "O", "C-end"], 20.0),
+        (0, (0,), ["A-end", "O", "B-end"], 20.0),
+        (1, (1,), ["C-end", "O", "A-end"], 20.0),
+        (0, (0, 1), ["B-end", "B:5"], 5.0),
+        (1, (0, 1), ["A-end", "A:5"], 5.0),
+    ]
+    assert [len(step) for step in on_graph.steps] == [2, 1, 1, 1, 2]
+    assert on_graph.travel == (34.0, 54.0) == tuple(route.travel)
+    assert on_graph.label == "planned (counterclockwise)"
+    assert_array_equal(on_graph.corners(), [[0, 0], [9, 9], [9, 29], [29, 29], [29, 49], [34, 54]])
+    report = verify_graph_route(on_graph)
+    assert report.passed, report.failures
+    assert report.closest == 2.0  # where they start
+    summary = graph_route_summary(on_graph)
+    assert summary["moves"][0]["with"] == ["agv2"]
+    assert summary["moves"][0]["standing"] == {}
+    assert "with" not in summary["moves"][2]
+    assert summary["moves"][2]["standing"] == {"agv1": "A-end"}
+
+
+@settings(max_examples=80)
+@given(query=star_queries(3, 8), homotopy=st.sampled_from(["planned", "other"]))
+def test_every_junction_route_on_its_track_graph_is_verified_and_travels_as_far(query, homotopy):
+    star, start, goal, separation = query
+    assume(resolved(star, (*start, *goal), separation))
+    try:
+        route = plan(star, start, goal, min_separation=separation, homotopy=homotopy)
+    except OptionError:  # no other class of a query whose retractions meet
+        assume(False)
+    on_graph = junction_graph_route(route)
+    report = verify_graph_route(on_graph)
+    assert report.passed, report.failures
+    assert report.closest >= separation - 1e-9
+    assert on_graph.travel == pytest.approx(route.travel, abs=1e-9)
+    track = on_graph.track
+    junction = track.node_point(track.node("O"))
+    for ends, placed in (
+        (route.indexed_waypoints[0], on_graph.start),
+        (route.indexed_waypoints[-1], on_graph.goal),
+    ):
+        for v in (0, 1):
+            leg, s = ends[2 * v], ends[2 * v + 1]
+            assert track.distance(placed[v], junction if s == 0.0 else EdgePoint(leg, s)) <= 1e-9
+
+
+@pytest.mark.parametrize(
+    ("parts", "match"),
+    [
+        pytest.param(
+            [(0, (0, 1))], r"move 1 is part of a joint move of vehicles \[0, 1\]", id="a-part-missing"
+        ),
+        pytest.param([(1, (0, 1)), (0, (0, 1))], r"move vehicles \[1, 0\]", id="out-of-order"),
+        pytest.param([(0, (0, 1)), (1, (1,))], r"move vehicles \[0, 1\]", id="movers-disagree"),
+    ],
+)
+def test_a_joint_move_is_refused_unless_its_parts_follow_each_other_in_vehicle_order(parts, match):
+    track = TrackGraph.from_edges({"line": ("W", "E", 20.0)})
+    at_start = (track.point("line:2"), track.point("line:10"))
+    moves = tuple(
+        GraphMove(v, (at_start[v], track.point(f"line:{at_start[v].s + 1}")), (0,), 1.0, at_start, movers)
+        for v, movers in parts
+    )
+    with pytest.raises(PositionError, match=match):
+        GraphRoute(track, 1.5, at_start, at_start, moves, (1.0, 1.0), 0, 0)
+
+
+def _driving_at_once(first: tuple[str, str], second: tuple[str, str]):
+    track = TrackGraph.from_edges({"line": ("W", "E", 20.0)})
+    at_start = (track.point(first[0]), track.point(second[0]))
+    moves = tuple(
+        GraphMove(
+            v,
+            (track.point(a), track.point(b)),
+            (0,),
+            abs(track.point(b).s - track.point(a).s),
+            at_start,
+            (0, 1),
+        )
+        for v, (a, b) in enumerate((first, second))
+    )
+    goal = (moves[0].points[-1], moves[1].points[-1])
+    return GraphRoute(track, 1.5, at_start, goal, moves, (moves[0].length, moves[1].length), 0, 0)
+
+
+def test_two_vehicles_that_pass_through_each_other_driving_at_once_are_caught():
+    """Both ends of the joint move are 6 m apart; in between the two cross on one edge."""
+    report = verify_graph_route(_driving_at_once(("line:2", "line:12"), ("line:8", "line:6")))
+    assert not report.passed
+    assert report.closest == 0.0
+    assert "driving at once, vehicle 1 and vehicle 2 come 0 m apart" in report.failures[0]
+
+
+def test_a_convoy_the_separation_apart_driving_at_once_keeps_it_exactly():
+    report = verify_graph_route(_driving_at_once(("line:2", "line:12"), ("line:3.5", "line:13.5")))
+    assert report.passed, report.failures
+    assert report.closest == pytest.approx(1.5, abs=1e-12)
+    closing = verify_graph_route(_driving_at_once(("line:2", "line:12"), ("line:3.5", "line:13")))
+    assert not closing.passed
+    assert closing.closest == pytest.approx(1.0, abs=1e-12)

@@ -15,9 +15,12 @@ import math
 import numpy as np
 import pytest
 from hypothesis import assume, given, settings
+from hypothesis import strategies as st
+from numpy.testing import assert_allclose
 
 from limits import Limits, VehicleLimits
 from tests.conftest import REPO
+from tests.support.cases import case
 from tests.support.fleets import FLEETS, SEPARATION
 from tests.support.graph_cases import random_routes, verified_example
 from tests.support.graph_rows import ScenarioFile, check_profiles
@@ -25,7 +28,7 @@ from tests.support.grid_oracle import random_case
 from tests.support.helpers import AGV, LIMITS, MIXED, SLOW, legs_cases, legs_id, route_of, too_close
 from tests.support.sampled_verifier import sampled_verify
 from tests.support.star_scenarios import STAR_METHODS, STAR_SCENARIOS, leg_index, star_scenario, star_schedule
-from tests.support.strategies import star_queries
+from tests.support.strategies import resolved, star_queries
 from topology import (
     JUNCTION_INDEX,
     Configuration,
@@ -50,6 +53,7 @@ from trajgen.model.analysis import lower_bound
 from trajgen.model.axes import route_axes, straight_pieces
 from trajgen.model.blended import ToppraKinematics
 from trajgen.model.graph_schedule import GraphSchedule, GraphSection
+from trajgen.model.junction_route import junction_graph_route
 from trajgen.model.profiles import PiecewiseCubic, rest_to_rest_time, scurve_phases
 from trajgen.model.schedule import CubicKinematics, FallbackReason, TimingMethod
 from trajgen.pipeline import Outputs, run
@@ -925,3 +929,49 @@ def test_optimal_on_more_than_two_vehicles_plays_exact_and_says_why(case):
     assert verified.schedule.duration == case.verified("exact").schedule.duration
     expected = f"times two vehicles at once, the route moves {case.count}: expected exact or toppra"
     assert expected in verified.schedule.notes[0]
+
+
+# -- a junction's route on its track graph: the one route every method times ---------------------------
+
+
+@settings(max_examples=60)
+@given(query=star_queries(3, 8), homotopy=st.sampled_from(["planned", "other"]), jerk=st.booleans())
+def test_a_junctions_route_on_its_track_graph_is_timed_exactly_as_the_junction_times_it(
+    query, homotopy, jerk
+):
+    """Two independent ways to the ``exact`` schedule: the junction's axes and the graph's travel."""
+    star, start, goal, separation = query
+    assume(resolved(star, (*start, *goal), separation))
+    try:
+        route = plan(star, start, goal, min_separation=separation, homotopy=homotopy)
+    except OptionError:  # no other class of a query whose retractions meet
+        assume(False)
+    limits = Limits(vehicles=(AGV, SLOW), min_separation=separation)
+    junction = Exact(jerk=jerk).schedule(route, limits)
+    on_graph = Exact(jerk=jerk).schedule_graph(junction_graph_route(route), limits)
+    assert on_graph.duration == pytest.approx(junction.duration, rel=1e-12, abs=1e-12)
+    # the last instant left out: at rest there a trapezoid's acceleration jumps, and each takes a side
+    t = np.linspace(0.0, junction.duration, 101)[:-1]
+    ours, theirs = on_graph.state(t), junction.state(t)
+    # a path leaves out a move shorter than MOVE_RESOLUTION (1 nm) that a junction's axis keeps
+    for name in ("axis", "velocity", "acceleration"):
+        assert_allclose(getattr(ours, name), getattr(theirs, name), rtol=0, atol=2e-9, err_msg=name)
+    track = on_graph.track
+    for v in (0, 1):
+        apart = track.distances(ours.edge[v], ours.s[v], theirs.edge[v], theirs.s[v])
+        assert np.max(apart) <= 2e-9
+    report = verify(on_graph)
+    assert report.passed, report.failures
+
+
+@pytest.mark.parametrize("method", ["toppra", pytest.param("optimal", marks=pytest.mark.slow)])
+@pytest.mark.parametrize("name", ["y", "4-leg", "8-leg"])
+def test_every_method_times_a_junctions_route_on_its_track_graph_and_the_verifier_passes_it(name, method):
+    scenario = case(name).scenario()
+    route = junction_graph_route(scenario.route(), names=scenario.names)
+    schedule = METHODS.create(method).schedule_graph(route, scenario.limits)
+    report = verify(schedule)
+    assert report.passed, report.failures
+    assert schedule.fallback_reason is None
+    exact = Exact().schedule_graph(route, scenario.limits)
+    assert schedule.duration < exact.duration  # each overlaps the moves the exact one makes one by one

@@ -41,7 +41,8 @@ from topology.errors import (
     VehicleCountError,
 )
 from topology.graph import MAX_LEGS, MIN_LEGS, StarGraph, YGraph
-from topology.graph_planner import GraphMove, GraphRoute, class_signature, plan_graph, plan_graph_classes
+from topology.graph_planner import plan_graph, plan_graph_classes
+from topology.graph_route import GraphMove, GraphRoute, class_signature
 from topology.indexed import JUNCTION_INDEX, RegionKey, reduce_regions
 from topology.options import Option
 from topology.positions import JUNCTION, JUNCTION_NAME, Configuration, Position

@@ -32,15 +32,15 @@ import bisect
 import heapq
 import itertools
 from collections.abc import Sequence
-from dataclasses import dataclass
 
 import numpy as np
 
-from topology.errors import InfeasibleError, PositionError, SeparationError
+from topology.errors import InfeasibleError, SeparationError
+from topology.graph_route import GraphMove, GraphRoute, class_signature
 from topology.track_graph import EdgePoint, TrackGraph
 from topology.validation import check_vehicle_count, finite_real, short_repr
 
-__all__ = ["CLASS_WEIGHT", "GraphMove", "GraphRoute", "class_signature", "plan_graph", "plan_graph_classes"]
+__all__ = ["CLASS_WEIGHT", "plan_graph", "plan_graph_classes"]
 
 #: Weight of the yielding-free vehicle's metres in the alternative classes of :func:`plan_graph_classes`.
 CLASS_WEIGHT = 4.0
@@ -50,92 +50,6 @@ CLASS_WEIGHT = 4.0
 TOLERANCE = 1e-9
 #: Pairs of critical points searched at most (a safety stop against a track too large to plan).
 MAX_STATES = 2_000_000
-
-
-@dataclass(frozen=True, slots=True)
-class GraphMove:
-    """One vehicle's move along the track while the others stand.
-
-    Attributes
-    ----------
-    vehicle : int
-        Which vehicle moves: its index in the route's vehicles.
-    points : tuple of EdgePoint
-        Where it starts, each node it passes, where it ends.
-    edges : tuple of int
-        The edge it runs along from each point to the next (``len(points) - 1`` of them).
-    length : float
-        Metres travelled.
-    at_start : tuple of EdgePoint
-        Every vehicle's point as the move begins, one per vehicle (the moving one's is
-        ``points[0]``); the others stand there throughout.
-    """
-
-    vehicle: int
-    points: tuple[EdgePoint, ...]
-    edges: tuple[int, ...]
-    length: float
-    at_start: tuple[EdgePoint, ...]
-
-    def standing(self) -> tuple[tuple[int, EdgePoint], ...]:
-        """``(vehicle, point)`` of each vehicle that stands during the move, in vehicle order."""
-        return tuple((v, point) for v, point in enumerate(self.at_start) if v != self.vehicle)
-
-
-@dataclass(frozen=True, slots=True, eq=False)
-class GraphRoute:
-    """A collision-free route of two vehicles on a track graph, one moving at a time.
-
-    Attributes
-    ----------
-    track : TrackGraph
-    min_separation : float
-        Metres of track distance kept at all times.
-    start, goal : tuple of 2 EdgePoint
-    moves : tuple of GraphMove
-        In order. A new move starts where the other vehicle takes over or the moving one turns back.
-    travel : tuple of float
-        Metres each vehicle travels; the route minimises their sum.
-    critical_points : int
-        Critical points of the roadmap before the search (nodes, starts, goals and the points at
-        the separation from them); the search adds those at the separation from where a vehicle
-        stands as it reaches them.
-    searched : int
-        Pairs of critical points the search expanded (how hard the planning was).
-    names : tuple of str
-        The vehicles' names the planner was given (for messages and summaries).
-    """
-
-    track: TrackGraph
-    min_separation: float
-    start: tuple[EdgePoint, ...]
-    goal: tuple[EdgePoint, ...]
-    moves: tuple[GraphMove, ...]
-    travel: tuple[float, ...]
-    critical_points: int
-    searched: int
-    names: tuple[str, ...] = ("vehicle 1", "vehicle 2")
-
-    def __post_init__(self) -> None:
-        counts = {len(self.start), len(self.goal), len(self.travel), len(self.names)}
-        counts |= {len(move.at_start) for move in self.moves}
-        if len(counts) != 1 or not all(0 <= move.vehicle < len(self.start) for move in self.moves):
-            raise PositionError(
-                f"a route of {len(self.start)} vehicle(s) has {len(self.goal)} goal(s), "
-                f"{len(self.travel)} travel(s), {len(self.names)} name(s) and moves of "
-                f"{sorted({len(m.at_start) for m in self.moves})} vehicle(s) by vehicles "
-                f"{sorted({m.vehicle for m in self.moves})}: expected one of each per vehicle"
-            )
-
-    @property
-    def count(self) -> int:
-        """How many vehicles the route moves."""
-        return len(self.start)
-
-    @property
-    def length(self) -> float:
-        """The route's cost, metres: every vehicle's travel."""
-        return sum(self.travel)
 
 
 def plan_graph(
@@ -203,15 +117,6 @@ def plan_graph(
     search = _Search(track, separation, starts, goals, tuple(names))
     search.weights = (float(weights[0]), float(weights[1]))
     return search.run()
-
-
-def class_signature(route: GraphRoute) -> tuple:
-    """What makes a route's class: each move's vehicle and the edges it runs along, in order.
-
-    Two routes whose moves run the same edges in the same order (parking in the same siding,
-    passing a loop on the same side) differ only in how deep a vehicle waits: one class.
-    """
-    return tuple((move.vehicle, move.edges) for move in route.moves)
 
 
 def plan_graph_classes(

@@ -113,3 +113,21 @@ def star_queries(draw, min_legs: int = 4, max_legs: int = 8):
     ceiling = min(graph.shortest_leg, graph.separation(start), graph.separation(goal))
     separation = draw(st.one_of(st.just(0.0), st.just(ceiling), st.floats(0.0, ceiling)))
     return graph, start, goal, separation
+
+
+def resolved(graph: StarGraph, positions, separation: float) -> bool:
+    """Whether a query is within what a track graph resolves: each position at the junction or a leg's end
+    or at least 1 µm from both, and a separation of at least 1 µm.
+
+    A track graph holds a point within ``POINT_TOLERANCE`` (1 nm) of a node as the node; the queries
+    above reach down to 5e-324 m, where a junction's own planner and verifier still tell the places apart.
+    """
+    if separation < 1e-6:
+        return False
+    for position in positions:
+        if position.leg is None or position.s == 0.0:
+            continue
+        length = graph.lengths[graph.names.index(position.leg)]
+        if position.s < 1e-6 or (position.s != length and length - position.s < 1e-6):
+            return False
+    return True

@@ -54,22 +54,19 @@ def check_graph_request(route: object, limits: object) -> tuple[GraphRoute, Limi
     return route, limits
 
 
-def travel_corners(route: GraphRoute) -> tuple[np.ndarray, np.ndarray]:
-    """The route as a staircase in the space of every vehicle's travel.
+def travel_corners(route: GraphRoute) -> tuple[np.ndarray, tuple[frozenset[int], ...]]:
+    """The route as a polyline in the space of every vehicle's travel (:meth:`~topology.GraphRoute.corners`).
 
     Returns
     -------
     corners : ndarray, shape (m + 1, count)
-        Every vehicle's travel before the first move and after each, metres.
-    movers : ndarray of int, shape (m,)
-        The vehicle each move moves.
+        Every vehicle's travel before the first step and after each, metres.
+    movers : tuple of frozenset of int
+        The vehicles each of the m steps moves: one, or those of a joint move.
     """
-    moves = [move for move in route.moves if move.length > 0.0]
-    corners = np.zeros((len(moves) + 1, len(route.start)))
-    for k, move in enumerate(moves):
-        corners[k + 1] = corners[k]
-        corners[k + 1, move.vehicle] += move.length
-    return corners, np.array([move.vehicle for move in moves], dtype=int)
+    steps = [step for step in route.steps if any(part.length > 0.0 for part in step)]
+    movers = tuple(frozenset(part.vehicle for part in step if part.length > 0.0) for step in steps)
+    return route.corners(), movers
 
 
 def moves_one_at_a_time(route: GraphRoute, limits: Limits, method, *, jerk: bool) -> GraphSchedule:
@@ -147,20 +144,21 @@ def overlapped_moves(route: GraphRoute, limits: Limits, method, *, grid_points: 
     check_graph_request(route, limits)
     corners, movers = travel_corners(route)
     paths = graph_paths(route)
-    if movers.size == 0:
+    if not movers:
         exact = moves_one_at_a_time(route, limits, method, jerk=False)
         return exact
     required = max(limits.min_separation, route.min_separation)
     blends: list[Blend | None] = [None]
-    for corner in range(1, movers.size):
-        same_vehicle = movers[corner] == movers[corner - 1]  # it turned back: at rest there
+    for corner in range(1, len(movers)):
+        # a vehicle moving on both sides turned back (the planner's moves) or may: at rest there
+        same_vehicle = bool(movers[corner] & movers[corner - 1])
         blends.append(None if same_vehicle else _safe_blend(corners, corner, route.track, paths, required))
     groups, start = [], 0
-    for corner in range(1, movers.size):
+    for corner in range(1, len(movers)):
         if blends[corner] is None:
             groups.append((start, corner))
             start = corner
-    groups.append((start, movers.size))
+    groups.append((start, len(movers)))
     sections: list[GraphSection] = []
     clock = 0.0
     rounded = timed_sections = 0
@@ -192,7 +190,7 @@ def overlapped_moves(route: GraphRoute, limits: Limits, method, *, grid_points: 
             sections.append(GraphSection(clock, kinematics))
             clock += kinematics.duration
     notes = (
-        f"{rounded} of {movers.size - 1} hand-overs between the vehicles overlapped; "
+        f"{rounded} of {len(movers) - 1} hand-overs between the vehicles overlapped; "
         f"{timed_sections} section(s) timed by TOPPRA",
         "jerk is not limited by this method",
         *(f"TOPPRA failed on a section ({reason}); its corners are stops" for reason in failed),

@@ -158,6 +158,10 @@ def _progress_limits(delta: np.ndarray, limits: Limits) -> tuple[float, float, f
     return float(v), float(a), float(j)
 
 
+#: Metres below which a vehicle's share of a straight piece is round-off, not a move.
+_NO_MOVE = 1e-12
+
+
 def piece_profiles(
     start: np.ndarray, end: np.ndarray, limits: Limits, *, jerk: bool = True
 ) -> tuple[PiecewiseCubic, ...]:
@@ -171,7 +175,9 @@ def piece_profiles(
     jerk : bool
         S-curve (jerk-limited) if True, else trapezoid (velocity and acceleration only).
     """
-    delta = end - start
+    # a move of less than a picometre (a planner's round-off, down to 5e-324 m) is none: its limits on
+    # the progress would overflow; the profile still ends exactly at ``end``
+    delta = np.where(np.abs(end - start) < _NO_MOVE, 0.0, end - start)
     if not np.any(delta):  # nothing moves (start is the goal): at rest, zero duration
         return tuple(PiecewiseCubic.from_phases(float(value), []) for value in start)
     v, a, j = _progress_limits(delta, limits)

@@ -145,6 +145,8 @@ def class_label(route: Route | GraphRoute, *, planned: bool | None = None) -> st
     'other (clockwise)'
     """
     if isinstance(route, GraphRoute):
+        if route.label is not None:  # a junction's route on its track graph keeps the paper's class
+            return route.label
         moves = graph_class_label(route)
         return moves if planned is None else class_words("planned" if planned else "other", moves)
     return class_words(route.homotopy.value, class_name(route))
@@ -186,7 +188,8 @@ def graph_route_summary(route: GraphRoute, names: Sequence[str] | None = None) -
 
     Each move names the vehicle, where it starts and ends (``EDGE:s`` or a node), the nodes it
     passes, the edges it runs along, its length and where each other vehicle stands meanwhile
-    (``standing``: name to place). ``names``: the vehicles' (default the route's).
+    (``standing``: name to place); a part of a joint move names the vehicles that move with it
+    (``with``). ``names``: the vehicles' (default the route's).
     """
     track = route.track
     names = route.names if names is None else tuple(names)
@@ -206,6 +209,7 @@ def graph_route_summary(route: GraphRoute, names: Sequence[str] | None = None) -
                 "edges": [track.edges[e].name for e in move.edges],
                 "length_m": move.length,
                 "standing": {names[v]: track.name(point) for v, point in move.standing()},
+                **({"with": [names[v] for v in move.movers if v != move.vehicle]} if move.joint else {}),
             }
             for move in route.moves
         ],
@@ -222,7 +226,8 @@ def format_graph_route(route: GraphRoute, names: Sequence[str] | None = None) ->
     lines = [
         f"track: {summary['track']['nodes']} nodes, {summary['track']['edges']} edges, "
         f"{summary['track']['length_m']:g} m; minimum separation {route.min_separation:g} m",
-        f"travel: {travel} ({route.length:g} m in all, the least of any one-at-a-time route)",
+        f"travel: {travel} ({route.length:g} m in all, "
+        + (f"class {route.label})" if route.label else "the least of any one-at-a-time route)"),
         f"moves ({len(route.moves)}):",
     ]
     for number, move in enumerate(summary["moves"], start=1):
@@ -230,6 +235,7 @@ def format_graph_route(route: GraphRoute, names: Sequence[str] | None = None) ->
             f"  {number:2d}  {move['vehicle']}: {move['from']} -> {move['to']} along "
             f"{', '.join(move['edges'])}, {move['length_m']:g} m "
             f"({', '.join(f'{name} at {place}' for name, place in move['standing'].items())})"
+            + (f", with {', '.join(move['with'])}" if "with" in move else "")
         )
     return "\n".join(lines)
 

@@ -90,17 +90,12 @@ def _too_close_parts(
 
 
 def _route_curve(schedule: GraphSchedule, pair: tuple[int, int]) -> np.ndarray:
-    """The route's moves as a monotone staircase in the ``pair``'s travel plane, shape (m + 1, 2).
+    """The route as a monotone polyline in the ``pair``'s travel plane, shape (m + 1, 2).
 
-    Moves of the other vehicles are steps of no length there.
+    A move of one of them is a step along its axis, a joint move of both a diagonal; moves of the
+    other vehicles are steps of no length there.
     """
-    corners = [(0.0, 0.0)]
-    for move in schedule.route.moves:
-        here = list(corners[-1])
-        if move.vehicle in pair:
-            here[pair.index(move.vehicle)] += move.length
-        corners.append((here[0], here[1]))
-    return np.array(corners)
+    return schedule.route.corners()[:, list(pair)]
 
 
 def _side_of_polyline(curve: np.ndarray, point: tuple[float, float]) -> int:

@@ -7,6 +7,11 @@ minimum of two affine functions of the position (through either end of the edge)
 own edge, of ``|s - s_q|``; so its minimum over a stretch is at the stretch's ends, or 0 where the
 stretch passes ``q``. Nothing is sampled.
 
+The vehicles of a joint move (a junction's route) drive at once, each reaching its end together
+(:class:`~topology.GraphMove`): between the instants either passes a node, both are on fixed
+edges, so their distance is again a minimum of affine functions of the joint move's progress (and
+``|s_1 - s_2|`` on one edge): checked at those instants, and for a crossing on a shared edge.
+
 Also checked: each vehicle starts and ends where the route says, each move starts where its vehicle
 is, each standing vehicle is where it is said to be, the travel adds up, every number is finite. Every
 pair of vehicles is checked: a route may move any number.
@@ -19,7 +24,7 @@ import itertools
 import math
 from dataclasses import dataclass
 
-from topology import EdgePoint, GraphRoute, TrackGraph
+from topology import EdgePoint, GraphMove, GraphRoute, TrackGraph
 from trajgen.errors import InputError
 
 __all__ = ["GraphRouteReport", "TrackDistances", "verify_graph_route"]
@@ -117,6 +122,64 @@ class TrackDistances:
         return least
 
 
+def _segments(distances: TrackDistances, move: GraphMove) -> list[tuple[int, float, float, float]]:
+    """``(edge, s at its start, s at its end, travel at its start)`` of each edge ``move`` runs along."""
+    out, travel = [], 0.0
+    for (a, b), edge in zip(itertools.pairwise(move.points), move.edges, strict=True):
+        s_a, s_b = distances.along(a, edge), distances.along(b, edge)
+        out.append((edge, s_a, s_b, travel))
+        travel += abs(s_b - s_a)
+    return out
+
+
+def _segment_at(segments: list[tuple[int, float, float, float]], travel: float) -> int:
+    """Index of the segment a move is on after ``travel`` metres (the later one at a node)."""
+    found = 0
+    for k, (_, _, _, begin) in enumerate(segments):
+        if travel >= begin:
+            found = k
+    return found
+
+
+def _on(segment: tuple[int, float, float, float], travel: float) -> tuple[int, float]:
+    """``(edge, s)`` after ``travel`` metres of a move, on one of its segments (clamped to it)."""
+    edge, s_a, s_b, begin = segment
+    step = min(max(travel - begin, 0.0), abs(s_b - s_a))
+    return edge, s_a + math.copysign(step, s_b - s_a)
+
+
+def _joint_least(distances: TrackDistances, a: GraphMove, b: GraphMove) -> float:
+    """The least track distance of two vehicles driving moves ``a`` and ``b`` at once, metres.
+
+    Both progress in proportion (a straight line in their travel plane). Between two instants at
+    which either passes a node the distance is the least of affine functions of the progress, and on
+    a shared edge also ``|s_a - s_b|``: its least value is at those instants, or 0 where the two
+    cross on a shared edge.
+    """
+    moves = (a, b)
+    segments = tuple(_segments(distances, move) for move in moves)
+    fractions = {0.0, 1.0}
+    for found, move in zip(segments, moves, strict=True):
+        if move.length > 0.0:
+            fractions |= {begin / move.length for _, _, _, begin in found if 0.0 < begin < move.length}
+    least = math.inf
+    ordered = sorted(fractions)
+    for u0, u1 in itertools.pairwise(ordered):
+        ends = []
+        for found, move in zip(segments, moves, strict=True):
+            if not found:  # it runs no edge: it stands where it starts
+                ends.append(((move.points[0].edge, move.points[0].s),) * 2)
+                continue
+            segment = found[_segment_at(found, 0.5 * (u0 + u1) * move.length)]
+            ends.append((_on(segment, u0 * move.length), _on(segment, u1 * move.length)))
+        (a0, a1), (b0, b1) = ends
+        for (edge_a, s_a), (edge_b, s_b) in ((a0, b0), (a1, b1)):
+            least = min(least, distances.between(EdgePoint(edge_a, s_a), EdgePoint(edge_b, s_b)))
+        if a0[0] == b0[0] and (a0[1] - b0[1]) * (a1[1] - b1[1]) < 0.0:  # they cross on one edge
+            least = 0.0
+    return least
+
+
 def verify_graph_route(route: GraphRoute) -> GraphRouteReport:
     """Check every move of ``route`` against the separation, and that the moves make the route.
 
@@ -178,7 +241,7 @@ def verify_graph_route(route: GraphRoute) -> GraphRouteReport:
                 continue
             length += abs(s_b - s_a)
             for other in range(count):
-                if other == move.vehicle:
+                if other in move.movers:
                     continue
                 least = distances.least_along(where[other], edge, min(s_a, s_b), max(s_a, s_b))
                 if least < closest:
@@ -193,6 +256,17 @@ def verify_graph_route(route: GraphRoute) -> GraphRouteReport:
             failures.append(f"{label}: its length is {move.length!r} m, its edges add up to {length!r} m")
         travel[move.vehicle] += length
         where[move.vehicle] = move.points[-1]
+        if move.joint and move.vehicle == move.movers[-1]:  # the joint move's last part: all of it at once
+            parts = route.moves[number + 1 - len(move.movers) : number + 1]
+            for a, b in itertools.combinations(parts, 2):
+                least = _joint_least(distances, a, b)
+                if least < closest:
+                    closest, closest_move = least, number
+                if least < separation - ROUTE_TOLERANCE:
+                    failures.append(
+                        f"{label}: driving at once, {names[a.vehicle]} and {names[b.vehicle]} come "
+                        f"{least:.6g} m apart: expected at least the minimum separation {separation:g} m"
+                    )
     for vehicle in range(count):
         if distances.between(where[vehicle], route.goal[vehicle]) > ROUTE_TOLERANCE:
             failures.append(
