@@ -173,9 +173,11 @@ class GraphRoute:
 
 
 def class_signature(route: GraphRoute) -> tuple:
-    """What makes a route's class: each move's vehicle and the edges it runs along, in order.
+    """What makes a route's class: each move's vehicles and the edges it runs along, in order.
 
     Two routes whose moves run the same edges in the same order (parking in the same siding,
-    passing a loop on the same side) differ only in how deep a vehicle waits: one class.
+    passing a loop on the same side) differ only in how deep a vehicle waits: one class. A joint
+    move's parts carry every vehicle of it (two vehicles driving an edge each at once are not one
+    after the other).
     """
-    return tuple((move.vehicle, move.edges) for move in route.moves)
+    return tuple((move.vehicle, move.edges, *((move.movers,) if move.joint else ())) for move in route.moves)
