@@ -28,7 +28,7 @@ from tests.support.grid_oracle import random_case
 from tests.support.helpers import AGV, LIMITS, MIXED, SLOW, legs_cases, legs_id, route_of, too_close
 from tests.support.sampled_verifier import sampled_verify
 from tests.support.star_scenarios import STAR_METHODS, STAR_SCENARIOS, leg_index, star_scenario, star_schedule
-from tests.support.strategies import resolved, star_queries
+from tests.support.strategies import planned_junction_route, star_queries
 from topology import (
     JUNCTION_INDEX,
     Configuration,
@@ -940,12 +940,8 @@ def test_a_junctions_route_on_its_track_graph_is_timed_exactly_as_the_junction_t
     query, homotopy, jerk
 ):
     """Two independent ways to the ``exact`` schedule: the junction's axes and the graph's travel."""
-    star, start, goal, separation = query
-    assume(resolved(star, (*start, *goal), separation))
-    try:
-        route = plan(star, start, goal, min_separation=separation, homotopy=homotopy)
-    except OptionError:  # no other class of a query whose retractions meet
-        assume(False)
+    route = planned_junction_route(query, homotopy)
+    separation = query[3]
     limits = Limits(vehicles=(AGV, SLOW), min_separation=separation)
     junction = Exact(jerk=jerk).schedule(route, limits)
     on_graph = Exact(jerk=jerk).schedule_graph(junction_graph_route(route), limits)

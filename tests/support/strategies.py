@@ -116,8 +116,10 @@ def star_queries(draw, min_legs: int = 4, max_legs: int = 8):
 
 
 def resolved(graph: StarGraph, positions, separation: float) -> bool:
-    """Whether a query is within what a track graph resolves: each position at the junction or a leg's end
-    or at least 1 µm from both, and a separation of at least 1 µm.
+    """Whether a query is within what a track graph resolves (each place and the separation to 1 µm).
+
+    Each position at the junction or a leg's end or at least 1 µm from both, and a separation of at
+    least 1 µm.
 
     A track graph holds a point within ``POINT_TOLERANCE`` (1 nm) of a node as the node; the queries
     above reach down to 5e-324 m, where a junction's own planner and verifier still tell the places apart.
@@ -131,3 +133,20 @@ def resolved(graph: StarGraph, positions, separation: float) -> bool:
         if position.s < 1e-6 or (position.s != length and length - position.s < 1e-6):
             return False
     return True
+
+
+def planned_junction_route(query, homotopy: str):
+    """The junction's route of a :func:`star_queries` query in ``homotopy``.
+
+    A query a track graph does not resolve (:func:`resolved`), or with no other class (its
+    retractions meet), is skipped (``assume``).
+    """
+    from topology import OptionError, plan
+
+    star, start, goal, separation = query
+    assume(resolved(star, (*start, *goal), separation))
+    try:
+        return plan(star, start, goal, min_separation=separation, homotopy=homotopy)
+    except OptionError:
+        assume(False)
+        raise  # unreachable: assume(False) raises

@@ -202,6 +202,17 @@ def verify_graph_route(route: GraphRoute) -> GraphRouteReport:
         gap = distances.between(where[a], where[b])
         if gap < closest:
             closest, first = gap, (a, b)
+
+    def apart(least: float, number: int, who: str) -> None:
+        """Keep the closest approach; a failure where ``who`` (the move, the two) come too close."""
+        nonlocal closest, closest_move
+        if least < closest:
+            closest, closest_move = least, number
+        if least < separation - ROUTE_TOLERANCE:
+            failures.append(
+                f"{who} come {least:.6g} m apart: expected at least the minimum separation {separation:g} m"
+            )
+
     for number, move in enumerate(route.moves):
         label = f"move {number + 1} ({track.name(move.points[0])} -> {track.name(move.points[-1])})"
         numbers = [move.length, *(p.s for p in move.at_start), *(p.s for p in move.points)]
@@ -244,14 +255,11 @@ def verify_graph_route(route: GraphRoute) -> GraphRouteReport:
                 if other in move.movers:
                     continue
                 least = distances.least_along(where[other], edge, min(s_a, s_b), max(s_a, s_b))
-                if least < closest:
-                    closest, closest_move = least, number
-                if least < separation - ROUTE_TOLERANCE:
-                    failures.append(
-                        f"{label}: along {track.edges[edge].name!r} {names[move.vehicle]} and "
-                        f"{names[other]} come {least:.6g} m apart: expected at least the minimum "
-                        f"separation {separation:g} m"
-                    )
+                apart(
+                    least,
+                    number,
+                    f"{label}: along {track.edges[edge].name!r} {names[move.vehicle]} and {names[other]}",
+                )
         if abs(length - move.length) > ROUTE_TOLERANCE * max(1.0, length):
             failures.append(f"{label}: its length is {move.length!r} m, its edges add up to {length!r} m")
         travel[move.vehicle] += length
@@ -260,13 +268,7 @@ def verify_graph_route(route: GraphRoute) -> GraphRouteReport:
             parts = route.moves[number + 1 - len(move.movers) : number + 1]
             for a, b in itertools.combinations(parts, 2):
                 least = _joint_least(distances, a, b)
-                if least < closest:
-                    closest, closest_move = least, number
-                if least < separation - ROUTE_TOLERANCE:
-                    failures.append(
-                        f"{label}: driving at once, {names[a.vehicle]} and {names[b.vehicle]} come "
-                        f"{least:.6g} m apart: expected at least the minimum separation {separation:g} m"
-                    )
+                apart(least, number, f"{label}: driving at once, {names[a.vehicle]} and {names[b.vehicle]}")
     for vehicle in range(count):
         if distances.between(where[vehicle], route.goal[vehicle]) > ROUTE_TOLERANCE:
             failures.append(
