@@ -52,9 +52,11 @@ from trajgen.execution.tracks import GraphTrack
 from trajgen.model.graph_paths import graph_paths
 from trajgen.model.graph_vehicle_path import GraphMetric, GraphVehiclePath
 from trajgen.model.paths import VehiclePath
+from trajgen.plots.simulation import plot_simulation
 from trajgen.scenario import GraphScenario, Scenario
 from trajgen.scenario.graph_sampling import graph_campaign_faults, graph_online_campaign
 from trajgen.scenario.sampling import campaign_faults, online_campaign, random_scenarios
+from trajgen.simulation_pipeline import run_simulation
 
 AGV = VehicleLimits(max_velocity=1.0, max_acceleration=0.5, max_jerk=1.0)
 SWAP = REPO / "examples" / "swap.toml"
@@ -1641,3 +1643,69 @@ def test_a_stop_of_any_vehicle_of_a_fleet_holds_its_followers_and_costs_about_it
     # at most its bound; less where the others, not held by it, drive on meanwhile
     late = executor.time - schedule.duration
     assert late <= stop_bound(schedule, 4.0), late
+
+
+def _fleet_scenario(case, verified) -> GraphScenario:
+    """The fleet's scenario: its track, the plan's limits, its vehicles' names, starts and goals."""
+    route = case.route()
+    return GraphScenario(route.track, verified.schedule.limits, route.names, route.start, route.goal)
+
+
+@pytest.mark.parametrize("case", FLEETS, ids=lambda case: case.name)
+def test_a_fleet_is_simulated_with_every_vehicle_stopped_in_its_first_move_and_its_books_cover_every_vehicle(
+    case,
+):
+    """``simulate`` with the fleet's plan at hand: each vehicle stops 3 s halfway through its first move."""
+    verified = _fleet_plan(case)
+    schedule = verified.schedule
+    scenario = _fleet_scenario(case, verified)
+    specs = []
+    for vehicle, name in enumerate(scenario.names):
+        move = next(k for k, m in enumerate(schedule.route.moves) if m.vehicle == vehicle)
+        section = schedule.sections[move]
+        specs.append(f"stop:{name}@{section.start_time + 0.5 * section.duration:.3f}+3")
+    result, _ = simulate(scenario, parse_faults(scenario, specs, verified=verified), verified=verified)
+    assert result.reached_goal, result.summary()
+    assert result.violations == 0
+    assert result.emergency_brakes == 0
+    assert result.certified_separation_m >= scenario.limits.min_separation - 1e-6
+    assert result.position_margin == pytest.approx(0.05)  # the plan keeps 0.2 m beyond the separation
+    assert result.time_lost_s <= case.count * stop_bound(schedule, 3.0)
+    for key in ("speed", "travel", "frontier"):
+        assert result.plot[key].shape == (case.count, result.plot["t"].size)
+    assert result.plot["travel"][:, -1] == pytest.approx([path.length for path in schedule.paths], abs=1e-3)
+    json.dumps(result.summary())
+
+
+def test_a_fleets_simulation_writes_a_trace_per_vehicle_and_a_picture_of_every_vehicle(tmp_path):
+    case = FLEETS[0]
+    verified = _fleet_plan(case)
+    scenario = _fleet_scenario(case, verified)
+    run = run_simulation(scenario, trace_dir=tmp_path / "trace", plot_dir=tmp_path, verified=verified)
+    assert run.result.reached_goal
+    assert run.result.method == "exact"
+    assert sorted(path.name for path in run.files) == sorted(
+        [*(f"{n}.csv" for n in scenario.names), "simulation.png"]
+    )
+    figure = plot_simulation(run.result, names=scenario.names, min_separation=scenario.limits.min_separation)
+    speed_axis = figure.axes[0]
+    assert len(speed_axis.lines) == 2 * case.count  # planned and executed, each vehicle
+
+
+def test_a_plan_of_other_vehicles_than_the_scenarios_is_refused_by_simulate():
+    case = FLEETS[0]
+    verified = _fleet_plan(case)
+    with pytest.raises(InputError, match=r"the plan handed to simulate moves 3 vehicles, the scenario 2"):
+        simulate(builtin_scenario("crossing"), (), verified=verified)
+
+
+def test_a_new_goal_for_a_fleet_is_refused_naming_the_planner_and_the_run_keeps_its_goals():
+    case = FLEETS[0]  # the convoy on one line
+    verified = _fleet_plan(case)
+    scenario = _fleet_scenario(case, verified)
+    faults = parse_faults(scenario, [f"goal:{scenario.names[0]}@3=main:39"], verified=verified)
+    result, _ = simulate(scenario, faults, verified=verified)
+    assert result.reached_goal
+    assert result.rejected_goals == 1
+    refusal = next(event.detail for event in result.events if event.kind == "goal-refused")
+    assert "the track-graph planner plans exactly 2 vehicles, got 3" in refusal

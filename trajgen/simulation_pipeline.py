@@ -27,6 +27,7 @@ from trajgen.model.schedule import TimingMethod
 from trajgen.model.summary import closest_text, format_provenance
 from trajgen.plots import plot_simulation, png_bytes
 from trajgen.scenario import GraphScenario, Scenario
+from trajgen.verification import VerifiedSchedule
 
 __all__ = ["SIMULATION_PLOT_NAME", "SimulationRun", "format_simulation", "run_simulation", "simulation_paths"]
 
@@ -43,14 +44,14 @@ def _folder(value: object, option: str) -> Path | None:
 
 
 def simulation_paths(
-    names: tuple[str, str], *, trace_dir: str | Path | None = None, plot_dir: str | Path | None = None
+    names: tuple[str, ...], *, trace_dir: str | Path | None = None, plot_dir: str | Path | None = None
 ) -> tuple[Path, ...]:
     """Every file a simulation writes: ``trace_dir/<name>.csv`` per vehicle, ``plot_dir/simulation.png``.
 
     Parameters
     ----------
-    names : tuple of 2 str
-        The vehicles' names (file names of their traces).
+    names : tuple of str
+        The vehicles' names (file names of their traces), one per vehicle.
     trace_dir, plot_dir : path or None
         ``None``: no trace, no plot.
 
@@ -117,6 +118,7 @@ def run_simulation(
     trace_dir: str | Path | None = None,
     plot_dir: str | Path | None = None,
     csv_options: CsvOptions | None = None,
+    verified: VerifiedSchedule | None = None,
 ) -> SimulationRun:
     """Simulate ``scenario`` under the faults ``specs`` and commit its trace and plot.
 
@@ -132,12 +134,16 @@ def run_simulation(
     position_margin : float, optional
         The executor's position margin, metres (default 0.05); also the largest ``jump``.
     trace_dir : path, optional
-        Folder for ``<vehicle name>.csv`` of both vehicles: their executed (true) motion.
+        Folder for ``<vehicle name>.csv`` of every vehicle: its executed (true) motion.
     plot_dir : path, optional
         Folder for ``simulation.png`` (:func:`~trajgen.plots.plot_simulation`).
     csv_options : CsvOptions, optional
         Dialect of the trace (delimiter, decimal mark, units); its ``sample_period`` and
         ``max_rows`` do not apply: the trace has one row per control period.
+    verified : VerifiedSchedule, optional
+        The plan to execute, if already made for ``scenario``
+        (:func:`~trajgen.execution.goals.schedule_for_execution`, or a plan of any number of
+        vehicles made otherwise: the planners plan two today); ``method`` is then its method.
 
     Returns
     -------
@@ -162,7 +168,7 @@ def run_simulation(
     options = CsvOptions() if csv_options is None else csv_options
     if not isinstance(options, CsvOptions):
         raise InputError(f"csv options must be CsvOptions, got {type(options).__name__}")
-    faults = parse_faults(scenario, list(specs), position_margin=position_margin)
+    faults = parse_faults(scenario, list(specs), position_margin=position_margin, verified=verified)
     paths = simulation_paths(scenario.names, trace_dir=trace_dir, plot_dir=plot_dir)
     check_output_paths(paths)
     traced = trace_dir is not None
@@ -170,14 +176,15 @@ def run_simulation(
         scenario,
         faults,
         period=period,
-        method=chosen,
+        method=chosen if verified is None else None,  # a plan at hand tells its own method
         position_margin=position_margin,
         trace=options if traced else None,
+        verified=verified,
     )
     try:
         files: dict[Path, object] = {}
         if traced:  # streamed from the trace's temporary files into the commit
-            for vehicle, path in enumerate(paths[:2]):
+            for vehicle, path in enumerate(paths[: len(scenario.names)]):
                 files[path] = trace.chunks(vehicle)
         if plot_dir is not None:
             files[paths[-1]] = png_bytes(

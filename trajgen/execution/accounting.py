@@ -3,10 +3,10 @@
 :func:`~trajgen.execution.simulation.simulate` runs the loop; this module keeps its books, each
 of one job:
 
-- :class:`SeparationWatch`: the true track distance at every cycle, certified between cycles too
-  (track distance is 1-Lipschitz in each vehicle's position, so between two cycles it is at least
-  the mean of the two distances less half the distance both vehicles drove), the closest approach
-  and the cycles below the minimum separation;
+- :class:`SeparationWatch`: the true track distance of every pair at every cycle, certified between
+  cycles too (track distance is 1-Lipschitz in each vehicle's position, so between two cycles it is
+  at least the mean of the two distances less half the distance both vehicles drove), the closest
+  approach of any pair and the cycles below the minimum separation;
 - :class:`LimitWatch`: the commanded setpoints against the vehicle limits, the worst ratios and the
   cycles beyond them;
 - :class:`PlanLedger`: the plans the run drove (the undisturbed one, then one per re-plan for a new
@@ -15,6 +15,7 @@ of one job:
 
 from __future__ import annotations
 
+import itertools
 import math
 from dataclasses import dataclass, field
 
@@ -53,10 +54,10 @@ class ExecutedPlan:
         drove it to its end, or if it is the run's last (the goal the run ended at, reached or
         not), else the plan's time at which both vehicles got as far along their paths as they
         were when the run left it.
-    travel_before : tuple of 2 float
+    travel_before : tuple of float
         Each vehicle's travel along the earlier plans' paths when the run took this one up, metres
         (where its paths start on the run's travel axes).
-    axis_signs : tuple of 2 int
+    axis_signs : tuple of int
         Each vehicle's own axis against the plan's (+1 or -1): the plan's velocity times this is the
         vehicle's.
     """
@@ -65,8 +66,8 @@ class ExecutedPlan:
     started_s: float
     ended_s: float
     planned_s: float
-    travel_before: tuple[float, float]
-    axis_signs: tuple[int, int]
+    travel_before: tuple[float, ...]
+    axis_signs: tuple[int, ...]
 
     @property
     def lost_s(self) -> float:
@@ -138,7 +139,7 @@ def _graph_between(before, bodies, first: float, second: float, bend: float) -> 
     return 0.5 * (first + second - moved)
 
 
-def _time_reached(schedule, travel: tuple[float, float]) -> float:
+def _time_reached(schedule, travel: tuple[float, ...]) -> float:
     """The earliest time of ``schedule`` at which each vehicle has travelled ``travel``, seconds.
 
     Each vehicle's travel grows with time; between two instants of :func:`schedule_paths` a
@@ -147,7 +148,7 @@ def _time_reached(schedule, travel: tuple[float, float]) -> float:
     """
     _, times, along = schedule_paths(schedule)
     reached = 0.0
-    for v in (0, 1):
+    for v in range(len(travel)):
         wanted = travel[v] - _TRAVEL_TOLERANCE
         if wanted <= 0.0:
             continue
@@ -168,12 +169,12 @@ def _time_reached(schedule, travel: tuple[float, float]) -> float:
 
 
 class SeparationWatch:
-    """The true track distance between the vehicles' bodies, every cycle and between cycles.
+    """The true track distance between the vehicles' bodies, every pair, every cycle and between cycles.
 
     Parameters
     ----------
     track : StarGraph or TrackGraph
-    bodies : sequence of 2 plant bodies
+    bodies : sequence of plant bodies
         The plant's vehicles (``leg``, ``s``, ``v``, ``a``, ``orientation``, ``axis``), read in place.
     required : float
         The minimum separation, metres.
@@ -182,19 +183,25 @@ class SeparationWatch:
     def __init__(self, track, bodies, required: float) -> None:
         self.bodies = bodies
         self.required = required
+        self.pairs = tuple(itertools.combinations(range(len(bodies)), 2))
         if isinstance(track, TrackGraph):
             metric = GraphMetric(track)
-            self._apart = lambda: metric.distance(bodies[0].leg, bodies[0].s, bodies[1].leg, bodies[1].s)
+            self._distance = lambda a, b: metric.distance(a.leg, a.s, b.leg, b.s)
             self._between = _graph_between
         else:
-            self._apart = lambda: indexed_separation((bodies[0].leg, bodies[0].s, bodies[1].leg, bodies[1].s))
+            self._distance = lambda a, b: indexed_separation((a.leg, a.s, b.leg, b.s))
             self._between = _between
-        #: The distance at the last cycle, metres.
-        self.separation = self._apart()
+        #: Every pair's distance at the last cycle, metres.
+        self.distances = self._apart()
+        #: The closest pair's distance at the last cycle, metres.
+        self.separation = min(self.distances, default=math.inf)
         #: The smallest distance at a cycle, and the smallest certified between cycles too, metres.
         self.smallest = self.certified = self.separation
         #: Cycles at which the distance (or its bound between cycles) fell below the separation.
         self.violations = 0
+
+    def _apart(self) -> tuple[float, ...]:
+        return tuple(self._distance(self.bodies[i], self.bodies[j]) for i, j in self.pairs)
 
     def before(self) -> list[tuple]:
         """What the next :meth:`cycle` needs of the bodies before they move."""
@@ -203,17 +210,19 @@ class SeparationWatch:
     def cycle(self, before: list[tuple], period: float) -> float:
         """The distance after the bodies moved one ``period`` from ``before``, metres, accounted."""
         bodies = self.bodies
-        now = self._apart()
-        # how far the motions (acceleration between its values at the two cycles) leave their chords
-        bend = (
-            sum(max(abs(old[2]), abs(b.a)) for old, b in zip(before, bodies, strict=True)) * period**2 / 8.0
-        )
-        between = self._between(before, bodies, self.separation, now, bend)
+        distances = self._apart()
+        low = math.inf
+        for (i, j), first, second in zip(self.pairs, self.distances, distances, strict=True):
+            pair_before, pair = (before[i], before[j]), (bodies[i], bodies[j])
+            # how far the motions (acceleration between its values at the two cycles) leave their chords
+            bend = sum(max(abs(old[2]), abs(b.a)) for old, b in zip(pair_before, pair, strict=True))
+            low = min(low, second, self._between(pair_before, pair, first, second, bend * period**2 / 8.0))
+        now = min(distances, default=math.inf)
         self.smallest = min(self.smallest, now)
-        self.certified = min(self.certified, now, between)
-        if min(now, between) < self.required - _VIOLATION_TOLERANCE:
+        self.certified = min(self.certified, low)
+        if low < self.required - _VIOLATION_TOLERANCE:
             self.violations += 1
-        self.separation = now
+        self.distances, self.separation = distances, now
         return now
 
 
@@ -251,25 +260,25 @@ class PlanLedger:
     ----------
     schedule : Schedule or GraphSchedule
         The run's first plan, taken up at t = 0.
-    axis_signs : tuple of 2 int
-        The executor's axis signs for it.
+    axis_signs : tuple of int
+        The executor's axis signs for it, one per vehicle.
     """
 
     def __init__(self, schedule, axis_signs) -> None:
         self.plans: list[ExecutedPlan] = []
         # the plan driven: its schedule, when taken up, each vehicle's travel before it, its axis signs
-        self.driving = (schedule, 0.0, (0.0, 0.0), axis_signs)
+        self.driving = (schedule, 0.0, (0.0,) * len(axis_signs), tuple(axis_signs))
         #: When both came to rest at the driven plan's goals, if they have (seconds of the run).
         self.arrived: float | None = None
         #: Seconds both stood at their goals waiting for a new one.
         self.idle = 0.0
 
     @property
-    def offset(self) -> tuple[float, float]:
+    def offset(self) -> tuple[float, ...]:
         """Each vehicle's travel along the earlier plans' paths, metres."""
         return self.driving[2]
 
-    def replanned(self, t: float, travel: tuple[float, float], schedule, axis_signs) -> None:
+    def replanned(self, t: float, travel: tuple[float, ...], schedule, axis_signs) -> None:
         """The run left its plan at ``t`` (travel ``travel`` along it) for ``schedule``."""
         driven, started, offset, signs = self.driving
         if self.arrived is None:
@@ -278,8 +287,8 @@ class PlanLedger:
             part = ExecutedPlan(driven, started, self.arrived, driven.duration, offset, signs)
             self.idle += t - self.arrived
         self.plans.append(part)
-        offset = (offset[0] + travel[0], offset[1] + travel[1])
-        self.driving = (schedule, t, offset, axis_signs)
+        offset = tuple(before + now for before, now in zip(offset, travel, strict=True))
+        self.driving = (schedule, t, offset, tuple(axis_signs))
         self.arrived = None
 
     def finish(self, makespan: float) -> tuple[ExecutedPlan, ...]:

@@ -29,31 +29,55 @@ __all__ = [
 ]
 
 
-def execution_margin(scenario, position_margin: float) -> float:
+#: Metres a plan's closest approach may fall short of the separation plus twice the margin it was
+#: planned for (the solver's and the verifier's round-off).
+_CLEARANCE_ROUND_OFF = 1e-9
+
+
+def execution_margin(scenario, position_margin: float, *, verified: VerifiedSchedule | None = None) -> float:
     """The position margin an executor can keep for ``scenario``, metres: at most ``position_margin``.
 
     The plan needs twice the margin on top of the separation (:func:`schedule_for_execution`), which must
     fit the shortest leg and the start and goal; where it does not, the margin shrinks (to 0 when the
     separation is the shortest leg). On a track graph: the start and goal, and the margin is 0 where
-    the planner finds no route for the wider separation.
+    the planner finds no route for the wider separation. With the plan at hand (``verified``), its
+    closest approach is the room instead: nothing is planned, and a plan of any number of vehicles is
+    taken.
     """
     track = scenario.track
     separation = scenario.limits.min_separation
+    if verified is not None:
+        margin = _margin_of_plan(scenario, position_margin)
+        clearance = verified.report.min_separation - separation
+        # the plan made for this margin keeps 2 margins to round-off; one made otherwise bounds it
+        return margin if clearance >= 2.0 * margin - _CLEARANCE_ROUND_OFF else max(0.0, 0.5 * clearance)
     if isinstance(scenario, GraphScenario):
         scenario.check_planned()
-        room = min(
-            track.distance(a, b)
-            for points in (scenario.start, scenario.goal)
-            for a, b in itertools.combinations(points, 2)
-        )
-        margin = max(0.0, min(position_margin, 0.5 * (room - separation)))
+        margin = _margin_of_plan(scenario, position_margin)
         if margin > 0.0:  # on a graph the wider separation may close a siding or a loop
             try:
                 plan_graph(track, scenario.start, scenario.goal, min_separation=separation + 2.0 * margin)
             except InfeasibleError:
                 return 0.0
         return margin
-    room = min(track.shortest_leg, track.separation(scenario.start), track.separation(scenario.goal))
+    return _margin_of_plan(scenario, position_margin)
+
+
+def _margin_of_plan(scenario, position_margin: float) -> float:
+    """The margin the start and goal allow, metres: at most ``position_margin``.
+
+    Half of what they (and a junction's shortest leg) leave beyond the separation.
+    """
+    track = scenario.track
+    separation = scenario.limits.min_separation
+    if isinstance(scenario, GraphScenario):
+        room = min(
+            track.distance(a, b)
+            for points in (scenario.start, scenario.goal)
+            for a, b in itertools.combinations(points, 2)
+        )
+    else:
+        room = min(track.shortest_leg, track.separation(scenario.start), track.separation(scenario.goal))
     return max(0.0, min(position_margin, 0.5 * (room - separation)))
 
 

@@ -35,7 +35,7 @@ from trajgen.model.schedule import TimingMethod
 from trajgen.model.summary import provenance
 from trajgen.model.values import frozen
 from trajgen.scenario import GraphScenario, Scenario
-from trajgen.verification import VerifiedSchedule
+from trajgen.verification import VerifiedSchedule, require_verified
 
 __all__ = ["PLOT_SAMPLES", "ExecutedPlan", "SimulationResult", "Trace", "parse_faults", "simulate"]
 
@@ -52,7 +52,7 @@ class SimulationResult:
     Attributes
     ----------
     reached_goal : bool
-        Both vehicles at rest (under 1 mm/s) at their goals, every fault applied, within the time limit.
+        Every vehicle at rest (under 1 mm/s) at their goals, every fault applied, within the time limit.
     makespan_s : float
         When they got there, seconds (the time limit if they did not).
     planned_s : float
@@ -80,23 +80,23 @@ class SimulationResult:
     faults : tuple of Fault
     cycles : int
     plot : dict
-        Decimated samples for the plot (read-only arrays): ``t`` (n,), ``speed`` (2, n) m/s,
-        ``separation`` (n,) m, ``travel`` (2, n) each vehicle's travel along its paths, m (across
-        re-plans: each plan's paths continue where the earlier ones were left), and
-        ``frontier`` (2, n) its frontier, m of travel (``inf`` where none binds it).
+        Decimated samples for the plot (read-only arrays): ``t`` (n,), ``speed`` (V, n) m/s,
+        ``separation`` (n,) m (the closest pair), ``travel`` (V, n) each vehicle's travel along its
+        paths, m (across re-plans: each plan's paths continue where the earlier ones were left), and
+        ``frontier`` (V, n) its frontier, m of travel (``inf`` where none binds it).
     schedule : VerifiedSchedule
         The undisturbed plan.
     position_margin : float
         The margin the executor's conflicts kept beyond the separation, metres.
     unapplied_faults : tuple of Fault
-        The faults that never applied: due after the run had ended (both vehicles at their goals).
+        The faults that never applied: due after the run had ended (every vehicle at its goal).
     method : str
         The timing method asked for the plan (its ``computed_by`` is the schedule's own, ``exact``
         after a fallback).
     plans : tuple of ExecutedPlan
         The plans the run drove, in order: the undisturbed one, then one per re-plan.
     idle_s : float
-        Seconds both vehicles stood at their goals waiting for a new goal (a goal that came after a
+        Seconds every vehicle stood at its goal waiting for a new goal (a goal that came after a
         plan was driven to its end): no plan's time, and not lost.
     """
 
@@ -170,14 +170,19 @@ class SimulationResult:
 
 
 def parse_faults(
-    scenario: Scenario | GraphScenario, specs: Sequence[str], *, position_margin: float = 0.05
+    scenario: Scenario | GraphScenario,
+    specs: Sequence[str],
+    *,
+    position_margin: float = 0.05,
+    verified: VerifiedSchedule | None = None,
 ) -> tuple[Fault, ...]:
     """Parse ``--fault`` specs against a scenario (see :func:`~trajgen.execution.faults.parse_fault`).
 
     A jump may be as large as the position margin the executor keeps in this scenario
-    (:func:`~trajgen.execution.executor.execution_margin`: at most ``position_margin``).
+    (:func:`~trajgen.execution.goals.execution_margin`: at most ``position_margin``; with the plan
+    at hand, ``verified``, what its closest approach leaves).
     """
-    margin = execution_margin(scenario, position_margin)
+    margin = execution_margin(scenario, position_margin, verified=verified)
     return tuple(
         parse_fault(
             spec,
@@ -199,7 +204,7 @@ def _time_limit(
         if fault.kind is FaultKind.SLOW:
             slowest = min(slowest, fault.value)
     total = graph.total_length
-    crawl = 2.0 * total * 2.0 / slowest  # both vehicles round the whole track twice
+    crawl = limits.count * total * 2.0 / slowest  # every vehicle round the whole track twice
     latest = max((f.time + (f.value if f.kind is FaultKind.STOP else 0.0) for f in faults), default=0.0)
     return latest + 3.0 * planned + crawl + 60.0
 
@@ -213,7 +218,7 @@ def simulate(
     position_margin: float = 0.05,
     trace: CsvOptions | None = None,
     verified: VerifiedSchedule | None = None,
-    observer: Callable[[Executor, tuple[VehicleState, VehicleState], Command], None] | None = None,
+    observer: Callable[[Executor, tuple[VehicleState, ...], Command], None] | None = None,
 ) -> tuple[SimulationResult, Trace | None]:
     """Run the executor against the simulated plant with ``faults``.
 
@@ -243,7 +248,14 @@ def simulate(
     """
     if not isinstance(scenario, (Scenario, GraphScenario)):
         raise InputError(f"simulate expects a Scenario or a GraphScenario, got {type(scenario).__name__}")
-    margin = execution_margin(scenario, position_margin)
+    if verified is not None:
+        require_verified(verified, "simulate")
+        if verified.schedule.limits.count != scenario.limits.count:
+            raise InputError(
+                f"the plan handed to simulate moves {verified.schedule.limits.count} vehicles, the "
+                f"scenario {scenario.limits.count}: expected a plan of the scenario's vehicles"
+            )
+    margin = execution_margin(scenario, position_margin, verified=verified)
     for fault in faults:
         if not isinstance(fault, Fault):
             raise InputError(f"faults must be Fault objects (parse_faults), got {type(fault).__name__}")
@@ -278,10 +290,11 @@ def simulate(
     distance = SeparationWatch(scenario.track, bodies, limits.min_separation)
     commanded = LimitWatch(limits, verified.schedule.jerk_limited)
     ledger = PlanLedger(verified.schedule, executor.axis_signs)
+    count = len(bodies)
     if spool is not None:
         spool.add(0.0, bodies)
-    plot.add((0.0, bodies[0].v, bodies[1].v, distance.separation, 0.0, 0.0, math.inf, math.inf))
-    travel = (0.0, 0.0)  # along the plan's paths at the last cycle
+    plot.add((0.0, *(b.v for b in bodies), distance.separation, *(0.0,) * count, *(math.inf,) * count))
+    travel = (0.0,) * count  # along the plan's paths at the last cycle
     cycle = 0
     t = 0.0
     makespan = None
@@ -313,13 +326,10 @@ def simulate(
             plot.add(
                 (
                     t,
-                    bodies[0].v,
-                    bodies[1].v,
+                    *(b.v for b in bodies),
                     now,
-                    offset[0] + travel[0],
-                    offset[1] + travel[1],
-                    offset[0] + command.frontiers[0],
-                    offset[1] + command.frontiers[1],
+                    *(o + p for o, p in zip(offset, travel, strict=True)),
+                    *(o + f for o, f in zip(offset, command.frontiers, strict=True)),
                 )
             )
             at_goals = command.mode is Mode.DONE and all(abs(b.v) <= _AT_REST for b in bodies)
@@ -333,13 +343,13 @@ def simulate(
         if spool is not None:
             spool.close()
         raise
-    rows = np.array(plot.rows) if plot.rows else np.zeros((0, 8))
+    rows = np.array(plot.rows) if plot.rows else np.zeros((0, 2 + 3 * count))
     samples = {
         "t": frozen(rows[:, 0].copy()),
-        "speed": frozen(rows[:, 1:3].T.copy()),
-        "separation": frozen(rows[:, 3].copy()),
-        "travel": frozen(rows[:, 4:6].T.copy()),
-        "frontier": frozen(rows[:, 6:8].T.copy()),
+        "speed": frozen(rows[:, 1 : 1 + count].T.copy()),
+        "separation": frozen(rows[:, 1 + count].copy()),
+        "travel": frozen(rows[:, 2 + count : 2 + 2 * count].T.copy()),
+        "frontier": frozen(rows[:, 2 + 2 * count :].T.copy()),
     }
     reached = makespan is not None
     makespan = makespan if reached else t

@@ -9,7 +9,7 @@ import numpy as np
 from topology.validation import short_repr
 from trajgen.errors import InputError
 from trajgen.plots.figure import clip_to_data_box, drawing_area, finished, numbered_handle, polygon_patch
-from trajgen.plots.speed import VEHICLE_COLOURS
+from trajgen.plots.speed import vehicle_colour
 
 __all__ = ["plot_simulation"]
 
@@ -82,8 +82,8 @@ def _mark_key(marks) -> list:
 def _progress(axis, result, names, *, pad: float) -> None:
     """Each vehicle's travel along its path over time, and its frontier (dashed) where one binds it."""
     t = np.asarray(result.plot["t"])
-    for vehicle in range(2):
-        colour = VEHICLE_COLOURS[vehicle]
+    for vehicle in range(len(result.plot["travel"])):
+        colour = vehicle_colour(vehicle)
         travel = result.plot["travel"][vehicle]
         frontier = np.where(
             np.isfinite(result.plot["frontier"][vehicle]), result.plot["frontier"][vehicle], np.nan
@@ -101,26 +101,47 @@ def _progress(axis, result, names, *, pad: float) -> None:
     axis.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=7)
 
 
-def _coordination(axis, result, names, min_separation: float) -> None:
-    """Each plan's conflicts in the plane of both vehicles' travel, each plan's curve and the executed one.
+def _shown_pair(result, required: float) -> tuple[int, int]:
+    """The pair of vehicles the coordination panel draws.
 
+    Of two vehicles, both; of more, the pair with the most conflicts in the first plan (the first
+    such pair in the order of ``itertools.combinations``).
+    """
+    from trajgen.model.coordination import pair_diagrams, schedule_paths
+
+    if len(result.plot["travel"]) == 2:
+        return (0, 1)
+    schedule = result.plans[0].schedule
+    paths, times, _ = schedule_paths(schedule)
+    diagrams = pair_diagrams(schedule, paths, required, times)
+    most = max(len(diagram.conflicts) for _, diagram in diagrams)
+    return next(pair for pair, diagram in diagrams if len(diagram.conflicts) == most)
+
+
+def _coordination(axis, result, names, min_separation: float) -> None:
+    """Each plan's conflicts in the plane of two vehicles' travel, each plan's curve and the executed one.
+
+    The pair of two vehicles, or of more the pair with the most conflicts (:func:`_shown_pair`).
     After a re-plan for a new goal the new plan's paths continue where the vehicles stood: its
     conflicts and curve are drawn from that point on, the old plan's up to it.
     """
-    from trajgen.model.coordination import CoordinationDiagram, schedule_paths
+    from trajgen.model.coordination import CoordinationDiagram, SchedulePair, schedule_paths
 
+    required = min_separation + result.position_margin
+    i, j = pair = _shown_pair(result, required)
     plans = result.plans
-    ends = [plan.travel_before for plan in plans[1:]]
+    ends = [(plan.travel_before[i], plan.travel_before[j]) for plan in plans[1:]]
     corner = (0.0, 0.0)
     for k, plan in enumerate(plans):
         paths, times, travel = schedule_paths(plan.schedule)
-        origin = plan.travel_before
+        paths, travel = (paths[i], paths[j]), travel[[i, j]]
+        origin = (plan.travel_before[i], plan.travel_before[j])
         far = ends[k] if k < len(ends) else (origin[0] + paths[0].length, origin[1] + paths[1].length)
         corner = (max(corner[0], far[0]), max(corner[1], far[1]))
         # what the run drove of this plan: from where it took it up to where it left it
-        diagram = CoordinationDiagram(paths, min_separation + result.position_margin, plan.schedule, times)
+        diagram = CoordinationDiagram(paths, required, SchedulePair(plan.schedule, pair), times)
         for conflict in diagram.conflicts:
-            colour = VEHICLE_COLOURS[conflict.leader]
+            colour = vehicle_colour(pair[conflict.leader])
             for polygon in conflict.polygons:
                 patch = polygon_patch(
                     np.asarray(polygon) + np.asarray(origin), facecolor=colour, alpha=0.25, edgecolor="none"
@@ -141,23 +162,21 @@ def _coordination(axis, result, names, min_separation: float) -> None:
             axis.annotate(
                 "re-plan", origin, xytext=(4, -10), textcoords="offset points", fontsize=7, color="black"
             )
-    executed = result.plot["travel"]
+    executed = result.plot["travel"][[i, j]]
     axis.plot(executed[0], executed[1], color="tab:purple", linewidth=1.3, label="executed")
-    for vehicle in range(2):
+    for side, vehicle in enumerate(pair):
         limit = np.where(
             np.isfinite(result.plot["frontier"][vehicle]), result.plot["frontier"][vehicle], np.nan
         )
         if np.isfinite(limit).any():
             last = int(np.nonzero(np.isfinite(limit))[0][-1])
-            point = (limit[last], executed[1, last]) if vehicle == 0 else (executed[0, last], limit[last])
-            axis.plot(
-                *point, marker=">" if vehicle == 0 else "^", color=VEHICLE_COLOURS[vehicle], markersize=7
-            )
+            point = (limit[last], executed[1, last]) if side == 0 else (executed[0, last], limit[last])
+            axis.plot(*point, marker=">" if side == 0 else "^", color=vehicle_colour(vehicle), markersize=7)
     for set_limits, length in ((axis.set_xlim, corner[0]), (axis.set_ylim, corner[1])):
         pad = 0.02 * max(length, 1e-6)  # a plan that waits runs along the frame: keep it visible
         set_limits(-pad, length + pad)
-    axis.set_xlabel(f"{names[0]} travel [m]")
-    axis.set_ylabel(f"{names[1]} travel [m]")
+    axis.set_xlabel(f"{names[i]} travel [m]")
+    axis.set_ylabel(f"{names[j]} travel [m]")
     axis.set_title(
         "coordination diagram: conflicts shaded in the colour of the vehicle that passes first\n"
         "(the other waits at its frontier; arrows: each vehicle's last frontier)",
@@ -167,20 +186,20 @@ def _coordination(axis, result, names, min_separation: float) -> None:
 
 
 def _planned_velocity(result, t: np.ndarray) -> np.ndarray:
-    """Each vehicle's planned velocity at ``t``, m/s, shape (2, n): each plan from when the run took it up."""
-    planned = np.full((2, t.size), np.nan)
+    """Each vehicle's planned velocity at ``t``, m/s, shape (V, n): each plan from when the run took it up."""
+    planned = np.full((len(result.plot["speed"]), t.size), np.nan)
     for plan in result.plans:
         inside = (t >= plan.started_s) & (t <= plan.ended_s)
         if not inside.any():
             continue
         local = np.clip(t[inside] - plan.started_s, 0.0, plan.schedule.duration)
         velocity = plan.schedule.state(local).velocity
-        for v in (0, 1):
-            planned[v, inside] = plan.axis_signs[v] * velocity[v]
+        for v, sign in enumerate(plan.axis_signs):
+            planned[v, inside] = sign * velocity[v]
     return planned
 
 
-def plot_simulation(result, *, names: tuple[str, str], min_separation: float, figure=None):
+def plot_simulation(result, *, names: tuple[str, ...], min_separation: float, figure=None):
     """A simulated run: speeds, separation, progress with frontiers, coordination diagram.
 
     Left: each vehicle's velocity along its axis, m/s, planned (each plan the run drove, from when
@@ -198,8 +217,8 @@ def plot_simulation(result, *, names: tuple[str, str], min_separation: float, fi
     ----------
     result : SimulationResult
         From :func:`trajgen.execution.simulation.simulate`.
-    names : pair of str
-        Legend labels of the vehicles.
+    names : sequence of str
+        Legend labels of the vehicles, one per vehicle.
     min_separation : float
         The separation the run had to keep, metres (the scenario's, not the plan's wider one).
     figure : matplotlib Figure or SubFigure, optional
@@ -234,8 +253,8 @@ def plot_simulation(result, *, names: tuple[str, str], min_separation: float, fi
     separation_axis = area.add_subplot(grid[1, 0], sharex=speed_axis)
     progress_axis = area.add_subplot(grid[0, 1], sharex=speed_axis)
     coordination_axis = area.add_subplot(grid[1, 1])
-    for vehicle in range(2):
-        colour = VEHICLE_COLOURS[vehicle]
+    for vehicle in range(len(planned)):
+        colour = vehicle_colour(vehicle)
         speed_axis.plot(
             t,
             planned[vehicle],
