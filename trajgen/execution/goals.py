@@ -46,31 +46,8 @@ def execution_margin(scenario, position_margin: float, *, verified: VerifiedSche
     """
     track = scenario.track
     separation = scenario.limits.min_separation
-    if verified is not None:
-        margin = _margin_of_plan(scenario, position_margin)
-        clearance = verified.report.min_separation - separation
-        # the plan made for this margin keeps 2 margins to round-off; one made otherwise bounds it
-        return margin if clearance >= 2.0 * margin - _CLEARANCE_ROUND_OFF else max(0.0, 0.5 * clearance)
-    if isinstance(scenario, GraphScenario):
-        scenario.check_planned()
-        margin = _margin_of_plan(scenario, position_margin)
-        if margin > 0.0:  # on a graph the wider separation may close a siding or a loop
-            try:
-                plan_graph(track, scenario.start, scenario.goal, min_separation=separation + 2.0 * margin)
-            except InfeasibleError:
-                return 0.0
-        return margin
-    return _margin_of_plan(scenario, position_margin)
-
-
-def _margin_of_plan(scenario, position_margin: float) -> float:
-    """The margin the start and goal allow, metres: at most ``position_margin``.
-
-    Half of what they (and a junction's shortest leg) leave beyond the separation.
-    """
-    track = scenario.track
-    separation = scenario.limits.min_separation
-    if isinstance(scenario, GraphScenario):
+    on_graph = isinstance(scenario, GraphScenario)
+    if on_graph:
         room = min(
             track.distance(a, b)
             for points in (scenario.start, scenario.goal)
@@ -78,7 +55,19 @@ def _margin_of_plan(scenario, position_margin: float) -> float:
         )
     else:
         room = min(track.shortest_leg, track.separation(scenario.start), track.separation(scenario.goal))
-    return max(0.0, min(position_margin, 0.5 * (room - separation)))
+    margin = max(0.0, min(position_margin, 0.5 * (room - separation)))
+    if verified is not None:
+        clearance = verified.report.min_separation - separation
+        # the plan made for this margin keeps 2 margins to round-off; one made otherwise bounds it
+        return margin if clearance >= 2.0 * margin - _CLEARANCE_ROUND_OFF else max(0.0, 0.5 * clearance)
+    if on_graph:
+        scenario.check_planned()
+        if margin > 0.0:  # on a graph the wider separation may close a siding or a loop
+            try:
+                plan_graph(track, scenario.start, scenario.goal, min_separation=separation + 2.0 * margin)
+            except InfeasibleError:
+                return 0.0
+    return margin
 
 
 def schedule_from_rest(
