@@ -14,6 +14,12 @@ Sets (limits 1.0 m/s, 0.5 m/s², 1.0 m/s³, separation 1.5 m): the three swaps o
 (10, 10, 10) m (equal legs: uniform layouts), the three swaps on (12, 8, 15) m, ``--random``
 seeded random start/goal pairs on (12, 8, 15) m, and as many on 4-leg and 8-leg stars of equal
 10 m legs. This is the measurement issue 50 asks for before the two optimal formulations merge.
+
+Each ``optimal`` is its method as a user gets it: the junction's is free within the route's
+homotopy class (it may dodge shallower than the route, or skip a retraction) and picks the faster
+of the two classes; the graph's keeps the route's paths (to the legs' ends where Baldi's route goes
+there) and picks the fastest of the route's class and of the planner's other classes on the track
+graph. So the two may end in different classes.
 """
 
 from __future__ import annotations

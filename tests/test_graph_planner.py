@@ -366,8 +366,18 @@ def test_the_verifier_passes_the_planners_route_with_its_closest_approach():
             ),
             r"move 1 \(A -> c:1.5\): a number is not finite",
         ),
+        (
+            lambda r: dataclasses.replace(
+                r,
+                moves=(
+                    dataclasses.replace(r.moves[0], at_start=(r.track.point("a:2"), r.moves[0].at_start[1])),
+                    *r.moves[1:],
+                ),
+            ),
+            r"move 1 \(A -> c:1.5\): says vehicle 1 stands at a:2 as it begins, but its points start at A",
+        ),
     ],
-    ids=["separation", "order", "short", "travel", "standing", "nan"],
+    ids=["separation", "order", "short", "travel", "standing", "nan", "mover-said-elsewhere"],
 )
 def test_the_verifier_refuses_a_route_that_is_not_what_its_moves_do(tamper, match):
     report = verify_graph_route(tamper(_swap_route()))
@@ -508,25 +518,71 @@ def test_every_junction_route_on_its_track_graph_is_verified_and_travels_as_far(
             assert track.distance(placed[v], junction if s == 0.0 else EdgePoint(leg, s)) <= 1e-9
 
 
+_JOINT_TRACK = TrackGraph.from_edges({"a": ("W", "M", 10.0), "b": ("M", "E", 10.0)})
+_AT_START = (_JOINT_TRACK.point("a:2"), _JOINT_TRACK.point("b:5"))
+
+
 @pytest.mark.parametrize(
     ("parts", "match"),
     [
         pytest.param(
-            [(0, (0, 1))], r"move 1 is part of a joint move of vehicles \[0, 1\]", id="a-part-missing"
+            [(0, (0, 1), _AT_START)],
+            r"move 1 \(vehicle 1, of a joint move of \['vehicle 1', 'vehicle 2'\]\): the 2 moves from it "
+            r"move \['vehicle 1'\], not one per vehicle in turn",
+            id="a-part-missing",
         ),
-        pytest.param([(1, (0, 1)), (0, (0, 1))], r"move vehicles \[1, 0\]", id="out-of-order"),
-        pytest.param([(0, (0, 1)), (1, (1,))], r"move vehicles \[0, 1\]", id="movers-disagree"),
+        pytest.param(
+            [(1, (0, 1), _AT_START), (0, (0, 1), _AT_START)],
+            r"move \['vehicle 2', 'vehicle 1'\], not one per vehicle in turn",
+            id="parts-out-of-order",
+        ),
+        pytest.param(
+            [(1, (1, 0), _AT_START), (0, (1, 0), _AT_START)],
+            r"its movers are not distinct vehicles in order",
+            id="movers-out-of-order",
+        ),
+        pytest.param(
+            [(0, (0, 1), _AT_START), (1, (1,), _AT_START)],
+            r"the other parts name other movers",
+            id="movers-disagree",
+        ),
+        pytest.param(
+            [(0, (0, 1), _AT_START), (1, (0, 1), (_JOINT_TRACK.point("a:3"), _AT_START[1]))],
+            r"its parts say the vehicles stand at different places as it begins: expected one move per "
+            r"vehicle of a joint move",
+            id="different-places",
+        ),
     ],
 )
 def test_a_joint_move_is_refused_unless_its_parts_follow_each_other_in_vehicle_order(parts, match):
-    track = TrackGraph.from_edges({"line": ("W", "E", 20.0)})
-    at_start = (track.point("line:2"), track.point("line:10"))
+    track = _JOINT_TRACK
     moves = tuple(
-        GraphMove(v, (at_start[v], track.point(f"line:{at_start[v].s + 1}")), (0,), 1.0, at_start, movers)
-        for v, movers in parts
+        GraphMove(
+            v,
+            (_AT_START[v], EdgePoint(_AT_START[v].edge, _AT_START[v].s + 1.0)),
+            (_AT_START[v].edge,),
+            1.0,
+            at,
+            movers,
+        )
+        for v, movers, at in parts
     )
     with pytest.raises(PositionError, match=match):
-        GraphRoute(track, 1.5, at_start, at_start, moves, (1.0, 1.0), 0, 0)
+        GraphRoute(track, 1.5, _AT_START, _AT_START, moves, (1.0, 1.0), 0, 0)
+
+
+def test_a_joint_move_whose_parts_write_one_node_two_ways_is_taken():
+    """Node M is the end of edge ``a`` and the start of edge ``b``: one place, written either way."""
+    track = _JOINT_TRACK
+    start = (EdgePoint(0, 10.0), track.point("b:5"))  # vehicle 1 at M, as a's end
+    other = (EdgePoint(1, 0.0), start[1])  # ... and as b's start
+    moves = (
+        GraphMove(0, (start[0], track.point("a:8")), (0,), 2.0, start, (0, 1)),
+        GraphMove(1, (start[1], track.point("b:7")), (1,), 2.0, other, (0, 1)),
+    )
+    route = GraphRoute(track, 1.5, start, (moves[0].points[-1], moves[1].points[-1]), moves, (2.0, 2.0), 0, 0)
+    assert [len(step) for step in route.steps] == [2]
+    assert verify_graph_route(route).passed
 
 
 def _driving_at_once(first: tuple[str, str], second: tuple[str, str]):

@@ -78,7 +78,7 @@ class GraphRoute:
         In order. A new move starts where another vehicle takes over or the moving one turns back;
         the parts of a joint move are consecutive (:attr:`steps`).
     travel : tuple of float
-        Metres each vehicle travels; the route minimises their sum.
+        Metres each vehicle travels (the track-graph planner minimises their sum).
     critical_points : int
         Critical points of the roadmap before the search (nodes, starts, goals and the points at
         the separation from them); the search adds those at the separation from where a vehicle
@@ -118,21 +118,32 @@ class GraphRoute:
 
     def _joint_moves(self) -> None:
         """Refuse parts of a joint move that are not consecutive, in vehicle order, from one place."""
+        track, names = self.track, self.names
         k = 0
         while k < len(self.moves):
-            movers = self.moves[k].movers
+            first = self.moves[k]
+            movers = tuple(first.movers)
             parts = self.moves[k : k + len(movers)]
-            vehicles = tuple(part.vehicle for part in parts)
-            if (
-                vehicles != movers
-                or any(part.movers != movers or part.at_start != parts[0].at_start for part in parts)
-                or list(movers) != sorted(set(movers))
+            together = [names[v] if 0 <= v < len(names) else v for v in movers]
+            where = f"move {k + 1} ({names[first.vehicle]}, of a joint move of {together})"
+            problem = None
+            if list(movers) != sorted(set(movers)) or first.vehicle not in movers:
+                problem = "its movers are not distinct vehicles in order, its own among them"
+            elif tuple(part.vehicle for part in parts) != movers:
+                moved = [names[part.vehicle] for part in parts]
+                problem = f"the {len(movers)} moves from it move {moved}, not one per vehicle in turn"
+            elif any(tuple(part.movers) != movers for part in parts):
+                problem = "the other parts name other movers"
+            elif any(
+                track.canonical(a) != track.canonical(b)
+                for part in parts
+                for a, b in zip(part.at_start, first.at_start, strict=True)
             ):
+                problem = "its parts say the vehicles stand at different places as it begins"
+            if problem is not None:
                 raise PositionError(
-                    f"move {k + 1} is part of a joint move of vehicles {list(movers)}, but the route's "
-                    f"moves {k + 1} to {k + len(parts)} move vehicles {list(vehicles)}: expected one "
-                    f"consecutive move per vehicle of a joint move, in vehicle order, all beginning "
-                    f"where the vehicles stand together"
+                    f"{where}: {problem}: expected one move per vehicle of a joint move, consecutive, in "
+                    f"vehicle order, all beginning where the vehicles stand together"
                 )
             k += len(movers)
 

@@ -1,10 +1,13 @@
 """Timing a route on a track graph (docs/graphs.md).
 
-The planner's route on a track graph moves one vehicle at a time: in the plane of both vehicles'
-travel (metres driven along their paths) it is a staircase, each move a step along one axis.
+The track-graph planner's route moves one vehicle at a time: in the space of every vehicle's
+travel (metres driven along its path) it is a staircase, each move a step along one axis. A
+junction's route on its track graph also has joint moves, several vehicles at once in fixed shares:
+a diagonal step (:meth:`~topology.GraphRoute.corners`).
 
-- ``exact`` times it as it is: each move rest to rest with the time-optimal S-curve of its vehicle's
-  limits (closed form), the other vehicle standing; without jerk, the trapezoids.
+- ``exact`` times it as it is: each step rest to rest with the time-optimal S-curve of the limits of
+  the vehicles it moves, scaled to their shares (closed form), the others standing; without jerk,
+  the trapezoids.
 - ``toppra`` overlaps the moves: where one vehicle's move hands over to the other's, the corner of
   the staircase is replaced by a quadratic Bézier blend (both vehicles drive at once), as large as
   half of each adjacent move, shrunk until the whole triangle of the corner keeps the separation (so
@@ -70,7 +73,7 @@ def travel_corners(route: GraphRoute) -> tuple[np.ndarray, tuple[frozenset[int],
 
 
 def moves_one_at_a_time(route: GraphRoute, limits: Limits, method, *, jerk: bool) -> GraphSchedule:
-    """The route's moves one after the other, each rest to rest and time-optimal for its vehicle.
+    """The route's steps one after the other, each rest to rest and time-optimal for the vehicles it moves.
 
     Parameters
     ----------
@@ -108,7 +111,7 @@ def _safe_blend(
     """The largest blend at ``corners[corner]`` whose whole triangle keeps ``required`` metres, or None.
 
     The track distance of two vehicles changes by at most ``|dp_i| + |dp_j|`` between two points of
-    the travel space (the triangle moves only the two vehicles of the hand-over), so a grid of the
+    the travel space (each pair's share of the triangle's two sides), so a grid of the
     triangle with spacing ``h`` per axis on which every pair keeps ``required + h`` keeps ``required``
     everywhere in it; the blend and the corner both lie in the triangle, which then holds
     no part of a conflict, so the blend passes every conflict on the route's side.

@@ -175,8 +175,9 @@ def piece_profiles(
     jerk : bool
         S-curve (jerk-limited) if True, else trapezoid (velocity and acceleration only).
     """
-    # a move of less than a picometre (a planner's round-off, down to 5e-324 m) is none: its limits on
-    # the progress would overflow; the profile still ends exactly at ``end``
+    # a share of less than a picometre (a planner's round-off, down to 5e-324 m) is no move: its limits
+    # on the progress would overflow; its profile still ends exactly at ``end`` (spread over the piece),
+    # unless no share moves: then every vehicle rests where it is, under a picometre from ``end``
     delta = np.where(np.abs(end - start) < _NO_MOVE, 0.0, end - start)
     if not np.any(delta):  # nothing moves (start is the goal): at rest, zero duration
         return tuple(PiecewiseCubic.from_phases(float(value), []) for value in start)

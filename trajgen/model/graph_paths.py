@@ -1,8 +1,9 @@
 """Each vehicle's path on a track graph as a function of the distance it has travelled.
 
-A route on a track graph (:class:`topology.GraphRoute`) moves one vehicle at a time; each vehicle's
-moves, taken in order, make its path: a sequence of segments, each on one edge and monotone in the
-metres ``s`` from the edge's ``from`` node. The path is parameterised by the vehicle's *travel*
+A route on a track graph (:class:`topology.GraphRoute`) moves one vehicle at a time, or several in a
+joint move; each vehicle's moves (its parts of joint moves too), taken in order, make its path: a
+sequence of segments, each on one edge and monotone in the metres ``s`` from the edge's ``from``
+node. The path is parameterised by the vehicle's *travel*
 ``p`` (metres driven, ``0 <= p <= length``), which never decreases, so a schedule is a monotone
 curve in the ``(p1, p2)`` plane. The vehicle's signed axis (its odometer, exported beside ``s``)
 changes by ``heading * dp``; the heading flips at a *cusp*, where the path turns back on its edge

@@ -76,6 +76,13 @@ def junction_graph_route(route: Route, *, names: Sequence[str] = ("vehicle 1", "
     GraphRoute
         Its ``label`` the route's class (:func:`~trajgen.model.summary.class_label`); no roadmap was
         searched (``critical_points`` and ``searched`` 0).
+
+    Notes
+    -----
+    A track graph holds a place within 1 nm (``POINT_TOLERANCE``) of a node as the node: a route
+    that moves a vehicle less than that there (a start 5e-10 m out on a leg) gives a route the
+    route verifier passes, but a schedule of it the verifier refuses (its path leaves out the
+    move).
     """
     track = route.graph.track_graph()
     waypoints = route.indexed_waypoints

@@ -113,11 +113,17 @@ def class_words(homotopy: str, name: str) -> str:
 
 
 def graph_class_label(route: GraphRoute) -> str:
-    """A route's class on a track graph in words: its moves in order, by the vehicles' names."""
+    """A route's class on a track graph in words: its moves in order, by the vehicles' names.
+
+    The parts of a joint move are joined by ``&`` (they happen at once).
+    """
     track, names = route.track, route.names
     return (
         "; ".join(
-            f"{names[m.vehicle]} {track.name(m.points[0])} -> {track.name(m.points[-1])}" for m in route.moves
+            " & ".join(
+                f"{names[m.vehicle]} {track.name(m.points[0])} -> {track.name(m.points[-1])}" for m in step
+            )
+            for step in route.steps
         )
         or "no move"
     )
@@ -145,7 +151,7 @@ def class_label(route: Route | GraphRoute, *, planned: bool | None = None) -> st
     'other (clockwise)'
     """
     if isinstance(route, GraphRoute):
-        if route.label is not None:  # a junction's route on its track graph keeps the paper's class
+        if route.label is not None and planned is None:  # a junction's route keeps the paper's class
             return route.label
         moves = graph_class_label(route)
         return moves if planned is None else class_words("planned" if planned else "other", moves)
@@ -215,7 +221,16 @@ def graph_route_summary(route: GraphRoute, names: Sequence[str] | None = None) -
         ],
         "critical_points": route.critical_points,
         "searched": route.searched,
+        **({"label": route.label} if route.label is not None else {}),
     }
+
+
+def _meanwhile(move: dict) -> list[str]:
+    """What the other vehicles do during a move of the summary: where each stands, who moves with it."""
+    said = [", ".join(f"{name} at {place}" for name, place in move["standing"].items())]
+    if "with" in move:
+        said.append("with " + ", ".join(move["with"]))
+    return [text for text in said if text]
 
 
 def format_graph_route(route: GraphRoute, names: Sequence[str] | None = None) -> str:
@@ -234,8 +249,7 @@ def format_graph_route(route: GraphRoute, names: Sequence[str] | None = None) ->
         lines.append(
             f"  {number:2d}  {move['vehicle']}: {move['from']} -> {move['to']} along "
             f"{', '.join(move['edges'])}, {move['length_m']:g} m "
-            f"({', '.join(f'{name} at {place}' for name, place in move['standing'].items())})"
-            + (f", with {', '.join(move['with'])}" if "with" in move else "")
+            f"({'; '.join(_meanwhile(move))})"
         )
     return "\n".join(lines)
 

@@ -235,6 +235,11 @@ def verify_graph_route(route: GraphRoute) -> GraphRouteReport:
                 f"{label}: starts at {track.name(move.points[0])}, but the vehicle is at "
                 f"{track.name(where[move.vehicle])}"
             )
+        if distances.between(move.at_start[move.vehicle], move.points[0]) > ROUTE_TOLERANCE:
+            failures.append(
+                f"{label}: says {names[move.vehicle]} stands at {track.name(move.at_start[move.vehicle])} "
+                f"as it begins, but its points start at {track.name(move.points[0])}"
+            )
         for other, said in move.standing():
             if distances.between(where[other], said) > ROUTE_TOLERANCE:
                 failures.append(
