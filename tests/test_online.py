@@ -1651,7 +1651,11 @@ def _fleet_scenario(case, verified) -> GraphScenario:
     return GraphScenario(route.track, verified.schedule.limits, route.names, route.start, route.goal)
 
 
-@pytest.mark.parametrize("case", FLEETS, ids=lambda case: case.name)
+@pytest.mark.parametrize(
+    "case",
+    [pytest.param(case, marks=() if case.name == "ring-of-3" else pytest.mark.slow) for case in FLEETS],
+    ids=lambda case: case.name,
+)  # the ring in the fast set
 def test_a_fleet_is_simulated_with_every_vehicle_stopped_in_its_first_move_and_its_books_cover_every_vehicle(
     case,
 ):
@@ -1677,6 +1681,7 @@ def test_a_fleet_is_simulated_with_every_vehicle_stopped_in_its_first_move_and_i
     json.dumps(result.summary())
 
 
+@pytest.mark.slow
 def test_a_fleets_simulation_writes_a_trace_per_vehicle_and_a_picture_of_every_vehicle(tmp_path):
     case = FLEETS[0]
     verified = _fleet_plan(case)
