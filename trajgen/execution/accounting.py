@@ -47,13 +47,13 @@ class ExecutedPlan:
     schedule : Schedule or GraphSchedule
         The plan (the first is the run's undisturbed plan; each later one was verified when it was made).
     started_s, ended_s : float
-        When the run took it up, and when both came to rest at its goals, or the run left it (for a
-        new goal) or ended, seconds of the run.
+        When the run took it up, and when every vehicle came to rest at its goal, or the run left it
+        (for a new goal) or ended, seconds of the run.
     planned_s : float
         How long the part of it the run drove takes undisturbed, seconds: the whole plan if the run
         drove it to its end, or if it is the run's last (the goal the run ended at, reached or
-        not), else the plan's time at which both vehicles got as far along their paths as they
-        were when the run left it.
+        not), else the plan's time at which every vehicle got as far along its path as it was
+        when the run left it.
     travel_before : tuple of float
         Each vehicle's travel along the earlier plans' paths when the run took this one up, metres
         (where its paths start on the run's travel axes).
@@ -268,9 +268,9 @@ class PlanLedger:
         self.plans: list[ExecutedPlan] = []
         # the plan driven: its schedule, when taken up, each vehicle's travel before it, its axis signs
         self.driving = (schedule, 0.0, (0.0,) * len(axis_signs), tuple(axis_signs))
-        #: When both came to rest at the driven plan's goals, if they have (seconds of the run).
+        #: When every vehicle came to rest at the driven plan's goals, if they have (seconds of the run).
         self.arrived: float | None = None
-        #: Seconds both stood at their goals waiting for a new one.
+        #: Seconds every vehicle stood at its goal waiting for a new one.
         self.idle = 0.0
 
     @property

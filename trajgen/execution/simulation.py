@@ -73,7 +73,7 @@ class SimulationResult:
     holds : int
         Cycles in which the braking invariant held a vehicle back.
     emergency_brakes : int
-        Cycles in which nothing but both braking hard could be certified (must be 0).
+        Cycles in which nothing but every vehicle braking hard could be certified (must be 0).
     separation_violations, limit_violations : int
         Cycles with the true separation below the minimum, or a setpoint beyond a limit.
     events : tuple of Event
@@ -311,7 +311,7 @@ def simulate(
             command = executor.step(measured)
             if observer is not None:
                 observer(executor, measured, command)
-            if executor.replans > len(ledger.plans):  # left for a new goal where both stood at rest
+            if executor.replans > len(ledger.plans):  # left for a new goal where every vehicle stood at rest
                 ledger.replanned(t, travel, executor.schedule, executor.axis_signs)
             travel = executor.travel
             commanded.check(command.setpoints)
