@@ -31,6 +31,7 @@ from trajgen.export.plc.dialects import DIALECTS, TableDialect
 from trajgen.export.plc.resample import resample
 from trajgen.export.plc.table_check import check_tables, graph_travel, turning_points
 from trajgen.export.plc.tables import Interpolation, ProfileTable, divided_differences
+from trajgen.model.junction_route import junction_graph_route
 from trajgen.model.profiles import PiecewiseCubic
 from trajgen.pipeline import Outputs
 
@@ -1024,3 +1025,25 @@ def test_a_fleets_table_that_runs_into_the_vehicle_ahead_is_refused_naming_the_p
     assert not check.passed
     named = [re.search(r"vehicle 1 (on|and) .*vehicle 2", failure) for failure in check.failures]
     assert any(named), check.failures
+
+
+# -- a junction's route timed on its track graph (issue 49: one model below the planners) ------------------
+
+
+@pytest.mark.parametrize("dialect", TABLE_DIALECTS, ids=[d.name.value for d in TABLE_DIALECTS])
+@pytest.mark.parametrize("name", ["swap", "crossing"])
+def test_the_tables_of_a_junctions_exact_schedule_timed_on_its_track_graph_are_the_junctions(name, dialect):
+    """The knots of a table include where a vehicle changes legs, on the junction and on its track graph.
+
+    At the golden files' 300 points every byte agrees. (At a dialect's default points, thousands of
+    rows, a track graph's axis, taken from the travel, lies 1e-15 m from the junction's and flips a
+    last decimal here and there: ``benchmarks/bench_golden_on_graph.py``.)
+    """
+    scenario = load_scenario(REPO / "examples" / f"{name}.toml")
+    route = scenario.route()
+    junction = certify(Exact().schedule(route, scenario.limits))
+    on_graph = certify(
+        Exact().schedule_graph(junction_graph_route(route, names=scenario.names), scenario.limits)
+    )
+    made = [plc_tables(verified, dialect, max_points=300).contents for verified in (junction, on_graph)]
+    assert made[1] == made[0]

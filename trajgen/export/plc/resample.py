@@ -22,7 +22,7 @@ import numpy as np
 from trajgen.errors import InputError, OutputLimitError
 from trajgen.export.plc.tables import Interpolation, ProfileTable, divided_differences, limit_ratios, slowdown
 from trajgen.model.graph_schedule import GraphSchedule
-from trajgen.model.pieces import kinematics_polynomials, schedule_pieces
+from trajgen.model.pieces import kinematics_polynomials, schedule_pieces, split_at_values
 from trajgen.model.schedule import Schedule
 from trajgen.model.values import sorted_unique
 from trajgen.verification import VerifiedSchedule, require_verified
@@ -93,12 +93,26 @@ def _pieces(schedule: Schedule | GraphSchedule) -> tuple[np.ndarray, np.ndarray]
     if isinstance(schedule, Schedule):
         pieces = schedule_pieces(schedule)
         return pieces.start, pieces.length
+    # a junction's legs are numbered in its rows: a vehicle changing legs starts a piece, as on the junction
+    changes = tuple(_leg_changes(path) for path in schedule.paths) if schedule.track.numbered_legs else None
     starts, lengths = [], []
     for section in schedule.sections:
-        times = kinematics_polynomials(section.kinematics)[0]
-        starts.append(section.start_time + times[:-1])
-        lengths.append(np.diff(times))
+        times, travel, intervals = kinematics_polynomials(section.kinematics)
+        if changes is not None:
+            start, length, _, _ = split_at_values(times, travel, intervals, changes)
+        else:
+            start, length = times[:-1], np.diff(times)
+        starts.append(section.start_time + start)
+        lengths.append(length)
     return np.concatenate(starts), np.concatenate(lengths)
+
+
+def _leg_changes(path) -> np.ndarray:
+    """The travel (m) at which a vehicle's path goes on from one edge to another."""
+    edges = np.asarray(path.edges)
+    return (
+        np.asarray(path.starts, dtype=float)[1:-1][edges[1:] != edges[:-1]] if edges.size > 1 else np.zeros(0)
+    )
 
 
 def _reference_times(
