@@ -8,15 +8,14 @@ junction's track graph (:func:`~trajgen.model.junction_route.junction_graph_rout
 ``Exact.schedule_graph``) instead of the junction's own ``Exact.schedule``, renders every golden
 file as the suite does, and prints for each case whether its bytes are the stored ones, and the
 first difference where not. Cases timed by ``toppra`` are rendered as they are (unchanged) and
-listed apart.
+listed apart. The VDA 5050 runs are the order files of the schedule (the command's pipeline
+around it is not one model yet).
 """
 
 from __future__ import annotations
 
-import contextlib
-import io
 import sys
-import tempfile
+from datetime import UTC, datetime
 from pathlib import Path
 
 REPO = Path(__file__).resolve().parent.parent
@@ -35,25 +34,29 @@ def _on_the_track_graph(self, route, limits):
 
 
 def _vda5050(case: str) -> str | None:
-    from trajgen.cli import main
+    """The first difference of a VDA 5050 golden run's files (the order files of its schedule), or None.
 
-    scenario, method = case.split("-")
+    Made from the schedule (:func:`~trajgen.export.vda5050.files.order_files`), not through the
+    command: the pipeline around the schedule is not one model yet.
+    """
+    from trajgen import certify, load_scenario
+    from trajgen.export.vda5050.files import order_files
+    from trajgen.export.vda5050.options import Vda5050Options
+    from trajgen.methods import make_schedule
+
+    name, method = case.split("-")
+    scenario = load_scenario(REPO / "examples" / f"{name}.toml")
+    verified = certify(make_schedule(scenario.route(), scenario.limits, method=method))
+    options = Vda5050Options(start_time=datetime(2026, 5, 1, 8, 0, tzinfo=UTC))
+    made = order_files(verified, scenario.names, Path("out"), options=options)
     stored = GOLDEN.parent / "golden-vda5050" / case
-    with tempfile.TemporaryDirectory() as folder:
-        out = Path(folder) / case
-        options = ["--method", method, "--start-time", "2026-05-01T08:00:00Z", "--out", str(out)]
-        said = io.StringIO()
-        with contextlib.redirect_stderr(said), contextlib.redirect_stdout(io.StringIO()):
-            status = main(["export-vda5050", str(REPO / "examples" / f"{scenario}.toml"), *options])
-        if status != 0:  # the pipeline around the schedule is not one model yet
-            return f"the export failed: {said.getvalue().strip().splitlines()[-1]}"
-        for path in sorted(stored.rglob("*.json")):
-            made = out / path.relative_to(stored)
-            if not made.exists():
-                return f"{path.relative_to(stored)} not written"
-            problem = first_difference(path.read_bytes(), made.read_bytes())
-            if problem is not None:
-                return f"{path.relative_to(stored)}: {problem}"
+    names = sorted(path.relative_to(stored) for path in stored.rglob("*.json"))
+    if names != sorted(path.relative_to("out") for path in made):
+        return "other files"
+    for name in names:
+        problem = first_difference((stored / name).read_bytes(), made[Path("out") / name])
+        if problem is not None:
+            return f"{name}: {problem}"
     return None
 
 

@@ -47,8 +47,10 @@ from trajgen.export.vda5050 import (
     render_orders,
     write_orders,
 )
-from trajgen.export.vda5050.graph_path import GraphOrderPath
+from trajgen.export.vda5050.files import order_files
+from trajgen.export.vda5050.graph_path import GraphOrderPath, point_id
 from trajgen.export.vda5050.release import BaseRelease
+from trajgen.model.junction_route import junction_graph_route
 from trajgen.scenario import PLAUSIBLE, load_scenario
 from trajgen.scenario.factsheet import MAX_FACTSHEET_BYTES, read_factsheet
 
@@ -1525,3 +1527,33 @@ def test_the_node_plan_of_a_fleet_follows_the_schedules_order_of_arrivals():
     order = [(release.vehicle, release.update) for release in releases.releases if release.update]
     assert order == [(1, 1), (0, 1)]  # agv2 once agv3 is at its goal, agv1 once agv2 is
     assert releases.releases[2].decision_point == 1  # agv3's whole path at once
+
+
+# -- a junction's route timed on its track graph (issue 49: one order path) ---------------------------------
+
+
+def test_the_swaps_exact_schedule_timed_on_its_track_graph_gives_the_junctions_order_files_byte_for_byte():
+    """The track graph's order path, on a junction's track graph, writes the junction's golden files.
+
+    A leg's end is named by its leg and metres (``A:10``) and a hold by its metres from the junction,
+    as on the junction; the nodes, holds, times and releases are the track graph's rules.
+    """
+    scenario = load_scenario(REPO / "examples" / "swap.toml")
+    route = junction_graph_route(scenario.route(), names=scenario.names)
+    verified = certify(Exact().schedule_graph(route, scenario.limits))
+    options = Vda5050Options(start_time=datetime(2026, 5, 1, 8, 0, tzinfo=UTC))
+    made = order_files(verified, scenario.names, Path("out"), options=options)
+    stored = REPO / "tests" / "data" / "golden-vda5050" / "swap-exact"
+    names = sorted(path.relative_to(stored) for path in stored.rglob("*.json"))
+    assert names == sorted(path.relative_to("out") for path in made)
+    for name in names:
+        assert made[Path("out") / name] == (stored / name).read_bytes(), name
+
+
+def test_a_junctions_leg_end_is_named_by_its_leg_and_metres_and_its_junction_by_its_name():
+    track = load_scenario(REPO / "examples" / "crossing.toml").track.track_graph()
+    assert point_id(track, track.point("E-end")) == "E:10"
+    assert point_id(track, track.point("E:10")) == "E:10"
+    assert point_id(track, track.point("O")) == "O"
+    assert point_id(track, track.point("N:2.5")) == "N:2.5"
+    assert track.point(point_id(track, track.point("W-end"))) == track.point("W-end")  # it reads back

@@ -96,7 +96,8 @@ class TrackGraph:
     numbered_legs : bool, optional
         Every edge leaves one node, the junction of a star: rows and tables name where a vehicle is
         by the number of its edge (1 for the first, 0 at the junction), in a column ``leg``, as a
-        star's always have. Default False: by the edge's name, in a column ``edge``.
+        star's always have, and VDA 5050 orders name a leg's end by its leg and metres (``A:10``).
+        Default False: by the edge's name, in a column ``edge``.
 
     Raises
     ------

@@ -178,8 +178,22 @@ class GraphOrderPath:
         return self.track.xy(self.nodes[index].point) if self.placed(index) else None
 
     def node_description(self, index: int) -> str:
-        """Why node ``index`` is on the path, in words (``nodeDescription``)."""
-        return self.nodes[index].description
+        """Why node ``index`` is on the path, in words (``nodeDescription``).
+
+        On a track whose legs are numbered (a junction's) a hold names its metres from the
+        junction, as the junction's order paths always have.
+        """
+        node = self.nodes[index]
+        if not self.track.numbered_legs or NodeKind.HOLD not in node.kinds:
+            return node.description
+        junction = self.track.node_point(self.track.ends(0)[0])
+        metres = f"{self.track.distance(node.point, junction):.6f}".rstrip("0").rstrip(".")
+        return ", ".join(
+            f"hold: {metres} m from the junction (the minimum separation)"
+            if kind is NodeKind.HOLD
+            else kind.value
+            for kind in node.kinds
+        )
 
     def edge_direction(self, index: int) -> str | None:
         """The track edge edge ``index`` takes where it leaves a junction (``None`` elsewhere)."""
@@ -388,7 +402,9 @@ def point_id(track: TrackGraph, point: EdgePoint, *, decimals: int = 6) -> str:
     """The VDA 5050 node id of ``point``: a track node's name, or ``"<edge>:<metres>"``.
 
     The metres to ``decimals`` places (1 µm by default), trailing zeros dropped; parsed back by
-    :meth:`~topology.TrackGraph.point`.
+    :meth:`~topology.TrackGraph.point`. On a track whose legs are numbered (a junction's,
+    :meth:`~topology.StarGraph.track_graph`) a leg's end is named by its leg and metres, as the
+    junction's places are written (``"A:10"``), and only the junction by its name.
 
     Examples
     --------
@@ -398,6 +414,8 @@ def point_id(track: TrackGraph, point: EdgePoint, *, decimals: int = 6) -> str:
     """
     node = track.node_at(point)
     if node is not None:
-        return track.nodes[node]
+        if not track.numbered_legs or node == track.ends(0)[0]:
+            return track.nodes[node]
+        point = track.node_point(node)  # a leg's end: on its one leg, at its length
     metres = f"{point.s:.{decimals}f}".rstrip("0").rstrip(".")
     return f"{track.edges[point.edge].name}:{metres}"
