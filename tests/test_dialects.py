@@ -1030,7 +1030,14 @@ def test_a_fleets_table_that_runs_into_the_vehicle_ahead_is_refused_naming_the_p
 # -- a junction's route timed on its track graph (issue 49: one model below the planners) ------------------
 
 
-@pytest.mark.parametrize("dialect", TABLE_DIALECTS, ids=[d.name.value for d in TABLE_DIALECTS])
+@pytest.mark.parametrize(
+    "dialect",
+    [
+        pytest.param(d, marks=() if d.name.value == "logix-time-cam" else pytest.mark.slow)
+        for d in TABLE_DIALECTS
+    ],
+    ids=[d.name.value for d in TABLE_DIALECTS],
+)  # the dialect whose knots are the point in the fast set
 @pytest.mark.parametrize("name", ["swap", "crossing"])
 def test_the_tables_of_a_junctions_exact_schedule_timed_on_its_track_graph_are_the_junctions(name, dialect):
     """The knots of a table include where a vehicle changes legs, on the junction and on its track graph.

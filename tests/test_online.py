@@ -1622,7 +1622,9 @@ def test_a_fleet_is_executed_to_every_goal_keeping_every_pair_apart_on_time_when
     assert len(executor.diagrams) == math.comb(case.count, 2)
 
 
-@pytest.mark.parametrize("stopped", [0, 1, 2])
+@pytest.mark.parametrize(
+    "stopped", [pytest.param(0, marks=pytest.mark.slow), 1, pytest.param(2, marks=pytest.mark.slow)]
+)  # the middle vehicle in the fast set
 @pytest.mark.parametrize("case", FLEETS, ids=lambda case: case.name)
 def test_a_stop_of_any_vehicle_of_a_fleet_holds_its_followers_and_costs_about_its_length(case, stopped):
     """Each vehicle in turn stops for 4 s halfway through its first move: orders kept, nobody brakes hard.
