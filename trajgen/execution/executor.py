@@ -57,6 +57,7 @@ from trajgen.execution.tracks import execution_track
 from trajgen.model.coordination import CoordinationDiagram, earliest_rest, stopping_distance
 from trajgen.model.graph_vehicle_path import GraphVehiclePath
 from trajgen.model.paths import VehiclePath
+from trajgen.model.summary import both_or_all
 from trajgen.scenario.naming import check_vehicle_index
 from trajgen.verification import VerifiedSchedule, require_verified
 from trajgen.verification.braking_rule import BRAKING_RULE_TOLERANCE
@@ -256,7 +257,7 @@ class Executor:
         self._log(
             "goal-accepted",
             f"new goal {self._track.name(candidate[vehicle])} for {self.names[vehicle]}: "
-            f"{'both' if self.limits.count == 2 else 'all'} stop, then re-plan",
+            f"{both_or_all(self.limits.count)} stop, then re-plan",
         )
         return GoalDecision(True)
 
@@ -461,7 +462,7 @@ class Executor:
             for v in range(count)
         ):
             self._mode = Mode.DONE
-            self._log("done", f"{'both' if count == 2 else 'all'} vehicles at their goals")
+            self._log("done", f"{both_or_all(count)} vehicles at their goals")
         return Command(
             self._time,
             tuple(setpoints),

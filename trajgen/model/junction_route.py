@@ -11,54 +11,29 @@ in ``exact``. The route keeps the paper's homotopy class as its label.
 
 from __future__ import annotations
 
-import itertools
 from collections.abc import Sequence
 
-from topology import JUNCTION_INDEX, JUNCTION_NAME, EdgePoint, GraphMove, GraphRoute, Route, TrackGraph
+from topology import EdgePoint, GraphMove, GraphRoute, Route, TrackGraph
 from trajgen.model.axes import route_axes, straight_pieces
+from trajgen.model.graph_paths import path_through
 from trajgen.model.summary import class_label
 
 __all__ = ["junction_graph_route"]
 
 
-def _point(track: TrackGraph, leg: int, s: float) -> EdgePoint:
-    """The point ``s`` metres out on leg ``leg`` (the junction at ``JUNCTION_INDEX`` or 0 m)."""
-    if leg == JUNCTION_INDEX or s == 0.0:
-        return track.node_point(track.node(JUNCTION_NAME))
-    return track.canonical(EdgePoint(leg, s))
-
-
 def _part(
-    track: TrackGraph, vehicle: int, places: list[tuple[int, float]], length: float, at_start, movers
+    track: TrackGraph, vehicle: int, places: list[EdgePoint], length: float, at_start, movers
 ) -> GraphMove:
-    """The move of ``vehicle`` through ``places`` (leg, s), kept at its ends and at the nodes it passes."""
-    junction = track.node_point(track.node(JUNCTION_NAME))
-    points = [_point(track, *places[0])]
-    edges: list[int] = []
-    for (leg_a, s_a), (leg_b, s_b) in itertools.pairwise(places):
-        if (leg_a, s_a) == (leg_b, s_b):
-            continue
-        target = _point(track, leg_b, s_b)
-        on_a = leg_a != JUNCTION_INDEX and s_a > 0.0
-        on_b = leg_b != JUNCTION_INDEX and s_b > 0.0
-        if on_a and on_b and leg_a != leg_b:  # through the junction
-            points.append(junction)
-            edges.append(leg_a)
-            edges.append(leg_b)
-        else:
-            edges.append(leg_a if on_a else leg_b)
-        points.append(target)
-    # one point per node passed: drop the route's waypoints between them
-    kept = [0] + [k for k in range(1, len(points) - 1) if track.node_at(points[k]) is not None]
-    kept.append(len(points) - 1)
-    return GraphMove(
-        vehicle,
-        tuple(points[k] for k in kept),
-        tuple(edges[k] for k in kept[:-1]),
-        length,
-        at_start,
-        movers,
-    )
+    """The move of ``vehicle`` through ``places``, kept at its ends and at the nodes it passes."""
+    path = path_through(track, [p.edge for p in places], [p.s for p in places])
+    if path.edges.size == 0:  # it moves less than a path resolves (MOVE_RESOLUTION)
+        return GraphMove(vehicle, (places[0], places[-1]), (places[-1].edge,), length, at_start, movers)
+    passed = [
+        track.canonical(EdgePoint(int(e), float(s)))
+        for e, s in zip(path.edges[1:], path.s_from[1:], strict=True)
+    ]
+    edges = tuple(int(e) for e in path.edges)
+    return GraphMove(vehicle, (places[0], *passed, places[-1]), edges, length, at_start, movers)
 
 
 def junction_graph_route(route: Route, *, names: Sequence[str] = ("vehicle 1", "vehicle 2")) -> GraphRoute:
@@ -85,28 +60,26 @@ def junction_graph_route(route: Route, *, names: Sequence[str] = ("vehicle 1", "
     move).
     """
     track = route.graph.track_graph()
-    waypoints = route.indexed_waypoints
+    places = [
+        tuple(track.canonical(route.graph.edge_point(position)) for position in configuration)
+        for configuration in route.waypoints
+    ]
     axes = route_axes(route).axes
-    count = len(waypoints[0]) // 2
-
-    def places(k: int) -> tuple[EdgePoint, ...]:
-        return tuple(_point(track, waypoints[k][2 * v], waypoints[k][2 * v + 1]) for v in range(count))
-
+    count = len(places[0])
     moves: list[GraphMove] = []
     travel = [0.0] * count
     for first, last in straight_pieces(axes):
         lengths = [abs(float(axes[last, v] - axes[first, v])) for v in range(count)]
         movers = tuple(v for v in range(count) if lengths[v] > 0.0)
-        at_start = places(first)
         for v in movers:
-            stops = [(waypoints[k][2 * v], waypoints[k][2 * v + 1]) for k in range(first, last + 1)]
-            moves.append(_part(track, v, stops, lengths[v], at_start, movers))
+            stops = [places[k][v] for k in range(first, last + 1)]
+            moves.append(_part(track, v, stops, lengths[v], places[first], movers))
             travel[v] += lengths[v]
     return GraphRoute(
         track,
         route.min_separation,
-        places(0),
-        places(len(waypoints) - 1),
+        places[0],
+        places[-1],
         tuple(moves),
         tuple(travel),
         0,

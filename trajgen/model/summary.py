@@ -19,6 +19,7 @@ from topology import GraphRoute, Homotopy, Instruction, Route, WayRound
 __all__ = [
     "DISTANCE_PLACES",
     "ROUND_OFF_M",
+    "both_or_all",
     "class_label",
     "class_name",
     "class_words",
@@ -71,6 +72,17 @@ def class_name(route: Route) -> str:
     if route.homotopy is Homotopy.OTHER:
         return f"second-shortest route on {graph}"
     return _PLANNER_CLASS[route.instruction].format(graph=graph)
+
+
+def both_or_all(count: int) -> str:
+    """How the messages say "every vehicle" of ``count``: ``both`` of two, ``all`` of more.
+
+    Examples
+    --------
+    >>> both_or_all(2), both_or_all(4)
+    ('both', 'all')
+    """
+    return "both" if count == 2 else "all"
 
 
 def closest_text(metres: float) -> str:

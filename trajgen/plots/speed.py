@@ -9,7 +9,7 @@ from __future__ import annotations
 import numpy as np
 
 from trajgen.model.pieces import kinematics_polynomials
-from trajgen.model.summary import class_label
+from trajgen.model.summary import both_or_all, class_label
 from trajgen.plots.figure import checked_names, drawing_area, finished
 from trajgen.verification import VerifiedSchedule, require_verified
 
@@ -162,7 +162,7 @@ def plot_speed(verified: VerifiedSchedule, *, names=None, figure=None):
             limits = [getattr(schedule.limits.vehicles[vehicle], limit_name) for vehicle in range(count)]
             shared = len(set(limits)) == 1  # one black line for all, else one per vehicle in its colour
             for vehicle in (0,) if shared else range(count):
-                whose = ("both" if count == 2 else "all") if shared else names[vehicle]
+                whose = both_or_all(count) if shared else names[vehicle]
                 for sign in (1, -1):
                     axis.axhline(
                         sign * limits[vehicle],

@@ -24,7 +24,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from topology import EdgePoint, TrackGraph
-from trajgen.export.vda5050.path import HOLD_MARGIN, NodeKind
+from trajgen.export.vda5050.path import HOLD_MARGIN, NodeKind, hold_description, metres_text
 from trajgen.model.graph_paths import GraphPath
 from trajgen.model.graph_schedule import GraphSchedule
 from trajgen.model.paths import MOVE_RESOLUTION
@@ -187,12 +187,9 @@ class GraphOrderPath:
         if not self.track.numbered_legs or NodeKind.HOLD not in node.kinds:
             return node.description
         junction = self.track.node_point(self.track.ends(0)[0])
-        metres = f"{self.track.distance(node.point, junction):.6f}".rstrip("0").rstrip(".")
+        metres = self.track.distance(node.point, junction)
         return ", ".join(
-            f"hold: {metres} m from the junction (the minimum separation)"
-            if kind is NodeKind.HOLD
-            else kind.value
-            for kind in node.kinds
+            hold_description(metres) if kind is NodeKind.HOLD else kind.value for kind in node.kinds
         )
 
     def edge_direction(self, index: int) -> str | None:
@@ -417,5 +414,4 @@ def point_id(track: TrackGraph, point: EdgePoint, *, decimals: int = 6) -> str:
         if not track.numbered_legs or node == track.ends(0)[0]:
             return track.nodes[node]
         point = track.node_point(node)  # a leg's end: on its one leg, at its length
-    metres = f"{point.s:.{decimals}f}".rstrip("0").rstrip(".")
-    return f"{track.edges[point.edge].name}:{metres}"
+    return f"{track.edges[point.edge].name}:{metres_text(point.s, decimals)}"

@@ -31,14 +31,28 @@ __all__ = [
     "OrderPath",
     "PathEdge",
     "PathNode",
+    "hold_description",
+    "metres_text",
     "node_id",
     "vehicle_path",
 ]
 
 
-def _number(value: float) -> str:
-    text = f"{value:.6f}".rstrip("0").rstrip(".")
+def metres_text(value: float, places: int = 6) -> str:
+    """Metres as a VDA 5050 id or description writes them: ``places`` decimals, trailing zeros dropped.
+
+    Examples
+    --------
+    >>> metres_text(1.5), metres_text(10.0), metres_text(1.5000004), metres_text(-0.0)
+    ('1.5', '10', '1.5', '0')
+    """
+    text = f"{value:.{places}f}".rstrip("0").rstrip(".")
     return "0" if text in ("", "-0") else text
+
+
+def hold_description(metres: float) -> str:
+    """A junction's hold node in words: ``hold: 1.5 m from the junction (the minimum separation)``."""
+    return f"hold: {metres_text(metres)} m from the junction (the minimum separation)"
 
 
 def node_id(graph: StarGraph, leg: int, s: float) -> str:
@@ -53,7 +67,7 @@ def node_id(graph: StarGraph, leg: int, s: float) -> str:
     """
     if leg == JUNCTION_INDEX or s == 0.0:
         return JUNCTION_NAME
-    return f"{graph.names[leg]}:{_number(s)}"
+    return f"{graph.names[leg]}:{metres_text(s)}"
 
 
 #: Reversals shorter than this are round-off; nodes this close to each other, to a route waypoint,
@@ -171,9 +185,7 @@ class OrderPath:
         parts = []
         for kind in self.nodes[index].kinds:
             if kind is NodeKind.HOLD:
-                parts.append(
-                    f"hold: {_number(self.nodes[index].s)} m from the junction (the minimum separation)"
-                )
+                parts.append(hold_description(self.nodes[index].s))
             else:
                 parts.append(kind.value)
         return ", ".join(parts)
