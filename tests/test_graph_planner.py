@@ -497,7 +497,7 @@ def test_a_junctions_route_on_its_track_graph_is_its_straight_pieces_in_closed_f
     assert summary["moves"][2]["standing"] == {"agv1": "A-end"}
 
 
-@settings(max_examples=50)
+@settings(max_examples=30)
 @given(query=star_queries(3, 8), homotopy=st.sampled_from(["planned", "other"]))
 def test_every_junction_route_on_its_track_graph_is_verified_and_travels_as_far(query, homotopy):
     route = planned_junction_route(query, homotopy)

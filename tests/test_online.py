@@ -1242,7 +1242,7 @@ def plan(name: str, method: str):
     return scenario, schedule_for_execution(scenario, method=method)
 
 
-@pytest.mark.parametrize("method", ["exact", "toppra"])
+@pytest.mark.parametrize("method", ["exact", pytest.param("toppra", marks=pytest.mark.slow)])  # exact fast
 @pytest.mark.parametrize("name", NAMES)
 def test_an_undisturbed_run_on_a_graph_plays_its_plan_and_never_brakes(name, method):
     scenario, verified = plan(name, method)

@@ -934,7 +934,7 @@ def test_optimal_on_more_than_two_vehicles_plays_exact_and_says_why(case):
 # -- a junction's route on its track graph: the one route every method times ---------------------------
 
 
-@settings(max_examples=40)
+@settings(max_examples=25)
 @given(query=star_queries(3, 8), homotopy=st.sampled_from(["planned", "other"]), jerk=st.booleans())
 def test_a_junctions_route_on_its_track_graph_is_timed_exactly_as_the_junction_times_it(
     query, homotopy, jerk
